@@ -1,0 +1,355 @@
+"""The catalog C (thesis Sec. 3.3.2, Alg. 3.2/3.3): arc consistency on a :class:`Problem`.
+
+A catalog is a boolean array ``(n, K)`` (reshape to ``(*shape, K)`` to view it on the grid):
+``C[x, b]`` says label ``b`` is still possible at cell ``x``. :func:`propagate` computes the
+largest catalog inside the given one that satisfies statements 3.6 (every label keeps a
+support across every arc) and 3.7 (assigned cells hold one label) -- arc consistency -- and
+reports whether a domain was wiped out. By Theorem 3.3.2 it never removes a label that
+occurs in some solution.
+
+:func:`propagate` runs the compiled bitset kernel of :mod:`csplab._kernels`;
+:func:`propagate_reference` is a slow, literal transcription of Alg. 3.2/3.3 kept for tests.
+:class:`Propagator` is the stateful engine solvers use (assign, propagate, save/restore).
+
+Examples
+--------
+>>> import numpy as np
+>>> from csplab import ExampleModel, Problem
+>>> E = ExampleModel([[0, 1], [1, 0]])                  # checkerboard
+>>> P = Problem.from_example(E, (3, 3))
+>>> C = initial_catalog(P)
+>>> C, ok = assign(P, C, P.cell((0, 0)), 1)
+>>> ok
+True
+>>> C.reshape(3, 3, 2).argmax(axis=2).tolist()          # the whole board is forced
+[[1, 0, 1], [0, 1, 0], [1, 0, 1]]
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from csplab import _kernels as kern
+from csplab.errors import InputError
+from csplab.problem import Problem
+
+__all__ = [
+    "Propagator",
+    "assign",
+    "initial_catalog",
+    "jit_warmup",
+    "pack",
+    "propagate",
+    "propagate_reference",
+    "unpack",
+]
+
+
+# ----------------------------------------------------------------------------- bitsets
+
+
+def words(K: int) -> int:
+    return max(1, (K + 63) // 64)
+
+
+def pack(catalog: ArrayLike) -> NDArray[np.uint64]:
+    """Boolean ``(n, K)`` -> bitsets ``uint64 (n, ceil(K/64))`` (bit ``b`` = label ``b``)."""
+    C = np.asarray(catalog, dtype=bool)
+    n, K = C.shape
+    W = words(K)
+    padded = np.zeros((n, W * 64), dtype=bool)
+    padded[:, :K] = C
+    by = np.packbits(padded, axis=1, bitorder="little")
+    return np.ascontiguousarray(by).view("<u8").astype(np.uint64).reshape(n, W)
+
+
+def unpack(bits: NDArray[np.uint64], K: int) -> NDArray[np.bool_]:
+    """Inverse of :func:`pack`."""
+    n = bits.shape[0]
+    by = np.ascontiguousarray(bits.astype("<u8")).view(np.uint8).reshape(n, -1)
+    return np.unpackbits(by, axis=1, bitorder="little")[:, :K].astype(bool)
+
+
+# ----------------------------------------------------------------------------- engine
+
+
+class _Compiled:
+    """CSR adjacency and support bitsets of a problem (shared by engines of one problem)."""
+
+    def __init__(self, problem: Problem) -> None:
+        n, K, R = problem.n, problem.K, problem.R
+        W = words(K)
+        a = problem.arcs
+        keep = a[:, 0] != a[:, 1]  # self-arcs are folded into the domains
+        a = a[keep]
+        src = np.concatenate([a[:, 0], a[:, 1]])
+        dst = np.concatenate([a[:, 1], a[:, 0]])
+        sid = np.concatenate([2 * a[:, 2], 2 * a[:, 2] + 1])
+        o = np.argsort(src, kind="stable")
+        self.nbr = np.ascontiguousarray(dst[o], dtype=np.int64)
+        self.sidx = np.ascontiguousarray(sid[o], dtype=np.int64)
+        self.ptr = np.zeros(n + 1, dtype=np.int64)
+        np.cumsum(np.bincount(src, minlength=n), out=self.ptr[1:])
+        rel = problem.relations
+        both = np.empty((2 * R, K, K), dtype=bool)
+        both[0::2] = rel
+        both[1::2] = rel.transpose(0, 2, 1)
+        self.sup = pack(both.reshape(2 * R * K, K)).reshape(2 * R, K, W)
+        self.supall = pack(both.any(axis=1))  # (2R, W): union of supports of all labels
+        self.full = pack(np.ones((1, K), dtype=bool))[0]
+        self.n, self.K, self.W = n, K, W
+        w = np.asarray(problem.weights, dtype=np.float64)
+        self.weights = np.ascontiguousarray(w)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            self.wlogw = np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0)
+
+
+class Propagator:
+    """Stateful bitset arc-consistency engine for one :class:`Problem`.
+
+    The state is the packed catalog ``bits`` (``uint64 (n, W)``). :meth:`assign` and
+    :meth:`restrict` shrink it and propagate; :meth:`save`/:meth:`load` copy it for
+    backtracking.
+
+    Parameters
+    ----------
+    problem : Problem
+    domains : bool array ``(n, K)``, optional
+        Start from this catalog instead of the problem's domains.
+    propagate_initial : bool
+        Make the initial domains arc consistent right away (default).
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, Problem
+    >>> P = Problem.from_example(ExampleModel([0, 1, 2]), (3,))
+    >>> eng = Propagator(P)
+    >>> eng.catalog().astype(int).tolist()              # 1D: only the example itself
+    [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+    """
+
+    def __init__(
+        self,
+        problem: Problem,
+        *,
+        domains: ArrayLike | None = None,
+        propagate_initial: bool = True,
+    ) -> None:
+        self.problem = problem
+        self.c = _compiled_for(problem)
+        self.bits = pack(problem.domains if domains is None else _check_catalog(problem, domains))
+        n = problem.n
+        self._queue = np.zeros(max(n, 1), dtype=np.int64)
+        self._inq = np.zeros(max(n, 1), dtype=np.bool_)
+        self.stats = np.zeros(2, dtype=np.int64)  # pops, removals
+        self._nohp = np.zeros(0, dtype=np.int64)
+        self._nohk = np.zeros(0, dtype=np.float64)
+        self.ok = bool(np.all(self.bits.any(axis=1))) if n else True
+        self.wiped: int = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
+        if propagate_initial and self.ok:
+            self.propagate(None)
+
+    # --------------------------------------------------------------- core
+    def propagate(self, changed: ArrayLike | None = None) -> bool:
+        """Propagate from ``changed`` cells (default: all); returns ``False`` on wipe-out."""
+        if not self.ok:
+            return False
+        start = (
+            np.arange(self.c.n, dtype=np.int64)
+            if changed is None
+            else np.ascontiguousarray(np.asarray(changed, dtype=np.int64).ravel())
+        )
+        c = self.c
+        wiped = kern.propagate(
+            self.bits, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, self._queue, self._inq,
+            start, start.size, self.stats, self._nohp, self._nohp, self._nohk, 0, self._nohk,
+            c.weights, c.wlogw, False,
+        )  # fmt: skip
+        if wiped >= 0:
+            self.ok = False
+            self.wiped = int(wiped)
+        return self.ok
+
+    def assign(self, cell: int, label: int) -> bool:
+        """Set ``cell`` to ``label`` (statement 3.7) and propagate; ``False`` on wipe-out."""
+        if not 0 <= label < self.c.K:
+            raise InputError(f"label {label} outside 0..{self.c.K - 1}")
+        if not self.ok:
+            return False
+        w, bit = divmod(int(label), 64)
+        if not (int(self.bits[cell, w]) >> bit) & 1:
+            self.bits[cell] = 0
+            self.ok = False
+            self.wiped = int(cell)
+            return False
+        self.bits[cell] = 0
+        self.bits[cell, w] = np.uint64(1) << np.uint64(bit)
+        return self.propagate([cell])
+
+    def restrict(self, cell: int, allowed: ArrayLike) -> bool:
+        """Intersect ``D(cell)`` with a boolean label mask and propagate."""
+        if not self.ok:
+            return False
+        m = pack(np.asarray(allowed, dtype=bool).reshape(1, -1))[0]
+        new = self.bits[cell] & m
+        if np.array_equal(new, self.bits[cell]):
+            return True
+        self.bits[cell] = new
+        if not new.any():
+            self.ok = False
+            self.wiped = int(cell)
+            return False
+        return self.propagate([cell])
+
+    # --------------------------------------------------------------- state
+    def save(self) -> tuple[NDArray[np.uint64], bool, int]:
+        return self.bits.copy(), self.ok, self.wiped
+
+    def load(self, state: tuple[NDArray[np.uint64], bool, int]) -> None:
+        self.bits[...] = state[0]
+        self.ok, self.wiped = state[1], state[2]
+
+    def copy(self) -> Propagator:
+        new = object.__new__(Propagator)
+        new.__dict__.update(self.__dict__)
+        new.bits = self.bits.copy()
+        new._queue = self._queue.copy()
+        new._inq = self._inq.copy()
+        new.stats = self.stats.copy()
+        return new
+
+    # --------------------------------------------------------------- views
+    def catalog(self) -> NDArray[np.bool_]:
+        """The current catalog as ``bool (n, K)``."""
+        return unpack(self.bits, self.c.K)
+
+    def domain(self, cell: int) -> NDArray[np.int64]:
+        """Labels still possible at ``cell``."""
+        return np.flatnonzero(unpack(self.bits[cell : cell + 1], self.c.K)[0])
+
+    def sizes(self) -> NDArray[np.int64]:
+        return self.catalog().sum(axis=1)
+
+
+# ----------------------------------------------------------------------------- pure API
+
+
+def initial_catalog(problem: Problem) -> NDArray[np.bool_]:
+    """The catalog before any assignment: a copy of the problem's domains (not propagated)."""
+    return np.array(problem.domains, dtype=bool)
+
+
+def _check_catalog(problem: Problem, catalog: ArrayLike) -> NDArray[np.bool_]:
+    C = np.asarray(catalog, dtype=bool)
+    if C.shape == (*problem.shape, problem.K):
+        C = C.reshape(problem.n, problem.K)
+    if C.shape != (problem.n, problem.K):
+        raise InputError(f"catalog must have shape ({problem.n}, {problem.K}), got {C.shape}")
+    return C
+
+
+def propagate(
+    problem: Problem, catalog: ArrayLike, changed: ArrayLike | None = None
+) -> tuple[NDArray[np.bool_], bool]:
+    """Arc-consistency fixpoint of statements 3.6/3.7 (compiled kernel).
+
+    Parameters
+    ----------
+    problem : Problem
+    catalog : bool array ``(n, K)`` or ``(*shape, K)``
+        Not modified.
+    changed : array of cell indices, optional
+        Cells whose entries were removed since the catalog was last consistent (default:
+        all cells). Propagation starts from these.
+
+    Returns
+    -------
+    catalog : bool array ``(n, K)``
+        The largest arc-consistent catalog inside the given one.
+    ok : bool
+        ``False`` if some cell lost every label (a wipe-out); the catalog is then partial.
+    """
+    eng = Propagator(problem, domains=catalog, propagate_initial=False)
+    eng.propagate(changed)
+    return eng.catalog(), eng.ok
+
+
+def assign(
+    problem: Problem, catalog: ArrayLike, cell: int, label: int
+) -> tuple[NDArray[np.bool_], bool]:
+    """Assign ``label`` to ``cell`` (statement 3.7) and propagate; returns a new catalog."""
+    C = _check_catalog(problem, catalog).copy()
+    if not C[cell, label]:
+        C[cell] = False
+        return C, False
+    C[cell] = False
+    C[cell, label] = True
+    return propagate(problem, C, [cell])
+
+
+def propagate_reference(
+    problem: Problem, catalog: ArrayLike, changed: ArrayLike | None = None
+) -> tuple[NDArray[np.bool_], bool]:
+    """Slow, literal Alg. 3.2/3.3 (a stack of cells, statement 3.6 per neighbour).
+
+    Same contract as :func:`propagate`; used to test the compiled kernel.
+    """
+    C = _check_catalog(problem, catalog).copy()
+    rel = problem.relations
+    adj: list[list[tuple[int, Any]]] = [[] for _ in range(problem.n)]
+    for s, d, r in problem.arcs.tolist():
+        if s == d:
+            continue
+        adj[s].append((d, rel[r]))  # T: C[d, c] needs some b in C[s] with T[b, c]
+        adj[d].append((s, rel[r].T))
+    if not C.any(axis=1).all():
+        return C, False
+    stack = deque(range(problem.n) if changed is None else [int(c) for c in np.ravel(changed)])
+    onstack = np.zeros(problem.n, dtype=bool)
+    onstack[list(stack)] = True
+    while stack:
+        v = stack.pop()
+        onstack[v] = False
+        for w, T in adj[v]:
+            for c in range(problem.K):
+                if C[w, c] and not any(C[v, b] and T[b, c] for b in range(problem.K)):
+                    C[w, c] = False
+                    if not onstack[w]:
+                        stack.append(w)
+                        onstack[w] = True
+            if not C[w].any():
+                return C, False
+    return C, True
+
+
+_COMPILED_CACHE: dict[int, tuple[Problem, _Compiled]] = {}
+
+
+def _compiled_for(problem: Problem) -> _Compiled:
+    hit = _COMPILED_CACHE.get(id(problem))
+    if hit is not None and hit[0] is problem:
+        return hit[1]
+    comp = _Compiled(problem)
+    if len(_COMPILED_CACHE) > 8:
+        _COMPILED_CACHE.clear()
+    _COMPILED_CACHE[id(problem)] = (problem, comp)
+    return comp
+
+
+def jit_warmup() -> float:
+    """Compile (or load from numba's on-disk cache) every kernel; returns seconds spent."""
+    t0 = time.perf_counter()
+    from csplab.example import ExampleModel
+    from csplab.solvers.catalog import run_alg31
+
+    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
+    rng = np.random.default_rng(0)
+    for order in ("scanline", "min-entropy"):
+        for choice in ("uniform", "weighted"):
+            run_alg31(P, rng, order=order, choice=choice)
+    return time.perf_counter() - t0

@@ -1,0 +1,226 @@
+"""The example model E: an integer label grid of 1 to 4 dimensions (thesis Sec. 3.1).
+
+Labels are indexed ``E[x, y, z]`` as in the thesis; the label count is
+``K = max label + 1`` (ids that never occur get no support). :meth:`ExampleModel.transitions`
+computes the transition matrices of Eq. 3.2.
+
+Examples
+--------
+>>> import numpy as np
+>>> E = ExampleModel(np.array([[0, 1], [1, 0]]))   # the checkerboard E1 (Fig. 3.1b)
+>>> E.K, E.ndim
+(2, 2)
+>>> T = E.transitions()
+>>> T.shape
+(2, 2, 2)
+>>> T[0].astype(int).tolist()      # T_x[b, c]: c may follow b along +x
+[[False, True], [True, False]]
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from csplab.errors import InputError
+
+__all__ = ["ExampleModel", "pair_transitions"]
+
+MAX_NDIM = 4
+
+
+def pair_transitions(grid: NDArray[np.integer[Any]], K: int) -> NDArray[np.bool_]:
+    """Transition matrices of a fully labelled grid: ``T[d, b, c]`` (Eq. 3.2).
+
+    ``T[d, b, c]`` is true iff some cell has label ``b`` and its ``+1`` neighbour along axis
+    ``d`` has label ``c``. Cells with negative labels (unassigned) are skipped.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pair_transitions(np.array([0, 1, 1]), 2)[0].tolist()
+    [[False, True], [False, True]]
+    """
+    g = np.asarray(grid)
+    T = np.zeros((g.ndim, K, K), dtype=bool)
+    for d in range(g.ndim):
+        if g.shape[d] < 2:
+            continue
+        a = np.moveaxis(g, d, 0)
+        b, c = a[:-1].ravel(), a[1:].ravel()
+        ok = (b >= 0) & (c >= 0)
+        T[d, b[ok], c[ok]] = True
+    return T
+
+
+@dataclass(frozen=True, eq=False)
+class ExampleModel:
+    """An example model ``E``: labels indexed ``[x, y, z]`` plus optional names and weights.
+
+    Parameters
+    ----------
+    labels : array_like of int
+        Label grid with 1 to 4 dimensions; non-negative integers. Copied and made read-only.
+    names : sequence of str, optional
+        One name per label id (length ``K``).
+    weights : array_like of float, optional
+        One non-negative weight per label (default: the label frequencies in ``labels``).
+    name : str
+        A short name used in reports.
+    metadata : mapping
+        Free-form data carried along (for example the header and trailing table of a
+        Merrell-format file, so it can be written back).
+    num_labels : int, optional
+        Force ``K`` larger than ``max label + 1`` (labels that never occur).
+    """
+
+    labels: NDArray[np.int32]
+    names: tuple[str, ...] | None = None
+    weights: NDArray[np.float64] | None = None
+    name: str = ""
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+    num_labels: int | None = None
+
+    def __init__(
+        self,
+        labels: ArrayLike,
+        names: Sequence[str] | None = None,
+        weights: ArrayLike | None = None,
+        name: str = "",
+        metadata: Mapping[str, Any] | None = None,
+        num_labels: int | None = None,
+    ) -> None:
+        raw = np.asarray(labels)
+        if raw.dtype == bool or not (np.issubdtype(raw.dtype, np.integer) or raw.size == 0):
+            if np.issubdtype(raw.dtype, np.floating) and np.all(np.mod(raw, 1) == 0):
+                raw = raw.astype(np.int64)
+            else:
+                raise InputError(f"example labels must be integers, got dtype {raw.dtype}")
+        if not 1 <= raw.ndim <= MAX_NDIM:
+            raise InputError(
+                f"example model must have 1 to {MAX_NDIM} dimensions, got shape {raw.shape}"
+            )
+        if raw.size == 0:
+            raise InputError(f"example model is empty (shape {raw.shape})")
+        if raw.min() < 0:
+            bad = tuple(int(i) for i in np.argwhere(raw < 0)[0])
+            raise InputError(f"negative label {int(raw[bad])} at {bad} in example model")
+        if raw.max() > np.iinfo(np.int32).max // 2:
+            raise InputError(f"label {int(raw.max())} is too large")
+        arr = np.ascontiguousarray(raw, dtype=np.int32)
+        arr.setflags(write=False)
+        K = int(arr.max()) + 1
+        if num_labels is not None:
+            if num_labels < K:
+                raise InputError(f"num_labels={num_labels} is less than max label + 1 = {K}")
+            K = int(num_labels)
+        if names is not None:
+            names = tuple(str(n) for n in names)
+            if len(names) < K:
+                raise InputError(f"{len(names)} label names given for K={K} labels")
+            K = len(names)
+        w: NDArray[np.float64] | None = None
+        if weights is not None:
+            w = np.array(weights, dtype=np.float64).reshape(-1)
+            if w.shape != (K,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+                raise InputError(f"weights must be {K} finite non-negative numbers")
+            w.setflags(write=False)
+        object.__setattr__(self, "labels", arr)
+        object.__setattr__(self, "names", names)
+        object.__setattr__(self, "weights", w)
+        object.__setattr__(self, "name", name)
+        object.__setattr__(self, "metadata", dict(metadata or {}))
+        object.__setattr__(self, "num_labels", K)
+
+    # ------------------------------------------------------------------ basic properties
+    @property
+    def K(self) -> int:
+        """Number of labels ``k`` (``max label + 1`` unless forced larger)."""
+        assert self.num_labels is not None
+        return self.num_labels
+
+    @property
+    def ndim(self) -> int:
+        return int(self.labels.ndim)
+
+    @property
+    def shape(self) -> tuple[int, ...]:
+        return tuple(int(s) for s in self.labels.shape)
+
+    def counts(self) -> NDArray[np.int64]:
+        """How often each label occurs in the example, shape ``(K,)``."""
+        return np.bincount(self.labels.ravel(), minlength=self.K).astype(np.int64)
+
+    def label_weights(self) -> NDArray[np.float64]:
+        """Per-label weights: the given ``weights`` or else the label frequencies."""
+        if self.weights is not None:
+            return np.array(self.weights, dtype=np.float64)
+        return self.counts().astype(np.float64)
+
+    def transitions(self) -> NDArray[np.bool_]:
+        """Transition matrices ``T[d, b, c]`` of Eq. 3.2, shape ``(ndim, K, K)``."""
+        return pair_transitions(self.labels, self.K)
+
+    def label_name(self, b: int) -> str:
+        """Name of label ``b`` (its number when the example has no names)."""
+        if self.names is not None and 0 <= b < len(self.names):
+            return self.names[b]
+        return str(b)
+
+    def hash(self) -> str:
+        """A stable content hash (labels, K, names, weights) for result stores."""
+        import hashlib
+
+        h = hashlib.sha256()
+        h.update(str((self.shape, self.K)).encode())
+        h.update(self.labels.tobytes())
+        if self.names is not None:
+            h.update("\0".join(self.names).encode())
+        if self.weights is not None:
+            h.update(self.weights.tobytes())
+        return h.hexdigest()[:16]
+
+    def __repr__(self) -> str:
+        nm = f"{self.name!r}, " if self.name else ""
+        return f"ExampleModel({nm}shape={self.shape}, K={self.K})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, ExampleModel):
+            return NotImplemented
+        return (
+            self.shape == other.shape
+            and self.K == other.K
+            and bool(np.array_equal(self.labels, other.labels))
+            and self.names == other.names
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    # ------------------------------------------------------------------ files
+    @classmethod
+    def load(cls, path: str | Path) -> ExampleModel:
+        """Read an example model file; the format is detected from extension and content.
+
+        See :mod:`csplab.io` for the formats (Merrell's tiled-model text format, the csplab
+        grid text format, ``.npy``).
+        """
+        from csplab.io import read_example
+
+        return read_example(path)
+
+    def save(self, path: str | Path, format: str | None = None) -> None:
+        """Write the model; ``format`` is ``"merrell"``, ``"grid"`` or ``"npy"`` (default:
+        from the extension, ``.txt`` meaning Merrell's format)."""
+        from csplab.io import write_example
+
+        write_example(self, path, format=format)
+
+    def _repr_png_(self) -> bytes:
+        from csplab.render import render_png_bytes
+
+        return render_png_bytes(self.labels, names=self.names)

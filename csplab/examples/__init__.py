@@ -1,0 +1,63 @@
+"""Built-in example models, loadable by name with :func:`load_example`.
+
+The 2D examples reconstruct the thesis' small figures (each file documents which figure it
+stands for and which property it has; where the text does not pin the exact grid, the file
+says so and the tests check the stated property). The 3D examples are csplab's own.
+
+Examples
+--------
+>>> from csplab.examples import load_example, example_names
+>>> "line" in example_names()
+True
+>>> load_example("fig3_1b").labels[:, :, ].tolist()
+[[0, 1, 0], [1, 0, 1], [0, 1, 0]]
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+
+from csplab.errors import InputError
+from csplab.example import ExampleModel
+
+__all__ = ["EXAMPLES", "example_info", "example_names", "load_example"]
+
+# name -> (file, one-line description); aliases below
+EXAMPLES: dict[str, tuple[str, str]] = {
+    "fig3_1a": ("fig3_1a_empty.grid", "E0, Fig. 3.1(a): all empty space; one solution"),
+    "fig3_1b": ("fig3_1b_checkerboard.grid", "E1, Fig. 3.1(b): checkerboard; two solutions"),
+    "line": ("fig3_1c_line.grid", "Fig. 3.1(c)/3.12: a line in empty space; infallible"),
+    "fig3_1d": ("fig3_1d_unique.grid", "E3, Fig. 3.1(d): no repeated label; no larger model"),
+}
+ALIASES: dict[str, str] = {
+    "E0": "fig3_1a",
+    "empty": "fig3_1a",
+    "E1": "fig3_1b",
+    "checkerboard": "fig3_1b",
+    "fig3_1c": "line",
+    "fig3_12": "line",
+    "E3": "fig3_1d",
+}
+
+
+def example_names() -> list[str]:
+    """Names of the built-in examples."""
+    return list(EXAMPLES)
+
+
+def example_info() -> list[tuple[str, str]]:
+    """``(name, description)`` of every built-in example."""
+    return [(k, v[1]) for k, v in EXAMPLES.items()]
+
+
+def load_example(name: str) -> ExampleModel:
+    """Load a built-in example by name (or alias such as ``"E1"``)."""
+    key = ALIASES.get(name, name)
+    if key not in EXAMPLES:
+        raise InputError(f"unknown example {name!r}; built-in examples: {', '.join(EXAMPLES)}")
+    from csplab.io.gridtext import parse_grid
+
+    fname = EXAMPLES[key][0]
+    text = resources.files(__package__).joinpath(fname).read_text(encoding="utf-8")
+    ex = parse_grid(text, path=f"csplab/examples/{fname}", name=key)
+    return ex

@@ -1,0 +1,782 @@
+"""`Problem`: a general binary extensional CSP, the model-synthesis problem of Sec. 3.1.
+
+A problem has ``n`` cells (with a grid ``shape`` whose C-order flattening numbers them, so
+cell order is the thesis' scan order: x outermost, z innermost), ``K`` labels, initial
+domains ``bool (n, K)``, relations ``bool (R, K, K)`` and arcs ``(src, dst, relation)``:
+an arc requires ``relations[r, label[src], label[dst]]``. Grid adjacency is one relation per
+axis (the transition matrices ``T_d`` of Eq. 3.2); symmetry pairs, diagonals, wrap-around or
+anything else are just more arcs. Fixed cells, boundary labels and masks (Sec. 3.3.6, 3.5.3)
+are domain restrictions, remembered one by one in :attr:`Problem.unary` so that analysis
+tools can explain which of them make a problem unsatisfiable.
+
+:meth:`Problem.violations` is the one solver-independent checker used by every solver and
+test.
+
+Examples
+--------
+>>> import numpy as np
+>>> from csplab.example import ExampleModel
+>>> E1 = ExampleModel([[0, 1], [1, 0]])                  # checkerboard
+>>> P = Problem.from_example(E1, (3, 3))
+>>> P.n, P.K, len(P.arcs)
+(9, 2, 12)
+>>> P.is_solution(np.array([[0, 1, 0], [1, 0, 1], [0, 1, 0]]))
+True
+>>> v = P.violations(np.zeros((3, 3), dtype=int))
+>>> len(v.arcs), len(v.cells)
+(12, 0)
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import TYPE_CHECKING, Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from csplab.errors import InputError
+
+if TYPE_CHECKING:
+    from csplab.example import ExampleModel
+
+__all__ = ["AXIS_NAMES", "Problem", "Unary", "Violations", "parse_shape"]
+
+AXIS_NAMES = "xyzw"
+UnaryKind = Literal["fixed", "boundary", "mask", "domain"]
+
+
+@dataclass(frozen=True)
+class Unary:
+    """One remembered domain restriction: ``cells`` may only take ``allowed`` labels.
+
+    ``kind`` is ``"fixed"`` (one cell, one label), ``"boundary"`` (one face),
+    ``"mask"`` (one cell's mask) or ``"domain"`` (anything else); ``key`` names it
+    (coordinates or a face such as ``"z-"``).
+    """
+
+    kind: UnaryKind
+    key: Any
+    cells: NDArray[np.int64]
+    allowed: NDArray[np.bool_]  # (len(cells), K)
+
+    def describe(self, problem: Problem, names: bool = True) -> str:
+        labels = np.flatnonzero(self.allowed.any(axis=0) if len(self.cells) else [])
+        if self.kind == "fixed":
+            b = int(labels[0]) if labels.size else -1
+            return f"fixed cell {self.key} = {problem.label_name(b) if names else b}"
+        if self.kind == "boundary":
+            b = int(labels[0]) if labels.size == 1 else None
+            what = problem.label_name(b) if b is not None else f"{labels.size} labels"
+            return f"boundary face {self.key} = {what} ({len(self.cells)} cells)"
+        if self.kind == "mask":
+            return f"mask at cell {self.key} allows {labels.size} of {problem.K} labels"
+        return f"domain restriction {self.key} ({len(self.cells)} cells)"
+
+
+@dataclass(frozen=True)
+class Violations:
+    """What :meth:`Problem.violations` found: violated arcs and out-of-domain cells.
+
+    ``arcs`` are indices into ``problem.arcs``; ``cells`` are flat cell indices whose label is
+    unassigned (negative), out of range or not in the cell's domain. ``len()`` is the total.
+    """
+
+    arcs: NDArray[np.int64]
+    cells: NDArray[np.int64]
+    problem: Problem = field(repr=False, compare=False)
+    grid: NDArray[np.int64] = field(repr=False, compare=False)
+
+    def __len__(self) -> int:
+        return int(self.arcs.size + self.cells.size)
+
+    def __bool__(self) -> bool:
+        return len(self) > 0
+
+    def describe(self, limit: int = 10) -> str:
+        """Human-readable list of the first ``limit`` violations."""
+        P, lab = self.problem, self.grid
+        lines = [f"{self.arcs.size} violated arcs, {self.cells.size} cells outside their domain"]
+        for c in self.cells[:limit]:
+            b = int(lab[c])
+            why = "unassigned" if b < 0 else ("out of range" if b >= P.K else "not allowed")
+            lines.append(f"  cell {P.coords(int(c))}: label {b} {why}")
+        for i in self.arcs[:limit]:
+            s, d, r = (int(t) for t in P.arcs[i])
+            lines.append(
+                f"  arc {P.coords(s)} -> {P.coords(d)} ({P.relation_name(r)}): "
+                f"{int(lab[s])} then {int(lab[d])} never occurs"
+            )
+        return "\n".join(lines)
+
+
+def parse_shape(text: str | Sequence[int], *, what: str = "size") -> tuple[int, ...]:
+    """Parse ``"40x40x10"`` (or a sequence) into a shape tuple of positive ints.
+
+    Examples
+    --------
+    >>> parse_shape("40x40x10")
+    (40, 40, 10)
+    >>> parse_shape([5, 6])
+    (5, 6)
+    """
+    if isinstance(text, str):
+        parts = text.lower().replace("×", "x").replace(",", "x").split("x")
+        try:
+            shape = tuple(int(p) for p in parts)
+        except ValueError:
+            raise InputError(
+                f"{what} {text!r} is not of the form NxM or NxMxL (positive integers)"
+            ) from None
+    else:
+        try:
+            shape = tuple(int(p) for p in text)
+        except (TypeError, ValueError):
+            raise InputError(f"{what} {text!r} is not a sequence of integers") from None
+    if not 1 <= len(shape) <= 4 or any(s < 1 for s in shape):
+        raise InputError(f"{what} {text!r} must have 1 to 4 positive extents")
+    if math.prod(shape) > 200_000_000:
+        raise InputError(f"{what} {text!r} has too many cells")
+    return shape
+
+
+def _face_list(ndim: int) -> list[str]:
+    return [f"{AXIS_NAMES[d]}{s}" for d in range(ndim) for s in "-+"]
+
+
+def _as_flag_tuple(value: bool | Sequence[bool], ndim: int, what: str) -> tuple[bool, ...]:
+    if isinstance(value, bool | np.bool_):
+        return (bool(value),) * ndim
+    flags = tuple(bool(v) for v in value)
+    if len(flags) != ndim:
+        raise InputError(f"{what} needs {ndim} flags (one per axis), got {len(flags)}")
+    return flags
+
+
+class Problem:
+    """A binary extensional CSP over the cells of a grid.
+
+    Parameters
+    ----------
+    shape : tuple of int
+        Grid shape; cells are numbered in C order (``x`` outermost).
+    domains : array_like of bool, shape ``(n, K)`` or ``(*shape, K)``
+        Allowed labels per cell (after all unary restrictions).
+    relations : array_like of bool, shape ``(R, K, K)``
+    arcs : array_like of int, shape ``(A, 3)``
+        ``(src, dst, relation)``: ``relations[r, label[src], label[dst]]`` must hold.
+    weights : array_like of float, optional
+        Per-label weights for weighted label choice and entropy (default: all ones).
+    names : sequence of str, optional
+        Label names.
+    relation_names : sequence of str, optional
+        A name for each relation (e.g. ``"T_x"``), used in messages.
+    unary : sequence of Unary, optional
+        The restrictions that produced ``domains`` from ``base_domains``.
+    base_domains : array_like of bool, optional
+        Domains before the ``unary`` restrictions (default: ``domains``).
+    name : str
+        A short name for reports.
+    meta : mapping
+        Free-form provenance (example name and hash, boundary labels, periodicity ...).
+
+    Notes
+    -----
+    Self-arcs (a cell related to itself, as on a periodic axis of length 1) are kept in
+    ``arcs`` for the checker and folded into the domains (``label`` must satisfy
+    ``R[label, label]``).
+    """
+
+    def __init__(
+        self,
+        shape: Sequence[int],
+        domains: ArrayLike,
+        relations: ArrayLike,
+        arcs: ArrayLike,
+        *,
+        weights: ArrayLike | None = None,
+        names: Sequence[str] | None = None,
+        relation_names: Sequence[str] | None = None,
+        unary: Sequence[Unary] = (),
+        base_domains: ArrayLike | None = None,
+        name: str = "",
+        meta: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.shape: tuple[int, ...] = tuple(int(s) for s in shape)
+        if not self.shape or any(s < 1 for s in self.shape):
+            raise InputError(f"shape {self.shape} must have positive extents")
+        n = math.prod(self.shape)
+        rel = np.array(relations, dtype=bool)
+        if rel.ndim != 3 or rel.shape[1] != rel.shape[2]:
+            raise InputError(f"relations must have shape (R, K, K), got {rel.shape}")
+        K = int(rel.shape[1])
+        if K < 1:
+            raise InputError("a problem needs at least one label")
+        dom = np.array(domains, dtype=bool)
+        if dom.shape == (*self.shape, K):
+            dom = dom.reshape(n, K)
+        if dom.shape != (n, K):
+            raise InputError(f"domains must have shape ({n}, {K}), got {dom.shape}")
+        a = np.array(arcs, dtype=np.int64).reshape(-1, 3)
+        if a.size:
+            if a[:, :2].min() < 0 or a[:, :2].max() >= n:
+                raise InputError(f"arc endpoints must be cells 0..{n - 1}")
+            if a[:, 2].min() < 0 or a[:, 2].max() >= rel.shape[0]:
+                raise InputError(f"arc relation ids must be 0..{rel.shape[0] - 1}")
+        base = dom.copy() if base_domains is None else np.array(base_domains, dtype=bool)
+        if base.shape == (*self.shape, K):
+            base = base.reshape(n, K)
+        # fold self-arcs into the domains
+        selfarc = a[:, 0] == a[:, 1]
+        if selfarc.any():
+            for c, r in a[selfarc][:, [0, 2]]:
+                diag = np.diagonal(rel[r]).copy()
+                dom[c] &= diag
+                base[c] &= diag
+        w = np.ones(K) if weights is None else np.array(weights, dtype=np.float64).reshape(-1)
+        if w.shape != (K,) or not np.all(np.isfinite(w)) or np.any(w < 0):
+            raise InputError(f"weights must be {K} finite non-negative numbers")
+        if names is not None:
+            names = tuple(str(s) for s in names)
+            if len(names) != K:
+                raise InputError(f"{len(names)} label names for K={K}")
+        if relation_names is not None:
+            relation_names = tuple(relation_names)
+            if len(relation_names) != rel.shape[0]:
+                raise InputError("one relation name per relation is needed")
+        for arr in (dom, rel, a, w, base):
+            arr.setflags(write=False)
+        self.domains: NDArray[np.bool_] = dom
+        self.relations: NDArray[np.bool_] = rel
+        self.arcs: NDArray[np.int64] = a
+        self.weights: NDArray[np.float64] = w
+        self.names: tuple[str, ...] | None = names
+        self.relation_names: tuple[str, ...] | None = relation_names
+        self.unary: tuple[Unary, ...] = tuple(unary)
+        self.base_domains: NDArray[np.bool_] = base
+        self.name = name
+        self.meta: dict[str, Any] = dict(meta or {})
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n(self) -> int:
+        """Number of cells."""
+        return int(self.domains.shape[0])
+
+    @property
+    def K(self) -> int:
+        """Number of labels."""
+        return int(self.relations.shape[1])
+
+    @property
+    def ndim(self) -> int:
+        return len(self.shape)
+
+    @property
+    def R(self) -> int:
+        """Number of relations."""
+        return int(self.relations.shape[0])
+
+    def __repr__(self) -> str:
+        nm = f"{self.name!r}, " if self.name else ""
+        return (
+            f"Problem({nm}shape={self.shape}, K={self.K}, relations={self.R}, "
+            f"arcs={len(self.arcs)}, unary={len(self.unary)})"
+        )
+
+    # ------------------------------------------------------------------ naming helpers
+    def coords(self, cell: int) -> tuple[int, ...]:
+        """Grid coordinates of a flat cell index."""
+        return tuple(int(i) for i in np.unravel_index(int(cell), self.shape))
+
+    def cell(self, coords: Sequence[int]) -> int:
+        """Flat index of grid coordinates."""
+        try:
+            return int(np.ravel_multi_index(tuple(int(c) for c in coords), self.shape))
+        except ValueError:
+            raise InputError(f"cell {tuple(coords)} is outside the grid {self.shape}") from None
+
+    def label_name(self, b: int | None) -> str:
+        if b is None:
+            return "?"
+        if self.names is not None and 0 <= b < len(self.names):
+            return self.names[b]
+        return str(b)
+
+    def relation_name(self, r: int) -> str:
+        if self.relation_names is not None:
+            return self.relation_names[r]
+        return f"R{r}"
+
+    # ------------------------------------------------------------------ the checker
+    def _flat_grid(self, grid: ArrayLike) -> NDArray[np.int64]:
+        g = np.asarray(grid)
+        if g.shape != self.shape and g.shape != (self.n,):
+            raise InputError(f"grid has shape {g.shape}, the problem has shape {self.shape}")
+        if not (np.issubdtype(g.dtype, np.integer) or g.size == 0):
+            raise InputError(f"grid must hold integer labels, got dtype {g.dtype}")
+        return g.reshape(-1).astype(np.int64)
+
+    def violations(self, grid: ArrayLike) -> Violations:
+        """Every violated arc and every cell whose label is not in its domain.
+
+        Unassigned cells (negative labels) and labels outside ``0..K-1`` count as
+        out-of-domain cells; arcs touching them count as violated.
+        """
+        lab = self._flat_grid(grid)
+        K = self.K
+        inr = (lab >= 0) & (lab < K)
+        safe = np.where(inr, lab, 0)
+        bad_cell = ~inr | ~self.domains[np.arange(self.n), safe]
+        s, d, r = self.arcs[:, 0], self.arcs[:, 1], self.arcs[:, 2]
+        ok = inr[s] & inr[d] & self.relations[r, safe[s], safe[d]]
+        return Violations(
+            arcs=np.flatnonzero(~ok).astype(np.int64),
+            cells=np.flatnonzero(bad_cell).astype(np.int64),
+            problem=self,
+            grid=lab,
+        )
+
+    def is_solution(self, grid: ArrayLike) -> bool:
+        """``True`` iff ``grid`` is complete and violates nothing."""
+        return len(self.violations(grid)) == 0
+
+    # ------------------------------------------------------------------ derived data
+    @cached_property
+    def fixed_grid(self) -> NDArray[np.int32]:
+        """Labels of cells whose domain is a single label (else -1), shape ``shape``."""
+        single = self.domains.sum(axis=1) == 1
+        out = np.full(self.n, -1, dtype=np.int32)
+        out[single] = self.domains[single].argmax(axis=1)
+        out.setflags(write=False)
+        return out.reshape(self.shape)
+
+    def neighbours(self, cell: int) -> Iterator[tuple[int, int, bool]]:
+        """Yield ``(other, relation, forward)`` for each arc touching ``cell``."""
+        a = self.arcs
+        for i in np.flatnonzero(a[:, 0] == cell):
+            yield int(a[i, 1]), int(a[i, 2]), True
+        for i in np.flatnonzero(a[:, 1] == cell):
+            yield int(a[i, 0]), int(a[i, 2]), False
+
+    # ------------------------------------------------------------------ building
+    @classmethod
+    def grid(
+        cls,
+        shape: Sequence[int] | str,
+        transitions: ArrayLike,
+        *,
+        periodic: bool | Sequence[bool] = False,
+        fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
+        boundary: Mapping[str, int] | None = None,
+        mask: ArrayLike | None = None,
+        weights: ArrayLike | None = None,
+        names: Sequence[str] | None = None,
+        name: str = "",
+        meta: Mapping[str, Any] | None = None,
+    ) -> Problem:
+        """A grid problem from per-axis transition matrices ``T[d, b, c]``.
+
+        ``T[d]`` constrains each cell and its ``+1`` neighbour along axis ``d``; with
+        ``periodic`` (all axes or one flag per axis) the last cell also wraps to the first.
+        ``fixed``, ``boundary`` and ``mask`` restrict domains as in
+        :meth:`from_example` (which supplies ``T`` from an example model).
+        """
+        shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
+        T = np.asarray(transitions, dtype=bool)
+        ndim = len(shp)
+        if T.ndim != 3 or T.shape[0] != ndim or T.shape[1] != T.shape[2]:
+            raise InputError(
+                f"transitions must have shape ({ndim}, K, K) for a {ndim}-D grid, got {T.shape}"
+            )
+        K = T.shape[1]
+        per = _as_flag_tuple(periodic, ndim, "periodic")
+        n = math.prod(shp)
+        idx = np.arange(n, dtype=np.int64).reshape(shp)
+        parts = []
+        for d in range(ndim):
+            a = np.moveaxis(idx, d, 0)
+            if shp[d] > 1:
+                src, dst = a[:-1].ravel(), a[1:].ravel()
+                parts.append(np.stack([src, dst, np.full_like(src, d)], axis=1))
+            if per[d]:
+                src, dst = a[-1].ravel(), a[0].ravel()
+                parts.append(np.stack([src, dst, np.full_like(src, d)], axis=1))
+        arcs = np.concatenate(parts) if parts else np.zeros((0, 3), dtype=np.int64)
+        base = np.ones((n, K), dtype=bool)
+        unary = _build_unary(shp, K, fixed=fixed, boundary=boundary, mask=mask)
+        dom = base.copy()
+        for u in unary:
+            dom[u.cells] &= u.allowed
+        m = dict(meta or {})
+        m.setdefault("periodic", per)
+        if boundary is not None:
+            m.setdefault("boundary", dict(boundary))
+        return cls(
+            shp,
+            dom,
+            T,
+            arcs,
+            weights=weights,
+            names=names,
+            relation_names=tuple(f"T_{AXIS_NAMES[d]}" for d in range(ndim)),
+            unary=unary,
+            base_domains=base,
+            name=name,
+            meta=m,
+        )
+
+    @classmethod
+    def from_example(
+        cls,
+        example: ExampleModel,
+        shape: Sequence[int] | str,
+        *,
+        periodic: bool | Sequence[bool] = False,
+        fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
+        boundary: Mapping[str, int] | Literal["auto", "none"] | None = None,
+        mask: ArrayLike | None = None,
+    ) -> Problem:
+        """The model-synthesis problem for example ``E`` and output size ``shape``.
+
+        Parameters
+        ----------
+        example : ExampleModel
+        shape : sequence of int or str
+            Output size, e.g. ``(40, 40, 10)`` or ``"40x40x10"``. It may omit trailing axes
+            along which the example has extent 1 (a 2D size for an ``nz = 1`` model).
+        periodic : bool or sequence of bool
+            Wrap around on all axes or on the flagged ones (toroidal output).
+        fixed : int array with -1 for free cells, or mapping ``{coords: label}``
+            Pre-assigned cells.
+        boundary : mapping ``{face: label}``, ``"auto"`` or ``None``/``"none"``
+            Label the outer layer of the model (Sec. 3.3.6, Fig. 3.11). Faces are ``"x-"``,
+            ``"x+"``, ``"y-"``, ... . Where faces meet, the bottom face (the ``-`` face of the
+            last axis) wins, then faces later in the order ``x-, x+, y-, y+, ...``.
+            ``"auto"`` puts on the bottom face the example's most frequent bottom-layer
+            label that tiles itself along the other axes (the ground), and on every other
+            face the example's empty-space label: the label that tiles itself along every
+            axis and is most frequent on the example's outer layer (bottom excluded).
+        mask : bool array ``(*shape, K)`` (or broadcastable)
+            Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
+        """
+        shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
+        shp = _match_ndim(shp, example.shape)
+        if isinstance(boundary, str):
+            if boundary == "auto":
+                boundary = auto_boundary(example, len(shp))
+            elif boundary == "none":
+                boundary = None
+            else:
+                raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
+        T = example.transitions()
+        if T.shape[0] < len(shp):
+            pad = np.zeros((len(shp) - T.shape[0], example.K, example.K), dtype=bool)
+            T = np.concatenate([T, pad])
+        meta = {"example": example.name, "example_hash": example.hash()}
+        return cls.grid(
+            shp,
+            T,
+            periodic=periodic,
+            fixed=fixed,
+            boundary=boundary,
+            mask=mask,
+            weights=example.label_weights(),
+            names=example.names,
+            name=example.name,
+            meta=meta,
+        )
+
+    # ------------------------------------------------------------------ derived problems
+    def restrict(
+        self, allowed: ArrayLike, *, kind: UnaryKind = "domain", key: Any = None
+    ) -> Problem:
+        """A copy with domains intersected with ``allowed`` (``(n, K)`` or ``(*shape, K)``),
+        recorded as one unary restriction."""
+        al = np.broadcast_to(np.asarray(allowed, dtype=bool), (*self.shape, self.K))
+        al = al.reshape(self.n, self.K)
+        cells = np.flatnonzero(~al.all(axis=1)).astype(np.int64)
+        u = Unary(kind, key, cells, al[cells].copy())
+        return self._with_unary([u])
+
+    def with_fixed(self, fixed: ArrayLike | Mapping[Sequence[int], int]) -> Problem:
+        """A copy with some cells pre-assigned (same forms as in :meth:`from_example`)."""
+        return self._with_unary(_build_unary(self.shape, self.K, fixed=fixed))
+
+    def _with_unary(self, extra: Sequence[Unary]) -> Problem:
+        dom = self.domains.copy()
+        for u in extra:
+            dom[u.cells] &= u.allowed
+        return Problem(
+            self.shape,
+            dom,
+            self.relations,
+            self.arcs,
+            weights=self.weights,
+            names=self.names,
+            relation_names=self.relation_names,
+            unary=(*self.unary, *extra),
+            base_domains=self.base_domains,
+            name=self.name,
+            meta=self.meta,
+        )
+
+    def without_unary(self, keep: Sequence[int] = ()) -> Problem:
+        """A copy with only the unary restrictions whose indices are in ``keep``."""
+        kept = [self.unary[i] for i in keep]
+        dom = self.base_domains.copy()
+        for u in kept:
+            dom[u.cells] &= u.allowed
+        return Problem(
+            self.shape,
+            dom,
+            self.relations,
+            self.arcs,
+            weights=self.weights,
+            names=self.names,
+            relation_names=self.relation_names,
+            unary=kept,
+            base_domains=self.base_domains,
+            name=self.name,
+            meta=self.meta,
+        )
+
+    def add_arcs(
+        self, relation: ArrayLike, src: ArrayLike, dst: ArrayLike, name: str | None = None
+    ) -> Problem:
+        """A copy with one more relation and arcs ``src[i] -> dst[i]`` carrying it
+        (symmetry pairs, diagonal or distance-2 neighbours ...)."""
+        R = np.asarray(relation, dtype=bool)
+        if R.shape != (self.K, self.K):
+            raise InputError(f"relation must have shape ({self.K}, {self.K}), got {R.shape}")
+        s = np.asarray(src, dtype=np.int64).ravel()
+        d = np.asarray(dst, dtype=np.int64).ravel()
+        if s.shape != d.shape:
+            raise InputError("src and dst must have the same length")
+        r = np.full_like(s, self.R)
+        rn = None
+        if self.relation_names is not None or name is not None:
+            old = self.relation_names or tuple(f"R{i}" for i in range(self.R))
+            rn = (*old, name or f"R{self.R}")
+        return Problem(
+            self.shape,
+            self.domains,
+            np.concatenate([self.relations, R[None]]),
+            np.concatenate([self.arcs, np.stack([s, d, r], axis=1)]),
+            weights=self.weights,
+            names=self.names,
+            relation_names=rn,
+            unary=self.unary,
+            base_domains=self.base_domains,
+            name=self.name,
+            meta=self.meta,
+        )
+
+    def subproblem(
+        self,
+        cells: ArrayLike,
+        grid: ArrayLike,
+        shape: Sequence[int] | None = None,
+    ) -> Problem:
+        """The problem on ``cells`` with every other cell fixed to its label in ``grid``.
+
+        Arcs inside ``cells`` are kept (renumbered in the given cell order); arcs from a
+        labelled outside cell become domain restrictions on the inside cell (this is how a
+        block of Alg. 3.4 sees the fixed labels around it); arcs to unlabelled (negative)
+        outside cells are dropped. ``shape`` gives the sub-grid's shape (default: flat).
+        """
+        idx = np.asarray(cells, dtype=np.int64).ravel()
+        lab = self._flat_grid(grid)
+        local = np.full(self.n, -1, dtype=np.int64)
+        local[idx] = np.arange(idx.size)
+        a = self.arcs
+        ls, ld = local[a[:, 0]], local[a[:, 1]]
+        inside = (ls >= 0) & (ld >= 0)
+        dom = self.domains[idx].copy()
+        # outside src (labelled) -> inside dst
+        m = (ls < 0) & (ld >= 0) & (lab[a[:, 0]] >= 0)
+        if m.any():
+            np.logical_and.at(dom, ld[m], self.relations[a[m, 2], lab[a[m, 0]], :])
+        m = (ls >= 0) & (ld < 0) & (lab[a[:, 1]] >= 0)
+        if m.any():
+            np.logical_and.at(dom, ls[m], self.relations[a[m, 2], :, lab[a[m, 1]]])
+        arcs = np.stack([ls[inside], ld[inside], a[inside, 2]], axis=1)
+        shp = (idx.size,) if shape is None else tuple(shape)
+        return Problem(
+            shp,
+            dom,
+            self.relations,
+            arcs,
+            weights=self.weights,
+            names=self.names,
+            relation_names=self.relation_names,
+            name=self.name,
+            meta={**self.meta, "subproblem_of": self.shape},
+        )
+
+
+# ---------------------------------------------------------------------- helpers
+
+
+def _match_ndim(shape: tuple[int, ...], ex_shape: tuple[int, ...]) -> tuple[int, ...]:
+    if len(shape) == len(ex_shape):
+        return shape
+    if len(shape) < len(ex_shape):
+        if all(s == 1 for s in ex_shape[len(shape) :]):
+            return shape + (1,) * (len(ex_shape) - len(shape))
+        raise InputError(
+            f"size {'x'.join(map(str, shape))} has {len(shape)} axes but the example has "
+            f"shape {'x'.join(map(str, ex_shape))}"
+        )
+    raise InputError(
+        f"size {'x'.join(map(str, shape))} has more axes than the example "
+        f"({'x'.join(map(str, ex_shape))})"
+    )
+
+
+def _build_unary(
+    shape: tuple[int, ...],
+    K: int,
+    *,
+    fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
+    boundary: Mapping[str, int] | None = None,
+    mask: ArrayLike | None = None,
+) -> list[Unary]:
+    n = math.prod(shape)
+    ndim = len(shape)
+    out: list[Unary] = []
+    if boundary is not None:
+        faces = _face_list(ndim)
+        bottom = f"{AXIS_NAMES[ndim - 1]}-"
+        unknown = [f for f in boundary if f not in faces]
+        if unknown:
+            raise InputError(f"unknown boundary face(s) {unknown}; faces are {faces}")
+        order = [f for f in faces if f != bottom] + [bottom]
+        owner = np.full(shape, -1, dtype=np.int64)  # index into order
+        for j, f in enumerate(order):
+            if f in boundary:
+                d, side = AXIS_NAMES.index(f[0]), f[1]
+                sl: list[slice | int] = [slice(None)] * ndim
+                sl[d] = 0 if side == "-" else shape[d] - 1
+                owner[tuple(sl)] = j
+        flat_owner = owner.ravel()
+        for j, f in enumerate(order):
+            if f not in boundary:
+                continue
+            b = _check_label(boundary[f], K, f"boundary[{f!r}]")
+            cells = np.flatnonzero(flat_owner == j).astype(np.int64)
+            allowed = np.zeros((cells.size, K), dtype=bool)
+            allowed[:, b] = True
+            out.append(Unary("boundary", f, cells, allowed))
+    if fixed is not None:
+        if isinstance(fixed, Mapping):
+            items = []
+            for coords, b in fixed.items():
+                c = tuple(int(i) for i in (coords if isinstance(coords, Sequence) else (coords,)))
+                if len(c) != ndim or any(not 0 <= ci < si for ci, si in zip(c, shape, strict=True)):
+                    raise InputError(f"fixed cell {c} is outside the grid {shape}")
+                items.append((int(np.ravel_multi_index(c, shape)), c, b))
+        else:
+            arr = np.asarray(fixed)
+            if arr.shape != shape:
+                raise InputError(f"fixed array has shape {arr.shape}, expected {shape}")
+            if not np.issubdtype(arr.dtype, np.integer):
+                raise InputError(f"fixed array must hold integers (-1 = free), got {arr.dtype}")
+            flat = arr.reshape(-1)
+            if np.any(flat < -1):
+                raise InputError("fixed array may only hold labels and -1 for free cells")
+            items = [
+                (int(c), tuple(int(i) for i in np.unravel_index(int(c), shape)), int(flat[c]))
+                for c in np.flatnonzero(flat >= 0)
+            ]
+        for c, coords, b in items:
+            lb = _check_label(b, K, f"fixed label at {coords}")
+            allowed = np.zeros((1, K), dtype=bool)
+            allowed[0, lb] = True
+            out.append(Unary("fixed", coords, np.array([c], dtype=np.int64), allowed))
+    if mask is not None:
+        m = np.asarray(mask)
+        if m.dtype != bool:
+            raise InputError(f"mask must be boolean, got dtype {m.dtype}")
+        try:
+            m = np.broadcast_to(m, (*shape, K)).reshape(n, K)
+        except ValueError:
+            raise InputError(
+                f"mask of shape {np.shape(mask)} does not fit ({shape}, K={K})"
+            ) from None
+        for c in np.flatnonzero(~m.all(axis=1)):
+            coords = tuple(int(i) for i in np.unravel_index(int(c), shape))
+            out.append(Unary("mask", coords, np.array([c], dtype=np.int64), m[c : c + 1].copy()))
+    return out
+
+
+def _check_label(b: Any, K: int, what: str) -> int:
+    try:
+        lb = int(b)
+    except (TypeError, ValueError):
+        raise InputError(f"{what} must be a label id, got {b!r}") from None
+    if not 0 <= lb < K:
+        raise InputError(f"{what} = {lb} is outside the label range 0..{K - 1}")
+    return lb
+
+
+def auto_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, int]:
+    """The ``boundary="auto"`` labelling for an example (see :meth:`Problem.from_example`).
+
+    Returns a mapping face -> label. Raises :class:`~csplab.errors.InputError` when the
+    example has no empty-space label (one that tiles itself along every axis) or, for 2D and
+    higher, no ground label (a bottom-layer label that tiles itself along the other axes).
+
+    Examples
+    --------
+    >>> from csplab.example import ExampleModel
+    >>> E = ExampleModel([[1, 0, 0], [1, 0, 0], [1, 0, 0]])   # ground 1 at y = 0
+    >>> auto_boundary(E)
+    {'x-': 0, 'x+': 0, 'y+': 0, 'y-': 1}
+    """
+    ndim = example.ndim if ndim is None else ndim
+    T = example.transitions()
+    lab = example.labels
+    K = example.K
+    diag = np.stack([np.diagonal(T[d]) for d in range(example.ndim)])  # (ndim, K)
+    self_tiling = diag.all(axis=0)
+    # outer layer minus the bottom face
+    outer = np.zeros(lab.shape, dtype=bool)
+    for d in range(example.ndim):
+        sl: list[slice | int] = [slice(None)] * example.ndim
+        if d != example.ndim - 1 or example.ndim == 1:
+            sl[d] = 0
+            outer[tuple(sl)] = True
+        sl[d] = lab.shape[d] - 1
+        outer[tuple(sl)] = True
+    counts_outer = np.bincount(lab[outer], minlength=K)
+    counts_all = np.bincount(lab.ravel(), minlength=K)
+    cand = np.flatnonzero(self_tiling & (counts_all > 0))
+    if cand.size == 0:
+        raise InputError(
+            f"boundary='auto': example {example.name or ''} has no empty-space label "
+            "(no label is adjacent to itself along every axis); give boundary labels explicitly"
+        )
+    empty = int(cand[np.lexsort((-counts_all[cand], -counts_outer[cand]))[0]])
+    faces = _face_list(ndim)
+    result = {f: empty for f in faces}
+    if ndim >= 2 and example.ndim >= 2:
+        last = example.ndim - 1
+        bottom_layer = np.take(lab, 0, axis=last)
+        cb = np.bincount(bottom_layer.ravel(), minlength=K)
+        tiles_sideways = diag[:last].all(axis=0)
+        gcand = np.flatnonzero(tiles_sideways & (cb > 0))
+        if gcand.size == 0:
+            raise InputError(
+                "boundary='auto': no label on the example's bottom layer tiles itself along "
+                "the horizontal axes, so there is no ground label; give boundary labels "
+                "explicitly"
+            )
+        ground = int(gcand[np.argmax(cb[gcand])])
+        bottom = f"{AXIS_NAMES[ndim - 1]}-"
+        del result[bottom]
+        result[bottom] = ground
+    return result

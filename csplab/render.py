@@ -1,0 +1,155 @@
+"""Pictures of label grids: 2D as coloured cells, 3D as an isometric voxel preview.
+
+2D grids are drawn as in the thesis figures: x to the right, y up. 3D grids are drawn from
+above the ``+x, +y`` corner; cells holding the empty-space label (and unassigned cells) are
+left out. Each label gets a fixed colour (label 0 a light grey).
+
+Examples
+--------
+>>> import numpy as np
+>>> img = render(np.array([[0, 1], [1, 0]]), scale=4)
+>>> img.size
+(8, 8)
+"""
+
+from __future__ import annotations
+
+import colorsys
+import io
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from PIL import Image, ImageDraw
+
+__all__ = ["empty_label_guess", "palette", "render", "render_png_bytes", "save_png"]
+
+
+def palette(K: int) -> NDArray[np.uint8]:
+    """``K`` distinct RGB colours; label 0 light grey, others spread over hue."""
+    cols = np.zeros((max(K, 1), 3), dtype=np.uint8)
+    cols[0] = (225, 225, 225)
+    for b in range(1, K):
+        h = (b * 0.618033988749895) % 1.0
+        s = 0.55 + 0.35 * ((b * 7) % 3) / 2
+        v = 0.95 - 0.3 * ((b * 5) % 4) / 3
+        r, g, bl = colorsys.hsv_to_rgb(h, s, v)
+        cols[b] = (int(r * 255), int(g * 255), int(bl * 255))
+    return cols
+
+
+def empty_label_guess(grid: NDArray[np.integer[Any]]) -> int:
+    """Most frequent label on the top layer of a 3D grid (the sky), else -1."""
+    g = np.asarray(grid)
+    top = g[..., -1].ravel()
+    top = top[top >= 0]
+    if top.size == 0:
+        return -1
+    return int(np.bincount(top).argmax())
+
+
+def _render_2d(g: NDArray[np.int64], K: int, scale: int) -> Image.Image:
+    cols = palette(K)
+    rgb = np.where(g[..., None] >= 0, cols[np.clip(g, 0, K - 1)], np.uint8(40))
+    img = np.transpose(rgb, (1, 0, 2))[::-1]  # rows = y descending, columns = x
+    img = np.repeat(np.repeat(img, scale, axis=0), scale, axis=1)
+    return Image.fromarray(np.ascontiguousarray(img, dtype=np.uint8), "RGB")
+
+
+def _render_3d(g: NDArray[np.int64], K: int, scale: int, empty: int | None) -> Image.Image:
+    nx, ny, nz = g.shape
+    if empty is None:
+        empty = empty_label_guess(g)
+    filled = (g >= 0) & (g != empty)
+    cols = palette(K).astype(np.float64)
+    a = scale * 0.866
+    b = scale * 0.5
+    c = scale * 1.0
+    W = int((nx + ny) * a) + 4
+    H = int((nx + ny) * b + nz * c) + 4
+    ox = ny * a + 2
+    oy = nz * c + 2
+
+    def pt(x: float, y: float, z: float) -> tuple[float, float]:
+        return (ox + (x - y) * a, oy + (x + y) * b - z * c)
+
+    img = Image.new("RGB", (W, H), (250, 250, 250))
+    draw = ImageDraw.Draw(img)
+    # only cells with a visible face
+    pad = np.zeros((nx + 1, ny + 1, nz + 1), dtype=bool)
+    pad[:nx, :ny, :nz] = filled
+    vis_x = filled & ~pad[1:, :ny, :nz]
+    vis_y = filled & ~pad[:nx, 1:, :nz]
+    vis_z = filled & ~pad[:nx, :ny, 1:]
+    xs, ys, zs = np.nonzero(vis_x | vis_y | vis_z)
+    order = np.lexsort((zs, xs + ys + zs))
+    edge = (90, 90, 90)
+    for i in order:
+        x, y, z = int(xs[i]), int(ys[i]), int(zs[i])
+        col = cols[int(g[x, y, z]) % K]
+        if vis_z[x, y, z]:
+            q = [pt(x, y, z + 1), pt(x + 1, y, z + 1), pt(x + 1, y + 1, z + 1), pt(x, y + 1, z + 1)]
+            draw.polygon(q, fill=tuple(int(v) for v in col), outline=edge if scale >= 6 else None)
+        if vis_x[x, y, z]:
+            q = [pt(x + 1, y, z), pt(x + 1, y + 1, z), pt(x + 1, y + 1, z + 1), pt(x + 1, y, z + 1)]
+            draw.polygon(
+                q, fill=tuple(int(v * 0.75) for v in col), outline=edge if scale >= 6 else None
+            )
+        if vis_y[x, y, z]:
+            q = [pt(x, y + 1, z), pt(x + 1, y + 1, z), pt(x + 1, y + 1, z + 1), pt(x, y + 1, z + 1)]
+            draw.polygon(
+                q, fill=tuple(int(v * 0.55) for v in col), outline=edge if scale >= 6 else None
+            )
+    return img
+
+
+def render(
+    grid: ArrayLike,
+    *,
+    K: int | None = None,
+    scale: int | None = None,
+    empty: int | None = None,
+) -> Image.Image:
+    """A PIL image of a label grid (1D/2D: cells; 3D: isometric voxels; 4D: the ``w = 0`` slice).
+
+    Parameters
+    ----------
+    grid : int array
+        Labels (``-1`` = unassigned, drawn dark in 2D and left out in 3D).
+    K : int, optional
+        Number of labels (for the palette); default ``max + 1``.
+    scale : int, optional
+        Pixels per cell (default chosen from the grid size).
+    empty : int, optional
+        3D only: the label left out (default: the most frequent label of the top layer).
+    """
+    g = np.asarray(grid, dtype=np.int64)
+    if g.ndim == 4:
+        g = g[..., 0]
+    if g.ndim == 1:
+        g = g[:, None]
+    if K is None:
+        K = int(g.max()) + 1 if g.size and g.max() >= 0 else 1
+    if g.ndim == 3 and g.shape[2] == 1:
+        g = g[:, :, 0]
+    if g.ndim == 2:
+        s = scale or max(2, min(24, 640 // max(g.shape)))
+        return _render_2d(g, K, s)
+    s = scale or max(3, min(20, 900 // max(g.shape[0] + g.shape[1], 1)))
+    return _render_3d(g, K, s, empty)
+
+
+def save_png(grid: ArrayLike, path: str | Path, *, names: Sequence[str] | None = None,
+             **kwargs: Any) -> None:  # fmt: skip
+    """Write :func:`render` of ``grid`` to a PNG file."""
+    K = len(names) if names is not None else None
+    render(grid, K=K, **kwargs).save(Path(path), format="PNG")
+
+
+def render_png_bytes(grid: ArrayLike, *, names: Sequence[str] | None = None) -> bytes:
+    buf = io.BytesIO()
+    K = len(names) if names is not None else None
+    render(grid, K=K).save(buf, format="PNG")
+    return buf.getvalue()
