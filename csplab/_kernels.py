@@ -36,7 +36,7 @@ _DEBRUIJN_TABLE = np.array(
 def ctz64(x: np.uint64) -> int:
     """Index of the lowest set bit of a non-zero uint64."""
     low = x & (~x + np.uint64(1))
-    return _DEBRUIJN_TABLE[(low * _DEBRUIJN) >> np.uint64(58)]
+    return int(_DEBRUIJN_TABLE[(low * _DEBRUIJN) >> np.uint64(58)])
 
 
 @njit(cache=True, inline="always")
@@ -89,8 +89,8 @@ def entropy_of(
             sl += wlogw[a]
             cnt += 1
     if s <= 0.0:
-        return np.log(cnt) if cnt > 0 else 0.0
-    return np.log(s) - sl / s
+        return float(np.log(cnt)) if cnt > 0 else 0.0
+    return float(np.log(s) - sl / s)
 
 
 # ----------------------------------------------------------------------------- indexed heap
@@ -164,7 +164,7 @@ def heap_pop(heap: np.ndarray, pos: np.ndarray, key: np.ndarray, size: int) -> i
     _heap_swap(heap, pos, 0, last)
     pos[v] = -1
     _heap_down(heap, pos, key, 0, last)
-    return v
+    return int(v)
 
 
 # ----------------------------------------------------------------------------- propagation

@@ -40,6 +40,7 @@ from csplab.problem import Problem
 
 __all__ = [
     "Propagator",
+    "alg31_reference",
     "assign",
     "initial_catalog",
     "jit_warmup",
@@ -233,7 +234,7 @@ class Propagator:
         return np.flatnonzero(unpack(self.bits[cell : cell + 1], self.c.K)[0])
 
     def sizes(self) -> NDArray[np.int64]:
-        return self.catalog().sum(axis=1)
+        return np.asarray(self.catalog().sum(axis=1), dtype=np.int64)
 
 
 # ----------------------------------------------------------------------------- pure API
@@ -300,31 +301,87 @@ def propagate_reference(
     Same contract as :func:`propagate`; used to test the compiled kernel.
     """
     C = _check_catalog(problem, catalog).copy()
+    adj = _reference_adjacency(problem)
+    if not C.any(axis=1).all():
+        return C, False
+    ok = _reference_fixpoint(C, adj, range(problem.n) if changed is None else np.ravel(changed))
+    return C, ok
+
+
+def _reference_adjacency(problem: Problem) -> list[list[tuple[int, NDArray[np.bool_]]]]:
     rel = problem.relations
-    adj: list[list[tuple[int, Any]]] = [[] for _ in range(problem.n)]
+    adj: list[list[tuple[int, NDArray[np.bool_]]]] = [[] for _ in range(problem.n)]
     for s, d, r in problem.arcs.tolist():
         if s == d:
             continue
         adj[s].append((d, rel[r]))  # T: C[d, c] needs some b in C[s] with T[b, c]
         adj[d].append((s, rel[r].T))
-    if not C.any(axis=1).all():
-        return C, False
-    stack = deque(range(problem.n) if changed is None else [int(c) for c in np.ravel(changed)])
-    onstack = np.zeros(problem.n, dtype=bool)
+    return adj
+
+
+def _reference_fixpoint(
+    C: NDArray[np.bool_], adj: list[list[tuple[int, NDArray[np.bool_]]]], changed: Any
+) -> bool:
+    """Alg. 3.2 lines 7-16 with Alg. 3.3 (statement 3.6), a stack of cells; in place."""
+    stack = deque(int(c) for c in changed)
+    onstack = np.zeros(C.shape[0], dtype=bool)
     onstack[list(stack)] = True
     while stack:
         v = stack.pop()
         onstack[v] = False
         for w, T in adj[v]:
-            for c in range(problem.K):
-                if C[w, c] and not any(C[v, b] and T[b, c] for b in range(problem.K)):
+            for c in np.flatnonzero(C[w]):
+                # Alg. 3.3 line 2: is there a b with C[v, b] = 1 and T[b, c] = 1?
+                if not np.any(C[v] & T[:, c]):
                     C[w, c] = False
                     if not onstack[w]:
                         stack.append(w)
                         onstack[w] = True
             if not C[w].any():
-                return C, False
-    return C, True
+                return False
+    return True
+
+
+def alg31_reference(
+    problem: Problem, rng: np.random.Generator, *, order: str = "scanline",
+    choice: str = "uniform",
+) -> tuple[str, NDArray[np.int32]]:  # fmt: skip
+    """Slow, literal Alg. 3.1 on top of :func:`propagate_reference`.
+
+    Draws random numbers exactly as :func:`csplab.solvers.catalog.run_alg31` does for the
+    ``scanline`` and ``random`` orders, so both return the same grid for the same seed.
+    Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
+    """
+    if order not in ("scanline", "random"):
+        raise InputError("the reference Alg. 3.1 supports the scanline and random orders")
+    n, K = problem.n, problem.K
+    perm = rng.permutation(n) if order == "random" else np.arange(n)
+    ustream = rng.random(n)
+    adj = _reference_adjacency(problem)
+    C = problem.domains.copy()
+    grid = np.full(n, -1, dtype=np.int32)
+    if not C.any(axis=1).all() or not _reference_fixpoint(C, adj, range(n)):
+        return "unsat", grid.reshape(problem.shape)
+    w = problem.weights
+    for t in range(n):
+        p = int(perm[t])
+        labels = np.flatnonzero(C[p])
+        if labels.size == 0:  # Alg. 3.1 line 9
+            return "failed", grid.reshape(problem.shape)
+        u = ustream[t]
+        if choice == "weighted" and w[labels].sum() > 0:
+            pos = labels[w[labels] > 0]
+            cum = np.cumsum(w[pos])
+            b = int(pos[min(int(np.searchsorted(cum, u * cum[-1], side="right")), pos.size - 1)])
+        else:
+            b = int(labels[min(int(u * labels.size), labels.size - 1)])
+        grid[p] = b
+        C[p] = False  # statement 3.7
+        C[p, b] = True
+        if not _reference_fixpoint(C, adj, [p]):
+            return "failed", grid.reshape(problem.shape)
+    assert K == C.shape[1]
+    return "solved", grid.reshape(problem.shape)
 
 
 _COMPILED_CACHE: dict[int, tuple[Problem, _Compiled]] = {}

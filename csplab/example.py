@@ -14,7 +14,7 @@ Examples
 >>> T.shape
 (2, 2, 2)
 >>> T[0].astype(int).tolist()      # T_x[b, c]: c may follow b along +x
-[[False, True], [True, False]]
+[[0, 1], [1, 0]]
 """
 
 from __future__ import annotations

@@ -69,8 +69,8 @@ class Unary:
             b = int(labels[0]) if labels.size else -1
             return f"fixed cell {self.key} = {problem.label_name(b) if names else b}"
         if self.kind == "boundary":
-            b = int(labels[0]) if labels.size == 1 else None
-            what = problem.label_name(b) if b is not None else f"{labels.size} labels"
+            one = int(labels[0]) if labels.size == 1 else None
+            what = problem.label_name(one) if one is not None else f"{labels.size} labels"
             return f"boundary face {self.key} = {what} ({len(self.cells)} cells)"
         if self.kind == "mask":
             return f"mask at cell {self.key} allows {labels.size} of {problem.K} labels"
@@ -459,7 +459,9 @@ class Problem:
             ``"auto"`` puts on the bottom face the example's most frequent bottom-layer
             label that tiles itself along the other axes (the ground), and on every other
             face the example's empty-space label: the label that tiles itself along every
-            axis and is most frequent on the example's outer layer (bottom excluded).
+            axis and is most frequent on the example's outer layer (bottom excluded); for an
+            example whose empty space is one layer thin, a top-layer label that tiles itself
+            along the horizontal axes.
         mask : bool array ``(*shape, K)`` (or broadcastable)
             Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
         """
@@ -673,7 +675,7 @@ def _build_unary(
             out.append(Unary("boundary", f, cells, allowed))
     if fixed is not None:
         if isinstance(fixed, Mapping):
-            items = []
+            items: list[tuple[int, tuple[int, ...], Any]] = []
             for coords, b in fixed.items():
                 c = tuple(int(i) for i in (coords if isinstance(coords, Sequence) else (coords,)))
                 if len(c) != ndim or any(not 0 <= ci < si for ci, si in zip(c, shape, strict=True)):
@@ -692,11 +694,11 @@ def _build_unary(
                 (int(c), tuple(int(i) for i in np.unravel_index(int(c), shape)), int(flat[c]))
                 for c in np.flatnonzero(flat >= 0)
             ]
-        for c, coords, b in items:
-            lb = _check_label(b, K, f"fixed label at {coords}")
+        for cell, where, label in items:
+            lb = _check_label(label, K, f"fixed label at {where}")
             allowed = np.zeros((1, K), dtype=bool)
             allowed[0, lb] = True
-            out.append(Unary("fixed", coords, np.array([c], dtype=np.int64), allowed))
+            out.append(Unary("fixed", where, np.array([cell], dtype=np.int64), allowed))
     if mask is not None:
         m = np.asarray(mask)
         if m.dtype != bool:
@@ -707,9 +709,11 @@ def _build_unary(
             raise InputError(
                 f"mask of shape {np.shape(mask)} does not fit ({shape}, K={K})"
             ) from None
-        for c in np.flatnonzero(~m.all(axis=1)):
-            coords = tuple(int(i) for i in np.unravel_index(int(c), shape))
-            out.append(Unary("mask", coords, np.array([c], dtype=np.int64), m[c : c + 1].copy()))
+        for mc in np.flatnonzero(~m.all(axis=1)):
+            mcoords = tuple(int(i) for i in np.unravel_index(int(mc), shape))
+            out.append(
+                Unary("mask", mcoords, np.array([mc], dtype=np.int64), m[mc : mc + 1].copy())
+            )
     return out
 
 
@@ -755,6 +759,12 @@ def auto_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, i
     counts_outer = np.bincount(lab[outer], minlength=K)
     counts_all = np.bincount(lab.ravel(), minlength=K)
     cand = np.flatnonzero(self_tiling & (counts_all > 0))
+    if cand.size == 0 and example.ndim >= 2:
+        # a thin example (empty space only one layer deep): fall back to labels on the top
+        # layer that tile themselves along the horizontal axes
+        top = np.take(lab, lab.shape[-1] - 1, axis=example.ndim - 1)
+        on_top = np.bincount(top.ravel(), minlength=K) > 0
+        cand = np.flatnonzero(diag[:-1].all(axis=0) & on_top)
     if cand.size == 0:
         raise InputError(
             f"boundary='auto': example {example.name or ''} has no empty-space label "

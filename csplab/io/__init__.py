@@ -3,7 +3,9 @@
 :func:`read_example` detects the format from the extension and the content:
 ``.npy`` is a numpy int array; ``.grid`` (or a first line ``# csplab grid``) is
 :mod:`csplab.io.gridtext`; other text files are Merrell's format (:mod:`csplab.io.merrell`)
-when the fourth line starts with three positive integers, and the grid format otherwise.
+for ``.txt`` files (unless they start with the grid magic line or are a bare numeric
+grid) and for other files whose fourth line starts with three positive integers; anything
+else is read as the grid format.
 :func:`write_example` picks the format from the extension (``.txt`` = Merrell).
 """
 
@@ -47,15 +49,17 @@ def detect_format(path: str | Path, text: str | None = None) -> str:
     lines = text.splitlines()
     if lines and lines[0].strip().lower().startswith(MAGIC[:12]):
         return "grid"
+    rows = [ln.split() for ln in lines[:4]]
+    if len(rows) == 4 and all(r and all(t.lstrip("-").isdigit() for t in r) for r in rows):
+        if len({len(r) for r in rows}) == 1:
+            # Merrell header lines are free text: four numeric rows of one length are a grid
+            return "grid"
+    if ext == ".txt":
+        return "merrell"
     if len(lines) >= 4:
         toks = lines[3].split()[:3]
         if len(toks) == 3 and all(t.isdigit() and int(t) > 0 for t in toks):
-            # a grid file whose first rows are numbers too: the header lines of a Merrell
-            # file are free text, so three all-numeric rows as long as row 4 mean "grid"
-            rows = [ln.split() for ln in lines[:4]]
-            numeric = all(r and all(t.lstrip("-").isdigit() for t in r) for r in rows)
-            if not (numeric and len({len(r) for r in rows}) == 1):
-                return "merrell"
+            return "merrell"
     return "grid"
 
 

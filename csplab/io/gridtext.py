@@ -219,8 +219,9 @@ def format_grid(example: ExampleModel, comments: str = "") -> str:
         out.append("labels: " + " ".join(example.names))
     if example.weights is not None:
         out.append("weights: " + " ".join(f"{w:g}" for w in example.weights))
-    lab4 = lab.reshape(lab.shape + (1,) * (4 - lab.ndim))
-    nx, ny, nz, nw = lab4.shape
+    shp4: tuple[int, ...] = (*lab.shape, *(1,) * (4 - lab.ndim))
+    lab4 = lab.reshape(shp4)
+    ny, nz, nw = shp4[1], shp4[2], shp4[3]
     width = len(str(int(lab.max())))
     for w in range(nw):
         if w:

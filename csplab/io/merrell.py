@@ -118,8 +118,9 @@ def format_merrell(example: ExampleModel) -> str:
         raise FormatError(
             f"Merrell's format holds at most 3 dimensions; this model has shape {lab.shape}"
         )
-    lab3 = lab.reshape(lab.shape + (1,) * (3 - lab.ndim))
-    nx, ny, nz = lab3.shape
+    shp3: tuple[int, ...] = (*lab.shape, *(1,) * (3 - lab.ndim))
+    lab3 = lab.reshape(shp3)
+    nx, ny, nz = shp3[0], shp3[1], shp3[2]
     md = example.metadata
     header = list(md.get("merrell_header", []))[:3]
     if len(header) < 3:

@@ -94,7 +94,7 @@ def trivial_solution(problem: Problem) -> NDArray[np.int32]:
     w = np.asarray(problem.weights, dtype=np.float64)
     pref = np.argsort(-w, kind="stable")
     # 1. a single label everywhere
-    allowed_everywhere = problem.domains.all(axis=0)
+    allowed_everywhere = np.asarray(problem.domains.all(axis=0), dtype=bool)
     used_rel = np.unique(arcs[:, 2]) if arcs.size else np.zeros(0, dtype=np.int64)
     for a in pref:
         if allowed_everywhere[a] and all(rel[r, a, a] for r in used_rel):
@@ -134,9 +134,9 @@ def trivial_solution(problem: Problem) -> NDArray[np.int32]:
         labels[-1] = int(best.argmax())
         for i in range(L - 1, 0, -1):
             labels[i - 1] = back[i, labels[i]]
-        g = labels[layer].astype(np.int32).reshape(problem.shape)
-        if problem.is_solution(g):
-            return g
+        lg: NDArray[np.int32] = labels[layer].astype(np.int32).reshape(problem.shape)
+        if problem.is_solution(lg):
+            return lg
     raise NoTrivialSolutionError(
         "modify-in-blocks needs a consistent starting model and none was found: no label "
         "tiles every axis within the domains, and no stack of uniform layers (e.g. ground "

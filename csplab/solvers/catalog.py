@@ -135,7 +135,7 @@ def _entropies(eng: Propagator, weighted: bool) -> np.ndarray:
     C = eng.catalog()
     if not weighted:
         cnt = C.sum(axis=1)
-        return np.log(np.maximum(cnt, 1)).astype(np.float64)
+        return np.asarray(np.log(np.maximum(cnt, 1)), dtype=np.float64)
     w = eng.c.weights
     s = C @ w
     sl = C @ eng.c.wlogw
@@ -143,7 +143,7 @@ def _entropies(eng: Propagator, weighted: bool) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         h = np.where(s > 0, np.log(np.where(s > 0, s, 1.0)) - sl / np.where(s > 0, s, 1.0),
                      np.log(np.maximum(cnt, 1)))  # fmt: skip
-    return h.astype(np.float64)
+    return np.asarray(h, dtype=np.float64)
 
 
 class CatalogSolver:

@@ -1,0 +1,69 @@
+"""The ``csplab`` command line.
+
+Each subcommand lives in its own module with ``add_parser(subparsers)`` and
+``run(args) -> int``; :data:`COMMANDS` maps names to modules. Exit codes: 0 success,
+1 the algorithm failed / the problem is unsatisfiable / a check found problems,
+2 bad input (one line on stderr, no traceback).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from csplab.errors import CsplabError
+
+__all__ = ["COMMANDS", "main"]
+
+# name -> module (one line per command)
+COMMANDS: dict[str, str] = {
+    "synthesize": "csplab.cli.synthesize",
+    "check": "csplab.cli.check",
+    "info": "csplab.cli.info",
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.print_usage(sys.stderr)
+        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    from csplab import __version__
+
+    parser = _Parser(
+        prog="csplab",
+        description="Example-based model synthesis as constraint programming (Merrell 2009).",
+    )
+    parser.add_argument("--version", action="version", version=f"csplab {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    sub.required = True
+    for modname in COMMANDS.values():
+        mod = importlib.import_module(modname)
+        p = mod.add_parser(sub)
+        p.set_defaults(_run=mod.run)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``csplab`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        code: int = args._run(args)
+        return code
+    except CsplabError as e:
+        msg = str(e).strip().splitlines()
+        print(f"csplab: error: {msg[0] if msg else type(e).__name__}", file=sys.stderr)
+        for extra in msg[1:6]:
+            print(f"  {extra}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("csplab: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:
+        return 0

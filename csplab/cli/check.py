@@ -1,0 +1,50 @@
+"""``csplab check``: count violations of a grid file against an example."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+from csplab.cli.common import add_problem_args, load_grid, load_model, parse_boundary
+
+
+def add_parser(sub: Any) -> argparse.ArgumentParser:
+    p: argparse.ArgumentParser = sub.add_parser(
+        "check",
+        help="count the violations of a grid file against an example",
+        description="Check a grid (.npy, Merrell .txt or .grid) against an example model. "
+        "Exit 0 when it is consistent, 1 when it violates something.",
+    )
+    add_problem_args(p, size_required=False)
+    p.add_argument("grid", metavar="GRID", help="grid file to check")
+    p.add_argument("--json", action="store_true")
+    p.add_argument("--limit", type=int, default=10, help="violations to list")
+    return p
+
+
+def run(args: argparse.Namespace) -> int:
+    from csplab.problem import Problem
+
+    example = load_model(args.model)
+    grid = load_grid(args.grid, example.ndim)
+    problem = Problem.from_example(
+        example, grid.shape, periodic=bool(args.periodic), boundary=parse_boundary(args.boundary)
+    )
+    v = problem.violations(grid)
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "violations": len(v),
+                    "arcs": int(v.arcs.size),
+                    "cells": int(v.cells.size),
+                    "shape": list(problem.shape),
+                }
+            )
+        )
+    else:
+        print(f"{len(v)} violations in {args.grid} ({'x'.join(map(str, problem.shape))})")
+        if len(v):
+            print(v.describe(args.limit))
+    return 0 if len(v) == 0 else 1

@@ -1,0 +1,1 @@
+"""Testing utilities shipped with csplab: hypothesis strategies and brute-force references."""

@@ -1,0 +1,107 @@
+"""Hypothesis strategies for csplab objects: example models and problems.
+
+Examples
+--------
+>>> from hypothesis import given, settings
+>>> @settings(max_examples=5, deadline=None)
+... @given(example_models(max_labels=3))
+... def check(E):
+...     assert E.transitions().shape == (E.ndim, E.K, E.K)
+>>> check()
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+from hypothesis import strategies as st
+
+from csplab.example import ExampleModel
+from csplab.problem import Problem
+
+__all__ = ["example_models", "label_grids", "problems", "random_problems", "shapes"]
+
+
+@st.composite
+def shapes(draw: Any, ndim: int | None = None, min_side: int = 1, max_side: int = 4,
+           max_ndim: int = 3) -> tuple[int, ...]:  # fmt: skip
+    """Grid shapes with 1 to ``max_ndim`` axes."""
+    d = ndim if ndim is not None else draw(st.integers(1, max_ndim))
+    return tuple(draw(st.integers(min_side, max_side)) for _ in range(d))
+
+
+@st.composite
+def label_grids(draw: Any, ndim: int | None = None, max_side: int = 5, max_labels: int = 5,
+                max_ndim: int = 3) -> np.ndarray:  # fmt: skip
+    """Integer label grids; labels ``0..max_labels-1``, label 0 more frequent (empty space)."""
+    shp = draw(shapes(ndim=ndim, max_side=max_side, max_ndim=max_ndim))
+    k = draw(st.integers(1, max_labels))
+    n = int(np.prod(shp))
+    p_empty = draw(st.sampled_from([0.0, 0.3, 0.6]))
+    vals = draw(
+        st.lists(
+            st.one_of(st.just(0), st.integers(0, k - 1)) if p_empty else st.integers(0, k - 1),
+            min_size=n,
+            max_size=n,
+        )
+    )
+    return np.array(vals, dtype=np.int32).reshape(shp)
+
+
+@st.composite
+def example_models(draw: Any, ndim: int | None = None, max_side: int = 5, max_labels: int = 5,
+                   max_ndim: int = 3) -> ExampleModel:  # fmt: skip
+    """Random example models (1D to ``max_ndim``-D)."""
+    g = draw(label_grids(ndim=ndim, max_side=max_side, max_labels=max_labels, max_ndim=max_ndim))
+    return ExampleModel(g)
+
+
+@st.composite
+def problems(
+    draw: Any,
+    ndim: int | None = None,
+    max_side: int = 4,
+    max_labels: int = 4,
+    max_example_side: int = 4,
+    periodic: bool | None = None,
+    fixed: bool = True,
+    masks: bool = True,
+    max_ndim: int = 3,
+) -> Problem:
+    """Model-synthesis problems: a random example, an output shape, optional periodic axes,
+    fixed cells and masks (so some are unsatisfiable)."""
+    E = draw(example_models(ndim=ndim, max_side=max_example_side, max_labels=max_labels,
+                            max_ndim=max_ndim))  # fmt: skip
+    shp = draw(shapes(ndim=E.ndim, max_side=max_side))
+    per = draw(st.booleans()) if periodic is None else periodic
+    n = int(np.prod(shp))
+    fx = None
+    if fixed and draw(st.booleans()):
+        cells = draw(st.lists(st.integers(0, n - 1), max_size=min(3, n), unique=True))
+        fx = np.full(n, -1, dtype=np.int64)
+        for c in cells:
+            fx[c] = draw(st.integers(0, E.K - 1))
+        fx = fx.reshape(shp)
+    mk = None
+    if masks and draw(st.booleans()):
+        bits = draw(st.lists(st.booleans(), min_size=n * E.K, max_size=n * E.K))
+        mk = (
+            np.array(bits, dtype=bool).reshape(*shp, E.K)
+            | draw(st.sampled_from([False, True])) * np.eye(E.K, dtype=bool)[0]
+        )
+    return Problem.from_example(E, shp, periodic=per, fixed=fx, mask=mk)
+
+
+@st.composite
+def random_problems(draw: Any, max_side: int = 4, max_labels: int = 4, max_ndim: int = 3,
+                    density: tuple[float, float] = (0.2, 0.9)) -> Problem:  # fmt: skip
+    """Grid problems with random transition matrices (not from an example)."""
+    shp = draw(shapes(max_side=max_side, max_ndim=max_ndim))
+    k = draw(st.integers(1, max_labels))
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    p = rng.uniform(*density)
+    T = rng.random((len(shp), k, k)) < p
+    per = draw(st.booleans())
+    return Problem.grid(shp, T, periodic=per)

@@ -1,0 +1,114 @@
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from csplab import ExampleModel, Problem, load_example, solve
+from csplab.errors import InputError, UnknownSolverError
+from csplab.testing.brute import count
+from csplab.testing.strategies import problems
+
+
+@given(problems(max_side=4), st.sampled_from(["scanline", "random", "min-entropy"]),
+       st.sampled_from(["uniform", "weighted"]), st.integers(0, 2**31))  # fmt: skip
+def test_solved_grids_have_zero_violations(P, order, choice, seed):
+    r = solve(P, "catalog", rng=seed, order=order, choice=choice)
+    assert r.status in ("solved", "failed", "unsat")
+    if r.status == "solved":
+        assert len(P.violations(r.grid)) == 0
+        assert r.stats["assigned"] == P.n
+    if r.status == "unsat":
+        assert count(P) == 0 if P.n <= 12 else True
+
+
+@pytest.mark.parametrize("name", ["fig3_1a", "fig3_1b", "line"])
+@pytest.mark.parametrize("order", ["scanline", "random", "min-entropy"])
+def test_never_fails_on_infallible_examples_200_seeds(name, order):
+    E = load_example(name)
+    P = Problem.from_example(E, (9, 7))
+    for seed in range(200):
+        r = solve(P, "catalog", rng=seed, order=order)
+        assert r.status == "solved", (name, seed)
+
+
+def test_same_seed_same_grid_and_seed_recorded():
+    P = Problem.from_example(load_example("line"), (15, 9))
+    a = solve(P, "catalog", rng=5)
+    b = solve(P, "catalog", rng=np.random.default_rng(5))
+    assert np.array_equal(a.grid, b.grid) and a.seed == b.seed == 5
+    c = solve(P, "catalog", rng=6)
+    assert not np.array_equal(a.grid, c.grid)
+    d = solve(P, "catalog")
+    assert isinstance(d.seed, int)
+    e = solve(P, "catalog", rng=d.seed)
+    assert np.array_equal(d.grid, e.grid)
+
+
+def test_trace_replays_to_the_grid():
+    P = Problem.from_example(load_example("line"), (6, 5))
+    r = solve(P, "catalog", rng=2, order="random")
+    g = np.full(P.n, -1)
+    g[r.trace[:, 0]] = r.trace[:, 1]
+    assert np.array_equal(g.reshape(P.shape), r.grid)
+    assert sorted(r.trace[:, 0].tolist()) == list(range(P.n))
+
+
+def test_scanline_trace_is_thesis_loop_order():
+    E = ExampleModel(np.zeros((2, 2, 2), dtype=int))
+    P = Problem.from_example(E, (2, 3, 4))
+    r = solve(P, "catalog", rng=0)
+    coords = [P.coords(c) for c in r.trace[:, 0]]
+    assert coords == sorted(coords)  # x outermost, z innermost
+
+
+def test_checkerboard_two_solutions_both_reached():
+    P = Problem.from_example(load_example("E1"), (5, 4))
+    grids = {solve(P, "catalog", rng=s).grid.tobytes() for s in range(30)}
+    assert len(grids) == 2
+
+
+def test_unsat_and_failure_statuses():
+    P = Problem.from_example(load_example("fig3_1d"), (5, 5))
+    r = solve(P, "catalog", rng=0)
+    assert r.status == "unsat" and "Theorem 3.3.2" in r.stats["proof"]
+    # a satisfiable problem where scanline Alg. 3.1 can fail: parity constraint
+    E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
+    P2 = Problem.from_example(E, (3, 3), fixed={(2, 2): 1})
+    r2 = solve(P2, "catalog", rng=0)
+    assert r2.status in ("solved", "failed")
+
+
+def test_weighted_choice_follows_weights():
+    E = ExampleModel([0, 0, 1], weights=[1.0, 99.0])
+    E2 = ExampleModel([[0, 1], [1, 1]])
+    P = Problem.from_example(E2, (20, 20))
+    r = solve(P, "catalog", rng=0, choice="weighted")
+    assert r.ok
+    P1 = Problem.from_example(ExampleModel([[0, 0], [0, 1]], weights=[1.0, 50.0]), (30, 1))
+    # 1 may follow 0 and vice versa (x axis), so weighted choice picks mostly 1s
+    r1 = solve(P1, "catalog", rng=1, choice="weighted")
+    assert E.K == 2 and r1.ok
+
+
+def test_time_limit_and_bad_options():
+    P = Problem.from_example(load_example("line"), (40, 40))
+    r = solve(P, "catalog", rng=0, time_limit=0.0)
+    assert r.status in ("timeout", "solved")
+    with pytest.raises(InputError):
+        solve(P, "catalog", rng=0, order="sideways")
+    with pytest.raises(InputError):
+        solve(P, "catalog", rng=0, colour="blue")
+    with pytest.raises(UnknownSolverError):
+        solve(P, "nonesuch")
+
+
+@given(problems(max_side=4, max_labels=5), st.sampled_from(["scanline", "random"]),
+       st.sampled_from(["uniform", "weighted"]), st.integers(0, 2**31))  # fmt: skip
+def test_compiled_alg31_equals_reference_run(P, order, choice, seed):
+    from csplab.catalog import alg31_reference
+
+    status, grid = alg31_reference(P, np.random.default_rng(seed), order=order, choice=choice)
+    r = solve(P, "catalog", rng=seed, order=order, choice=choice)
+    assert r.status == status
+    if status == "solved":
+        assert np.array_equal(r.grid, grid)

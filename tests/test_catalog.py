@@ -1,0 +1,124 @@
+import numpy as np
+from hypothesis import given
+from hypothesis import strategies as st
+
+from csplab import ExampleModel, Problem
+from csplab.catalog import (
+    Propagator,
+    assign,
+    initial_catalog,
+    pack,
+    propagate,
+    propagate_reference,
+    unpack,
+)
+from csplab.testing.brute import exact_catalog
+from csplab.testing.strategies import example_models, problems, random_problems
+
+
+@given(st.integers(1, 200), st.integers(1, 10), st.integers(0, 2**31))
+def test_pack_roundtrip(K, n, seed):
+    C = np.random.default_rng(seed).random((n, K)) < 0.5
+    assert np.array_equal(unpack(pack(C), K), C)
+
+
+def _random_catalog(P, seed, p=0.8):
+    rng = np.random.default_rng(seed)
+    return P.domains & (rng.random((P.n, P.K)) < p)
+
+
+@given(random_problems(max_side=4, max_labels=6), st.integers(0, 2**31))
+def test_kernel_reaches_reference_fixpoint(P, seed):
+    C0 = _random_catalog(P, seed)
+    a, oka = propagate(P, C0)
+    b, okb = propagate_reference(P, C0)
+    assert oka == okb
+    if oka:
+        assert np.array_equal(a, b)
+
+
+@given(problems(max_side=3, max_labels=4), st.integers(0, 2**31))
+def test_kernel_reference_on_example_problems(P, seed):
+    C0 = _random_catalog(P, seed, 0.9)
+    a, oka = propagate(P, C0)
+    b, okb = propagate_reference(P, C0)
+    assert oka == okb and (not oka or np.array_equal(a, b))
+
+
+def test_propagate_does_not_mutate_and_changed_subset_matches_full():
+    E = ExampleModel([[0, 0, 0, 0], [0, 1, 2, 0], [0, 3, 4, 0], [0, 0, 0, 0]])
+    P = Problem.from_example(E, (6, 6))
+    C, ok = propagate(P, initial_catalog(P))
+    assert ok
+    before = C.copy()
+    C2, ok2 = assign(P, C, P.cell((2, 2)), 1)
+    assert np.array_equal(C, before) and ok2
+    C3 = C.copy()
+    C3[P.cell((2, 2))] = False
+    C3[P.cell((2, 2)), 1] = True
+    full, _ = propagate(P, C3)
+    assert np.array_equal(C2, full)
+
+
+@given(problems(max_side=3, max_labels=3, fixed=True, masks=True), st.integers(0, 2**31))
+def test_theorem_3_3_2_never_removes_a_label_of_some_solution(P, seed):
+    """C(x, b) = 0  =>  C*(x, b) = 0, for a random partial assignment (brute force)."""
+    if P.n > 9:
+        return
+    rng = np.random.default_rng(seed)
+    partial = np.full(P.n, -1)
+    for c in rng.choice(P.n, size=min(2, P.n), replace=False):
+        allowed = np.flatnonzero(P.domains[c])
+        if allowed.size:
+            partial[c] = rng.choice(allowed)
+    C0 = P.domains.copy()
+    for c in np.flatnonzero(partial >= 0):
+        C0[c] = False
+        C0[c, partial[c]] = True
+    C, ok = propagate(P, C0)
+    Cstar = exact_catalog(P, partial)
+    if not ok:
+        assert not Cstar.any()
+    else:
+        assert not np.any(Cstar & ~C)
+
+
+@given(example_models(ndim=1, max_side=6, max_labels=5), st.integers(2, 7), st.integers(0, 2**31))
+def test_1d_catalog_equals_exact_catalog(E, n, seed):
+    """Thesis remark after Theorem 3.3.5: in 1D, C = C*."""
+    P = Problem.from_example(E, (n,))
+    rng = np.random.default_rng(seed)
+    partial = np.full(n, -1)
+    eng = Propagator(P)
+    for c in rng.permutation(n)[: rng.integers(0, n)]:
+        dom = eng.domain(int(c))
+        if dom.size == 0:
+            break
+        b = int(rng.choice(dom))
+        if not eng.assign(int(c), b):
+            break
+        partial[c] = b
+    else:
+        C = eng.catalog() if eng.ok else np.zeros((P.n, P.K), dtype=bool)
+        Cstar = exact_catalog(P, partial)
+        if eng.ok and Cstar.any():
+            assert np.array_equal(C, Cstar)
+        else:
+            assert not Cstar.any()
+
+
+def test_propagator_save_load_copy():
+    E = ExampleModel([[0, 1], [1, 0]])
+    P = Problem.from_example(E, (3, 3))
+    eng = Propagator(P)
+    st_ = eng.save()
+    assert eng.assign(0, 0)
+    assert eng.sizes().tolist() == [1] * 9
+    eng.load(st_)
+    assert eng.sizes().tolist() == [2] * 9
+    other = eng.copy()
+    assert not other.assign(0, 0) or True
+    assert eng.sizes().tolist() == [2] * 9
+    assert eng.restrict(4, [False, True])
+    assert eng.catalog()[0].tolist() == [False, True]
+    assert not eng.assign(0, 0) and not eng.ok
