@@ -35,6 +35,7 @@ __all__ = ["Solver", "available_solvers", "get_solver", "solve", "solver_names"]
 _REGISTRY: dict[str, str] = {
     "catalog": "csplab.solvers.catalog:CatalogSolver",
     "blocks": "csplab.solvers.blocks:BlocksSolver",
+    "sat": "csplab.solvers.sat:SatSolver",
 }
 
 
