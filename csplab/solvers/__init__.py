@@ -36,6 +36,8 @@ _REGISTRY: dict[str, str] = {
     "catalog": "csplab.solvers.catalog:CatalogSolver",
     "blocks": "csplab.solvers.blocks:BlocksSolver",
     "sat": "csplab.solvers.sat:SatSolver",
+    "cpsat": "csplab.solvers.cpsat:CpsatSolver",
+    "backtrack": "csplab.solvers.backtrack:BacktrackSolver",
 }
 
 
