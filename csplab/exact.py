@@ -407,9 +407,9 @@ def explain_unsat(
     descr = [U[i].describe(problem) for i in core]
     witness = {"core": core, "unary": descr, "minimal": minimal}
     if not core:
-        msg = "unsatisfiable even without fixed cells, boundary or masks"
+        msg = "no solution even without the fixed cells, boundary or masks"
     else:
-        msg = f"unsatisfiable: {len(core)} of {len(U)} restrictions conflict" + (
+        msg = f"{len(core)} of {len(U)} restrictions conflict" + (
             " (minimal)" if minimal else ""
         )
     return Verdict(True, witness, stats, msg)

@@ -38,6 +38,8 @@ _REGISTRY: dict[str, str] = {
     "sat": "csplab.solvers.sat:SatSolver",
     "cpsat": "csplab.solvers.cpsat:CpsatSolver",
     "backtrack": "csplab.solvers.backtrack:BacktrackSolver",
+    "perfect": "csplab.solvers.perfect:PerfectSolver",
+    "hybrid": "csplab.solvers.hybrid:HybridSolver",
 }
 
 
