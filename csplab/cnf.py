@@ -56,12 +56,18 @@ import numpy as np
 from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from csplab._kernels import ctz64, popcount64
+from csplab._kernels import ctz64
 from csplab.catalog import Propagator
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["AMO_ENCODINGS", "Encoding", "amo_clauses", "encode"]
+__all__ = ["AMO_ENCODINGS", "MAX_LITERALS", "DeadlineExceeded", "Encoding", "amo_clauses", "encode"]
+
+MAX_LITERALS = 60_000_000  # ~240 MB of int32: refuse larger formulas with a clear message
+
+
+class DeadlineExceeded(Exception):
+    """Raised by :func:`encode` when its ``deadline`` passes (callers report a timeout)."""
 
 EncodingName = Literal["support", "direct"]
 AMO_ENCODINGS = (
@@ -84,6 +90,7 @@ AMO_ENCODINGS = (
 @njit(cache=True)
 def _support_clauses(
     bits: np.ndarray,
+    isconst: np.ndarray,
     vid: np.ndarray,
     ptr: np.ndarray,
     nbr: np.ndarray,
@@ -94,7 +101,7 @@ def _support_clauses(
     lits: np.ndarray,
     starts: np.ndarray,
 ) -> tuple[int, int]:
-    """Support clauses of every non-singleton cell; returns ``(clauses, literals)``.
+    """Support clauses of every non-constant cell; returns ``(clauses, literals)``.
 
     With ``fill=False`` only counts (``lits``/``starts`` are not touched).
     """
@@ -102,10 +109,7 @@ def _support_clauses(
     nl = 0
     nc = 0
     for v in range(n):
-        size = 0
-        for w in range(W):
-            size += popcount64(bits[v, w])
-        if size <= 1:
+        if isconst[v]:
             continue
         for e in range(ptr[v], ptr[v + 1]):
             s = sidx[e]
@@ -145,6 +149,7 @@ def _support_clauses(
 @njit(cache=True)
 def _direct_clauses(
     bits: np.ndarray,
+    isconst: np.ndarray,
     vid: np.ndarray,
     ptr: np.ndarray,
     nbr: np.ndarray,
@@ -153,14 +158,15 @@ def _direct_clauses(
     fill: bool,
     lits: np.ndarray,
 ) -> int:
-    """Binary conflict clauses (each arc once, from its source); returns the count."""
+    """Binary conflict clauses (each arc once, from its source); returns the count.
+
+    A constant cell (arc consistent, so compatible with all of its neighbours' labels) needs
+    none.
+    """
     n, W = bits.shape
     nc = 0
     for v in range(n):
-        size = 0
-        for w in range(W):
-            size += popcount64(bits[v, w])
-        if size <= 1:
+        if isconst[v]:
             continue
         for e in range(ptr[v], ptr[v + 1]):
             s = sidx[e]
@@ -172,6 +178,8 @@ def _direct_clauses(
                 while x:
                     b = w * 64 + ctz64(x)
                     x &= x - np.uint64(1)
+                    if isconst[u]:
+                        continue
                     for w2 in range(W):
                         y = bits[u, w2] & ~sup[s, b, w2]
                         while y:
@@ -276,6 +284,7 @@ def encode(
     amo: str = "lazy",
     domains: ArrayLike | None = None,
     prune: bool = True,
+    deadline: float | None = None,
 ) -> Encoding:
     """Build the CNF of ``problem`` (see the module docstring).
 
@@ -293,7 +302,16 @@ def encode(
         the unary restrictions back as assumptions).
     prune : bool
         Make the domains arc consistent first (default). Without pruning every domain
-        label gets a variable.
+        label gets a variable (no constants).
+    deadline : float, optional
+        A ``time.perf_counter()`` value; :class:`DeadlineExceeded` is raised when it has
+        passed between the stages (arc consistency, counting, filling).
+
+    Raises
+    ------
+    InputError
+        If the formula would have more than :data:`MAX_LITERALS` literals (the direct
+        encoding grows with ``K**2`` per arc).
     """
     if encoding not in ("support", "direct"):
         raise InputError(f"encoding must be 'support' or 'direct', not {encoding!r}")
@@ -313,7 +331,8 @@ def encode(
         )  # fmt: skip
     C = eng.catalog()
     size = C.sum(axis=1)
-    single = size == 1
+    # a cell with one label is a constant only when arc consistency vouches for it
+    single = (size == 1) if prune else np.zeros(n, dtype=bool)
     const = np.where(single, C.argmax(axis=1), -1).astype(np.int32)
     has = C & ~single[:, None]
     var = np.zeros((n, K), dtype=np.int32)
@@ -323,6 +342,7 @@ def encode(
     var[has] = np.arange(1, nx + 1, dtype=np.int32)
     c = eng.c
     t1 = time.perf_counter()
+    _check_deadline(deadline)
     parts_l: list[NDArray[np.int32]] = []
     parts_s: list[NDArray[np.int64]] = []  # clause lengths
     stats: dict[str, Any] = {"ac_s": t1 - t0, "x_vars": nx}
@@ -330,18 +350,23 @@ def encode(
     dummy_s = np.zeros(1, dtype=np.int64)
     if encoding == "support":
         fwd = supports == "forward"
-        nc, nl = _support_clauses(eng.bits, var, c.ptr, c.nbr, c.sidx, c.sup, fwd, False,
-                                  dummy_l, dummy_s)  # fmt: skip
+        nc, nl = _support_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, fwd,
+                                  False, dummy_l, dummy_s)  # fmt: skip
+        _check_size(nl, encoding)
+        _check_deadline(deadline)
         lits = np.empty(nl, dtype=np.int32)
         starts = np.empty(nc + 1, dtype=np.int64)
-        _support_clauses(eng.bits, var, c.ptr, c.nbr, c.sidx, c.sup, fwd, True, lits, starts)
+        _support_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, fwd, True, lits,
+                         starts)  # fmt: skip
         parts_l.append(lits)
         parts_s.append(np.diff(starts))
         stats["support_clauses"] = nc
     else:
-        nc = _direct_clauses(eng.bits, var, c.ptr, c.nbr, c.sidx, c.sup, False, dummy_l)
+        nc = _direct_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, False, dummy_l)
+        _check_size(2 * nc, encoding)
+        _check_deadline(deadline)
         lits = np.empty(2 * nc, dtype=np.int32)
-        _direct_clauses(eng.bits, var, c.ptr, c.nbr, c.sidx, c.sup, True, lits)
+        _direct_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, True, lits)
         parts_l.append(lits)
         parts_s.append(np.full(nc, 2, dtype=np.int64))
         stats["conflict_clauses"] = nc
@@ -366,6 +391,20 @@ def encode(
     stats["encode_s"] = time.perf_counter() - t0
     return Encoding(problem, C, var, const, top, all_l, all_s, True, encoding, amo, nx=nx,
                     stats=stats)  # fmt: skip
+
+
+def _check_deadline(deadline: float | None) -> None:
+    if deadline is not None and time.perf_counter() > deadline:
+        raise DeadlineExceeded
+
+
+def _check_size(nlits: int, encoding: str) -> None:
+    if nlits > MAX_LITERALS:
+        hint = "; the support encoding is much smaller" if encoding == "direct" else ""
+        raise InputError(
+            f"the {encoding} encoding of this problem needs {nlits:,} literals, more than "
+            f"csplab's limit of {MAX_LITERALS:,}{hint}"
+        )
 
 
 def amo_clauses(

@@ -46,7 +46,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from csplab.cnf import encode
+from csplab.cnf import DeadlineExceeded, encode
 from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result
@@ -110,8 +110,13 @@ class CpsatSolver:
         grid = np.full(problem.shape, -1, dtype=np.int32)
         stats: dict[str, Any] = {"model": model, "diversity": diversity,
                                  "num_workers": int(num_workers), "presolve": bool(presolve)}  # fmt: skip
-        enc = encode(problem)
+        try:
+            enc = encode(problem, deadline=deadline)
+        except DeadlineExceeded:
+            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
         stats["encode_s"] = enc.stats.get("encode_s", 0.0)
+        if deadline is not None and time.perf_counter() > deadline:
+            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
         if not enc.ok:
             stats["proof"] = "arc-consistency wipe-out before search (Theorem 3.3.2)"
             stats["fail_cell"] = list(problem.coords(enc.wiped))
@@ -166,18 +171,23 @@ class CpsatSolver:
     def _onehot(m: Any, enc: Any, pref: Any, deadline: float | None) -> Any:
         """Booleans x[v, b] (proto index = SAT variable - 1) and the support clauses."""
         p = m.proto
-        for _ in range(enc.nx):
-            p.variables.add().domain.extend((0, 1))
-        _check(deadline)
+        variables = p.variables
+        for a in range(0, enc.nx, _CHUNK):
+            _check(deadline)
+            for _ in range(a, min(a + _CHUNK, enc.nx)):
+                variables.add().domain.extend((0, 1))
         nalo = int(enc.stats["alo_clauses"])
         nsup = enc.nclauses - nalo
-        lits = np.where(enc.lits > 0, enc.lits - 1, enc.lits).astype(np.int64).tolist()
-        st = enc.starts.tolist()
         cons = p.constraints
         for a in range(0, enc.nclauses, _CHUNK):
             _check(deadline)
-            for i in range(a, min(a + _CHUNK, enc.nclauses)):
-                if i < nsup:
+            b = min(a + _CHUNK, enc.nclauses)
+            lo, hi = int(enc.starts[a]), int(enc.starts[b])
+            chunk = enc.lits[lo:hi]
+            lits = np.where(chunk > 0, chunk - 1, chunk).astype(np.int64).tolist()
+            st = (enc.starts[a : b + 1] - lo).tolist()
+            for i in range(b - a):
+                if a + i < nsup:
                     cons.add().bool_or.literals.extend(lits[st[i] : st[i + 1]])
                 else:
                     cons.add().exactly_one.literals.extend(lits[st[i] : st[i + 1]])

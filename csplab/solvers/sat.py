@@ -60,7 +60,7 @@ import numpy as np
 from numba import njit
 from numpy.typing import NDArray
 
-from csplab.cnf import AMO_ENCODINGS, Encoding, amo_clauses, encode
+from csplab.cnf import AMO_ENCODINGS, DeadlineExceeded, Encoding, amo_clauses, encode
 from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result
@@ -253,13 +253,18 @@ class SatOracle:
         if deadline is not None and self.backend in _NO_LIMIT:
             raise InputError(f"sat backend {self.backend!r} cannot honour a time limit")
         self.problem = problem
-        self.enc: Encoding = encode(problem, encoding=encoding,  # type: ignore[arg-type]
-                                    supports=supports, amo=amo, domains=domains)  # type: ignore[arg-type]  # fmt: skip
+        self.timed_out = False
+        try:
+            self.enc: Encoding = encode(problem, encoding=encoding,  # type: ignore[arg-type]
+                                        supports=supports, amo=amo, domains=domains,  # type: ignore[arg-type]
+                                        deadline=deadline)  # fmt: skip
+        except DeadlineExceeded:
+            self.timed_out = True
+            self.enc = encode(Problem((1,), [[True]], [[[True]]], []))  # a trivial stand-in
         self.top = self.enc.nvars
         self.stats: dict[str, Any] = dict(self.enc.stats)
         self.stats.update(backend=self.backend, refinements=0, calls=0, solve_s=0.0)
         self.grid: NDArray[np.int32] | None = None
-        self.timed_out = False
         self._amo_done = np.zeros(problem.n, dtype=bool)
         self._fast: tuple[Any, Any, Any, Any] | None = None
         self._ptr: int | None = None
@@ -278,7 +283,7 @@ class SatOracle:
         t0 = time.perf_counter()
         if not self.enc.ok:
             self.solver.add_clause([])  # the empty clause: arc consistency wiped out
-        else:
+        elif not self.timed_out:
             self._load(self.enc.lits, self.enc.starts, deadline)
         self.stats["load_s"] = time.perf_counter() - t0
         self.stats["vars"] = self.enc.nvars
@@ -289,7 +294,9 @@ class SatOracle:
         self, lits: NDArray[np.int32], starts: NDArray[np.int64], deadline: float | None = None
     ) -> None:
         nc = starts.size - 1
-        chunk = 500_000 if deadline is not None else max(nc, 1)
+        chunk = max(nc, 1)
+        if deadline is not None:
+            chunk = 500_000 if self._fast is not None else 50_000
         for a in range(0, nc, chunk):
             if deadline is not None and time.perf_counter() > deadline:
                 self.timed_out = True
@@ -305,7 +312,8 @@ class SatOracle:
 
     def add_clause(self, clause: Sequence[int]) -> None:
         """Add one clause (Python ints)."""
-        self.solver.add_clause([int(x) for x in clause])
+        if not self.timed_out:
+            self.solver.add_clause([int(x) for x in clause])
 
     def add_clauses(self, lits: NDArray[np.int32], lengths: NDArray[np.int64]) -> None:
         """Add clauses given flat (``lits`` and per-clause lengths)."""
@@ -334,6 +342,8 @@ class SatOracle:
     # ------------------------------------------------------------------ queries
     def literal(self, cell: int, label: int) -> int:
         """The literal of ``cell = label``; constants map to a fresh true/false variable."""
+        if self.timed_out:  # nothing is loaded; any variable will do
+            return self.new_var()
         lit = self.enc.literal(cell, label)
         if isinstance(lit, bool):
             key = ("const", lit)
@@ -348,6 +358,8 @@ class SatOracle:
 
     def set_phases(self, preferred: NDArray[np.integer[Any]]) -> None:
         """Prefer label ``preferred[v]`` at each cell (``-1``: no preference)."""
+        if self.timed_out:
+            return
         var = self.enc.var
         n = var.shape[0]
         pref = np.asarray(preferred, dtype=np.int64).reshape(-1)
@@ -441,6 +453,8 @@ class SatOracle:
 
     def block(self, grid: NDArray[np.integer[Any]]) -> bool:
         """Exclude ``grid`` from future models; ``False`` if nothing is left to vary."""
+        if self.timed_out:
+            return False
         var = self.enc.var
         g = np.asarray(grid).reshape(-1)
         free = np.flatnonzero(self.enc.const < 0)
@@ -562,6 +576,8 @@ class SatSolver:
         ) as o:  # fmt: skip
             stats = o.stats
             stats.update(encoding=encoding, supports=supports, amo=amo, phase=phase)
+            if o.timed_out:
+                return Result("timeout", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
             if not o.enc.ok:
                 stats["proof"] = "arc-consistency wipe-out (unit propagation on the support encoding)"
                 stats["fail_cell"] = list(problem.coords(o.enc.wiped))

@@ -20,7 +20,14 @@ from hypothesis import strategies as st
 from csplab.example import ExampleModel
 from csplab.problem import Problem
 
-__all__ = ["example_models", "label_grids", "problems", "random_problems", "shapes"]
+__all__ = [
+    "csp_problems",
+    "example_models",
+    "label_grids",
+    "problems",
+    "random_problems",
+    "shapes",
+]
 
 
 @st.composite
@@ -105,3 +112,23 @@ def random_problems(draw: Any, max_side: int = 4, max_labels: int = 4, max_ndim:
     T = rng.random((len(shp), k, k)) < p
     per = draw(st.booleans())
     return Problem.grid(shp, T, periodic=per)
+
+
+@st.composite
+def csp_problems(draw: Any, max_side: int = 3, max_labels: int = 4, max_ndim: int = 3,
+                 max_cells: int = 12) -> Problem:  # fmt: skip
+    """Small problems of every kind for solver conformance: from example models (periodic
+    or not, fixed cells, masks) or random relations (periodic or not, sometimes with a
+    fixed cell), at most ``max_cells`` cells; some are unsatisfiable."""
+    P = draw(
+        st.one_of(
+            problems(max_side=max_side, max_labels=max_labels, max_ndim=max_ndim),
+            random_problems(max_side=max_side, max_labels=max_labels, max_ndim=max_ndim),
+        )
+    )
+    if P.n > max_cells:
+        P = P.subproblem(np.arange(max_cells), np.full(P.n, -1))
+    if not P.unary and draw(st.booleans()):
+        c = draw(st.integers(0, P.n - 1))
+        P = P.with_fixed({P.coords(c): draw(st.integers(0, P.K - 1))})
+    return P
