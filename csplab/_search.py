@@ -207,7 +207,7 @@ def _choose_cell(dom: np.ndarray, scan: bool, order: np.ndarray, state: np.ndarr
             v = order[p]
             if domain_size(dom, v) > 1:
                 state[SCAN] = p
-                return v
+                return int(v)
             p += 1
         state[SCAN] = n
         return -1

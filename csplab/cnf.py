@@ -28,7 +28,7 @@ Every cell gets an at-least-one clause. At-most-one (``amo``):
     added and the solver runs again (counterexample-guided refinement, done by
     :class:`csplab.solvers.sat.SatOracle`). With the direct encoding any true label of each
     cell gives a solution, so no refinement is ever needed.
-any :class:`pysat.card.EncType` name (``"seqcounter"``, ``"ladder"``, ``"bitwise"``, ``"pairwise"``, ...)
+a :class:`pysat.card.EncType` name (``"seqcounter"``, ``"ladder"``, ``"bitwise"``, ...)
     Built once per domain size as a template from :mod:`pysat.card` and instantiated for
     every cell with numpy.
 
@@ -48,6 +48,7 @@ Examples
 
 from __future__ import annotations
 
+import itertools
 import time
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -68,6 +69,7 @@ MAX_LITERALS = 60_000_000  # ~240 MB of int32: refuse larger formulas with a cle
 
 class DeadlineExceeded(Exception):
     """Raised by :func:`encode` when its ``deadline`` passes (callers report a timeout)."""
+
 
 EncodingName = Literal["support", "direct"]
 AMO_ENCODINGS = (
@@ -256,7 +258,7 @@ class Encoding:
     def cell_vars(self, cell: int) -> NDArray[np.int32]:
         """Variables of one cell (empty for a constant cell)."""
         row = self.var[cell]
-        return row[row > 0]
+        return np.asarray(row[row > 0], dtype=np.int32)
 
     def decode(self, truth: NDArray[np.bool_]) -> tuple[NDArray[np.int32], NDArray[np.int64]]:
         """Grid from a model, plus the cells with several true labels.
@@ -447,4 +449,4 @@ def amo_clauses(
 def _split_lists(lits: NDArray[np.int32], starts: NDArray[np.int64]) -> list[list[int]]:
     flat = lits.tolist()
     st = starts.tolist()
-    return [flat[a:b] for a, b in zip(st[:-1], st[1:], strict=True)]
+    return [flat[a:b] for a, b in itertools.pairwise(st)]

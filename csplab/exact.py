@@ -236,7 +236,7 @@ def catalog_gap(
     trace = run.trace if run.trace is not None else np.zeros((0, 2), dtype=np.int64)
     steps: list[list[Any]] = []
     stats: dict[str, Any] = {"seed": seed, "order": order, "choice": choice,
-                             "alg31_status": run.status, "steps_taken": int(len(trace))}  # fmt: skip
+                             "alg31_status": run.status, "steps_taken": len(trace)}  # fmt: skip
     if run.status == "unsat":
         stats["time_s"] = time.perf_counter() - t0
         return Verdict(True, None, stats, "arc consistency proves the problem unsatisfiable; "
@@ -286,14 +286,14 @@ def catalog_gap(
                              "label_name": problem.label_name(int(b))}  # fmt: skip
     stats.update(calls=calls, steps=steps, time_s=time.perf_counter() - t0)
     if run.status == "failed":
-        stats["fail_step"] = int(len(trace))
+        stats["fail_step"] = len(trace)
         stats["fail_cell"] = run.stats.get("fail_cell")
     if first_bad is None:
         if stats.get("unsat"):
             return Verdict(False, None, stats, "the problem is unsatisfiable (no label is in C*)")
         return Verdict(True, None, stats, f"all {len(trace)} chosen labels were in C*")
     if run.status == "failed":
-        first_bad["steps_until_failure"] = int(len(trace)) - first_bad["step"]
+        first_bad["steps_until_failure"] = len(trace) - first_bad["step"]
     msg = (
         f"step {first_bad['step']}: label {first_bad['label_name']} at {tuple(first_bad['cell'])}"
         f" was in C but not in C*; Alg. 3.1 {run.status}"
@@ -409,7 +409,5 @@ def explain_unsat(
     if not core:
         msg = "no solution even without the fixed cells, boundary or masks"
     else:
-        msg = f"{len(core)} of {len(U)} restrictions conflict" + (
-            " (minimal)" if minimal else ""
-        )
+        msg = f"{len(core)} of {len(U)} restrictions conflict" + (" (minimal)" if minimal else "")
     return Verdict(True, witness, stats, msg)

@@ -1,3 +1,5 @@
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -73,7 +75,7 @@ def test_amo_templates_allow_exactly_the_single_labels(amo):
     var = np.array([[1, 2, 3, 4, 5]], dtype=np.int32)
     lits, lens, top = amo_clauses(var, var > 0, amo, 5)
     starts = np.concatenate([[0], np.cumsum(lens)])
-    clauses = [lits[a:b].tolist() for a, b in zip(starts[:-1], starts[1:], strict=True)]
+    clauses = [lits[a:b].tolist() for a, b in itertools.pairwise(starts)]
     with Solver(name="cadical195", bootstrap_with=[[1, 2, 3, 4, 5], *clauses]) as S:
         seen = set()
         while S.solve():

@@ -9,7 +9,7 @@ from csplab.testing import brute
 from csplab.testing.strategies import csp_problems
 
 pytest.importorskip("pysat")
-from csplab.exact import catalog_gap, exact_catalog, explain_unsat, is_consistent  # noqa: E402
+from csplab.exact import catalog_gap, exact_catalog, explain_unsat, is_consistent
 
 FALLIBLE = ExampleModel([[0, 0, 0, 2], [2, 0, 0, 1], [0, 1, 2, 1]])
 
@@ -103,9 +103,9 @@ def test_explanation_names_the_conflicting_boundary_and_cells():
     Q = Problem.from_example(E, (4, 4), fixed={(0, 0): 0, (0, 1): 1, (3, 3): 0})
     w = explain_unsat(Q)
     assert sorted(w.witness["unary"]) == ["fixed cell (0, 1) = 1"]
-    assert explain_unsat(Problem.from_example(load_example("fig3_1d"), (5, 5))).witness[
-        "core"
-    ] == []
+    assert (
+        explain_unsat(Problem.from_example(load_example("fig3_1d"), (5, 5))).witness["core"] == []
+    )
 
 
 def test_time_limits_and_bad_partials():

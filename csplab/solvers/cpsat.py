@@ -108,8 +108,12 @@ class CpsatSolver:
         deadline = None if time_limit is None else t0 + float(time_limit)
         rseed = int(rng.integers(2**31 - 1))
         grid = np.full(problem.shape, -1, dtype=np.int32)
-        stats: dict[str, Any] = {"model": model, "diversity": diversity,
-                                 "num_workers": int(num_workers), "presolve": bool(presolve)}  # fmt: skip
+        stats: dict[str, Any] = {
+            "model": model,
+            "diversity": diversity,
+            "num_workers": int(num_workers),
+            "presolve": bool(presolve),
+        }
         try:
             enc = encode(problem, deadline=deadline)
         except DeadlineExceeded:
@@ -216,7 +220,8 @@ class CpsatSolver:
         C = enc.catalog
         X = []
         for v in range(P.n):
-            X.append(m.NewIntVarFromDomain(cp_model.Domain.FromValues(np.flatnonzero(C[v]).tolist()), ""))  # fmt: skip
+            labels = np.flatnonzero(C[v]).tolist()
+            X.append(m.NewIntVarFromDomain(cp_model.Domain.FromValues(labels), ""))
             if v % _CHUNK == 0:
                 _check(deadline)
         tuples = [np.argwhere(P.relations[r]).tolist() for r in range(P.R)]

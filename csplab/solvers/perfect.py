@@ -171,11 +171,12 @@ class PerfectSolver:
                     return _result("timeout", grid, problem, stats, t0)
                 labels = eng.domain(p)
                 if labels.size == 1:
-                    b: int | None = int(labels[0])
+                    b = int(labels[0])
                 else:
-                    b = choose_from_exact(o, wit, p, labels, w, rng, stats, deadline)
-                    if b is None:
+                    pick = choose_from_exact(o, wit, p, labels, w, rng, stats, deadline)
+                    if pick is None:
                         return _result("timeout", grid, problem, stats, t0)
+                    b = pick
                     o.add_clause([o.literal(p, b)])
                 grid[p] = b
                 wit.fix(p, b)

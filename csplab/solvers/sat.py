@@ -51,6 +51,7 @@ Examples
 from __future__ import annotations
 
 import ctypes
+import itertools
 import threading
 import time
 from collections.abc import Iterator, Sequence
@@ -95,8 +96,7 @@ _NOT_SUPPORTED = {
     "time limit) and aborts the process when reused",
     "cadical103": "cadical103 cannot set decision phases, so its outputs would not vary "
     "with the seed; use cadical153, cadical195 or cadical300",
-    "cryptosat": "cryptosat needs the pycryptosat package and has no phases or budgets "
-    "in pysat",
+    "cryptosat": "cryptosat needs the pycryptosat package and has no phases or budgets in pysat",
 }
 _NO_LIMIT = ("lingeling",)  # no conflict budget and no interrupt in pysat
 
@@ -119,7 +119,7 @@ def _canonical(backend: str | None) -> str:
             if canon in _NOT_SUPPORTED:
                 raise InputError(f"sat backend {canon!r} is not supported: {_NOT_SUPPORTED[canon]}")
             if canon in _SUPPORTED:
-                return canon
+                return str(canon)
     raise InputError(f"unknown sat backend {backend!r}; available: {', '.join(_SUPPORTED)}")
 
 
@@ -161,17 +161,21 @@ def _cadical_functions(backend: str) -> tuple[Any, Any, Any, Any] | None:
     found = None
     if tag is not None:
         try:
-            import pysolvers
+            import pysolvers  # type: ignore[import-not-found]
 
             lib = ctypes.CDLL(pysolvers.__file__)
-            add = _VOID_INT(ctypes.cast(getattr(lib, f"_ZN10CaDiCaL{tag}Solver3addEi"),
-                                        ctypes.c_void_p).value)  # fmt: skip
-            phase = _VOID_INT(ctypes.cast(getattr(lib, f"_ZN10CaDiCaL{tag}Solver5phaseEi"),
-                                          ctypes.c_void_p).value)  # fmt: skip
+
+            def address(method: str) -> int:
+                a = ctypes.cast(getattr(lib, f"_ZN10CaDiCaL{tag}Solver{method}"), ctypes.c_void_p)
+                if not a.value:
+                    raise AttributeError(method)
+                return int(a.value)
+
+            add = _VOID_INT(address("3addEi"))
+            phase = _VOID_INT(address("5phaseEi"))
             val = None
             if hasattr(lib, f"_ZN10CaDiCaL{tag}Solver3valEi"):
-                val = _INT_INT(ctypes.cast(getattr(lib, f"_ZN10CaDiCaL{tag}Solver3valEi"),
-                                           ctypes.c_void_p).value)  # fmt: skip
+                val = _INT_INT(address("3valEi"))
             reserve = getattr(lib, f"_ZN10CaDiCaL{tag}Solver7reserveEi", None)
             if reserve is not None:
                 reserve.argtypes = [ctypes.c_void_p, ctypes.c_int]
@@ -267,7 +271,7 @@ class SatOracle:
         self.grid: NDArray[np.int32] | None = None
         self._amo_done = np.zeros(problem.n, dtype=bool)
         self._fast: tuple[Any, Any, Any, Any] | None = None
-        self._ptr: int | None = None
+        self._ptr: int = 0
         self._last_core: list[int] | None = None
         self.solver = Solver(name=_PYSAT_NAME.get(self.backend, self.backend))
         if self.backend.startswith("cadical") and seed is not None:
@@ -308,7 +312,7 @@ class SatOracle:
                 lo, hi = int(starts[a]), int(starts[b])
                 sub = lits[lo:hi].tolist()
                 st = (starts[a : b + 1] - lo).tolist()
-                self.solver.append_formula([sub[i:j] for i, j in zip(st[:-1], st[1:], strict=True)])
+                self.solver.append_formula([sub[i:j] for i, j in itertools.pairwise(st)])
 
     def add_clause(self, clause: Sequence[int]) -> None:
         """Add one clause (Python ints)."""
@@ -353,7 +357,7 @@ class SatOracle:
                 self.add_clause([v if lit else -v])
                 cached[key] = v
                 self._const_vars = cached
-            return cached[key]
+            return int(cached[key])
         return lit
 
     def set_phases(self, preferred: NDArray[np.integer[Any]]) -> None:
@@ -494,7 +498,7 @@ def preferred_labels(
     pick = (cum <= u[:, None]).sum(axis=1)
     pick = np.minimum(pick, K - 1)
     pick[~catalog.any(axis=1)] = -1
-    return pick.astype(np.int64)
+    return np.asarray(pick, dtype=np.int64)
 
 
 def enumerate_solutions(
@@ -579,7 +583,9 @@ class SatSolver:
             if o.timed_out:
                 return Result("timeout", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
             if not o.enc.ok:
-                stats["proof"] = "arc-consistency wipe-out (unit propagation on the support encoding)"
+                stats["proof"] = (
+                    "arc-consistency wipe-out (unit propagation on the support encoding)"
+                )
                 stats["fail_cell"] = list(problem.coords(o.enc.wiped))
                 return Result("unsat", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
             if phase != "none":
@@ -595,4 +601,3 @@ class SatSolver:
                 stats["proof"] = f"refutation by {o.backend}"
                 return Result("unsat", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
             return Result("timeout", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
-

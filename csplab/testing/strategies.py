@@ -120,7 +120,7 @@ def csp_problems(draw: Any, max_side: int = 3, max_labels: int = 4, max_ndim: in
     """Small problems of every kind for solver conformance: from example models (periodic
     or not, fixed cells, masks) or random relations (periodic or not, sometimes with a
     fixed cell), at most ``max_cells`` cells; some are unsatisfiable."""
-    P = draw(
+    P: Problem = draw(
         st.one_of(
             problems(max_side=max_side, max_labels=max_labels, max_ndim=max_ndim),
             random_problems(max_side=max_side, max_labels=max_labels, max_ndim=max_ndim),

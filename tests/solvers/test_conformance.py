@@ -88,9 +88,7 @@ def test_solver_conforms(spec, opts, P, seed):
 
 @given(P=csp_problems(), seed=st.integers(0, 2**31))
 def test_complete_solvers_agree(P, seed):
-    statuses = {
-        spec: _run(spec, opts, P, seed).status for spec, opts in SPECS if _complete(spec)
-    }
+    statuses = {spec: _run(spec, opts, P, seed).status for spec, opts in SPECS if _complete(spec)}
     assert len(set(statuses.values())) == 1, statuses
 
 

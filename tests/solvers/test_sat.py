@@ -10,7 +10,7 @@ from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
 
 pytest.importorskip("pysat")
-from csplab.solvers.sat import SatOracle, backends, enumerate_solutions  # noqa: E402
+from csplab.solvers.sat import SatOracle, backends, enumerate_solutions
 
 CHECKER = ExampleModel([[0, 1], [1, 0]])
 ODD_CYCLE = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)
@@ -38,8 +38,12 @@ def test_aliases_and_unsupported_backends():
         solve(P, "sat", rng=0, colour="red")
 
 
-@given(csp_problems(max_cells=9), st.sampled_from(["lazy", "seqcounter", "ladder", "pairwise"]),
-       st.sampled_from(["support", "direct"]), st.sampled_from(["cadical195", "glucose4"]))  # fmt: skip
+@given(
+    csp_problems(max_cells=9),
+    st.sampled_from(["lazy", "seqcounter", "ladder", "pairwise"]),
+    st.sampled_from(["support", "direct"]),
+    st.sampled_from(["cadical195", "glucose4"]),
+)
 def test_enumeration_matches_brute_force_counts(P, amo, encoding, backend):
     n = sum(1 for _ in enumerate_solutions(P, amo=amo, encoding=encoding, backend=backend))
     assert n == count(P)
