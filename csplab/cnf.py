@@ -41,9 +41,9 @@ Examples
 >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))   # checkerboard
 >>> enc = encode(P)
 >>> enc.nvars, enc.nclauses
-(8, 12)
->>> enc.clause(0).tolist()                   # cell (0,0)=0 needs (0,1)=1 above it
-[-1, 4]
+(8, 20)
+>>> enc.clause(0).tolist()          # (0,0)=0 needs its +x neighbour (1,0) to be 1
+[-1, 6]
 """
 
 from __future__ import annotations
