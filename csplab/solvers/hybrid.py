@@ -40,7 +40,7 @@ from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result
 from csplab.solvers.catalog import CHOICES, ORDERS, run_alg31
-from csplab.solvers.perfect import _Pool, choose_from_exact
+from csplab.solvers.perfect import _SAT_KEYS, _Pool, choose_from_exact
 from csplab.solvers.sat import SatOracle
 
 __all__ = ["HybridSolver"]
@@ -151,9 +151,7 @@ class HybridSolver:
                 stats["repairs"] += 1
         finally:
             if oracle is not None:
-                stats["sat"] = {k: oracle.stats[k] for k in ("backend", "vars", "clauses",
-                                                             "encode_s", "load_s", "solve_s")
-                                if k in oracle.stats}  # fmt: skip
+                stats["sat"] = {k: oracle.stats[k] for k in _SAT_KEYS if k in oracle.stats}
                 oracle.close()
 
     @staticmethod

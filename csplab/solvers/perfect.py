@@ -48,6 +48,8 @@ from csplab.solvers.sat import SatOracle
 
 __all__ = ["PerfectSolver", "label_order"]
 
+_SAT_KEYS = ("backend", "vars", "clauses", "encode_s", "load_s", "solve_s", "calls")
+
 
 def label_order(
     labels: NDArray[np.int64], weights: NDArray[np.float64] | None, rng: np.random.Generator
@@ -183,6 +185,7 @@ class PerfectSolver:
                 stats["assigned"] += 1
                 if not eng.assign(p, b):  # impossible: M_t stays completable
                     raise CsplabError("perfect: arc consistency failed after a C* choice (a bug)")
+            stats["sat"] = {k: o.stats[k] for k in _SAT_KEYS if k in o.stats}
         return _result("solved", grid, problem, stats, t0)
 
 
