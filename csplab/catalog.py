@@ -170,8 +170,8 @@ class Propagator:
         c = self.c
         wiped = kern.propagate(
             self.bits, self.prev, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, self._queue,
-            self._inq, start, start.size, self.stats, self._nohp, self._nohp, self._nohk, 0, self._nohk,
-            c.weights, c.wlogw, False,
+            self._inq, start, start.size, self.stats, self._nohp, self._nohp, self._nohk, 0,
+            self._nohk, c.weights, c.wlogw, False,
         )  # fmt: skip
         if wiped >= 0:
             self.ok = False
