@@ -105,7 +105,8 @@ class Result:
         from csplab.render import render_png_bytes
 
         names = self.problem.names if self.problem is not None else None
-        return render_png_bytes(self.grid, names=names)
+        model = self.problem.meta.get("model") if self.problem is not None else None
+        return render_png_bytes(self.grid, names=names, model=model)
 
 
 @dataclass
