@@ -212,13 +212,17 @@ def save_png(grid: ArrayLike, path: str | Path, *, names: Sequence[str] | None =
 
 
 def render_png_bytes(
-    grid: ArrayLike, *, names: Sequence[str] | None = None, model: Any = None
+    grid: ArrayLike,
+    *,
+    names: Sequence[str] | None = None,
+    model: Any = None,
+    periodic: bool | None = None,
 ) -> bytes:
     """PNG bytes of :func:`render` (or of ``model.render(grid)`` when the model, e.g. a
     :class:`~csplab.io.ruleset.RuleSet`, draws its own tiles)."""
     buf = io.BytesIO()
     if model is not None and hasattr(model, "render"):
-        img = model.render(grid)
+        img = model.render(grid, periodic=periodic)
     else:
         K = len(names) if names is not None else None
         img = render(grid, K=K)

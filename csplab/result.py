@@ -106,7 +106,8 @@ class Result:
 
         names = self.problem.names if self.problem is not None else None
         model = self.problem.meta.get("model") if self.problem is not None else None
-        return render_png_bytes(self.grid, names=names, model=model)
+        per = self.problem.meta.get("periodic", False) if self.problem is not None else False
+        return render_png_bytes(self.grid, names=names, model=model, periodic=bool(np.all(per)))
 
 
 @dataclass

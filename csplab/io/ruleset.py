@@ -44,7 +44,7 @@ from csplab.problem import AXIS_NAMES, Problem, Unary, parse_shape
 if TYPE_CHECKING:
     from PIL import Image
 
-    from csplab.io.symmetry import Orientations
+    from csplab.io.symmetry import Group
 
 __all__ = ["DomainOp", "RuleSet"]
 
@@ -67,6 +67,9 @@ class DomainOp:
     region : sequence of ``(start, stop)`` per axis, optional
         A box of cells; ``None`` is open, negative numbers count from the end. Missing
         axes (and ``region=None`` without ``face``) mean the whole axis.
+    flip : sequence of bool, optional
+        Axes along which ``region`` counts from the other end (files whose ``y`` points
+        down, as in images).
     kind : {"boundary", "domain", "fixed"}
         The kind of the :class:`~csplab.problem.Unary` it becomes.
     key : str
@@ -77,12 +80,16 @@ class DomainOp:
     labels: NDArray[np.bool_]
     face: str | None = None
     region: Sequence[tuple[int | None, int | None]] | None = None
+    flip: Sequence[bool] = ()
     kind: Literal["boundary", "domain", "fixed"] = "domain"
     key: str = ""
 
     def cells(self, shape: tuple[int, ...]) -> NDArray[np.int64]:
         """Flat indices of the cells it applies to in a grid of ``shape``."""
         idx = np.arange(math.prod(shape), dtype=np.int64).reshape(shape)
+        for d, f in enumerate(self.flip[: len(shape)]):
+            if f:
+                idx = np.flip(idx, axis=d)
         sl: list[slice | int] = [slice(None)] * len(shape)
         if self.face is not None:
             d = AXIS_NAMES.index(self.face[0])
@@ -122,8 +129,9 @@ class RuleSet:
         One colour per label for pictures without tile images.
     empty : int, optional
         The empty-space label, left out of 3D pictures and exports.
-    orientations : Orientations, optional
-        The symmetry group acting on the labels (for :meth:`closure_violations`).
+    symmetry : (Group, perm), optional
+        The symmetry group and its action on the labels, ``perm[g, label]`` (for
+        :meth:`closure_violations`).
     meta : mapping
         Provenance: ``format``, ``source``, ``warnings`` and format-specific data.
     """
@@ -142,7 +150,7 @@ class RuleSet:
         images: ArrayLike | None = None,
         colors: ArrayLike | None = None,
         empty: int | None = None,
-        orientations: Orientations | None = None,
+        symmetry: tuple[Group, NDArray[np.int64]] | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:
         T = np.array(relations, dtype=bool)
@@ -188,7 +196,7 @@ class RuleSet:
         if empty is not None and not 0 <= empty < K:
             raise InputError(f"empty label {empty} is outside 0..{K - 1}")
         self.empty = empty
-        self.orientations = orientations
+        self.symmetry = symmetry
         self.meta: dict[str, Any] = dict(meta or {})
         self.meta.setdefault("warnings", [])
 
@@ -223,13 +231,13 @@ class RuleSet:
     def closure_violations(self, limit: int = 100) -> list[str]:
         """Rules whose image under the tileset's symmetry group is missing (empty when the
         rule set is closed under the group, or when the file has no symmetry group)."""
-        if self.orientations is None:
+        if self.symmetry is None:
             return []
         from csplab.io.symmetry import closure_violations
 
-        G = self.orientations.group
+        G, perm = self.symmetry
         out = []
-        for axis, a, b, g in closure_violations(self.orientations, self.relations, limit):
+        for axis, a, b, g in closure_violations(G, perm, self.relations, limit):
             out.append(
                 f"{self.names[a]!r} then {self.names[b]!r} along +{AXIS_NAMES[axis]}: "
                 f"its image under {G.name(g)!r} is missing"
@@ -359,9 +367,12 @@ class RuleSet:
             return np.clip((im[..., :3] * a).sum(axis=(1, 2)) / tot, 0, 255).astype(np.uint8)
         return palette(self.K)
 
-    def render(self, grid: ArrayLike, *, scale: int | None = None) -> Image.Image:
+    def render(
+        self, grid: ArrayLike, *, scale: int | None = None, periodic: bool | None = None
+    ) -> Image.Image:
         """A picture of a label grid: tile images composited in 2D when the file has them,
-        else one colour per label (3D: isometric, the empty label left out)."""
+        else one colour per label (3D: isometric, the empty label left out). ``periodic``
+        is used by models whose pictures depend on it (the overlapping model)."""
         from csplab.render import render
 
         g = np.asarray(grid)

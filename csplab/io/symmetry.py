@@ -24,7 +24,7 @@ Examples
 >>> O.K
 4
 >>> T = expand_rules(O, [(O.label(0, 0), O.label(0, 0), (0, 1))])   # "t 0" next to "t 0"
->>> closure_violations(O, T)
+>>> closure_violations(O.group, O.perm, T)
 []
 """
 
@@ -258,23 +258,26 @@ def expand_rules(
 
 
 def closure_violations(
-    orient: Orientations, T: NDArray[np.bool_], limit: int = 100
+    group: Group, perm: NDArray[np.int64], T: NDArray[np.bool_], limit: int = 100
 ) -> list[tuple[int, int, int, int]]:
     """Rules of ``T`` whose image under some group element is missing.
 
-    Returns up to ``limit`` tuples ``(axis, a, b, g)``: ``T[axis, a, b]`` holds but its image
-    under element ``g`` does not. An empty list means ``T`` is closed under the group.
+    ``perm[g, label]`` is the label ``label`` becomes under element ``g`` (``-1``: no such
+    label, that image is not required). Returns up to ``limit`` tuples ``(axis, a, b, g)``:
+    ``T[axis, a, b]`` holds but its image under element ``g`` does not. An empty list
+    means ``T`` is closed under the group.
     """
-    G = orient.group
     out: list[tuple[int, int, int, int]] = []
-    for g in range(1, len(G)):
-        p = orient.perm[g]
-        for axis in range(T.shape[0]):
-            if axis >= G.ndim:
-                continue
-            new_axis, sign = G.apply(g, (axis, 1))
-            img = T[new_axis][np.ix_(p, p)] if sign > 0 else T[new_axis][np.ix_(p, p)].T
-            missing = T[axis] & ~img
+    for g in range(1, len(group)):
+        p = perm[g]
+        ok = p >= 0
+        q = np.where(ok, p, 0)
+        for axis in range(min(T.shape[0], group.ndim)):
+            new_axis, sign = group.apply(g, (axis, 1))
+            img = T[new_axis][np.ix_(q, q)]
+            if sign < 0:
+                img = img.T
+            missing = T[axis] & ~img & ok[:, None] & ok[None, :]
             for a, b in zip(*np.nonzero(missing), strict=True):
                 out.append((axis, int(a), int(b), g))
                 if len(out) >= limit:

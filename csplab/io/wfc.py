@@ -265,7 +265,7 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
         weights=weights,
         name=stem + (f"[{subset}]" if subset else ""),
         images=imgs,
-        orientations=orient,
+        symmetry=(G, orient.perm),
         meta=meta,
     )
     bad = rs.closure_violations(limit=20)
