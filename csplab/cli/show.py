@@ -27,8 +27,12 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         "bad input.",
     )
     p.add_argument("file", metavar="FILE", help="model file or built-in example name")
-    p.add_argument("--out", help="PNG to write (default: FILE's name with .png, in the current directory)")
-    p.add_argument("--tiles", metavar="TILESET", help="draw the grid FILE with this tileset's pictures")
+    p.add_argument(
+        "--out", help="PNG to write (default: FILE's name with .png, in the current directory)"
+    )
+    p.add_argument(
+        "--tiles", metavar="TILESET", help="draw the grid FILE with this tileset's pictures"
+    )
     p.add_argument("--scale", type=int, help="pixels per cell (grids)")
     p.add_argument("--empty", type=int, help="3D: the label left out (default: guessed)")
     p.add_argument(

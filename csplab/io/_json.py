@@ -68,7 +68,9 @@ def load_json(text: str | bytes, *, path: object = "<string>", comments: bool = 
     try:
         return json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as e:
-        raise FormatError(f"not valid JSON: {e.msg} (column {e.colno})", path=path, line=e.lineno) from None
+        raise FormatError(
+            f"not valid JSON: {e.msg} (column {e.colno})", path=path, line=e.lineno
+        ) from None
     except RecursionError:
         raise FormatError("JSON nesting is too deep", path=path) from None
 

@@ -80,7 +80,9 @@ def _tile_list(v: Any, what: str, path: object) -> list[Any]:
     return [_key(t, what, path) for t in v]
 
 
-def parse_debroglie(text: str | bytes, *, path: object = "<string>", strict: bool = False) -> RuleSet:
+def parse_debroglie(
+    text: str | bytes, *, path: object = "<string>", strict: bool = False
+) -> RuleSet:
     """Parse a DeBroglie JSON config into a :class:`RuleSet`."""
     d = load_json(text, path=path, comments=True)
     if not isinstance(d, dict):
@@ -100,7 +102,9 @@ def parse_debroglie(text: str | bytes, *, path: object = "<string>", strict: boo
     if mtype == "overlapping" or (mtype == "adjacent" and not d.get("adjacencies")):
         return _from_sample(d, mtype, src, path, strict)
     if mtype != "adjacent":
-        raise FormatError(f"model type {mtype!r} is not supported (adjacent, overlapping)", path=path)
+        raise FormatError(
+            f"model type {mtype!r} is not supported (adjacent, overlapping)", path=path
+        )
     adj = d.get("adjacencies")
     if not isinstance(adj, list):
         raise FormatError("'adjacencies' must be a list", path=path)
@@ -245,7 +249,9 @@ def _tile_action(
     S = square_group()
     treat = str(d.get("rotationTreatment", "unchanged")).lower()
     if treat not in ("unchanged", "missing"):
-        raise FormatError(f"rotationTreatment {treat!r} is not supported (unchanged, missing)", path=path)
+        raise FormatError(
+            f"rotationTreatment {treat!r} is not supported (unchanged, missing)", path=path
+        )
     K = len(order)
     # facts over the full square group: img[s][t] = tile
     img: list[dict[int, int]] = [dict() for _ in range(len(S))]
@@ -375,11 +381,15 @@ def _constraints(
             for ax in "xyz"[:ndim]:
                 v = pt.get(ax, 0)
                 if isinstance(v, bool) or not isinstance(v, int) or v < 0:
-                    raise FormatError(f"constraints[{i}].point.{ax} must be an integer ≥ 0", path=path)
+                    raise FormatError(
+                        f"constraints[{i}].point.{ax} must be an integer ≥ 0", path=path
+                    )
                 region.append((v, v + 1))
             flip = [False, True, False][:ndim]
             cops.append(
-                DomainOp("force", lab, region=region, flip=flip, kind="fixed", key=f"fixedTile {pt}")
+                DomainOp(
+                    "force", lab, region=region, flip=flip, kind="fixed", key=f"fixedTile {pt}"
+                )
             )
         else:
             unsupported(

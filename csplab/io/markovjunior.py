@@ -111,7 +111,9 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
         parts = text.split()
         if not 1 <= len(parts) <= 2:
             raise FormatError(
-                f"<neighbor> {side}={text!r}: expected 'tile' or 'xyz tile'", path=path, line=node.line
+                f"<neighbor> {side}={text!r}: expected 'tile' or 'xyz tile'",
+                path=path,
+                line=node.line,
             )
         nm = parts[-1]
         if nm not in seen:
@@ -128,7 +130,9 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
         try:
             g = G.index(word)
         except InputError as e:
-            raise FormatError(f"<neighbor> {side}={text!r}: {e}", path=path, line=node.line) from None
+            raise FormatError(
+                f"<neighbor> {side}={text!r}: {e}", path=path, line=node.line
+            ) from None
         return seen[nm], g
 
     stated: list[tuple[tuple[int, int], tuple[int, int], tuple[int, int]]] = []
@@ -151,7 +155,9 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
             b = ref(node.get("top"), node, "top")
             stated.append((a, b, (2, 1)))
         else:
-            raise FormatError("<neighbor> needs left/right or top/bottom", path=path, line=node.line)
+            raise FormatError(
+                "<neighbor> needs left/right or top/bottom", path=path, line=node.line
+            )
     vox = _voxels(path, [t[0] for t in tiles], warn)
     if vox is not None:
         stabs = [
@@ -163,11 +169,12 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
         stabs = _infer_stabilizers(G, len(tiles), stated)
         how = "inferred from the rules"
     orient = Orientations(G, stabs)
-    rules = [
-        (orient.label(ta, ga), orient.label(tb, gb), d) for (ta, ga), (tb, gb), d in stated
-    ]
+    rules = [(orient.label(ta, ga), orient.label(tb, gb), d) for (ta, ga), (tb, gb), d in stated]
     T = expand_rules(orient, rules, ndim=3)
-    names = [_label_name(G, stabs[t], g, tiles[t][0]) for t, g in zip(orient.tile_of, orient.rep, strict=True)]
+    names = [
+        _label_name(G, stabs[t], g, tiles[t][0])
+        for t, g in zip(orient.tile_of, orient.rep, strict=True)
+    ]
     weights = [tiles[t][1] for t in orient.tile_of]
     counts = {tiles[t][0]: len(G) // len(stabs[t]) for t in range(len(tiles))}
     if vox is None:
@@ -251,7 +258,10 @@ def _infer_stabilizers(
     for t in range(ntiles):
         H = []
         for g in range(len(G)):
-            if all(sock[t * 6 + _DIRS.index(G.apply(g, d))] == sock[t * 6 + k] for k, d in enumerate(_DIRS)):
+            if all(
+                sock[t * 6 + _DIRS.index(G.apply(g, d))] == sock[t * 6 + k]
+                for k, d in enumerate(_DIRS)
+            ):
                 H.append(g)
         stabs.append(frozenset(H))
     return stabs

@@ -176,11 +176,11 @@ def write_obj(
         lines += ["v {:g} {:g} {:g}".format(*(v + off)) for v in mesh.vertices]
         cur = None
         mats = mesh.face_material or [None] * len(mesh.faces)
-        for f, mat in zip(mesh.faces, mats, strict=True):
+        for face, mat in zip(mesh.faces, mats, strict=True):
             if mat is not None and mat != cur:
                 lines.append(f"usemtl {mat}")
                 cur = mat
-            lines.append("f " + " ".join(str(nverts + i + 1) for i in f))
+            lines.append("f " + " ".join(str(nverts + i + 1) for i in face))
             faces += 1
         nverts += len(mesh.vertices)
         placed += 1
@@ -231,10 +231,10 @@ def parse_obj(text: str, *, path: object = "<string>") -> Mesh:
         kw = t[0]
         try:
             if kw in ("v", "vn"):
-                xyz = tuple(float(v) for v in t[1:4])
-                if len(xyz) != 3 or not all(math.isfinite(c) for c in xyz):
+                vals = [float(v) for v in t[1:4]]
+                if len(vals) != 3 or not all(math.isfinite(c) for c in vals):
                     raise ValueError
-                (verts if kw == "v" else normals).append(xyz)  # type: ignore[arg-type]
+                (verts if kw == "v" else normals).append((vals[0], vals[1], vals[2]))
             elif kw == "f":
                 idx = []
                 for tok in t[1:]:
@@ -256,7 +256,9 @@ def parse_obj(text: str, *, path: object = "<string>") -> Mesh:
             elif kw == "mtllib":
                 libs.extend(t[1:])
         except ValueError:
-            raise FormatError(f"bad {kw!r} statement: {raw.strip()!r}", path=path, line=lineno) from None
+            raise FormatError(
+                f"bad {kw!r} statement: {raw.strip()!r}", path=path, line=lineno
+            ) from None
     return Mesh(
         np.array(verts, dtype=np.float64).reshape(-1, 3),
         faces,

@@ -114,7 +114,7 @@ class OverlapModel(RuleSet):
         for anchor in np.ndindex(*[len(a) for a in anchors]):
             idx = tuple((g + a) % n for g, a, n in zip(grids, anchor, s.shape, strict=True))
             p = s[idx]
-            for k, q in enumerate(_sym_images(p)[:symmetry]):
+            for q in _sym_images(p)[:symmetry]:
                 key = q.tobytes()
                 j = index.get(key)
                 if j is None:
@@ -196,7 +196,9 @@ class OverlapModel(RuleSet):
         p = Path(path)
         img = load_image(p)
         if img.shape[0] * img.shape[1] > 256 * 256:
-            raise FormatError(f"sample {img.shape[1]}x{img.shape[0]} is too large (max 256x256)", path=p)
+            raise FormatError(
+                f"sample {img.shape[1]}x{img.shape[0]} is too large (max 256x256)", path=p
+            )
         flat = img.reshape(-1, 4)
         _, first, inv = np.unique(flat, axis=0, return_index=True, return_inverse=True)
         order = np.argsort(first)
@@ -252,4 +254,3 @@ class OverlapModel(RuleSet):
         img = self.reconstruct(g, periodic=periodic)
         K = int(self.patterns.max()) + 1
         return render(img, K=K, colors=self.sample_colors, scale=scale)
-

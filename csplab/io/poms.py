@@ -144,15 +144,24 @@ def parse_poms(
         if not isinstance(weights, list) or len(weights) != K:
             raise FormatError(f"'weight' must be a list of {K} numbers", path=path)
         for i, w in enumerate(weights):
-            if isinstance(w, bool) or not isinstance(w, int | float) or not w >= 0 or w == float("inf"):
-                raise FormatError(f"weight[{i}] must be a non-negative number, got {w!r}", path=path)
+            if (
+                isinstance(w, bool)
+                or not isinstance(w, int | float)
+                or not w >= 0
+                or w == float("inf")
+            ):
+                raise FormatError(
+                    f"weight[{i}] must be a non-negative number, got {w!r}", path=path
+                )
     F = np.zeros((6, K, K), dtype=bool)  # F[dir, a, b]: b may be in direction dir of a
     ok = arr[:, 3] > 0
     F[dr[ok].astype(int), src[ok].astype(int), dst[ok].astype(int)] = True
     opp = [1, 0, 3, 2, 5, 4]
     one_way = int((F & ~F[opp].transpose(0, 2, 1)).sum())
     if one_way:
-        warn.add(f"{one_way} rules are stated in one direction only; csplab uses every rule both ways")
+        warn.add(
+            f"{one_way} rules are stated in one direction only; csplab uses every rule both ways"
+        )
     size = d.get("size")
     shape3: tuple[int, int, int] | None = None
     if size is not None:
@@ -258,7 +267,9 @@ def parse_poms(
         "warnings": warn.items,
         "axes": "csplab (x, y) = POMS (x, -y)"
         if two_d
-        else ("csplab (x, y, z) = POMS (x, -z, y)" if y_up else "csplab (x, y, z) = POMS (x, y, z)"),
+        else (
+            "csplab (x, y, z) = POMS (x, -z, y)" if y_up else "csplab (x, y, z) = POMS (x, y, z)"
+        ),
     }
     pieces = _pieces(d.get("objMap"), path, K, warn)
     if pieces:

@@ -301,7 +301,9 @@ class RuleSet:
         elif boundary == "none":
             ops = list(self.constraint_ops)
         else:
-            raise InputError(f"boundary must be None, 'auto', 'none' or a mapping, not {boundary!r}")
+            raise InputError(
+                f"boundary must be None, 'auto', 'none' or a mapping, not {boundary!r}"
+            )
         meta = {
             "format": self.meta.get("format"),
             "source": self.meta.get("source"),
@@ -364,7 +366,8 @@ class RuleSet:
             im = self.images.astype(np.float64)
             a = im[..., 3:4] / 255.0
             tot = np.maximum(a.sum(axis=(1, 2)), 1e-9)
-            return np.clip((im[..., :3] * a).sum(axis=(1, 2)) / tot, 0, 255).astype(np.uint8)
+            mean = np.clip((im[..., :3] * a).sum(axis=(1, 2)) / tot, 0, 255)
+            return np.asarray(mean, dtype=np.uint8)
         return palette(self.K)
 
     def render(

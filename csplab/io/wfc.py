@@ -121,7 +121,9 @@ def load_image(path: Path, *, where: object = None) -> NDArray[np.uint8]:
     except FormatError:
         raise
     except Exception as e:  # PIL raises many kinds of errors on bad files
-        raise FormatError(f"cannot read image ({type(e).__name__}: {e})", path=where or path) from None
+        raise FormatError(
+            f"cannot read image ({type(e).__name__}: {e})", path=where or path
+        ) from None
     return arr
 
 
@@ -157,7 +159,11 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
     if subset is not None:
         xsubsets = root.find("subsets")
         names_ = [s.get("name") for s in xsubsets.iter("subset")] if xsubsets else []
-        xs = next((s for s in xsubsets.iter("subset") if s.get("name") == subset), None) if xsubsets else None
+        xs = (
+            next((s for s in xsubsets.iter("subset") if s.get("name") == subset), None)
+            if xsubsets
+            else None
+        )
         if xs is None:
             raise FormatError(
                 f"no subset {subset!r}; subsets: {', '.join(n for n in names_ if n) or 'none'}",
@@ -210,7 +216,9 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
         parts = text.split()
         if not 1 <= len(parts) <= 2:
             raise FormatError(
-                f"<neighbor> {side}={text!r}: expected 'name' or 'name k'", path=path, line=node.line
+                f"<neighbor> {side}={text!r}: expected 'name' or 'name k'",
+                path=path,
+                line=node.line,
             )
         nm = parts[0]
         if nm not in seen:
@@ -313,7 +321,9 @@ def _images(
                 continue
             base = load_image(f)
             if base.shape[0] != base.shape[1]:
-                raise FormatError(f"tile image is {base.shape[1]}x{base.shape[0]}, not square", path=f)
+                raise FormatError(
+                    f"tile image is {base.shape[1]}x{base.shape[0]}, not square", path=f
+                )
             for w in _STAB[sym]:
                 if not np.array_equal(_transform(base, w), base):
                     warn.add(

@@ -148,9 +148,8 @@ def corrupted(draw: Any, data: bytes, max_edits: int = 3) -> bytes:
                 continue
             m = attrs[draw(st.integers(0, len(attrs) - 1))]
             piece = b"" if kind == "del_attr" else m.group(0) + b" "
-            at = m.start() if kind == "dup_attr" else m.start()
             end = m.start() if kind == "dup_attr" else m.end()
-            out = out[:at] + piece + out[end:]
+            out = out[: m.start()] + piece + out[end:]
     return bytes(out)
 
 

@@ -172,7 +172,9 @@ def tiny_poms() -> None:
         "name": ["air", "ground", "pillar"],
         "weight": [4, 1, 1],
         "size": [5, 3, 4],
-        "boundaryCondition": {f: {"type": "tile", "value": 0} for f in ("x+", "x-", "z+", "z-", "y+")},
+        "boundaryCondition": {
+            f: {"type": "tile", "value": 0} for f in ("x+", "x-", "z+", "z-", "y+")
+        },
         "constraint": [
             {"type": "quiltForce", "range": {"x": [], "y": [0, 1], "z": [], "tile": [1, 2]}},
             {"type": "remove", "range": {"x": [], "y": [1], "z": [], "tile": [1, 2]}},

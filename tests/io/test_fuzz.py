@@ -9,7 +9,7 @@ from csplab.errors import CsplabError
 from csplab.io import read_model
 from csplab.testing.strategies import corrupted, tile_rule_sets
 
-from ._helpers import DATA, ANCHORS
+from ._helpers import ANCHORS, DATA
 
 SMALL = {
     "wfc.xml": (DATA / "pipes.xml").read_bytes(),
@@ -43,14 +43,16 @@ def load(tmp_path, name, data):
 
 
 @pytest.mark.parametrize("name", sorted(SMALL))
-@settings(max_examples=60, deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(data=__import__("hypothesis").strategies.data())
 def test_corrupted_files_raise_only_csplab_errors(tmp_path, name, data):
     bad = data.draw(corrupted(SMALL[name]))
     load(tmp_path, name, bad)
 
 
-@settings(max_examples=40, deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=40, deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(xml=tile_rule_sets())
 def test_random_wfc_tilesets_are_closed_and_solvable_or_fail_cleanly(tmp_path, xml):
     import csplab

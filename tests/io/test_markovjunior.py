@@ -92,8 +92,8 @@ def test_square_symmetry_top_bottom():
 @pytest.mark.parametrize(
     ("xml", "what"),
     [
-        ("<tileset fullSymmetry='1'><tiles><tile name='A'/></tiles><neighbors><neighbor left='q A' right='A'/>"
-         "</neighbors></tileset>", "unknown symmetry"),
+        ("<tileset fullSymmetry='1'><tiles><tile name='A'/></tiles><neighbors>"
+         "<neighbor left='q A' right='A'/></neighbors></tileset>", "unknown symmetry"),
         ("<tileset fullSymmetry='True'><tiles><tile name='A'/></tiles><neighbors>"
          "<neighbor top='A' bottom='A'/></neighbors></tileset>", "top/bottom"),
         ("<tileset><tiles><tile name='A'/></tiles><neighbors><neighbor left='x A' right='A'/>"

@@ -68,7 +68,9 @@ def test_adjacency_is_overlap_agreement(sample, N, sym):
     for d in range(2):
         for a in range(m.K):
             for b in range(m.K):
-                agree = np.array_equal(np.take(P[a], range(1, N), axis=d), np.take(P[b], range(N - 1), axis=d))
+                agree = np.array_equal(
+                    np.take(P[a], range(1, N), axis=d), np.take(P[b], range(N - 1), axis=d)
+                )
                 assert m.relations[d, a, b] == agree
 
 

@@ -40,7 +40,7 @@ def test_pieces_are_placed_in_the_obj(tmp_path):
     mesh = read_obj(tmp_path / "m.obj")
     assert stats["pieces"] == 3 and len(mesh.faces) == 3
     assert {m for m in mesh.face_material} == {"stone", "wood"}
-    # the pillar piece at csplab (1, 0, 1) sits at OBJ (x, z, -y) = (1, 1, 0) + its apex (0.5, 1, 0.5)
+    # the pillar at csplab (1, 0, 1) sits at OBJ (x, z, -y) = (1, 1, 0), apex (0.5, 1, 0.5)
     assert np.allclose(mesh.vertices.max(axis=0), [2.0, 2.0, 1.0])
 
 
@@ -112,7 +112,9 @@ def test_shared_files_every_solver(rel, shape, solver):
     statuses = []
     for seed in range(3):
         try:
-            r = csplab.solve(P, solver, rng=seed, **({"order": "min-entropy"} if solver == "catalog" else {}))
+            r = csplab.solve(
+                P, solver, rng=seed, **({"order": "min-entropy"} if solver == "catalog" else {})
+            )
         except csplab.CsplabError as e:  # blocks: no trivial starting model for pillMortal
             assert solver == "blocks" and "consistent starting model" in str(e)
             pytest.xfail(f"{solver}: {e}")

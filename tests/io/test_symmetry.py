@@ -2,8 +2,14 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab.io.symmetry import Orientations, closure_violations, cube_group, expand_rules, square_group
-from csplab.io.wfc import CARDINALITY, _ORDER, stabilizer_words
+from csplab.io.symmetry import (
+    Orientations,
+    closure_violations,
+    cube_group,
+    expand_rules,
+    square_group,
+)
+from csplab.io.wfc import _ORDER, CARDINALITY, stabilizer_words
 
 
 def test_group_orders_and_subgroups():
@@ -33,13 +39,18 @@ def test_wfc_action_tables_are_reproduced():
         "\\": (lambda i: 1 - i, lambda i: 1 - i),
         "T": (lambda i: (i + 1) % 4, lambda i: i if i % 2 == 0 else 4 - i),
         "L": (lambda i: (i + 1) % 4, lambda i: i + 1 if i % 2 == 0 else i - 1),
-        "F": (lambda i: (i + 1) % 4 if i < 4 else 4 + (i - 1) % 4, lambda i: i + 4 if i < 4 else i - 4),
+        "F": (
+            lambda i: (i + 1) % 4 if i < 4 else 4 + (i - 1) % 4,
+            lambda i: i + 4 if i < 4 else i - 4,
+        ),
     }
     G = square_group()
     a, b = G.index("a"), G.index("b")
     for sym, (fa, fb) in tables.items():
         card = CARDINALITY[sym]
-        O = Orientations(G, [G.subgroup(stabilizer_words(sym))], [[G.index(w) for w in _ORDER[:card]]])
+        O = Orientations(
+            G, [G.subgroup(stabilizer_words(sym))], [[G.index(w) for w in _ORDER[:card]]]
+        )
         assert O.K == card
         assert [int(O.perm[a, t]) for t in range(card)] == [fa(t) for t in range(card)], sym
         assert [int(O.perm[b, t]) for t in range(card)] == [fb(t) for t in range(card)], sym
@@ -62,7 +73,7 @@ def test_expanded_rules_are_closed(data):
     T = expand_rules(O, rules)
     assert closure_violations(G, O.perm, T) == []
     for a, b, (ax, s) in rules:
-        assert (T[ax, a, b] if s > 0 else T[ax, b, a])
+        assert T[ax, a, b] if s > 0 else T[ax, b, a]
 
 
 def test_closure_violations_finds_a_missing_image():
