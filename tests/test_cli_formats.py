@@ -44,7 +44,7 @@ def test_wfc_tileset_synthesize_check_show(tmp_path, capsys):
 
 def test_sample_png_overlapping(tmp_path, capsys):
     png = tmp_path / "o.png"
-    code, o, _ = run(capsys, "synthesize", DATA / "sample.png", "--size", "20x12", "--periodic",
+    code, _o, _ = run(capsys, "synthesize", DATA / "sample.png", "--size", "20x12", "--periodic",
                      "--seed", "2", "--model-option", "N=3", "--model-option", "symmetry=2",
                      "--out", png)  # fmt: skip
     assert code == 0
@@ -56,8 +56,9 @@ def test_sample_png_overlapping(tmp_path, capsys):
 def test_3d_exports_and_show(tmp_path, capsys):
     vox, obj = tmp_path / "k.vox", tmp_path / "k.obj"
     for f in (vox, obj):
-        code, _, err = run(capsys, "synthesize", DATA / "pipes3d.xml", "--size", "6x6x4", "--seed",
-                           "3", "--boundary", "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0", "--out", f)  # fmt: skip
+        empty = "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0"
+        code, _, err = run(capsys, "synthesize", DATA / "pipes3d.xml", "--size", "6x6x4",
+                           "--seed", "3", "--boundary", empty, "--out", f)  # fmt: skip
         assert code == 0, err
     v = read_vox(vox)
     assert v.grid.shape == (6, 6, 4) and not v.grid[0].any()  # the boundary is empty space
@@ -75,7 +76,7 @@ def test_show_every_format(tmp_path, capsys, monkeypatch):
         code, o, err = run(capsys, "show", DATA / f)
         assert code == 0, err
         assert (tmp_path / (f.rsplit(".", 1)[0] + ".png")).exists()
-    code, o, _ = run(capsys, "show", "line")
+    code, _o, _ = run(capsys, "show", "line")
     assert code == 0 and (tmp_path / "line.png").exists()
 
 
