@@ -73,7 +73,7 @@ def test_3d_exports_and_show(tmp_path, capsys):
 def test_show_every_format(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for f in ("pipes.xml", "pipes3d.xml", "tiny_poms.json", "tiny_debroglie.json", "sample.png"):
-        code, o, err = run(capsys, "show", DATA / f)
+        code, _, err = run(capsys, "show", DATA / f)
         assert code == 0, err
         assert (tmp_path / (f.rsplit(".", 1)[0] + ".png")).exists()
     code, _o, _ = run(capsys, "show", "line")
