@@ -18,11 +18,11 @@ Examples
 >>> import numpy as np
 >>> sample = np.array([[0, 0, 1], [0, 0, 1], [1, 1, 1]])    # [x, y]: wall on the right and top
 >>> m = OverlapModel.from_grid(sample, N=2, symmetry=1)
->>> m.K, int(m.weights.sum())                                # 9 anchors, periodic input
-(4, 9)
+>>> m.K, int(m.weights.sum())                      # 9 anchors, all different (periodic input)
+(9, 9)
 >>> import csplab
 >>> r = csplab.solve(m.problem((6, 6), periodic=True), "catalog", rng=0)
->>> r.status, m.reconstruct(r.grid).shape
+>>> r.status, m.reconstruct(r.grid, periodic=True).shape
 ('solved', (6, 6))
 """
 
