@@ -141,3 +141,19 @@ def test_shared_files_cli(tmp_path, capsys, rel, size, extra, solver):
         pytest.xfail(f"{solver} gave up on {rel} with 3 seeds")
     code, o, _ = run(capsys, "check", p, out, *extra)
     assert code == 0 and o.startswith("0 violations")
+
+
+def test_text_outputs_of_tilesets_check_back(tmp_path, capsys):
+    """Names with spaces, '#' or digits ("corner 1", "1") survive the .grid format."""
+    cfg = {"tiles": [{"value": 1}, {"value": 0}, {"value": "#a b"}],
+           "adjacencies": [{"left": [1, 0, "#a b"], "right": [0, "#a b"]},
+                           {"up": [1, 0], "down": [1, 0, "#a b"]}]}  # fmt: skip
+    (tmp_path / "n.json").write_text(json.dumps(cfg))
+    for model in (DATA / "pipes.xml", tmp_path / "n.json"):
+        for ext in ("grid", "txt", "npy"):
+            out = tmp_path / f"o.{ext}"
+            code, _, err = run(capsys, "synthesize", model, "--size", "5x4", "--seed", "1",
+                               "--out", out)  # fmt: skip
+            assert code == 0, err
+            code, o, _ = run(capsys, "check", model, out)
+            assert code == 0 and o.startswith("0 violations"), (model, ext, o)

@@ -50,6 +50,7 @@ __all__ = [
     "detect_format",
     "format_grid",
     "format_merrell",
+    "grid_safe_names",
     "model_format",
     "parse_grid",
     "parse_merrell",
@@ -308,5 +309,29 @@ def write_labels(
         )
     if g.min() < 0:
         raise InputError(f"{p}: the grid has unassigned cells; write it as .npy or .png")
+    if names is not None and ext == ".grid":
+        names = grid_safe_names(names)
     ex = ExampleModel(g, names=names, name=name, metadata=metadata or {})
     write_example(ex, p)
+
+
+def grid_safe_names(names: Any) -> list[str]:
+    """Label names usable as tokens of the grid format: no whitespace or ``#``, not a
+    number (tokens that are numbers mean label ids), all different.
+
+    Examples
+    --------
+    >>> grid_safe_names(["corner 1", "1", "#_0", "corner_1"])
+    ['corner_1', 't1', '__0', 'corner_1.3']
+    """
+    out: list[str] = []
+    seen: set[str] = set()
+    for i, n in enumerate(names):
+        t = re.sub(r"[\s#]+", "_", str(n)) or f"label{i}"
+        if t.lstrip("-").isdigit():
+            t = "t" + t
+        if t in seen:
+            t = f"{t}.{i}"
+        seen.add(t)
+        out.append(t)
+    return out
