@@ -293,6 +293,21 @@ def write_labels(
     if ext == ".npy":
         np.save(p, g)
         return
+    if ext in (".vox", ".obj") and isinstance(model, RuleSet) and model.voxels is not None:
+        vox = model.expand_voxels(g)  # the tiles' own voxels, as MarkovJunior writes them
+        if ext == ".obj" or max(vox.shape) <= 256:
+            assert model.voxel_palette is not None
+            g = vox.astype(np.int32) - 1  # colour index c -> label c - 1, empty -> -1
+            colors, empty, names, pieces = model.voxel_palette[1:], -1, None, {}
+        else:
+            import warnings
+
+            warnings.warn(
+                f"{p}: the tile voxels make a {'x'.join(map(str, vox.shape))} model, more than "
+                ".vox holds (256 per axis); writing one voxel per cell",
+                UserWarning,
+                stacklevel=2,
+            )
     if ext == ".vox":
         from csplab.io.vox import write_vox
 

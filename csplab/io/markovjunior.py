@@ -165,8 +165,10 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
             for v in vox
         ]
         how = "voxel data"
+        vox_src = vox
     else:
-        stabs = _infer_stabilizers(G, len(tiles), stated)
+        stabs, arms = _infer_stabilizers(G, len(tiles), stated)
+        vox_src = [_socket_voxels(arms[t], t + 1) for t in range(len(tiles))]
         how = "inferred from the rules"
     orient = Orientations(G, stabs)
     rules = [(orient.label(ta, ga), orient.label(tb, gb), d) for (ta, ga), (tb, gb), d in stated]
@@ -202,12 +204,27 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
         "rules_stated": len(stated),
         "warnings": warn.items,
     }
+    label_vox = np.stack(
+        [
+            transform_voxels(vox_src[t], G.elements[g])
+            for t, g in zip(orient.tile_of, orient.rep, strict=True)
+        ]
+    ).astype(np.uint8)
+    if vox is None:
+        from csplab.render import palette
+
+        pal = np.zeros((256, 3), dtype=np.uint8)
+        pal[1 : len(tiles) + 1] = palette(len(tiles) + 1)[1:]
+    else:
+        pal = _palette(path, [t[0] for t in tiles])
     rs = RuleSet(
         T,
         names=names,
         weights=weights,
         name=Path(str(path)).stem,
         empty=empty,
+        voxels=label_vox,
+        voxel_palette=pal,
         symmetry=(G, orient.perm),
         meta=meta,
     )
@@ -227,10 +244,34 @@ def _label_name(G: Group, H: frozenset[int], g: int, tile: str) -> str:
     return f"{best} {tile}" if best else tile
 
 
+def _socket_voxels(arms: list[bool], colour: int) -> NDArray[np.uint8]:
+    """A 3x3x3 picture of a tile from its sockets: an arm towards every face whose socket is
+    not the common one (pipes, for a tileset like Knots3D)."""
+    v = np.zeros((3, 3, 3), dtype=np.uint8)
+    if any(arms):
+        v[1, 1, 1] = colour
+    for (ax, sg), on in zip(_DIRS, arms, strict=True):
+        if on:
+            idx = [1, 1, 1]
+            idx[ax] = 2 if sg > 0 else 0
+            v[tuple(idx)] = colour
+    return v
+
+
+def _palette(path: object, names: list[str]) -> NDArray[np.uint8]:
+    from csplab.io.vox import read_vox
+
+    p = Path(str(path))
+    models = [read_vox(p.parent / p.stem / f"{nm}.vox") for nm in names]
+    best = max(models, key=lambda m: len(np.unique(m.grid)))  # the tile using most colours
+    return np.ascontiguousarray(best.palette[:, :3])
+
+
 def _infer_stabilizers(
     G: Group, ntiles: int, stated: list[tuple[tuple[int, int], tuple[int, int], tuple[int, int]]]
-) -> list[frozenset[int]]:
-    """Tile symmetries from face sockets glued together by the stated rules."""
+) -> tuple[list[frozenset[int]], list[list[bool]]]:
+    """Tile symmetries from face sockets glued together by the stated rules, and which faces
+    of each tile have a socket other than the most common one."""
     parent = list(range(ntiles * 6))
 
     def find(i: int) -> int:
@@ -264,7 +305,8 @@ def _infer_stabilizers(
             ):
                 H.append(g)
         stabs.append(frozenset(H))
-    return stabs
+    arms = [[sock[t * 6 + k] != default for k in range(6)] for t in range(ntiles)]
+    return stabs, arms
 
 
 def _voxels(path: object, names: list[str], warn: _Warnings) -> list[NDArray[np.uint8]] | None:

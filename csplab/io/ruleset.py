@@ -129,6 +129,10 @@ class RuleSet:
         One colour per label for pictures without tile images.
     empty : int, optional
         The empty-space label, left out of 3D pictures and exports.
+    voxels : uint8 array ``(K, s, s, s)``, optional
+        3D tile pictures: colour indices into ``voxel_palette`` (0 = empty), composited by
+        :meth:`render` and :meth:`expand_voxels`.
+    voxel_palette : uint8 array ``(256, 3)``, optional
     symmetry : (Group, perm), optional
         The symmetry group and its action on the labels, ``perm[g, label]`` (for
         :meth:`closure_violations`).
@@ -150,6 +154,8 @@ class RuleSet:
         images: ArrayLike | None = None,
         colors: ArrayLike | None = None,
         empty: int | None = None,
+        voxels: ArrayLike | None = None,
+        voxel_palette: ArrayLike | None = None,
         symmetry: tuple[Group, NDArray[np.int64]] | None = None,
         meta: Mapping[str, Any] | None = None,
     ) -> None:
@@ -196,6 +202,16 @@ class RuleSet:
         if empty is not None and not 0 <= empty < K:
             raise InputError(f"empty label {empty} is outside 0..{K - 1}")
         self.empty = empty
+        self.voxels: NDArray[np.uint8] | None = None
+        self.voxel_palette: NDArray[np.uint8] | None = None
+        if voxels is not None:
+            vx = np.asarray(voxels, dtype=np.uint8)
+            if vx.ndim != 4 or vx.shape[0] != K:
+                raise InputError(f"voxels must have shape ({K}, s, s, s), got {vx.shape}")
+            pal = np.asarray(voxel_palette if voxel_palette is not None else _gray(), np.uint8)
+            if pal.shape != (256, 3):
+                raise InputError(f"voxel_palette must have shape (256, 3), got {pal.shape}")
+            self.voxels, self.voxel_palette = vx, pal
         self.symmetry = symmetry
         self.meta: dict[str, Any] = dict(meta or {})
         self.meta.setdefault("warnings", [])
@@ -370,6 +386,21 @@ class RuleSet:
             return np.asarray(mean, dtype=np.uint8)
         return palette(self.K)
 
+    def expand_voxels(self, grid: ArrayLike) -> NDArray[np.uint8]:
+        """A 3D label grid with every cell replaced by its tile's voxels (colour indices,
+        0 = empty; unassigned cells are empty)."""
+        if self.voxels is None:
+            raise InputError(f"{self.name or 'this rule set'} has no voxel tiles")
+        g = np.asarray(grid, dtype=np.int64)
+        if g.ndim != 3:
+            raise InputError(f"voxel tiles need a 3D grid, got shape {g.shape}")
+        ext = np.concatenate([self.voxels, np.zeros((1, *self.voxels.shape[1:]), np.uint8)])
+        v = ext[np.where((g >= 0) & (g < self.K), g, self.K)]  # (nx, ny, nz, sx, sy, sz)
+        nx, ny, nz, sx, sy, sz = v.shape
+        return np.ascontiguousarray(
+            v.transpose(0, 3, 1, 4, 2, 5).reshape(nx * sx, ny * sy, nz * sz)
+        )
+
     def render(
         self, grid: ArrayLike, *, scale: int | None = None, periodic: bool | None = None
     ) -> Image.Image:
@@ -381,6 +412,11 @@ class RuleSet:
         g = np.asarray(grid)
         if self.images is not None and g.ndim == 2:
             return render(g, tiles=self.images, scale=scale)
+        if self.voxels is not None and g.ndim == 3 and g.size * self.voxels[0].size <= 2_000_000:
+            assert self.voxel_palette is not None
+            return render(
+                self.expand_voxels(g), K=256, colors=self.voxel_palette, empty=0, scale=scale
+            )
         return render(g, K=self.K, colors=self.label_colors(), empty=self.empty, scale=scale)
 
     def sheet(self, columns: int | None = None) -> Image.Image:
@@ -415,6 +451,14 @@ class RuleSet:
         buf = io.BytesIO()
         self.sheet().save(buf, format="PNG")
         return buf.getvalue()
+
+
+def _gray() -> NDArray[np.uint8]:
+    from csplab.render import palette
+
+    p = palette(256)
+    p[0] = 0
+    return p
 
 
 @dataclass

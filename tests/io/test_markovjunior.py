@@ -104,3 +104,43 @@ def test_square_symmetry_top_bottom():
 def test_errors(xml, what):
     with pytest.raises(FormatError, match=what):
         parse_markovjunior(xml, path="bad.xml")
+
+
+def test_tile_voxels_are_composited_in_pictures_and_exports(tmp_path):
+    from csplab.io import write_labels
+    from csplab.io.obj import read_obj
+    from csplab.io.vox import read_vox
+
+    rs = read_markovjunior(DATA / "pipes3d.xml")
+    assert rs.voxels is not None and rs.voxels.shape == (16, 3, 3, 3)
+    empty = {f"{a}{s}": 0 for a in "xyz" for s in "-+"}
+    P = rs.problem((5, 4, 3), boundary=empty)
+    r = csplab.solve(P, "catalog", rng=2)
+    assert r.ok
+    write_labels(r.grid, tmp_path / "m.vox", model=rs)
+    v = read_vox(tmp_path / "m.vox")
+    assert np.array_equal(v.grid, rs.expand_voxels(r.grid))  # MarkovJunior-style output
+    base = read_vox(DATA / "pipes3d" / "Turn.vox")
+    assert np.array_equal(v.palette[1:3], base.palette[1:3])  # the tiles' own colours
+    # pipes are closed: every arm voxel on a cell's +d face meets one across the border
+    vox = v.grid > 0
+    assert vox.sum() > 0
+    for d in range(3):
+        idx = np.indices(vox.shape)
+        on_face = (idx[d] % 3 == 2) & np.all([idx[e] % 3 == 1 for e in range(3) if e != d], axis=0)
+        arms = np.argwhere(vox & on_face)
+        nxt = arms.copy()
+        nxt[:, d] += 1
+        assert (nxt[:, d] < vox.shape[d]).all() and vox[tuple(nxt.T)].all()
+    write_labels(r.grid, tmp_path / "m.obj", model=rs)
+    assert len(read_obj(tmp_path / "m.obj").faces) > 0
+    assert rs.render(r.grid).size[0] > 0
+
+
+def test_inferred_tiles_get_pipe_pictures(tmp_path):
+    shutil.copy(DATA / "pipes3d.xml", tmp_path / "pipes3d.xml")
+    with pytest.warns(UserWarning):
+        inferred = read_markovjunior(tmp_path / "pipes3d.xml")
+    exact = read_markovjunior(DATA / "pipes3d.xml")
+    # same shapes (arms towards the connected faces), colours by tile
+    assert np.array_equal(inferred.voxels > 0, exact.voxels > 0)
