@@ -60,12 +60,12 @@ def test_3d_exports_and_show(tmp_path, capsys):
         code, _, err = run(capsys, "synthesize", DATA / "pipes3d.xml", "--size", "6x6x4",
                            "--seed", "3", "--boundary", empty, "--out", f)  # fmt: skip
         assert code == 0, err
-    v = read_vox(vox)
-    assert v.grid.shape == (6, 6, 4) and not v.grid[0].any()  # the boundary is empty space
+    v = read_vox(vox)  # the tiles' 3x3x3 voxels, composited
+    assert v.grid.shape == (18, 18, 12) and not v.grid[:3].any()  # the boundary is empty space
     mesh = read_obj(obj)
     assert len(mesh.faces) > 0 and len(mesh.materials) >= 1
     code, o, _ = run(capsys, "show", vox, "--out", tmp_path / "v.png")
-    assert code == 0 and "6x6x4 grid" in o
+    assert code == 0 and "18x18x12 grid" in o
     code, o, _ = run(capsys, "show", DATA / "pipes3d.xml", "--out", tmp_path / "s.png")
     assert code == 0 and "16 labels of markovjunior" in o
 
