@@ -87,19 +87,19 @@ def main() -> None:
     from csplab.testing.synthetic import box_town
 
     t_jit = jit_warmup()
-    print(f"csplab {csplab.__version__}, JIT/cache load {t_jit:.2f} s, size {args.size}, "
-          f"boundary {args.boundary}, {args.seeds} seeds, time limit {args.time_limit} s")  # fmt: skip
+    print(
+        f"csplab {csplab.__version__}, JIT/cache load {t_jit:.2f} s, size {args.size}, "
+        f"boundary {args.boundary}, {args.seeds} seeds, time limit {args.time_limit} s"
+    )
 
     examples: list[tuple[str, Any]] = []
-    names = args.examples or [
-        n for n in csplab.example_names() if csplab.load_example(n).ndim == 3
-        and min(csplab.load_example(n).shape) > 1
-    ]  # fmt: skip
-    for n in names:
+    for n in args.examples or csplab.example_names():
         if n.startswith("box_town_"):
             examples.append((n, box_town(int(n.rsplit("_", 1)[1]), rng=0)))
-        else:
-            examples.append((n, csplab.load_example(n)))
+            continue
+        E = csplab.load_example(n)
+        if args.examples or (E.ndim == 3 and min(E.shape) > 1):
+            examples.append((n, E))
     if not examples:
         print("(no built-in 3D examples yet: using the synthetic box towns of "
               "csplab.testing.synthetic)")  # fmt: skip

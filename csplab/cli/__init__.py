@@ -24,6 +24,7 @@ COMMANDS: dict[str, str] = {
     "info": "csplab.cli.info",
     "explain": "csplab.cli.explain",
     "catalog-gap": "csplab.cli.catalog_gap",
+    "show": "csplab.cli.show",
 }
 
 

@@ -26,7 +26,7 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    add_problem_args(p)
+    add_problem_args(p, size_required=True)
     add_fixed_args(p)
     p.add_argument("--seed", type=int, help="random seed of Alg. 3.1 (default: fresh, printed)")
     p.add_argument("--order", choices=["scanline", "random", "min-entropy"], default="scanline")
@@ -45,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
-    example, problem = problem_with_fixed(args)
+    model, problem = problem_with_fixed(args)
     v = catalog_gap(problem, args.seed, order=args.order, choice=args.choice,
                     backend=args.backend, sizes=args.sizes, time_limit=args.time_limit)  # fmt: skip
     code = 3 if v.holds is None else (0 if v.holds else 1)
@@ -54,7 +54,7 @@ def run(args: argparse.Namespace) -> int:
         return code
     st = v.stats
     size = "x".join(map(str, problem.shape))
-    print(f"{example.name or args.model} {size} (K={problem.K}), Alg. 3.1 {args.order}/"
+    print(f"{model.name or args.model} {size} (K={problem.K}), Alg. 3.1 {args.order}/"
           f"{args.choice}, seed {st.get('seed')}: {st.get('alg31_status')} after "
           f"{st.get('steps_taken', 0)} steps")  # fmt: skip
     if args.steps == "all":

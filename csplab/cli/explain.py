@@ -19,9 +19,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.cli.common import add_problem_args, load_model, parse_boundary
+from csplab.cli.common import add_problem_args, load_model, model_options, problem_from_args
 from csplab.errors import FormatError, InputError
-from csplab.problem import Problem, parse_shape
+from csplab.problem import Problem
 
 
 def add_parser(sub: Any) -> argparse.ArgumentParser:
@@ -31,7 +31,7 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    add_problem_args(p)
+    add_problem_args(p, size_required=True)
     add_fixed_args(p)
     p.add_argument("--backend", help="pysat backend (default cadical195)")
     p.add_argument("--no-minimize", action="store_true", help="report the first core as is")
@@ -60,8 +60,8 @@ def load_fixed(path: str, shape: tuple[int, ...]) -> NDArray[np.int64]:
         if not np.issubdtype(arr.dtype, np.integer):
             raise FormatError(f"fixed cells must be integers (-1 = free), got {arr.dtype}",
                               path=path)  # fmt: skip
-        while arr.ndim > len(shape) and arr.shape[-1] == 1:
-            arr = arr[..., 0]
+        if arr.shape != shape and [d for d in arr.shape if d != 1] == [d for d in shape if d != 1]:
+            arr = arr.reshape(shape)  # e.g. a 2D array for an nz = 1 model
         if arr.shape != shape:
             raise FormatError(f"array has shape {arr.shape}, the model {shape}", path=path)
         return np.asarray(arr, dtype=np.int64)
@@ -75,10 +75,11 @@ def load_fixed(path: str, shape: tuple[int, ...]) -> NDArray[np.int64]:
         except ValueError:
             raise FormatError(f"expected integers 'x y [z] label', got {raw.strip()!r}",
                               path=path, line=lineno) from None  # fmt: skip
-        if len(nums) != len(shape) + 1:
+        ncoord = len(nums) - 1
+        if not 1 <= ncoord <= len(shape) or any(d != 1 for d in shape[max(ncoord, 1) :]):
             raise FormatError(f"expected {len(shape)} coordinates and a label, got "
                               f"{len(nums)} numbers", path=path, line=lineno)  # fmt: skip
-        coords = tuple(nums[:-1])
+        coords = tuple(nums[:-1]) + (0,) * (len(shape) - ncoord)
         if any(not 0 <= c < s for c, s in zip(coords, shape, strict=True)):
             raise FormatError(f"cell {coords} is outside the model {shape}", path=path,
                               line=lineno)  # fmt: skip
@@ -87,23 +88,28 @@ def load_fixed(path: str, shape: tuple[int, ...]) -> NDArray[np.int64]:
 
 
 def problem_with_fixed(args: argparse.Namespace) -> tuple[Any, Problem]:
-    """The example and the problem from ``MODEL --size --boundary --periodic --fixed --mask``."""
-    example = load_model(args.model)
-    shape = parse_shape(args.size, what="--size") if args.size else example.shape
-    if len(shape) < example.ndim:
-        shape = shape + (1,) * (example.ndim - len(shape))
-    fixed = load_fixed(args.fixed, shape) if getattr(args, "fixed", None) else None
-    mask = None
+    """The model and the problem from ``MODEL --size --boundary --periodic --fixed --mask``.
+
+    Fixed cells and mask cells become one unary restriction each (so an explanation can
+    name them one by one).
+    """
+    from csplab.problem import _build_unary
+
+    model = load_model(args.model, model_options(args.model_option))
+    problem = problem_from_args(args, model)
+    extra = []
+    if getattr(args, "fixed", None):
+        fixed = load_fixed(args.fixed, problem.shape)
+        extra += _build_unary(problem.shape, problem.K, fixed=fixed)
     if getattr(args, "mask", None):
         try:
             mask = np.load(args.mask, allow_pickle=False)
         except (OSError, ValueError) as e:
             raise FormatError(f"not a numpy file ({e})", path=args.mask) from None
-    problem = Problem.from_example(
-        example, shape, periodic=bool(args.periodic), boundary=parse_boundary(args.boundary),
-        fixed=fixed, mask=mask,
-    )  # fmt: skip
-    return example, problem
+        extra += _build_unary(problem.shape, problem.K, mask=mask)
+    if extra:
+        problem = problem._with_unary(extra)
+    return model, problem
 
 
 def run(args: argparse.Namespace) -> int:
@@ -111,7 +117,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.time_limit is not None and args.time_limit < 0:
         raise InputError("--time-limit must be >= 0")
-    example, problem = problem_with_fixed(args)
+    model, problem = problem_with_fixed(args)
     v = explain_unsat(problem, backend=args.backend, minimize=not args.no_minimize,
                       time_limit=args.time_limit)  # fmt: skip
     size = "x".join(map(str, problem.shape))
@@ -119,10 +125,10 @@ def run(args: argparse.Namespace) -> int:
         d = v.to_dict()
         if v.holds is False:
             d["witness"] = "a solution exists"
-        d.update(example=example.name or args.model, size=size)
+        d.update(model=model.name or args.model, size=size)
         print(json.dumps(d))
     else:
-        head = f"{example.name or args.model} {size} (K={problem.K}, {len(problem.unary)} "
+        head = f"{model.name or args.model} {size} (K={problem.K}, {len(problem.unary)} "
         head += "fixed/boundary/mask restrictions)"
         if v.holds is None:
             print(f"undecided: {head}: {v.message}")

@@ -300,7 +300,7 @@ class SatOracle:
         nc = starts.size - 1
         chunk = max(nc, 1)
         if deadline is not None:
-            chunk = 500_000 if self._fast is not None else 50_000
+            chunk = 100_000 if self._fast is not None else 20_000
         for a in range(0, nc, chunk):
             if deadline is not None and time.perf_counter() > deadline:
                 self.timed_out = True

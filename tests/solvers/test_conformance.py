@@ -103,7 +103,7 @@ def test_sat_enumeration_matches_brute_force_counts(P, amo):
     assert all(P.is_solution(g) for g in grids)
 
 
-_BIG = Problem.from_example(box_town(2, rng=0), (40, 40, 10))
+_BIG = Problem.from_example(box_town(2, rng=0), (30, 30, 8))
 
 
 @pytest.mark.parametrize(("spec", "opts"), SPECS, ids=IDS)
