@@ -511,6 +511,10 @@ def enumerate_solutions(
 ) -> Iterator[NDArray[np.int32]]:
     """Every solution grid, each once, by SAT with blocking clauses.
 
+    The blocking clause of a solution mentions only its ``x`` variables (not pysat's
+    ``enum_models``, which blocks whole models: auxiliary variables of an at-most-one
+    encoding could then repeat a grid).
+
     Examples
     --------
     >>> from csplab import ExampleModel, Problem
