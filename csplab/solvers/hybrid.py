@@ -10,6 +10,13 @@ resumes from there with fresh random choices. Each repair fixes at least one mor
 the loop ends; it never fails on a satisfiable problem and proves unsatisfiability with its
 first SAT call. When Alg. 3.1 succeeds no SAT solver is even created.
 
+Its outputs follow the same distribution as ``perfect`` (for the scanline order): steps
+before the doomed one drew a label of C(p) that happened to lie in C*(p), i.e. a uniform
+label of C*(p); the doomed draw is exactly the one ``perfect`` would reject, and it is
+redrawn uniformly from C*(p); later steps use fresh randomness. (A chi-square test against
+the exact distribution checks this: ``tests/solvers/test_perfect_hybrid.py``.) So
+``hybrid`` is a cheap sampler of the thesis' ideal algorithm.
+
 Options
 -------
 order : {"scanline", "random", "min-entropy"}

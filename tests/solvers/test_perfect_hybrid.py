@@ -54,3 +54,38 @@ def test_unsat_proofs_and_options():
     big = Problem.from_example(FALLIBLE, (40, 40))
     r = solve(big, "perfect", rng=0, time_limit=0.3)
     assert r.status in ("timeout", "solved") and r.time_s < 1.3
+
+
+def _perfect_distribution(P):
+    """Exact output distribution of Alg. 3.1 drawing uniformly from C* (scanline)."""
+    import numpy as np
+
+    from csplab.testing.brute import solutions
+
+    S = np.array([g.reshape(-1) for g in solutions(P)])
+    probs = []
+    for g in S:
+        p, mask = 1.0, np.ones(len(S), dtype=bool)
+        for t in range(P.n):
+            p /= len(set(S[mask, t].tolist()))  # |C*(p_t)| given the prefix
+            mask &= S[:, t] == g[t]
+        probs.append(p)
+    return S, np.array(probs)
+
+
+def test_hybrid_samples_the_same_distribution_as_perfect():
+    """A doomed draw of Alg. 3.1 is exactly what `perfect` rejects, so redrawing it from C*
+    (hybrid) gives each step a uniform label of C*: both match the exact distribution."""
+    import numpy as np
+
+    P = Problem.from_example(FALLIBLE, (2, 2))  # 17 solutions; Alg. 3.1 fails 32% of runs
+    S, probs = _perfect_distribution(P)
+    assert len(S) == 17 and abs(probs.sum() - 1) < 1e-9
+    N = 600
+    for name in ("hybrid", "perfect"):
+        counts = {g.astype(np.int32).tobytes(): 0 for g in S}
+        for seed in range(N):
+            counts[solve(P, name, rng=seed).grid.reshape(-1).tobytes()] += 1
+        obs = np.array(list(counts.values()))
+        chi2 = float(((obs - N * probs) ** 2 / (N * probs)).sum())
+        assert chi2 < 39.25, (name, chi2)  # chi-square, 16 degrees of freedom, alpha = 0.001
