@@ -67,7 +67,7 @@ from numpy.typing import NDArray
 from csplab.cnf import AMO_ENCODINGS, DeadlineExceeded, Encoding, amo_clauses, encode
 from csplab.errors import InputError
 from csplab.problem import Problem
-from csplab.result import Result
+from csplab.result import Result, Status
 
 __all__ = ["DEFAULT_BACKEND", "SatOracle", "SatSolver", "backends", "enumerate_solutions"]
 
@@ -587,24 +587,27 @@ class SatSolver:
         ) as o:  # fmt: skip
             stats = o.stats
             stats.update(encoding=encoding, supports=supports, amo=amo, phase=phase)
+            status = "timeout"
             if o.timed_out:
-                return Result("timeout", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
-            if not o.enc.ok:
+                pass
+            elif not o.enc.ok:
+                status = "unsat"
                 stats["proof"] = (
                     "arc-consistency wipe-out (unit propagation on the support encoding)"
                 )
                 stats["fail_cell"] = list(problem.coords(o.enc.wiped))
-                return Result("unsat", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
-            if phase != "none":
-                w = problem.weights if phase == "weighted" else None
-                o.set_phases(preferred_labels(o.enc.catalog, w, rng))
-            status = o.solve(deadline=deadline)
-            stats.update(o.solver_stats())
-            if status == "sat":
-                assert o.grid is not None
-                return Result("solved", o.grid, "sat", time_s=time.perf_counter() - t0,
-                              stats=stats)  # fmt: skip
-            if status == "unsat":
-                stats["proof"] = f"refutation by {o.backend}"
-                return Result("unsat", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
-            return Result("timeout", grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
+            else:
+                if phase != "none":
+                    w = problem.weights if phase == "weighted" else None
+                    o.set_phases(preferred_labels(o.enc.catalog, w, rng))
+                status = o.solve(deadline=deadline)
+                stats.update(o.solver_stats())
+                if status == "sat" and o.grid is not None:
+                    grid = o.grid
+                if status == "unsat":
+                    stats["proof"] = f"refutation by {o.backend}"
+            t1 = time.perf_counter()
+        # freeing a solver with millions of clauses takes a while: it counts
+        stats["free_s"] = time.perf_counter() - t1
+        final: Status = "solved" if status == "sat" else "unsat" if status == "unsat" else "timeout"
+        return Result(final, grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
