@@ -19,8 +19,8 @@ solver the same clauses in the same order (a property test compares their models
 Diversity: before solving, every cell gets a preferred label drawn from the catalog with
 the rng (``phase="uniform"``, the default, like Alg. 3.1's uniform choice, or
 ``"weighted"`` by the example's label frequencies) and the solver's decision phases are set
-to it; CaDiCaL is also seeded. Two seeds' outputs differ in about 40-55% of the cells at
-40×40×10 (``benchmarks/bench_solvers.py``; Alg. 3.1: 17-30%); ``"weighted"`` phases give
+to it; CaDiCaL is also seeded. Two seeds' outputs differ in 30-46% of the cells at
+40×40×10 (``benchmarks/bench_solvers.py``; Alg. 3.1: 16-30%); ``"weighted"`` phases give
 mostly empty space and much less variety; ``phase="none"`` keeps the solver's own phases.
 
 Status ``unsat`` comes only with a proof: the SAT solver's refutation, or an arc-consistency
