@@ -41,7 +41,10 @@ def satisfiable(problem: Problem, eng: Propagator) -> bool:
     """Does the engine's catalog contain a complete consistent model?"""
     if not eng.ok:
         return False
-    return brute.satisfiable(problem.restrict(eng.catalog().reshape(*problem.shape, problem.K))) is True
+    return (
+        brute.satisfiable(problem.restrict(eng.catalog().reshape(*problem.shape, problem.K)))
+        is True
+    )
 
 
 def solutions(problem: Problem, limit: int | None = None) -> list[NDArray[np.int32]]:

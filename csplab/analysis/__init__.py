@@ -19,8 +19,7 @@ from csplab.analysis.infallible import (
     prove_infallible,
     region_catalog,
 )
-
-# from csplab.analysis.refine import lift_check, refine_labels, to_infallible
+from csplab.analysis.refine import lift_check, refine_labels, to_infallible
 from csplab.analysis.witness import alg31_exhaustive, find_failure, replay
 
 __all__ = [
