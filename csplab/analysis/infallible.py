@@ -507,7 +507,7 @@ def prove_infallible(
     failure["realized"] = False
     if realize:
         prefer = {tuple(c): b for c, b in failure["frame"]}
-        real = _realize(rules, failure, r, axes, prefer)
+        real = _realize(rules, failure, r, axes, prefer, order)
         if real is not None:
             failure["realized"] = True
             failure["run"] = real
@@ -670,6 +670,7 @@ def _realize(
     r: Coords,
     axes: tuple[int, ...],
     prefer: Mapping[Coords, int],
+    order: str,
 ) -> dict[str, Any] | None:
     """A concrete run of Alg. 3.6 failing at the window's point (or earlier), if one exists
     on the window's output or one a little larger at the lower edges."""
@@ -694,7 +695,7 @@ def _realize(
         except _Budget:
             continue
         if run is not None:
-            return {"shape": list(shp), "choices": run}
+            return {"shape": list(shp), "choices": run, "order": order}
     return None
 
 
