@@ -247,3 +247,24 @@ def test_examples_with_no_model_are_not_proven():
     v = prove_infallible(E, 2, order=FIG)
     assert v.holds is False
     assert v.witness["alg31"]["kind"] in ("failed", "unsat")
+
+
+def test_fig3_13_twelve_regions_in_fill_order():
+    """Fig. 3.13 lists R1..R12: a 2x2 region filled in the figure's order (bottom-left,
+    bottom-right, top-left) holding 1, 2 or 3 labels with a non-empty catalog: 2 + 4 + 6."""
+    from csplab import Problem
+    from csplab.catalog import Propagator
+
+    P = Problem.from_example(load_example("line"), (2, 2))
+    fill = [(0, 0), (1, 0), (0, 1)]
+    counts = []
+    for k in range(1, 4):
+        ok = 0
+        for labels in np.ndindex(*(2,) * k):
+            eng = Propagator(P)
+            if all(eng.assign(P.cell(c), int(b)) for c, b in zip(fill, labels, strict=False)):
+                ok += 1
+        counts.append(ok)
+    assert counts == [2, 4, 6] and sum(counts) == 12
+    eng = Propagator(P)  # R' = [[1], [1 1]]: its catalog is empty
+    assert not all(eng.assign(P.cell(c), 1) for c in fill)
