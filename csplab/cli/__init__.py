@@ -25,6 +25,9 @@ COMMANDS: dict[str, str] = {
     "explain": "csplab.cli.explain",
     "catalog-gap": "csplab.cli.catalog_gap",
     "show": "csplab.cli.show",
+    "prove": "csplab.cli.prove",
+    "witness": "csplab.cli.witness",
+    "refine": "csplab.cli.refine",
 }
 
 
