@@ -8,8 +8,9 @@ are none, csplab's synthetic box towns with 56 and 110 labels) and each solver, 
 * ``load``: handing the clauses to the SAT solver (the direct CaDiCaL loader or pysat's API),
 * ``solve``: the search itself (for ``catalog``/``blocks``/``backtrack``: the whole run),
 
-plus the total (everything the call costs, e.g. also freeing the SAT solver), the ratio of the total to Alg. 3.1 (``catalog``, run in the same process on
-the same problems: the baseline), how many seeds were solved, and the diversity: the mean
+plus the total (everything the call costs, e.g. also freeing the SAT solver), the ratio of
+the total to Alg. 3.1 (``catalog``, run in the same process on the same problems: the
+baseline), how many seeds were solved, and the diversity: the mean
 fraction of cells that differ between the outputs of two seeds (Hamming distance), with the
 fraction of non-empty cells (labels other than the most frequent one) for context.
 Solvers that need more than ``--time-limit`` seconds report ``timeout``. The numba JIT
