@@ -22,6 +22,8 @@ COMMANDS: dict[str, str] = {
     "synthesize": "csplab.cli.synthesize",
     "check": "csplab.cli.check",
     "info": "csplab.cli.info",
+    "explain": "csplab.cli.explain",
+    "catalog-gap": "csplab.cli.catalog_gap",
     "show": "csplab.cli.show",
     "prove": "csplab.cli.prove",
     "witness": "csplab.cli.witness",

@@ -35,6 +35,11 @@ __all__ = ["Solver", "available_solvers", "get_solver", "solve", "solver_names"]
 _REGISTRY: dict[str, str] = {
     "catalog": "csplab.solvers.catalog:CatalogSolver",
     "blocks": "csplab.solvers.blocks:BlocksSolver",
+    "sat": "csplab.solvers.sat:SatSolver",
+    "cpsat": "csplab.solvers.cpsat:CpsatSolver",
+    "backtrack": "csplab.solvers.backtrack:BacktrackSolver",
+    "perfect": "csplab.solvers.perfect:PerfectSolver",
+    "hybrid": "csplab.solvers.hybrid:HybridSolver",
 }
 
 

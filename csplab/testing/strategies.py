@@ -23,6 +23,7 @@ from csplab.problem import Problem
 __all__ = [
     "analysis_examples",
     "corrupted",
+    "csp_problems",
     "example_models",
     "label_grids",
     "problems",
@@ -186,3 +187,23 @@ def analysis_examples(draw: Any, ndim: int = 2, max_side: int = 4, max_labels: i
     if frame if frame is not None else draw(st.booleans()):
         g = np.pad(g, 1, constant_values=0)
     return ExampleModel(g)
+
+
+@st.composite
+def csp_problems(draw: Any, max_side: int = 3, max_labels: int = 4, max_ndim: int = 3,
+                 max_cells: int = 12) -> Problem:  # fmt: skip
+    """Small problems of every kind for solver conformance: from example models (periodic
+    or not, fixed cells, masks) or random relations (periodic or not, sometimes with a
+    fixed cell), at most ``max_cells`` cells; some are unsatisfiable."""
+    P: Problem = draw(
+        st.one_of(
+            problems(max_side=max_side, max_labels=max_labels, max_ndim=max_ndim),
+            random_problems(max_side=max_side, max_labels=max_labels, max_ndim=max_ndim),
+        )
+    )
+    if P.n > max_cells:
+        P = P.subproblem(np.arange(max_cells), np.full(P.n, -1))
+    if not P.unary and draw(st.booleans()):
+        c = draw(st.integers(0, P.n - 1))
+        P = P.with_fixed({P.coords(c): draw(st.integers(0, P.K - 1))})
+    return P

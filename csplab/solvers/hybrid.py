@@ -1,0 +1,186 @@
+"""Solver ``hybrid``: Alg. 3.1 at full speed, repaired with SAT only when it fails.
+
+csplab's design for a cheap complete variant of Merrell's algorithm. Alg. 3.1 runs as usual
+(compiled catalog, no SAT). If it fails, the partial models M_0 ⊆ M_1 ⊆ ... of the run are
+consistent up to some step and inconsistent after it (consistency is monotone), so a binary
+search with incremental SAT calls (assumptions = the run's prefix) finds the first choice
+that left C* -- the step where the catalog's imperfection (Fig. 3.5) bit. The consistent
+prefix is fixed, that cell gets a label drawn from C*(p) (as in ``perfect``), and Alg. 3.1
+resumes from there with fresh random choices. Each repair fixes at least one more cell, so
+the loop ends; it never fails on a satisfiable problem and proves unsatisfiability with its
+first SAT call. When Alg. 3.1 succeeds no SAT solver is even created.
+
+Its outputs follow the same distribution as ``perfect`` (for the scanline order): steps
+before the doomed one drew a label of C(p) that happened to lie in C*(p), i.e. a uniform
+label of C*(p); the doomed draw is exactly the one ``perfect`` would reject, and it is
+redrawn uniformly from C*(p); later steps use fresh randomness. (A chi-square test against
+the exact distribution checks this: ``tests/solvers/test_perfect_hybrid.py``.) So
+``hybrid`` is a cheap sampler of the thesis' ideal algorithm.
+
+Options
+-------
+order : {"scanline", "random", "min-entropy"}
+choice : {"uniform", "weighted"}
+backend : pysat backend (``hybrid:glucose4``), default ``cadical195``
+time_limit : float, optional
+
+Examples
+--------
+>>> from csplab import ExampleModel, Problem, solve
+>>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
+>>> P = Problem.from_example(E, (5, 5), fixed={(4, 4): 1})
+>>> r = solve(P, "hybrid", rng=3)
+>>> r.status, r.stats["repairs"] >= 0
+('solved', True)
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.catalog import Propagator
+from csplab.errors import CsplabError, InputError
+from csplab.problem import Problem
+from csplab.result import Result
+from csplab.solvers.catalog import CHOICES, ORDERS, run_alg31
+from csplab.solvers.perfect import _SAT_KEYS, _Pool, choose_from_exact
+from csplab.solvers.sat import SatOracle
+
+__all__ = ["HybridSolver"]
+
+
+class HybridSolver:
+    """Complete: Alg. 3.1, with SAT-guided repair of the first bad choice after a failure."""
+
+    name: ClassVar[str] = "hybrid"
+    complete: ClassVar[bool] = True
+    requires: ClassVar[tuple[str, ...]] = ("pysat",)
+    extra: ClassVar[str] = "sat"
+    description: ClassVar[str] = (
+        "Alg. 3.1; on failure, SAT binary search for the first choice outside C*, "
+        "redraw it from C*, resume"
+    )
+
+    @staticmethod
+    def backends() -> list[str]:
+        from csplab.solvers.sat import backends
+
+        return backends()
+
+    def solve(
+        self,
+        problem: Problem,
+        *,
+        rng: np.random.Generator,
+        seed: int | None,
+        backend: str | None = None,
+        order: str = "scanline",
+        choice: str = "uniform",
+        time_limit: float | None = None,
+        **options: Any,
+    ) -> Result:
+        if options:
+            raise InputError(f"unknown option(s) for solver 'hybrid': {', '.join(options)}")
+        if order not in ORDERS or choice not in CHOICES:
+            raise InputError(f"order must be one of {ORDERS} and choice one of {CHOICES}")
+        t0 = time.perf_counter()
+        deadline = None if time_limit is None else t0 + float(time_limit)
+        n = problem.n
+        fixed = np.full(n, -1, dtype=np.int64)
+        stats: dict[str, Any] = {"order": order, "choice": choice, "alg31_runs": 0,
+                                 "repairs": 0, "sat_calls": 0, "rejected": 0}  # fmt: skip
+        oracle: SatOracle | None = None
+        w = problem.weights if choice == "weighted" else None
+        try:
+            while True:
+                left = None if deadline is None else deadline - time.perf_counter()
+                if left is not None and left <= 0:
+                    return self._result("timeout", fixed, problem, stats, t0)
+                dom = problem.domains.copy()
+                idx = np.flatnonzero(fixed >= 0)
+                dom[idx] = False
+                dom[idx, fixed[idx]] = True
+                eng = Propagator(problem, domains=dom)
+                stats["alg31_runs"] += 1
+                r = run_alg31(problem, rng, order=order, choice=choice, time_limit=left,
+                              engine=eng)  # fmt: skip
+                if r.status == "solved":
+                    stats["fixed_by_repair"] = int(idx.size)
+                    return Result("solved", r.grid, "hybrid", time_s=time.perf_counter() - t0,
+                                  stats=stats)  # fmt: skip
+                if r.status == "timeout":
+                    return self._result("timeout", fixed, problem, stats, t0)
+                if r.status == "unsat" and idx.size == 0:
+                    stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
+                    return self._result("unsat", fixed, problem, stats, t0)
+                if oracle is None:
+                    oracle = SatOracle(problem, backend=backend, deadline=deadline,
+                                       seed=int(rng.integers(2**31 - 1)))  # fmt: skip
+                    st = oracle.solve(deadline=deadline)
+                    stats["sat_calls"] += 1
+                    if st != "sat":
+                        if st == "unsat":
+                            stats["proof"] = f"refutation by {oracle.backend}"
+                        return self._result(st if st == "timeout" else "unsat", fixed, problem,
+                                            stats, t0)  # fmt: skip
+                trace = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
+                if r.status != "failed" or trace.shape[0] == 0:
+                    raise CsplabError("hybrid: Alg. 3.1 failed on a consistent prefix (a bug)")
+                k = self._first_bad(oracle, trace, fixed, stats, deadline)
+                if k is None:
+                    return self._result("timeout", fixed, problem, stats, t0)
+                # fix the consistent prefix, then redraw step k from C*
+                for p, b in trace[:k].tolist():
+                    if fixed[p] < 0:
+                        fixed[p] = b
+                        oracle.add_clause([oracle.literal(p, b)])
+                p, bad = (int(x) for x in trace[k])
+                oracle.add_clause([-oracle.literal(p, bad)])
+                dom = problem.domains.copy()
+                idx = np.flatnonzero(fixed >= 0)
+                dom[idx] = False
+                dom[idx, fixed[idx]] = True
+                dom[p, bad] = False
+                eng = Propagator(problem, domains=dom)
+                labels = eng.domain(p) if eng.ok else np.zeros(0, dtype=np.int64)
+                pool = _Pool(n, 1)
+                b2 = choose_from_exact(oracle, pool, p, labels, w, rng, stats, deadline)
+                if b2 is None:
+                    if deadline is not None and time.perf_counter() > deadline:
+                        return self._result("timeout", fixed, problem, stats, t0)
+                    raise CsplabError("hybrid: no label of C* at a consistent step (a bug)")
+                fixed[p] = b2
+                oracle.add_clause([oracle.literal(p, b2)])
+                stats["repairs"] += 1
+        finally:
+            if oracle is not None:
+                stats["sat"] = {k: oracle.stats[k] for k in _SAT_KEYS if k in oracle.stats}
+                oracle.close()
+
+    @staticmethod
+    def _first_bad(oracle: SatOracle, trace: NDArray[np.int64], fixed: NDArray[np.int64],
+                   stats: dict[str, Any], deadline: float | None) -> int | None:  # fmt: skip
+        """Index of the first step whose prefix (with it) is inconsistent (binary search)."""
+        lits = [oracle.literal(int(p), int(b)) for p, b in trace.tolist()]
+        lo, hi = 0, len(lits)  # prefix lo is consistent, prefix hi is not
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            st = oracle.solve(lits[:mid], deadline=deadline)
+            stats["sat_calls"] += 1
+            if st == "timeout":
+                return None
+            if st == "sat":
+                lo = mid
+            else:
+                hi = mid
+        return hi - 1
+
+    @staticmethod
+    def _result(status: Any, fixed: NDArray[np.int64], problem: Problem,
+                stats: dict[str, Any], t0: float) -> Result:  # fmt: skip
+        grid = fixed.astype(np.int32).reshape(problem.shape)
+        return Result(status, grid, "hybrid", time_s=time.perf_counter() - t0, stats=stats)

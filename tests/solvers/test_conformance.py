@@ -1,0 +1,160 @@
+"""Solver conformance: every registered solver against brute force and each other.
+
+Rules checked on hypothesis-generated problems (from example models or random relations,
+periodic or not, with fixed cells and masks; some unsatisfiable):
+
+1. a ``solved`` grid has zero violations (``Problem.violations``, the single truth);
+2. complete solvers answer ``solved`` or ``unsat`` and agree with each other and with a
+   brute-force search (:mod:`csplab.testing.brute`);
+3. incomplete solvers (``catalog``, ``blocks``) never report ``unsat`` on their own: when
+   one does, it must carry a proof (``stats["proof"]``: an arc-consistency wipe-out before
+   any choice, Theorem 3.3.2) and the complete solvers must agree that the problem is
+   unsatisfiable;
+4. ``unsat`` always comes with ``stats["proof"]``;
+5. SAT enumeration (csplab's blocking clauses, and pysat's ``enum_models`` on the support
+   encoding with pairwise at-most-one) counts exactly the brute-force solutions;
+6. time limits are honoured within 1 s on a problem too large to finish in time.
+
+The default run uses the hypothesis profile of ``tests/conftest.py`` (60 examples); the
+``slow`` run (``pytest -m slow``) draws 5,000 problems and checks every solver on each.
+"""
+
+import time
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from csplab import Problem, solve
+from csplab.errors import InputError, NoTrivialSolutionError
+from csplab.solvers import available_solvers, get_solver
+from csplab.testing.brute import count, solutions
+from csplab.testing.strategies import csp_problems
+from csplab.testing.synthetic import box_town
+
+# every installed solver, plus the other sat backends and the cpsat table model
+_INSTALLED = [s["name"] for s in available_solvers() if s.get("installed")]
+SPECS: list[tuple[str, dict]] = [(name, {}) for name in _INSTALLED]
+if "sat" in _INSTALLED:
+    SPECS += [
+        ("sat:glucose4", {}),
+        ("sat:minisat22", {}),
+        ("sat", {"encoding": "direct"}),
+        ("sat", {"supports": "forward", "amo": "seqcounter"}),
+    ]
+if "cpsat" in _INSTALLED:
+    SPECS += [("cpsat", {"model": "table"})]
+if "backtrack" in _INSTALLED:
+    SPECS += [("backtrack", {"order": "scanline", "restart": 0})]
+IDS = [s + "".join(f",{k}={v}" for k, v in o.items()) for s, o in SPECS]
+
+
+def _complete(spec: str) -> bool:
+    return bool(get_solver(spec)[0].complete)
+
+
+def _run(spec, opts, P, seed):
+    try:
+        return solve(P, spec, rng=seed, **opts)
+    except NoTrivialSolutionError:
+        return None  # blocks: no consistent starting model (documented behaviour)
+
+
+def _check_one(spec, opts, P, seed, satisfiable):
+    r = _run(spec, opts, P, seed)
+    if r is None:
+        assert not _complete(spec)
+        return None
+    assert r.status in ("solved", "failed", "unsat", "timeout")
+    if r.status == "solved":
+        assert len(P.violations(r.grid)) == 0
+        assert satisfiable
+    if r.status == "unsat":
+        assert r.stats.get("proof"), (spec, "unsat without a proof")
+        assert not satisfiable, (spec, "claims unsat on a satisfiable problem")
+    if _complete(spec):
+        assert r.status == ("solved" if satisfiable else "unsat"), (spec, r.status)
+    return r.status
+
+
+def _satisfiable(P: Problem) -> bool:
+    return next(solutions(P, limit=1), None) is not None
+
+
+@pytest.mark.parametrize(("spec", "opts"), SPECS, ids=IDS)
+@given(P=csp_problems(), seed=st.integers(0, 2**31))
+def test_solver_conforms(spec, opts, P, seed):
+    _check_one(spec, opts, P, seed, _satisfiable(P))
+
+
+@given(P=csp_problems(), seed=st.integers(0, 2**31))
+def test_complete_solvers_agree(P, seed):
+    statuses = {spec: _run(spec, opts, P, seed).status for spec, opts in SPECS if _complete(spec)}
+    assert len(set(statuses.values())) == 1, statuses
+
+
+@pytest.mark.skipif("sat" not in _INSTALLED, reason="python-sat not installed")
+@given(P=csp_problems(max_cells=9), amo=st.sampled_from(["lazy", "seqcounter", "pairwise"]))
+def test_sat_enumeration_matches_brute_force_counts(P, amo):
+    from csplab.solvers.sat import enumerate_solutions
+
+    grids = list(enumerate_solutions(P, amo=amo))
+    assert len(grids) == count(P)
+    assert len({g.tobytes() for g in grids}) == len(grids)
+    assert all(P.is_solution(g) for g in grids)
+
+
+@pytest.mark.skipif("sat" not in _INSTALLED, reason="python-sat not installed")
+@given(P=csp_problems(max_cells=9), backend=st.sampled_from(["cadical195", "glucose4"]))
+def test_pysat_enum_models_matches_brute_force_counts(P, backend):
+    """pysat's own enum_models on the support encoding with pairwise at-most-one (no
+    auxiliary variables, so models and solutions correspond one to one)."""
+    from pysat.solvers import Solver
+
+    from csplab.cnf import encode
+
+    enc = encode(P, amo="pairwise")
+    if not enc.ok:
+        assert count(P) == 0
+        return
+    if enc.nvars == 0:  # every cell constant: the single solution
+        assert count(P) == 1
+        return
+    with Solver(name=backend, bootstrap_with=enc.clauses()) as S:
+        n = sum(1 for _ in S.enum_models())
+    assert n == count(P)
+
+
+_BIG = Problem.from_example(box_town(2, rng=0), (30, 30, 8))
+
+
+@pytest.mark.parametrize(("spec", "opts"), SPECS, ids=IDS)
+def test_time_limits_are_honoured_within_one_second(spec, opts):
+    tiny = Problem.from_example(box_town(1, rng=0), (3, 3, 3))
+    _run(spec, opts, tiny, 0)  # load compiled kernels first (not part of the limit)
+    if spec == "sat:lingeling":
+        pytest.skip("lingeling has no budgets or interrupt in pysat")
+    limit = 0.3
+    t0 = time.perf_counter()
+    if opts.get("encoding") == "direct":  # 148M literals: refused at once, with a message
+        with pytest.raises(InputError, match="support encoding is much smaller"):
+            solve(_BIG, spec, rng=0, time_limit=limit, **opts)
+        assert time.perf_counter() - t0 < limit + 1.0
+        return
+    r = solve(_BIG, spec, rng=0, time_limit=limit, **opts)
+    wall = time.perf_counter() - t0
+    assert r.status in ("timeout", "solved", "failed")
+    assert wall < limit + 1.0, (spec, wall)
+
+
+@pytest.mark.slow
+@settings(max_examples=5000, deadline=None, suppress_health_check=list(HealthCheck))
+@given(P=csp_problems(), seed=st.integers(0, 2**31))
+def test_all_solvers_conform_5000_problems(P, seed):
+    satisfiable = _satisfiable(P)
+    statuses = {}
+    for spec, opts in SPECS:
+        statuses[spec + str(opts)] = _check_one(spec, opts, P, seed, satisfiable)
+    done = {s for s in statuses.values() if s is not None}
+    assert done <= {"solved", "failed", "unsat"}
+    assert ("solved" in done) == satisfiable
