@@ -1,0 +1,12 @@
+"""Complexity tools for the thesis' negative and structural results.
+
+* :mod:`csplab.complexity.planar3sat`: random planar 3-SAT formulas with a
+  Knuth–Raghunathan drawing (variables on a line, clauses as combs).
+* :mod:`csplab.complexity.gadgets`: the labels and transition matrices of the
+  Theorem 3.3.4 / Fig. 3.7 reduction (enclosure, TRUE/FALSE fill, NOT and OR gates).
+* :mod:`csplab.complexity.reduction`: the layout of a formula as an incomplete model
+  ``M_t``, decoding and encoding of solutions, pictures and the verification.
+* :mod:`csplab.complexity.lba`: linear-bounded automata and Theorem 5.2.4's construction.
+* :mod:`csplab.complexity.grammar`: Theorem 5.2.1's example and Theorem 5.2.3's regular
+  grammar.
+"""
