@@ -23,6 +23,7 @@ Methods
     ApproxMC (``pip install pyapproxmc``, extra ``count``): an (ε, δ) approximation — with
     probability at least ``1 - delta`` the estimate lies within a factor ``1 + epsilon`` of
     the true count (Chakraborty, Meel, Vardi 2016). Not exact; ``Count.exact`` is False.
+    Pinned to pyapproxmc 4.1.24: 4.4.0 returned 1 for ``x1 XOR x2`` (measured).
 ``"auto"``
     ``transfer`` when its state space stays below ``max_states``, else ``ganak`` when
     installed, else ``enumerate``.

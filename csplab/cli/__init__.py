@@ -22,6 +22,8 @@ COMMANDS: dict[str, str] = {
     "synthesize": "csplab.cli.synthesize",
     "check": "csplab.cli.check",
     "info": "csplab.cli.info",
+    "reduction": "csplab.cli.reduction",
+    "count": "csplab.cli.count",
 }
 
 

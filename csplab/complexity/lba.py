@@ -364,8 +364,10 @@ def build_construction(lba: LBA) -> LBAConstruction:
     keys += [(s, q, "") for q in lba.states for s in syms]
     dep = sorted({(s2, q2, m) for (q2, s2, m) in lba.delta.values() if m != "S"})
     keys += [(s, q, m.lower()) for s, q, m in dep]  # departures: kind "r" / "l"
-    keys += [(s, q, "r'") for q in r_targets for s in syms]
-    keys += [(s, q, "l'") for q in l_targets for s in syms]
+    # arrivals; nothing arrives on '<' from its left or on '>' from its right (the model's
+    # border has no neighbour there to pair with, so such labels would be unconstrained)
+    keys += [(s, q, "r'") for q in r_targets for s in syms if s != LEFT]
+    keys += [(s, q, "l'") for q in l_targets for s in syms if s != RIGHT]
     index = {k: i for i, k in enumerate(keys)}
     K = len(keys)
 
@@ -382,9 +384,11 @@ def build_construction(lba: LBA) -> LBAConstruction:
         if not q:  # Eq. 5.4: a plain symbol, or an arrival on it
             below[i, index[k]] = True
             for q2 in r_targets:
-                below[i, index[(s, q2, "r'")]] = True
+                if (s, q2, "r'") in index:
+                    below[i, index[(s, q2, "r'")]] = True
             for q2 in l_targets:
-                below[i, index[(s, q2, "l'")]] = True
+                if (s, q2, "l'") in index:
+                    below[i, index[(s, q2, "l'")]] = True
         elif kind == "":
             if q == lba.accept:
                 below[i, i] = True
