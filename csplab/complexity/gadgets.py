@@ -101,7 +101,7 @@ K = 29
 
 _COMPAT = {
     frozenset("X"), frozenset("T"), frozenset("F"), frozenset("IT"), frozenset("IF"),
-    frozenset("Ia"), frozenset("n"), frozenset("o"),
+    frozenset("Ia"), frozenset("n"), frozenset("o"), frozenset("p"),
 }  # fmt: skip
 
 
@@ -133,13 +133,13 @@ def sockets() -> list[dict[str, str]]:
     out[NOT_DN] = {"L": "n", "R": "a", "D": "T", "U": "F"}
     out[NOT_UP] = {"L": "n", "R": "a", "D": "F", "U": "T"}
     out[OR_TOP] = {"L": "X", "R": "X", "D": "o", "U": "X"}
-    out[OR_BOT] = {"L": "X", "R": "X", "D": "X", "U": "o"}
+    out[OR_BOT] = {"L": "X", "R": "X", "D": "X", "U": "p"}
     demand = ("L", "D", "R")
     for lab, d in zip(ARROW_TOP, demand, strict=True):
         out[lab] = {"L": "I", "R": "I", "D": "I", "U": "o"}
         out[lab][d] = "T"
     for lab, d in zip(ARROW_BOT, ("L", "U", "R"), strict=True):
-        out[lab] = {"L": "I", "R": "I", "D": "o", "U": "I"}
+        out[lab] = {"L": "I", "R": "I", "D": "p", "U": "I"}
         out[lab][d] = "T"
     return out
 
@@ -219,7 +219,7 @@ def label_sheet(scale: int = 36) -> object:
     sk = sockets()
     sock_col = {
         "X": (40, 40, 40), "I": (255, 255, 255), "T": COLORS["TRUE"], "F": COLORS["FALSE"],
-        "a": (150, 150, 255), "n": COLORS["NOT"], "o": COLORS["OR"],
+        "a": (150, 150, 255), "n": COLORS["NOT"], "o": COLORS["OR"], "p": COLORS["OR"],
     }  # fmt: skip
     for b in range(K):
         r, c = divmod(b, cols)
