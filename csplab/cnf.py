@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 from csplab.catalog import Propagator
 from csplab.errors import DependencyError, InputError
 from csplab.problem import Problem
-from csplab.result import Result
+from csplab.result import Result, Status
 from csplab.rng import RngLike, make_rng
 
 __all__ = ["DEFAULT_BACKEND", "SupportCNF", "complete", "enumerate_solutions"]
@@ -100,9 +100,7 @@ class SupportCNF:
             self.unsat = bool((~dom.any(axis=1)).any())
         self.domains: NDArray[np.bool_] = dom
         size = dom.sum(axis=1)
-        self.base: NDArray[np.int32] = np.where(size == 1, dom.argmax(axis=1), -1).astype(
-            np.int32
-        )
+        self.base: NDArray[np.int32] = np.where(size == 1, dom.argmax(axis=1), -1).astype(np.int32)
         self.open_cells: NDArray[np.int64] = np.flatnonzero(size > 1).astype(np.int64)
         var = np.zeros((n, K), dtype=np.int64)
         od = dom[self.open_cells]
@@ -217,7 +215,7 @@ def complete(
     if enc.open_cells.size == 0:
         stats["decided_by"] = "arc consistency"
         g = enc.base.reshape(problem.shape)
-        st = "solved" if problem.is_solution(g) else "unsat"
+        st: Status = "solved" if problem.is_solution(g) else "unsat"
         return Result(st, g if st == "solved" else empty, "cnf", seed,
                       time.perf_counter() - t0, stats)  # fmt: skip
     stats["decided_by"] = f"sat:{backend}"

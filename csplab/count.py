@@ -59,8 +59,8 @@ __all__ = [
     "METHODS",
     "Count",
     "count_solutions",
-    "entropy_per_cell",
     "enclosed_sets",
+    "entropy_per_cell",
     "frontier_order",
     "lower_bound_3_2_1",
 ]
@@ -209,7 +209,11 @@ def _count_transfer(problem: Problem, max_states: int) -> tuple[int, dict[str, A
         peak = max(peak, labels.shape[0])
         if labels.shape[0] > max_states:
             raise _TooBig(labels.shape[0])
-        if not big and counts.dtype != object and counts.max(initial=0) > 2**62 // max(problem.K, 2):
+        if (
+            not big
+            and counts.dtype != object
+            and counts.max(initial=0) > 2**62 // max(problem.K, 2)
+        ):
             counts = counts.astype(object)
             big = True
     total = int(counts.sum()) if counts.size else 0
@@ -232,7 +236,7 @@ def _merge(labels: NDArray[np.int32], counts: NDArray[Any], K: int) -> tuple[Any
         sc = codes[order]
         starts = np.flatnonzero(np.r_[True, sc[1:] != sc[:-1]])
     else:
-        uniq, inv = np.unique(labels, axis=0, return_inverse=True)
+        _uniq, inv = np.unique(labels, axis=0, return_inverse=True)
         order = np.argsort(inv.ravel(), kind="stable")
         si = inv.ravel()[order]
         starts = np.flatnonzero(np.r_[True, si[1:] != si[:-1]])
@@ -414,8 +418,8 @@ def lower_bound_3_2_1(example: Any, shape: Sequence[int], empty: int = 0) -> int
     for h in enclosed_sets(example, empty):
         ext = list(h.extent) + [1] * (len(shape) - len(h.extent))
         copies = math.prod(int(n) // (e + 1) for n, e in zip(shape, ext, strict=False))
-        best = max(best, copies)
-    return 2**best
+        best = max(best, int(copies))
+    return int(2**best)
 
 
 def entropy_per_cell(

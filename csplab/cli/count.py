@@ -51,9 +51,7 @@ def run(args: argparse.Namespace) -> int:
 
     example = load_model(args.model)
     problem = problem_from_args(args, example)
-    c = count_solutions(
-        problem, args.method, rng=args.seed, epsilon=args.epsilon, delta=args.delta
-    )
+    c = count_solutions(problem, args.method, rng=args.seed, epsilon=args.epsilon, delta=args.delta)
     out: dict[str, Any] = {"example": example.name or args.model, "size": list(problem.shape)}
     out.update(c.to_dict())
     if args.bounds:
@@ -61,9 +59,7 @@ def run(args: argparse.Namespace) -> int:
         hi_log2 = problem.n * math.log2(problem.K)
         out["lower_bound_3_2_1"] = str(lo)
         out["upper_bound_3_2_2_log2"] = hi_log2
-        out["bounds_hold"] = (
-            (int(c) >= lo and c.log2() <= hi_log2 + 1e-9) if c.exact else None
-        )
+        out["bounds_hold"] = (int(c) >= lo and c.log2() <= hi_log2 + 1e-9) if c.exact else None
     if args.entropy:
         try:
             L1, L2 = (int(v) for v in args.entropy.split(","))

@@ -126,9 +126,10 @@ def _run_planar(args: argparse.Namespace) -> int:
             print(f"  wrote {out[k]}")
     if args.check:
         c = out["check"]
+        comp = "completable" if c["completable"] else "not completable"
         print(
             f"  check: formula {'satisfiable' if c['sat'] else 'unsatisfiable'} "
-            f"({c['models']} models), M_t {'completable' if c['completable'] else 'not completable'}"
+            f"({c['models']} models), M_t {comp}"
             f", decoded ok: {c['decoded_ok']}, encodings ok: {c['encoded_ok']}/{c['models']}, "
             f"catalog C non-empty: {c['catalog_nonempty']}, Alg. 3.1: {c['alg31']}"
         )

@@ -307,9 +307,7 @@ def load_lba(spec: str) -> LBA:
         return parse_lba(BUILTIN[spec], spec)
     p = Path(spec)
     if not p.exists():
-        raise InputError(
-            f"{spec!r} is neither a built-in LBA ({', '.join(BUILTIN)}) nor a file"
-        )
+        raise InputError(f"{spec!r} is neither a built-in LBA ({', '.join(BUILTIN)}) nor a file")
     return parse_lba(p.read_text(encoding="utf-8"), str(p))
 
 
@@ -453,7 +451,7 @@ def lba_consistent(lba: LBA, word: str, rows: int | None = None) -> Verdict:
     leaves a choice. ``witness`` is the completed grid; ``stats`` says what decided."""
     from csplab.catalog import Propagator
 
-    P, con = lba_problem(lba, word, rows)
+    P, _con = lba_problem(lba, word, rows)
     eng = Propagator(P)
     stats: dict[str, Any] = {"shape": P.shape, "labels": P.K}
     if not eng.ok:

@@ -56,7 +56,7 @@ class Clause:
     depth: int = 1
 
     @property
-    def l(self) -> int:
+    def l(self) -> int:  # noqa: E743 - the thesis' name for the left variable
         return self.vars[0]
 
     @property
@@ -75,9 +75,13 @@ class Clause:
         return any(bool(assignment[v]) == p for v, p in zip(self.vars, self.positive, strict=True))
 
     def __str__(self) -> str:
-        return "(" + " ∨ ".join(
-            f"{'' if p else '¬'}x{v + 1}" for v, p in zip(self.vars, self.positive, strict=True)
-        ) + ")"
+        return (
+            "("
+            + " ∨ ".join(
+                f"{'' if p else '¬'}x{v + 1}" for v, p in zip(self.vars, self.positive, strict=True)
+            )
+            + ")"
+        )
 
 
 def _compatible(a: tuple[int, int, int], b: tuple[int, int, int]) -> bool:
@@ -380,8 +384,6 @@ def random_planar3sat(
     )
 
 
-def _clauses(
-    placed: list[tuple[tuple[int, int, int], int]], pos: list[Any]
-) -> list[Clause]:
+def _clauses(placed: list[tuple[tuple[int, int, int], int]], pos: list[Any]) -> list[Clause]:
     return [Clause(t, (bool(p[0]), bool(p[1]), bool(p[2])), s)
             for (t, s), p in zip(placed, pos, strict=True)]  # fmt: skip

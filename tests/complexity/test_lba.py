@@ -82,6 +82,8 @@ def test_spec_errors():
         load_lba("anbncn").run("abd")
     with pytest.raises(InputError, match="neither"):
         load_lba("nope")
-    loop = parse_lba("input: a\ntape: a\nstart: q\naccept: y\nreject: n\nmax_steps: 5\nq a -> q a S\n")
+    loop = parse_lba(
+        "input: a\ntape: a\nstart: q\naccept: y\nreject: n\nmax_steps: 5\nq a -> q a S\n"
+    )
     with pytest.raises(InputError, match="did not halt"):
         loop.run("a")

@@ -45,7 +45,12 @@ def test_gadget_matrices():
         assert T[d, G.TRUE, G.TRUE] and T[d, G.FALSE, G.FALSE]
     # a cell next to an enclosure face can only hold TRUE, FALSE or a gate arrow
     arrows = {G.NOT_DN, G.NOT_UP, *G.ARROW_TOP, *G.ARROW_BOT}
-    for side, (d, fwd) in {"L": (0, True), "R": (0, False), "D": (1, True), "U": (1, False)}.items():
+    for side, (d, fwd) in {
+        "L": (0, True),
+        "R": (0, False),
+        "D": (1, True),
+        "U": (1, False),
+    }.items():
         col = T[d, :, G.enclosure(side)] if fwd else T[d, G.enclosure(side), :]
         assert set(np.flatnonzero(col).tolist()) <= {G.TRUE, G.FALSE} | arrows
     # NOT swaps: TRUE below and FALSE above NOT-dn, the reverse for NOT-up
