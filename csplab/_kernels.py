@@ -173,6 +173,7 @@ def heap_pop(heap: np.ndarray, pos: np.ndarray, key: np.ndarray, size: int) -> i
 @njit(cache=True)
 def propagate(
     dom: np.ndarray,
+    prev: np.ndarray,
     full: np.ndarray,
     ptr: np.ndarray,
     nbr: np.ndarray,
@@ -195,9 +196,12 @@ def propagate(
 ) -> int:
     """Arc consistency from the cells ``start[:nstart]``; returns the wiped-out cell or -1.
 
-    ``stats[0]`` counts queue pops (propagation steps), ``stats[1]`` label removals.
-    When ``hsize > 0`` the min-entropy heap keys of changed cells are updated.
-    The queue is left empty on return (also after a wipe-out).
+    ``prev[u]`` is ``D(u)`` when ``u`` was last processed (all zero: unknown). When ``u``
+    lost only a few of many labels since then, only the neighbour labels those supported
+    are re-checked (``D(u) & sup[s ^ 1, c]``); otherwise ``D(v)`` is intersected with the
+    union of the supports of ``D(u)``. ``stats[0]`` counts queue pops (propagation steps),
+    ``stats[1]`` label removals. When ``hsize > 0`` the min-entropy heap keys of changed cells
+    are updated. The queue is left empty on return (also after a wipe-out).
     """
     n = dom.shape[0]
     W = dom.shape[1]
@@ -214,6 +218,7 @@ def propagate(
                 tail = 0
             count += 1
     acc = np.empty(W, dtype=np.uint64)
+    rem = np.empty(W, dtype=np.uint64)
     wiped = -1
     while count > 0:
         u = queue[head]
@@ -224,14 +229,50 @@ def propagate(
         inq[u] = False
         stats[0] += 1
         isfull = True
+        known = False
+        nd = 0
+        nr = 0
         for w in range(W):
             if dom[u, w] != full[w]:
                 isfull = False
-                break
+            if prev[u, w]:
+                known = True
+            nd += popcount64(dom[u, w])
+            rem[w] = prev[u, w] & ~dom[u, w]
+            nr += popcount64(rem[w])
+        if known and nr == 0:
+            continue  # nothing changed since u was last processed
+        use_delta = known and nr < nd
+        for w in range(W):
+            prev[u, w] = dom[u, w]
         for e in range(ptr[u], ptr[u + 1]):
             v = nbr[e]
             s = sidx[e]
-            if isfull:
+            if use_delta:
+                # labels of v that some removed label of u supported
+                for w in range(W):
+                    acc[w] = 0
+                for w in range(W):
+                    x = rem[w]
+                    while x:
+                        a = w * 64 + ctz64(x)
+                        x &= x - np.uint64(1)
+                        for w2 in range(W):
+                            acc[w2] |= sup[s, a, w2]
+                # keep those that still have a support in D(u)
+                for w in range(W):
+                    x = dom[v, w] & acc[w]
+                    keep = ~x
+                    while x:
+                        cbit = x & (~x + np.uint64(1))
+                        c = w * 64 + ctz64(x)
+                        x ^= cbit
+                        for w2 in range(W):
+                            if dom[u, w2] & sup[s ^ 1, c, w2]:
+                                keep |= cbit
+                                break
+                    acc[w] = keep
+            elif isfull:
                 for w in range(W):
                     acc[w] = supall[s, w]
             else:
@@ -282,9 +323,12 @@ def propagate(
                     count += 1
         if wiped >= 0:
             break
-    # drain the queue flags
+    # drain the queue flags; cells left in the queue are not at their fixpoint
     while count > 0:
-        inq[queue[head]] = False
+        q = queue[head]
+        inq[q] = False
+        for w in range(W):
+            prev[q, w] = 0
         head += 1
         if head == n:
             head = 0
@@ -331,6 +375,7 @@ def choose_label(dom: np.ndarray, v: int, u: float, weights: np.ndarray, weighte
 @njit(cache=True)
 def alg31(
     dom: np.ndarray,
+    prev: np.ndarray,
     full: np.ndarray,
     ptr: np.ndarray,
     nbr: np.ndarray,
@@ -395,7 +440,7 @@ def alg31(
         if changed:
             start[0] = p
             wiped = propagate(
-                dom, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
+                dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
                 heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw, weighted,
             )  # fmt: skip
             if wiped >= 0:

@@ -144,6 +144,8 @@ class Propagator:
         self.problem = problem
         self.c = _compiled_for(problem)
         self.bits = pack(problem.domains if domains is None else _check_catalog(problem, domains))
+        # D(u) when u was last processed by the kernel (zero = unknown)
+        self.prev = np.zeros_like(self.bits)
         n = problem.n
         self._queue = np.zeros(max(n, 1), dtype=np.int64)
         self._inq = np.zeros(max(n, 1), dtype=np.bool_)
@@ -167,9 +169,9 @@ class Propagator:
         )
         c = self.c
         wiped = kern.propagate(
-            self.bits, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, self._queue, self._inq,
-            start, start.size, self.stats, self._nohp, self._nohp, self._nohk, 0, self._nohk,
-            c.weights, c.wlogw, False,
+            self.bits, self.prev, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, self._queue,
+            self._inq, start, start.size, self.stats, self._nohp, self._nohp, self._nohk, 0,
+            self._nohk, c.weights, c.wlogw, False,
         )  # fmt: skip
         if wiped >= 0:
             self.ok = False
@@ -208,17 +210,20 @@ class Propagator:
         return self.propagate([cell])
 
     # --------------------------------------------------------------- state
-    def save(self) -> tuple[NDArray[np.uint64], bool, int]:
-        return self.bits.copy(), self.ok, self.wiped
+    def save(self) -> tuple[NDArray[np.uint64], NDArray[np.uint64], bool, int]:
+        """A snapshot of the catalog for :meth:`load` (backtracking)."""
+        return self.bits.copy(), self.prev.copy(), self.ok, self.wiped
 
-    def load(self, state: tuple[NDArray[np.uint64], bool, int]) -> None:
+    def load(self, state: tuple[NDArray[np.uint64], NDArray[np.uint64], bool, int]) -> None:
         self.bits[...] = state[0]
-        self.ok, self.wiped = state[1], state[2]
+        self.prev[...] = state[1]
+        self.ok, self.wiped = state[2], state[3]
 
     def copy(self) -> Propagator:
         new = object.__new__(Propagator)
         new.__dict__.update(self.__dict__)
         new.bits = self.bits.copy()
+        new.prev = self.prev.copy()
         new._queue = self._queue.copy()
         new._inq = self._inq.copy()
         new.stats = self.stats.copy()

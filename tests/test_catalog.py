@@ -122,3 +122,29 @@ def test_propagator_save_load_copy():
     assert eng.restrict(4, [False, True])
     assert eng.catalog()[0].tolist() == [False, True]
     assert not eng.assign(0, 0) and not eng.ok
+
+
+@given(random_problems(max_side=4, max_labels=9, density=(0.3, 0.95)), st.integers(0, 2**31))
+def test_incremental_restrictions_match_reference(P, seed):
+    """Random restriction sequences on one engine (delta revisions) = fresh reference runs."""
+    rng = np.random.default_rng(seed)
+    eng = Propagator(P)
+    C = P.domains.copy()
+    C, ok = propagate_reference(P, C)
+    assert ok == eng.ok
+    for _ in range(6):
+        if not ok:
+            break
+        cell = int(rng.integers(P.n))
+        allowed = rng.random(P.K) < 0.7
+        ok_fast = eng.restrict(cell, allowed)
+        C[cell] &= allowed
+        C, ok = propagate_reference(P, C, [cell]) if C[cell].any() else (C, False)
+        assert ok_fast == ok
+        if ok:
+            assert np.array_equal(eng.catalog(), C)
+        if ok:  # a trial assignment (it may wipe out) and back
+            state = eng.save()
+            eng.assign(cell, int(eng.domain(cell)[0]))
+            eng.load(state)
+            assert eng.ok and np.array_equal(eng.catalog(), C)

@@ -28,6 +28,9 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "fig3_1b": ("fig3_1b_checkerboard.grid", "E1, Fig. 3.1(b): checkerboard; two solutions"),
     "line": ("fig3_1c_line.grid", "Fig. 3.1(c)/3.12: a line in empty space; infallible"),
     "fig3_1d": ("fig3_1d_unique.grid", "E3, Fig. 3.1(d): no repeated label; no larger model"),
+    "city": ("city3d.grid", "3D, csplab's own: a city block, K=119; Alg. 3.1 never failed"),
+    "castle": ("castle3d.grid", "3D, csplab's own: castle walls, towers, K=63; fails often"),
+    "canal": ("canal3d.grid", "3D, csplab's own: canal town, bridges, K=80; fails seldom"),
 }
 ALIASES: dict[str, str] = {
     "E0": "fig3_1a",

@@ -104,7 +104,7 @@ def run_alg31(
     status: Status
     while True:
         code = kern.alg31(
-            eng.bits, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, eng._queue, eng._inq,
+            eng.bits, eng.prev, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, eng._queue, eng._inq,
             order_arr, use_heap, ustream, noise, c.weights, c.wlogw, weighted, grid,
             trace_cell, trace_label, state, _CHUNK if deadline is not None else n + 1,
             eng.stats, heap, hpos, hkey,
