@@ -43,7 +43,7 @@ def test_model_consistent_iff_lba_accepts(name, max_len):
             assert states[: len(run["configurations"])] == [c[0] for c in run["configurations"]]
 
 
-@pytest.mark.parametrize("w", ["aabbcc", "abc", "aabbbcc", "abcabc", "cba"])
+@pytest.mark.parametrize("w", ["aabbcc", "aaabbbccc", "abc", "aabbbcc", "abcabc", "cba"])
 def test_sat_agrees_with_arc_consistency(w):
     M = load_lba("anbncn")
     P, _ = lba_problem(M, w)
