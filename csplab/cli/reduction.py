@@ -101,12 +101,12 @@ def _run_planar(args: argparse.Namespace) -> int:
         )}  # fmt: skip
         code = 0 if v["agree"] else 1
     if args.solution_png:
-        from csplab.cnf import complete
+        from csplab.complexity import complete_model
 
         models = f.models()
         grid = red.encode(models[0]) if len(models) else None
         if grid is None:
-            r = complete(red.problem(), rng=gen)
+            r = complete_model(red.problem(), rng=gen)
             grid = r.grid if r.ok else None
         if grid is not None:
             save_reduction_png(grid, args.solution_png, args.scale)

@@ -10,3 +10,26 @@
 * :mod:`csplab.complexity.grammar`: Theorem 5.2.1's example and Theorem 5.2.3's regular
   grammar.
 """
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from csplab.problem import Problem
+    from csplab.result import Result
+    from csplab.rng import RngLike
+
+__all__ = ["complete_model"]
+
+
+def complete_model(problem: Problem, rng: RngLike = None) -> Result:
+    """Decide whether an incomplete model can be completed, with a completion.
+
+    The reductions use this one function (a complete SAT-based decision:
+    :func:`csplab.cnf.complete`); it is the single place to switch to another complete
+    solver such as ``csplab.solve(problem, "sat")``.
+    """
+    from csplab.cnf import complete
+
+    return complete(problem, rng=rng)

@@ -464,9 +464,9 @@ def lba_consistent(lba: LBA, word: str, rows: int | None = None) -> Verdict:
         ok = P.is_solution(g)
         return Verdict(ok, g if ok else None, stats,
                        f"{word!r}: {'consistent' if ok else 'inconsistent'}")  # fmt: skip
-    from csplab.cnf import complete
+    from csplab.complexity import complete_model
 
-    r = complete(P)
+    r = complete_model(P)
     stats["decided_by"] = "sat"
     ok = r.status == "solved"
     return Verdict(ok, r.grid if ok else None, stats,

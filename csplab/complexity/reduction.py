@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab.complexity import complete_model
 from csplab.complexity import gadgets as G
 from csplab.complexity.planar3sat import Planar3SAT
 from csplab.errors import InputError
@@ -292,13 +293,6 @@ def _check_layout(red: Reduction) -> None:
 # ----------------------------------------------------------------------------- verification
 
 
-def _complete(problem: Problem, rng: np.random.Generator) -> Any:
-    """Decide completability with a complete SAT-based solver (one switch point)."""
-    from csplab.cnf import complete
-
-    return complete(problem, rng=rng)
-
-
 def verify_instance(
     formula: Planar3SAT, rng: RngLike = None, *, alg31: bool = True
 ) -> dict[str, Any]:
@@ -325,7 +319,7 @@ def verify_instance(
     out["t_build"] = time.perf_counter() - t0
     out["planar"] = formula.is_planar()
     t0 = time.perf_counter()
-    r = _complete(P, gen)
+    r = complete_model(P, gen)
     out["t_grid_sat"] = time.perf_counter() - t0
     out["completable"] = r.status == "solved"
     out["grid_status"] = r.status
