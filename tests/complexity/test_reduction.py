@@ -103,3 +103,20 @@ def test_pictures(tmp_path):
     save_reduction_png(red.fixed, tmp_path / "m.png", scale=4)
     img = G.label_sheet(scale=12)
     assert (tmp_path / "m.png").stat().st_size > 0 and img.size[0] > 0  # type: ignore[attr-defined]
+
+
+@pytest.mark.slow
+def test_full_experiment_plan():
+    """The 300 formulas of experiments/reduction_planar3sat.py (run with -m slow)."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "experiments" / "reduction_planar3sat.py"
+    spec = importlib.util.spec_from_file_location("reduction_planar3sat", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    cases = mod.plan(300)
+    assert sum(c[0] == "unsat" for c in cases) == 150
+    for mode, n, m, seed in cases:
+        out = verify_instance(random_planar3sat(n, m, rng=seed, signs=mode), rng=seed)
+        assert out["agree"], (mode, n, m, seed)
