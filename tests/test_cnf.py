@@ -113,3 +113,12 @@ def test_bad_arguments():
     for kw in ({"encoding": "log"}, {"supports": "sideways"}, {"amo": "magic"}):
         with pytest.raises(InputError):
             encode(P, **kw)
+
+
+def test_fixed_cell_that_forces_the_board_leaves_no_variables():
+    from csplab import ExampleModel, Problem
+
+    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 1})
+    enc = encode(P, amo="pairwise")
+    assert enc.ok and enc.nx == 0 and enc.nclauses == 0  # one label forces the checkerboard
+    assert P.is_solution(enc.const.reshape(P.shape))

@@ -28,6 +28,8 @@ COMMANDS: dict[str, str] = {
     "prove": "csplab.cli.prove",
     "witness": "csplab.cli.witness",
     "refine": "csplab.cli.refine",
+    "reduction": "csplab.cli.reduction",
+    "count": "csplab.cli.count",
 }
 
 
