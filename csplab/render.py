@@ -24,7 +24,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from PIL import Image, ImageDraw
 
-__all__ = ["empty_label_guess", "palette", "render", "render_png_bytes", "save_png"]
+__all__ = [
+    "empty_label_guess",
+    "palette",
+    "render",
+    "render_png_bytes",
+    "render_tiles",
+    "save_png",
+]
 
 
 def palette(K: int) -> NDArray[np.uint8]:
@@ -50,20 +57,28 @@ def empty_label_guess(grid: NDArray[np.integer[Any]]) -> int:
     return int(np.bincount(top).argmax())
 
 
-def _render_2d(g: NDArray[np.int64], K: int, scale: int) -> Image.Image:
-    cols = palette(K)
+def _render_2d(
+    g: NDArray[np.int64], K: int, scale: int, colors: NDArray[np.uint8] | None = None
+) -> Image.Image:
+    cols = palette(K) if colors is None else colors
     rgb = np.where(g[..., None] >= 0, cols[np.clip(g, 0, K - 1)], np.uint8(40))
     img = np.transpose(rgb, (1, 0, 2))[::-1]  # rows = y descending, columns = x
     img = np.repeat(np.repeat(img, scale, axis=0), scale, axis=1)
     return Image.fromarray(np.ascontiguousarray(img, dtype=np.uint8), "RGB")
 
 
-def _render_3d(g: NDArray[np.int64], K: int, scale: int, empty: int | None) -> Image.Image:
+def _render_3d(
+    g: NDArray[np.int64],
+    K: int,
+    scale: int,
+    empty: int | None,
+    colors: NDArray[np.uint8] | None = None,
+) -> Image.Image:
     nx, ny, nz = g.shape
     if empty is None:
         empty = empty_label_guess(g)
     filled = (g >= 0) & (g != empty)
-    cols = palette(K).astype(np.float64)
+    cols = (palette(K) if colors is None else colors).astype(np.float64)
     a = scale * 0.866
     b = scale * 0.5
     c = scale * 1.0
@@ -105,12 +120,46 @@ def _render_3d(g: NDArray[np.int64], K: int, scale: int, empty: int | None) -> I
     return img
 
 
+def render_tiles(grid: ArrayLike, tiles: ArrayLike, *, scale: int = 1) -> Image.Image:
+    """Composite one picture per label: ``tiles`` is ``(K, h, w, 3 or 4)`` uint8 (rows top to
+    bottom, as in an image file); cell ``[x, y]`` of a 2D grid is drawn with ``y`` up.
+    Unassigned cells (``-1``) are drawn dark grey.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> tiles = np.zeros((2, 3, 3, 3), dtype=np.uint8); tiles[1] = 255
+    >>> img = render_tiles(np.array([[0, 1]]), tiles)        # x = 0: y = 0 black, y = 1 white
+    >>> img.size, img.getpixel((0, 0)), img.getpixel((0, 5))
+    ((3, 6), (255, 255, 255), (0, 0, 0))
+    """
+    g = np.asarray(grid, dtype=np.int64)
+    t = np.asarray(tiles, dtype=np.uint8)
+    if g.ndim != 2:
+        raise ValueError(f"tile pictures need a 2D grid, got shape {g.shape}")
+    if t.shape[-1] == 4:  # composite on white
+        a = t[..., 3:4].astype(np.float64) / 255.0
+        t = (t[..., :3] * a + 255.0 * (1 - a)).astype(np.uint8)
+    K, h, w = t.shape[:3]
+    ext = np.concatenate([t[..., :3], np.full((1, h, w, 3), 40, np.uint8)])
+    idx = np.where((g >= 0) & (g < K), g, K)
+    rows = idx.T[::-1]  # image rows: y descending
+    img = ext[rows]  # (ny, nx, h, w, 3)
+    ny, nx = rows.shape
+    img = img.transpose(0, 2, 1, 3, 4).reshape(ny * h, nx * w, 3)
+    if scale > 1:
+        img = np.repeat(np.repeat(img, scale, axis=0), scale, axis=1)
+    return Image.fromarray(np.ascontiguousarray(img), "RGB")
+
+
 def render(
     grid: ArrayLike,
     *,
     K: int | None = None,
     scale: int | None = None,
     empty: int | None = None,
+    colors: ArrayLike | None = None,
+    tiles: ArrayLike | None = None,
 ) -> Image.Image:
     """A PIL image of a label grid (1D/2D: cells; 3D: isometric voxels; 4D: the ``w = 0`` slice).
 
@@ -124,6 +173,10 @@ def render(
         Pixels per cell (default chosen from the grid size).
     empty : int, optional
         3D only: the label left out (default: the most frequent label of the top layer).
+    colors : uint8 array ``(K, 3)``, optional
+        One colour per label (default :func:`palette`).
+    tiles : uint8 array ``(K, h, w, 3 or 4)``, optional
+        2D only: one picture per label, composited by :func:`render_tiles`.
     """
     g = np.asarray(grid, dtype=np.int64)
     if g.ndim == 4:
@@ -134,11 +187,21 @@ def render(
         K = int(g.max()) + 1 if g.size and g.max() >= 0 else 1
     if g.ndim == 3 and g.shape[2] == 1:
         g = g[:, :, 0]
+    cols = None
+    if colors is not None:
+        cols = np.asarray(colors, dtype=np.uint8).reshape(-1, 3)
+        K = max(K, len(cols))
+        if len(cols) < K:
+            cols = np.concatenate([cols, palette(K)[len(cols) :]])
+    if g.ndim == 2 and tiles is not None:
+        t = np.asarray(tiles)
+        s = scale or max(1, min(8, 640 // max(max(g.shape) * max(t.shape[1:3]), 1)))
+        return render_tiles(g, t, scale=s)
     if g.ndim == 2:
         s = scale or max(2, min(24, 640 // max(g.shape)))
-        return _render_2d(g, K, s)
+        return _render_2d(g, K, s, cols)
     s = scale or max(3, min(20, 900 // max(g.shape[0] + g.shape[1], 1)))
-    return _render_3d(g, K, s, empty)
+    return _render_3d(g, K, s, empty, cols)
 
 
 def save_png(grid: ArrayLike, path: str | Path, *, names: Sequence[str] | None = None,
@@ -148,8 +211,20 @@ def save_png(grid: ArrayLike, path: str | Path, *, names: Sequence[str] | None =
     render(grid, K=K, **kwargs).save(Path(path), format="PNG")
 
 
-def render_png_bytes(grid: ArrayLike, *, names: Sequence[str] | None = None) -> bytes:
+def render_png_bytes(
+    grid: ArrayLike,
+    *,
+    names: Sequence[str] | None = None,
+    model: Any = None,
+    periodic: bool | None = None,
+) -> bytes:
+    """PNG bytes of :func:`render` (or of ``model.render(grid)`` when the model, e.g. a
+    :class:`~csplab.io.ruleset.RuleSet`, draws its own tiles)."""
     buf = io.BytesIO()
-    K = len(names) if names is not None else None
-    render(grid, K=K).save(buf, format="PNG")
+    if model is not None and hasattr(model, "render"):
+        img = model.render(grid, periodic=periodic)
+    else:
+        K = len(names) if names is not None else None
+        img = render(grid, K=K)
+    img.save(buf, format="PNG")
     return buf.getvalue()

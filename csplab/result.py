@@ -105,7 +105,9 @@ class Result:
         from csplab.render import render_png_bytes
 
         names = self.problem.names if self.problem is not None else None
-        return render_png_bytes(self.grid, names=names)
+        model = self.problem.meta.get("model") if self.problem is not None else None
+        per = self.problem.meta.get("periodic", False) if self.problem is not None else False
+        return render_png_bytes(self.grid, names=names, model=model, periodic=bool(np.all(per)))
 
 
 @dataclass

@@ -22,6 +22,7 @@ COMMANDS: dict[str, str] = {
     "synthesize": "csplab.cli.synthesize",
     "check": "csplab.cli.check",
     "info": "csplab.cli.info",
+    "show": "csplab.cli.show",
     "experiment": "csplab.cli.experiment",
 }
 

@@ -6,15 +6,21 @@ import argparse
 import json
 from typing import Any
 
-from csplab.cli.common import add_problem_args, load_grid, load_model, parse_boundary
+from csplab.cli.common import (
+    add_problem_args,
+    load_grid,
+    load_model,
+    model_options,
+    problem_from_args,
+)
 
 
 def add_parser(sub: Any) -> argparse.ArgumentParser:
     p: argparse.ArgumentParser = sub.add_parser(
         "check",
         help="count the violations of a grid file against an example",
-        description="Check a grid (.npy, Merrell .txt or .grid) against an example model. "
-        "Exit 0 when it is consistent, 1 when it violates something.",
+        description="Check a grid (.npy, Merrell .txt or .grid) against an example model or "
+        "a tileset's rules. Exit 0 when it is consistent, 1 when it violates something.",
     )
     add_problem_args(p, size_required=False)
     p.add_argument("grid", metavar="GRID", help="grid file to check")
@@ -24,13 +30,9 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
 
 
 def run(args: argparse.Namespace) -> int:
-    from csplab.problem import Problem
-
-    example = load_model(args.model)
-    grid = load_grid(args.grid, example.ndim)
-    problem = Problem.from_example(
-        example, grid.shape, periodic=bool(args.periodic), boundary=parse_boundary(args.boundary)
-    )
+    model = load_model(args.model, model_options(args.model_option))
+    grid = load_grid(args.grid, model.ndim)
+    problem = problem_from_args(args, model, shape=tuple(grid.shape))
     v = problem.violations(grid)
     if args.json:
         print(

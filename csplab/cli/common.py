@@ -1,4 +1,9 @@
-"""Helpers shared by the CLI subcommands: loading a model, building a problem."""
+"""Helpers shared by the CLI subcommands: loading a model, building a problem.
+
+A model is an :class:`ExampleModel` (an example grid) or a
+:class:`~csplab.io.ruleset.RuleSet` (a tileset's rules); both become a :class:`Problem`
+through :func:`problem_from_args`.
+"""
 
 from __future__ import annotations
 
@@ -11,20 +16,56 @@ from numpy.typing import NDArray
 
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
+from csplab.io.ruleset import RuleSet
 from csplab.problem import Problem, parse_shape
 
-__all__ = ["add_problem_args", "load_grid", "load_model", "problem_from_args"]
+__all__ = [
+    "Model",
+    "add_problem_args",
+    "load_grid",
+    "load_model",
+    "model_options",
+    "problem_from_args",
+]
+
+Model = ExampleModel | RuleSet
 
 
-def load_model(spec: str) -> ExampleModel:
-    """A built-in example name or a model file path."""
+def model_options(items: list[str] | None) -> dict[str, Any]:
+    """``KEY=VALUE`` strings (values parsed as JSON when possible) as a dict."""
+    import json
+
+    opts: dict[str, Any] = {}
+    for kv in items or []:
+        key, sep, val = kv.partition("=")
+        if not sep or not key:
+            raise InputError(f"--model-option {kv!r} must be KEY=VALUE")
+        try:
+            opts[key] = json.loads(val)
+        except json.JSONDecodeError:
+            opts[key] = val
+    return opts
+
+
+def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
+    """A built-in example name or a model file path (any format of :func:`read_model`)."""
     from csplab.examples import ALIASES, EXAMPLES, load_example
 
     p = Path(spec)
     if p.exists():
-        from csplab.io import read_example
+        import sys
+        import warnings
 
-        return read_example(p)
+        from csplab.io import read_model
+
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            model = read_model(p, **(options or {}))
+        for w in caught:  # one line each, no source location
+            print(f"csplab: warning: {w.message}", file=sys.stderr)
+        return model
+    if options:
+        raise InputError("--model-option applies to model files only")
     if spec in EXAMPLES or spec in ALIASES:
         return load_example(spec)
     if p.suffix or "/" in spec or "\\" in spec:
@@ -48,23 +89,44 @@ def load_grid(path: str, ndim: int) -> NDArray[np.int32]:
 
 
 def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) -> None:
-    p.add_argument("model", metavar="MODEL", help="built-in example name or model file")
+    p.add_argument(
+        "model",
+        metavar="MODEL",
+        help="built-in example name or model file (example grid .txt/.grid/.npy/.vox, or "
+        "tileset: WFC/MarkovJunior .xml, POMS/DeBroglie .json, overlapping-model .png)",
+    )
     p.add_argument(
         "--size",
-        required=size_required,
-        help="output size such as 40x40x10 (trailing axes of extent 1 may be omitted)",
+        help="output size such as 40x40x10 (trailing axes of extent 1 may be omitted)"
+        + ("; required unless the tileset file gives one" if size_required else ""),
     )
     p.add_argument(
         "--boundary",
-        default="none",
-        help="'auto' (ground below, empty space around), 'none', or face=label pairs "
-        "such as 'z-=1,x-=0'",
+        default=None,
+        help="'auto' (examples: ground below, empty space around; tilesets: the file's "
+        "boundary conditions), 'none', or face=label pairs such as 'z-=1,x-=0' "
+        "(default: none for examples, the file's for tilesets)",
     )
-    p.add_argument("--periodic", action="store_true", help="wrap around on every axis")
+    p.add_argument(
+        "--periodic",
+        action="store_true",
+        default=None,
+        help="wrap around on every axis (default: off, or the tileset file's setting)",
+    )
+    p.add_argument(
+        "--model-option",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="option for the model file's loader (repeatable): subset=NAME (WFC), "
+        "N=3, symmetry=8, periodic_input=true, ground=true (PNG sample), up=y|z (POMS), "
+        "strict=true (DeBroglie)",
+    )
+    p.set_defaults(_size_required=size_required)
 
 
-def parse_boundary(text: str) -> Any:
-    if text in ("auto", "none"):
+def parse_boundary(text: str | None) -> Any:
+    if text is None or text in ("auto", "none"):
         return text
     out: dict[str, int] = {}
     for part in text.split(","):
@@ -78,8 +140,21 @@ def parse_boundary(text: str) -> Any:
     return out
 
 
-def problem_from_args(args: argparse.Namespace, example: ExampleModel) -> Problem:
-    shape = parse_shape(args.size, what="--size") if args.size else example.shape
+def problem_from_args(
+    args: argparse.Namespace, model: Model, shape: tuple[int, ...] | None = None
+) -> Problem:
+    """The problem for ``--size`` (or ``shape``), ``--boundary`` and ``--periodic``."""
+    if shape is None and args.size:
+        shape = parse_shape(args.size, what="--size")
+    boundary = parse_boundary(args.boundary)
+    if isinstance(model, RuleSet):
+        if shape is None and model.shape is None:
+            raise InputError(f"{model.name or args.model} gives no output size: use --size")
+        return model.problem(shape, periodic=args.periodic, boundary=boundary)
+    if shape is None:
+        if getattr(args, "_size_required", False):
+            raise InputError("--size is required for an example model (e.g. --size 40x40x10)")
+        shape = model.shape
     return Problem.from_example(
-        example, shape, periodic=bool(args.periodic), boundary=parse_boundary(args.boundary)
+        model, shape, periodic=bool(args.periodic), boundary=boundary or "none"
     )

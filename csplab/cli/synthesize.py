@@ -8,9 +8,11 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from csplab.cli.common import add_problem_args, load_model, problem_from_args
+from csplab.cli.common import add_problem_args, load_model, model_options, problem_from_args
 from csplab.errors import InputError
 from csplab.problem import parse_shape
+
+OUT_EXT = (".npy", ".txt", ".grid", ".png", ".vox", ".obj")
 
 
 def add_parser(sub: Any) -> argparse.ArgumentParser:
@@ -38,7 +40,11 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         metavar="KEY=VALUE",
         help="extra solver option (repeatable; VALUE parsed as JSON when possible)",
     )
-    p.add_argument("--out", help="output file: .npy, .txt (Merrell format), .grid or .png")
+    p.add_argument(
+        "--out",
+        help="output file: .npy, .txt (Merrell format), .grid, .png (tile pictures for "
+        "tilesets), .vox (MagicaVoxel) or .obj (+ .mtl)",
+    )
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
     return p
 
@@ -72,24 +78,30 @@ def run(args: argparse.Namespace) -> int:
     from csplab.io import write_labels
     from csplab.solvers import solve
 
-    example = load_model(args.model)
+    example = load_model(args.model, model_options(args.model_option))
     problem = problem_from_args(args, example)
     opts = _options(args)
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
     if args.out:
         out = Path(args.out)
-        if out.suffix.lower() not in (".npy", ".txt", ".grid", ".png"):
-            raise InputError(f"--out {args.out}: use .npy, .txt, .grid or .png")
+        if out.suffix.lower() not in OUT_EXT:
+            raise InputError(f"--out {args.out}: use {', '.join(OUT_EXT)}")
     result = solve(problem, args.solver, rng=args.seed, **opts)
     wrote = None
     if args.out and (result.ok or Path(args.out).suffix.lower() in (".npy", ".png")):
-        write_labels(result.grid, args.out, names=example.names, name=example.name)
+        per = problem.meta.get("periodic", False)
+        write_labels(
+            result.grid, args.out, name=example.name, model=example, periodic=bool(all(per))
+        )
         wrote = args.out
     if args.json:
         d = result.to_dict()
         d["example"] = example.name
         d["out"] = wrote
+        d["format"] = (getattr(example, "meta", None) or getattr(example, "metadata", {})).get(
+            "format"
+        )
         print(json.dumps(d))
     else:
         size = "x".join(map(str, problem.shape))

@@ -20,7 +20,15 @@ from hypothesis import strategies as st
 from csplab.example import ExampleModel
 from csplab.problem import Problem
 
-__all__ = ["example_models", "label_grids", "problems", "random_problems", "shapes"]
+__all__ = [
+    "corrupted",
+    "example_models",
+    "label_grids",
+    "problems",
+    "random_problems",
+    "shapes",
+    "tile_rule_sets",
+]
 
 
 @st.composite
@@ -105,3 +113,63 @@ def random_problems(draw: Any, max_side: int = 4, max_labels: int = 4, max_ndim:
     T = rng.random((len(shp), k, k)) < p
     per = draw(st.booleans())
     return Problem.grid(shp, T, periodic=per)
+
+
+@st.composite
+def corrupted(draw: Any, data: bytes, max_edits: int = 3) -> bytes:
+    """``data`` damaged by 1 to ``max_edits`` edits: truncation, byte flips, deleted or
+    duplicated lines, deleted or duplicated ``key="value"`` attributes (for fuzzing file
+    loaders: only :class:`~csplab.errors.CsplabError` may escape)."""
+    import re
+
+    out = bytearray(data)
+    for _ in range(draw(st.integers(1, max_edits))):
+        kind = draw(
+            st.sampled_from(["truncate", "flip", "del_line", "dup_line", "del_attr", "dup_attr"])
+        )
+        if not out:
+            break
+        if kind == "truncate":
+            out = out[: draw(st.integers(0, len(out) - 1))]
+        elif kind == "flip":
+            i = draw(st.integers(0, len(out) - 1))
+            out[i] = draw(st.integers(0, 255))
+        elif kind in ("del_line", "dup_line"):
+            lines = bytes(out).split(b"\n")
+            i = draw(st.integers(0, len(lines) - 1))
+            if kind == "del_line":
+                del lines[i]
+            else:
+                lines.insert(i, lines[i])
+            out = bytearray(b"\n".join(lines))
+        else:
+            attrs = list(re.finditer(rb'[\w"]+\s*[=:]\s*("[^"]*"|[-\w.]+)', bytes(out)))
+            if not attrs:
+                continue
+            m = attrs[draw(st.integers(0, len(attrs) - 1))]
+            piece = b"" if kind == "del_attr" else m.group(0) + b" "
+            end = m.start() if kind == "dup_attr" else m.end()
+            out = out[: m.start()] + piece + out[end:]
+    return bytes(out)
+
+
+@st.composite
+def tile_rule_sets(draw: Any, max_tiles: int = 4, max_rules: int = 8) -> str:
+    """Random valid WaveFunctionCollapse simple-tiled XML (no images)."""
+    syms = ["X", "L", "T", "I", "\\", "F"]
+    card = {"X": 1, "L": 4, "T": 4, "I": 2, "\\": 2, "F": 8}
+    n = draw(st.integers(1, max_tiles))
+    tiles = [(f"t{i}", draw(st.sampled_from(syms))) for i in range(n)]
+    lines = ["<set>", "  <tiles>"]
+    for nm, sym in tiles:
+        w = draw(st.sampled_from([0.5, 1, 2]))
+        lines.append(f'    <tile name="{nm}" symmetry="{sym}" weight="{w}"/>')
+    lines += ["  </tiles>", "  <neighbors>"]
+    for _ in range(draw(st.integers(1, max_rules))):
+        a, sa = draw(st.sampled_from(tiles))
+        b, sb = draw(st.sampled_from(tiles))
+        ka = draw(st.integers(0, card[sa] - 1))
+        kb = draw(st.integers(0, card[sb] - 1))
+        lines.append(f'    <neighbor left="{a} {ka}" right="{b} {kb}"/>')
+    lines += ["  </neighbors>", "</set>"]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,256 @@
+"""The overlapping model (WaveFunctionCollapse): patterns of a sample become the labels.
+
+From a sample (a small picture, or any 2D/3D label grid) every ``N``-wide pattern is
+extracted: with ``periodic_input`` the sample wraps around, and ``symmetry`` (1 to 8) adds
+the first ``symmetry`` of the pattern's 8 images under the square's symmetries in
+WaveFunctionCollapse's order (identity, mirror, quarter turn, its mirror, ...; in 3D they act
+on ``x, y``). A pattern's weight is how often it occurs. Pattern ``q`` may be the ``+1``
+neighbour of ``p`` along an axis iff they agree on their overlap (``p`` shifted by one).
+
+Cell ``[x, y]`` of a result holds the pattern whose corner is pixel ``[x, y]``: the
+picture of a periodic result has the grid's size; a non-periodic result of shape ``S`` shows
+every pattern whole, ``S + N - 1`` pixels. With ``ground`` (2D, symmetry 1 or 2) the bottom
+row of cells may only hold patterns found on the sample's bottom row and the other rows only
+patterns found elsewhere, so the output stands on the sample's ground.
+
+Examples
+--------
+>>> import numpy as np
+>>> sample = np.array([[0, 0, 1], [0, 0, 1], [1, 1, 1]])    # [x, y]: wall on the right and top
+>>> m = OverlapModel.from_grid(sample, N=2, symmetry=1)
+>>> m.K, int(m.weights.sum())                      # 9 anchors, all different (periodic input)
+(9, 9)
+>>> import csplab
+>>> r = csplab.solve(m.problem((6, 6), periodic=True), "catalog", rng=0)
+>>> r.status, m.reconstruct(r.grid, periodic=True).shape
+('solved', (6, 6))
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from csplab.errors import FormatError, InputError
+from csplab.io.ruleset import DomainOp, RuleSet
+
+__all__ = ["OverlapModel"]
+
+MAX_PATTERNS = 4000
+
+
+def _sym_images(p: NDArray[np.int64]) -> list[NDArray[np.int64]]:
+    """The 8 images of a pattern ``[x, y, ...]`` in WFC's order (rotation maps +x to +y)."""
+
+    def rot(a: NDArray[np.int64]) -> NDArray[np.int64]:
+        return np.rot90(a, 1, axes=(0, 1))  # [x, y]: quarter turn +x -> +y
+
+    def refl(a: NDArray[np.int64]) -> NDArray[np.int64]:
+        return a[::-1]
+
+    out = [p]
+    out.append(refl(p))
+    r = rot(p)
+    out += [r, refl(r)]
+    r2 = rot(r)
+    out += [r2, refl(r2)]
+    r3 = rot(r2)
+    out += [r3, refl(r3)]
+    return out
+
+
+class OverlapModel(RuleSet):
+    """A :class:`RuleSet` whose labels are the ``N``-wide patterns of a sample.
+
+    Build it with :meth:`from_png` or :meth:`from_grid`. ``patterns[k]`` is pattern ``k``
+    (sample labels, indexed ``[x, y, ...]``), ``colors`` the RGB colour of each sample
+    label; :meth:`reconstruct` turns a result into sample labels and :meth:`render` into a
+    picture.
+    """
+
+    patterns: NDArray[np.int64]
+    N: int
+    sample_colors: NDArray[np.uint8] | None
+
+    @classmethod
+    def from_grid(
+        cls,
+        sample: ArrayLike,
+        *,
+        N: int = 3,
+        symmetry: int = 8,
+        periodic_input: bool = True,
+        ground: bool = False,
+        colors: ArrayLike | None = None,
+        name: str = "sample",
+        meta: dict[str, Any] | None = None,
+    ) -> OverlapModel:
+        """The overlapping model of a 2D or 3D label grid ``sample[x, y, ...]``."""
+        s = np.asarray(sample)
+        if s.ndim not in (2, 3) or s.size == 0:
+            raise InputError(f"the sample must be a 2D or 3D grid, got shape {s.shape}")
+        if not np.issubdtype(s.dtype, np.integer) or s.min() < 0:
+            raise InputError("the sample must hold non-negative integer labels")
+        s = s.astype(np.int64)
+        if not 1 <= N <= 8:
+            raise InputError(f"N must be 1..8, got {N}")
+        if not 1 <= symmetry <= 8:
+            raise InputError(f"symmetry must be 1..8, got {symmetry}")
+        if ground and (s.ndim != 2 or symmetry > 2):
+            raise InputError("ground needs a 2D sample and symmetry 1 or 2 (turns would move it)")
+        if not periodic_input and any(n < N for n in s.shape):
+            raise InputError(f"a {N}-wide pattern does not fit the sample {s.shape}")
+        nd = s.ndim
+        anchors = [range(n if periodic_input else n - N + 1) for n in s.shape]
+        index: dict[bytes, int] = {}
+        pats: list[NDArray[np.int64]] = []
+        counts: list[int] = []
+        bottom: set[int] = set()
+        above: set[int] = set()
+        grids = np.meshgrid(*[np.arange(N)] * nd, indexing="ij")
+        for anchor in np.ndindex(*[len(a) for a in anchors]):
+            idx = tuple((g + a) % n for g, a, n in zip(grids, anchor, s.shape, strict=True))
+            p = s[idx]
+            for q in _sym_images(p)[:symmetry]:
+                key = q.tobytes()
+                j = index.get(key)
+                if j is None:
+                    j = index[key] = len(pats)
+                    pats.append(np.ascontiguousarray(q))
+                    counts.append(0)
+                    if len(pats) > MAX_PATTERNS:
+                        raise InputError(f"the sample has more than {MAX_PATTERNS} patterns")
+                counts[j] += 1
+                if ground:
+                    (bottom if anchor[1] == 0 else above).add(j)
+        P = np.stack(pats)  # (K, N, N[, N])
+        K = len(pats)
+        T = np.zeros((nd, K, K), dtype=bool)
+        for d in range(nd):
+            a = np.take(P, np.arange(1, N), axis=d + 1).reshape(K, -1)  # p shifted by one
+            b = np.take(P, np.arange(0, N - 1), axis=d + 1).reshape(K, -1)
+            if N == 1:
+                T[d] = True
+                continue
+            # group patterns by their overlap halves: equal keys agree
+            _, ia = np.unique(a, axis=0, return_inverse=True)
+            keys_b = {r.tobytes(): i for i, r in enumerate(np.unique(a, axis=0))}
+            ib = np.array([keys_b.get(r.tobytes(), -1) for r in b])
+            T[d] = ia.reshape(-1)[:, None] == ib[None, :]
+        ops: list[DomainOp] = []
+        if ground:
+            g_lab = np.zeros(K, dtype=bool)
+            g_lab[sorted(bottom)] = True
+            a_lab = np.zeros(K, dtype=bool)
+            a_lab[sorted(above)] = True
+            ops = [
+                DomainOp("keep", g_lab, face="y-", kind="domain", key="ground (bottom row)"),
+                DomainOp("keep", a_lab, region=[(None, None), (1, None)], key="above ground"),
+            ]
+        cols = None if colors is None else np.asarray(colors, dtype=np.uint8).reshape(-1, 3)
+        corner = P.reshape(K, -1)[:, 0]
+        label_cols = None
+        if cols is not None:
+            if int(s.max()) >= len(cols):
+                raise InputError("fewer colours than sample labels")
+            label_cols = cols[corner]
+        m = cls(
+            T,
+            names=[f"p{k}" for k in range(K)],
+            weights=np.array(counts, dtype=np.float64),
+            name=name,
+            colors=label_cols,
+            constraint_ops=ops,
+            meta={
+                "format": "overlapping",
+                "N": N,
+                "symmetry": symmetry,
+                "periodic_input": periodic_input,
+                "ground": ground,
+                "sample_shape": list(s.shape),
+                **(meta or {}),
+            },
+        )
+        m.patterns = P
+        m.N = N
+        m.sample_colors = cols
+        return m
+
+    @classmethod
+    def from_png(
+        cls,
+        path: str | Path,
+        *,
+        N: int = 3,
+        symmetry: int = 8,
+        periodic_input: bool = True,
+        ground: bool = False,
+    ) -> OverlapModel:
+        """The overlapping model of a picture; colours are numbered in order of first
+        appearance (rows from the top), the picture's ``y`` axis is turned to point up."""
+        from csplab.io.wfc import load_image
+
+        p = Path(path)
+        img = load_image(p)
+        if img.shape[0] * img.shape[1] > 256 * 256:
+            raise FormatError(
+                f"sample {img.shape[1]}x{img.shape[0]} is too large (max 256x256)", path=p
+            )
+        flat = img.reshape(-1, 4)
+        _, first, inv = np.unique(flat, axis=0, return_index=True, return_inverse=True)
+        order = np.argsort(first)
+        rank = np.empty_like(order)
+        rank[order] = np.arange(order.size)
+        lab = rank[inv.reshape(-1)].reshape(img.shape[:2])  # [row, col]
+        colors = flat[first[order], :3]
+        sample = lab.T[:, ::-1]  # [x, y] with y up
+        try:
+            return cls.from_grid(
+                sample,
+                N=N,
+                symmetry=symmetry,
+                periodic_input=periodic_input,
+                ground=ground,
+                colors=colors,
+                name=p.stem,
+                meta={"source": str(p)},
+            )
+        except InputError as e:
+            raise FormatError(str(e), path=p) from None
+
+    # ------------------------------------------------------------------ results
+    def reconstruct(self, grid: ArrayLike, periodic: bool | None = None) -> NDArray[np.int64]:
+        """Sample labels of a result: cell ``[x, y]`` gives pixel ``[x, y]`` (its pattern's
+        corner); a non-periodic result also gets the far rows of its last patterns.
+        Unassigned cells give ``-1``."""
+        g = np.asarray(grid, dtype=np.int64)
+        if g.ndim != self.ndim:
+            raise InputError(f"grid has {g.ndim} axes, the model {self.ndim}")
+        per = bool(self.periodic) if periodic is None else periodic
+        N = self.N
+        shape = g.shape if per else tuple(s + N - 1 for s in g.shape)
+        coords = np.meshgrid(*[np.arange(s) for s in shape], indexing="ij")
+        cell = [np.minimum(c, s - 1) for c, s in zip(coords, g.shape, strict=True)]
+        off = [c - k for c, k in zip(coords, cell, strict=True)]
+        lab = g[tuple(cell)]
+        ok = (lab >= 0) & (lab < self.K)
+        flat_p = self.patterns.reshape(self.K, -1)
+        strides = [N ** (self.ndim - 1 - d) for d in range(self.ndim)]
+        pos = sum(o * st for o, st in zip(off, strides, strict=True))
+        out = flat_p[np.where(ok, lab, 0), pos]
+        return np.where(ok, out, -1)
+
+    def render(
+        self, grid: ArrayLike, *, scale: int | None = None, periodic: bool | None = None
+    ) -> Any:
+        """The picture of a result (sample colours, ``y`` up); ``periodic`` says whether the
+        result wraps around (default: the model's setting)."""
+        from csplab.render import render
+
+        g = np.asarray(grid)
+        img = self.reconstruct(g, periodic=periodic)
+        K = int(self.patterns.max()) + 1
+        return render(img, K=K, colors=self.sample_colors, scale=scale)

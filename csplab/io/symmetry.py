@@ -1,0 +1,294 @@
+"""Symmetry groups of the grid and their action on tile orientations and adjacency rules.
+
+A grid symmetry is a signed permutation of the axes (a rotation or reflection of the grid),
+stored as an integer matrix ``M`` (``M @ e_i`` is the image of the unit vector along axis
+``i``). Tilesets (WaveFunctionCollapse, MarkovJunior, DeBroglie) state adjacency rules *up
+to symmetry*: a tile in orientation ``g`` is the base tile transformed by ``g``, and a rule
+"``b`` may follow ``a`` along ``+x``" holds in every transformed frame. Here:
+
+* :func:`square_group` (the 8 symmetries of the square acting on ``x, y``; csplab's ``y``
+  points up, so ``"a"`` maps ``+x`` to ``+y``, a counter-clockwise turn as drawn) and
+  :func:`cube_group` (the 48 symmetries of the cube);
+* :class:`Orientations`: the labels of a tileset as ``(tile, coset gH)`` pairs, where ``H``
+  is the tile's own symmetry group, with the group's action on them;
+* :func:`expand_rules`: the orbit of stated rules under the group, as transition matrices;
+* :func:`closure_violations`: rules whose image under some group element is missing (a
+  rule set that is not closed under the symmetry group).
+
+Examples
+--------
+>>> G = square_group()
+>>> len(G), G.name(G.index("a")), G.apply(G.index("a"), (0, 1))     # a maps +x to +y
+(8, 'a', (1, 1))
+>>> O = Orientations(G, [G.subgroup(["b"])])    # one tile, symmetric under the x-mirror (T)
+>>> O.K
+4
+>>> T = expand_rules(O, [(O.label(0, 0), O.label(0, 0), (0, 1))])   # "t 0" next to "t 0"
+>>> closure_violations(O.group, O.perm, T)
+[]
+"""
+
+from __future__ import annotations
+
+import functools
+import itertools
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.errors import InputError
+
+__all__ = [
+    "Group",
+    "Orientations",
+    "closure_violations",
+    "cube_group",
+    "expand_rules",
+    "square_group",
+]
+
+Direction = tuple[int, int]  # (axis, sign +1 / -1)
+
+
+def _key(m: NDArray[np.int64]) -> bytes:
+    return np.ascontiguousarray(m, dtype=np.int8).tobytes()
+
+
+class Group:
+    """A finite group of signed axis permutations, closed under composition.
+
+    Parameters
+    ----------
+    generators : mapping name -> matrix
+        Named generators (``ndim x ndim`` signed permutation matrices).
+    ndim : int
+    """
+
+    def __init__(self, generators: dict[str, NDArray[np.int64]], ndim: int) -> None:
+        eye = np.eye(ndim, dtype=np.int64)
+        self.ndim = ndim
+        self.elements: list[NDArray[np.int64]] = [eye]
+        self.words: list[str] = [""]  # shortest word (applied right to left) per element
+        index = {_key(eye): 0}
+        frontier = [0]
+        gens = list(generators.items())
+        while frontier:  # breadth first: shortest words first
+            nxt = []
+            for i in frontier:
+                for gname, gm in gens:
+                    m = gm @ self.elements[i]
+                    k = _key(m)
+                    if k not in index:
+                        index[k] = len(self.elements)
+                        self.elements.append(m)
+                        self.words.append(gname + self.words[i])
+                        nxt.append(index[k])
+            frontier = nxt
+        self._index = index
+        n = len(self.elements)
+        self.mul = np.zeros((n, n), dtype=np.int64)  # mul[g, h] = g h
+        for g, h in itertools.product(range(n), range(n)):
+            self.mul[g, h] = index[_key(self.elements[g] @ self.elements[h])]
+        self.inv = np.array([int(np.argmax(self.mul[g] == 0)) for g in range(n)])
+        self.gen_names = [g for g, _ in gens]
+        self._gen_mats = dict(gens)
+        self._subgroups: list[frozenset[int]] | None = None
+
+    def __len__(self) -> int:
+        return len(self.elements)
+
+    def __repr__(self) -> str:
+        return f"Group(order={len(self)}, ndim={self.ndim}, generators={self.gen_names})"
+
+    def index(self, word: str) -> int:
+        """The element named by a word of generator names, applied right to left
+        (``"zx"``: first ``x``, then ``z``, as in MarkovJunior)."""
+        m = np.eye(self.ndim, dtype=np.int64)
+        for ch in reversed(word):
+            if ch not in self._gen_mats:
+                raise InputError(
+                    f"unknown symmetry {ch!r} in {word!r}; generators are {self.gen_names}"
+                )
+            m = self._gen_mats[ch] @ m
+        return self._index[_key(m)]
+
+    def name(self, g: int) -> str:
+        return self.words[g] or "e"
+
+    def apply(self, g: int, direction: Direction) -> Direction:
+        """Image of a direction ``(axis, sign)``."""
+        axis, sign = direction
+        col = self.elements[g][:, axis] * sign
+        new_axis = int(np.flatnonzero(col)[0])
+        return new_axis, int(col[new_axis])
+
+    def subgroup(self, words: Iterable[str | int]) -> frozenset[int]:
+        """The subgroup generated by elements given as words or indices."""
+        gens = [w if isinstance(w, int) else self.index(w) for w in words]
+        sub = {0}
+        frontier = [0]
+        while frontier:
+            nxt = []
+            for h in frontier:
+                for g in gens:
+                    k = int(self.mul[g, h])
+                    if k not in sub:
+                        sub.add(k)
+                        nxt.append(k)
+            frontier = nxt
+        return frozenset(sub)
+
+    def all_subgroups(self) -> list[frozenset[int]]:
+        """Every subgroup (generated by at most three elements; enough for the square and
+        cube groups), largest first."""
+        if self._subgroups is None:
+            self._subgroups = self._all_subgroups()
+        return list(self._subgroups)
+
+    def _all_subgroups(self) -> list[frozenset[int]]:
+        found: set[frozenset[int]] = {frozenset({0})}
+        cyc = {self.subgroup([g]) for g in range(len(self))}
+        found |= cyc
+        layer = set(cyc)
+        for _ in range(2):
+            new: set[frozenset[int]] = set()
+            for H in layer:
+                for g in range(len(self)):
+                    if g not in H:
+                        S = self.subgroup([*H, g])
+                        if S not in found:
+                            new.add(S)
+            found |= new
+            layer = new
+        return sorted(found, key=lambda s: (-len(s), sorted(s)))
+
+
+@functools.lru_cache(maxsize=8)
+def square_group(ndim: int = 2) -> Group:
+    """The 8 symmetries of the square acting on axes ``x, y`` (other axes fixed).
+
+    Generators: ``a`` the quarter turn ``+x -> +y`` (counter-clockwise as drawn with ``y``
+    up, WaveFunctionCollapse's tile rotation), ``b`` the mirror ``x -> -x``.
+    """
+    a = np.eye(ndim, dtype=np.int64)
+    a[:2, :2] = [[0, -1], [1, 0]]
+    b = np.eye(ndim, dtype=np.int64)
+    b[0, 0] = -1
+    return Group({"a": a, "b": b}, ndim)
+
+
+@functools.lru_cache(maxsize=1)
+def cube_group() -> Group:
+    """The 48 symmetries of the cube, with MarkovJunior's generators: quarter turns ``x``
+    (``+y -> +z``), ``y`` (``+x -> +z``), ``z`` (``+x -> +y``) and the mirror ``m``
+    (``x -> -x``)."""
+    x = np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], dtype=np.int64)
+    y = np.array([[0, 0, -1], [0, 1, 0], [1, 0, 0]], dtype=np.int64)
+    z = np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1]], dtype=np.int64)
+    m = np.diag([-1, 1, 1]).astype(np.int64)
+    return Group({"x": x, "y": y, "z": z, "m": m}, 3)
+
+
+@dataclass
+class Orientations:
+    """The labels of a tileset: every distinct orientation of every tile.
+
+    Tile ``t`` with symmetry group ``H_t`` (the transformations that leave it unchanged)
+    has one orientation per left coset ``g H_t``; labels are numbered tile by tile, cosets
+    in the order of their first element (``order`` may give another order per tile, as a
+    list of group elements, one per coset).
+    """
+
+    group: Group
+    stabilizers: Sequence[frozenset[int]]
+    order: Sequence[Sequence[int]] | None = None
+
+    def __post_init__(self) -> None:
+        G = self.group
+        self.tile_of: list[int] = []
+        self.rep: list[int] = []  # a group element per label
+        self._lookup: dict[tuple[int, int], int] = {}  # (tile, element) -> label
+        for t, H in enumerate(self.stabilizers):
+            if 0 not in H or any(int(G.mul[a, b]) not in H for a in H for b in H):
+                raise InputError(f"the symmetry of tile {t} is not a group")
+            reps = list(self.order[t]) if self.order is not None else range(len(G))
+            for g in reps:
+                if (t, g) in self._lookup:
+                    if self.order is not None:
+                        raise InputError(f"tile {t}: two orientations are the same coset")
+                    continue
+                label = len(self.rep)
+                self.tile_of.append(t)
+                self.rep.append(g)
+                for h in H:
+                    self._lookup[(t, int(G.mul[g, h]))] = label
+            if any((t, g) not in self._lookup for g in range(len(G))):
+                raise InputError(f"tile {t}: the orientations do not cover the group")
+        K = len(self.rep)
+        self.perm = np.zeros((len(G), K), dtype=np.int64)  # perm[g, label]
+        for g in range(len(G)):
+            for lab in range(K):
+                self.perm[g, lab] = self._lookup[(self.tile_of[lab], int(G.mul[g, self.rep[lab]]))]
+
+    @property
+    def K(self) -> int:
+        return len(self.rep)
+
+    def label(self, tile: int, element: int | str = 0) -> int:
+        """The label of ``tile`` transformed by a group element (index or word)."""
+        g = self.group.index(element) if isinstance(element, str) else element
+        return self._lookup[(tile, g)]
+
+
+def expand_rules(
+    orient: Orientations,
+    rules: Iterable[tuple[int, int, Direction]],
+    ndim: int | None = None,
+) -> NDArray[np.bool_]:
+    """Transition matrices ``T[d, a, b]`` (``b`` may be at ``+1`` along axis ``d`` of ``a``)
+    holding every rule ``(a, b, direction)`` and all its images under the group.
+
+    A direction ``(axis, -1)`` means ``b`` is at ``-1`` along ``axis``.
+    """
+    G = orient.group
+    nd = G.ndim if ndim is None else ndim
+    T = np.zeros((nd, orient.K, orient.K), dtype=bool)
+    for a, b, direction in rules:
+        for g in range(len(G)):
+            axis, sign = G.apply(g, direction)
+            ga, gb = int(orient.perm[g, a]), int(orient.perm[g, b])
+            if sign > 0:
+                T[axis, ga, gb] = True
+            else:
+                T[axis, gb, ga] = True
+    return T
+
+
+def closure_violations(
+    group: Group, perm: NDArray[np.int64], T: NDArray[np.bool_], limit: int = 100
+) -> list[tuple[int, int, int, int]]:
+    """Rules of ``T`` whose image under some group element is missing.
+
+    ``perm[g, label]`` is the label ``label`` becomes under element ``g`` (``-1``: no such
+    label, that image is not required). Returns up to ``limit`` tuples ``(axis, a, b, g)``:
+    ``T[axis, a, b]`` holds but its image under element ``g`` does not. An empty list
+    means ``T`` is closed under the group.
+    """
+    out: list[tuple[int, int, int, int]] = []
+    for g in range(1, len(group)):
+        p = perm[g]
+        ok = p >= 0
+        q = np.where(ok, p, 0)
+        for axis in range(min(T.shape[0], group.ndim)):
+            new_axis, sign = group.apply(g, (axis, 1))
+            img = T[new_axis][np.ix_(q, q)]
+            if sign < 0:
+                img = img.T
+            missing = T[axis] & ~img & ok[:, None] & ok[None, :]
+            for a, b in zip(*np.nonzero(missing), strict=True):
+                out.append((axis, int(a), int(b), g))
+                if len(out) >= limit:
+                    return out
+    return out

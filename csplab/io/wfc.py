@@ -1,0 +1,353 @@
+"""WaveFunctionCollapse simple-tiled tilesets (mxgmn's XML format).
+
+Layout::
+
+    <set unique="False">                       unique: one image per orientation
+      <tiles>
+        <tile name="corner" symmetry="L" weight="0.5"/>
+        ...
+      </tiles>
+      <neighbors>
+        <neighbor left="corner 1" right="line"/>   "name k" = orientation k (default 0):
+        ...                                        right may be the +x neighbour of left
+      </neighbors>
+      <subsets>
+        <subset name="small"><tile name="corner"/>...</subset>
+      </subsets>
+    </set>
+
+A tile of symmetry class X, L, T, I, \\ or F has 1, 4, 4, 2, 2 or 8 orientations (labels
+``"corner 0"`` ... ``"corner 3"``): orientation ``k < 4`` is the tile turned ``k`` quarter
+turns counter-clockwise, ``k >= 4`` that turned ``k - 4`` times and mirrored left-right,
+as WaveFunctionCollapse numbers them. Rules are stated for ``+x`` and hold in every frame of
+the square's symmetry group (:mod:`csplab.io.symmetry`); vertical rules follow from the
+rotations. Tile images are read from a folder named after the XML file next to it (or
+from the XML file's own folder): ``corner.png``, or ``corner 0.png``, ``corner 1.png``
+... for ``unique`` tilesets. Image rows run top to bottom and csplab's ``y`` points up,
+so pictures look as in WaveFunctionCollapse.
+
+Examples
+--------
+>>> xml = '''<set><tiles><tile name="sea"/><tile name="coast" symmetry="T"/></tiles>
+... <neighbors><neighbor left="sea" right="sea"/><neighbor left="coast 1" right="sea"/>
+... <neighbor left="coast" right="coast"/></neighbors></set>'''
+>>> rs = parse_wfc(xml, path="toy.xml")
+>>> rs.K, rs.names
+(5, ('sea 0', 'coast 0', 'coast 1', 'coast 2', 'coast 3'))
+>>> rs.closure_violations()
+[]
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.errors import FormatError
+from csplab.io._xml import Node, parse_xml
+from csplab.io.ruleset import RuleSet, _Warnings
+from csplab.io.symmetry import Group, Orientations, expand_rules, square_group
+
+__all__ = ["CARDINALITY", "parse_wfc", "read_wfc", "stabilizer_words"]
+
+CARDINALITY = {"X": 1, "L": 4, "T": 4, "I": 2, "\\": 2, "F": 8}
+# words generating the symmetry group of orientation 0 (a: quarter turn +x -> +y, b: x-mirror)
+_STAB: dict[str, list[str]] = {
+    "X": ["a", "b"],
+    "I": ["aa", "b"],
+    "\\": ["aa", "aaab"],
+    "T": ["b"],
+    "L": ["aaab"],
+    "F": [],
+}
+_ORDER = ["", "a", "aa", "aaa", "b", "ba", "baa", "baaa"]  # orientation k = this element
+
+
+def stabilizer_words(symmetry: str) -> list[str]:
+    """Generators (words in ``a``, ``b``) of the symmetry group of a WFC symmetry class."""
+    return list(_STAB[symmetry])
+
+
+def _bool(node: Node, key: str, default: bool, path: object) -> bool:
+    v = node.get(key)
+    if v is None:
+        return default
+    if v.strip().lower() in ("true", "1", "yes"):
+        return True
+    if v.strip().lower() in ("false", "0", "no"):
+        return False
+    raise FormatError(f"<{node.tag}> {key}={v!r} is not True or False", path=path, line=node.line)
+
+
+def _float(node: Node, key: str, default: float, path: object) -> float:
+    v = node.get(key)
+    if v is None:
+        return default
+    try:
+        f = float(v)
+    except ValueError:
+        raise FormatError(
+            f"<{node.tag}> {key}={v!r} is not a number", path=path, line=node.line
+        ) from None
+    if not np.isfinite(f) or f < 0:
+        raise FormatError(
+            f"<{node.tag}> {key}={v!r} must be a non-negative number", path=path, line=node.line
+        )
+    return f
+
+
+def _transform(img: NDArray[np.uint8], word: str) -> NDArray[np.uint8]:
+    """Apply a word in ``a`` (counter-clockwise quarter turn) and ``b`` (left-right mirror) to
+    an image array (rows top to bottom), right to left."""
+    out = img
+    for ch in reversed(word):
+        out = np.rot90(out, 1) if ch == "a" else out[:, ::-1]
+    return np.ascontiguousarray(out)
+
+
+def load_image(path: Path, *, where: object = None) -> NDArray[np.uint8]:
+    """An RGBA uint8 array (rows top to bottom) from an image file, as a FormatError on
+    anything unreadable."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            if im.width * im.height > 4_000_000:
+                raise FormatError(f"image {im.width}x{im.height} is too large", path=path)
+            arr = np.asarray(im.convert("RGBA"), dtype=np.uint8)
+    except FormatError:
+        raise
+    except Exception as e:  # PIL raises many kinds of errors on bad files
+        raise FormatError(
+            f"cannot read image ({type(e).__name__}: {e})", path=where or path
+        ) from None
+    return arr
+
+
+def read_wfc(path: str | Path, *, subset: str | None = None, images: bool = True) -> RuleSet:
+    """Read a WaveFunctionCollapse simple-tiled XML tileset (see the module docstring)."""
+    p = Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
+    return parse_wfc(data, path=p, subset=subset, images=images)
+
+
+def parse_wfc(
+    text: str | bytes,
+    *,
+    path: object = "<string>",
+    subset: str | None = None,
+    images: bool = True,
+) -> RuleSet:
+    """Parse WaveFunctionCollapse simple-tiled XML (images looked up next to ``path``)."""
+    root = parse_xml(text, path=path)
+    return _build(root, path=path, subset=subset, images=images)
+
+
+def _build(root: Node, *, path: object, subset: str | None, images: bool) -> RuleSet:
+    warn = _Warnings(path)
+    xtiles = root.find("tiles")
+    if xtiles is None:
+        raise FormatError(f"<{root.tag}> has no <tiles> element", path=path, line=root.line)
+    unique = _bool(root, "unique", False, path)
+    wanted: set[str] | None = None
+    if subset is not None:
+        xsubsets = root.find("subsets")
+        names_ = [s.get("name") for s in xsubsets.iter("subset")] if xsubsets else []
+        xs = (
+            next((s for s in xsubsets.iter("subset") if s.get("name") == subset), None)
+            if xsubsets
+            else None
+        )
+        if xs is None:
+            raise FormatError(
+                f"no subset {subset!r}; subsets: {', '.join(n for n in names_ if n) or 'none'}",
+                path=path,
+            )
+        wanted = set()
+        for t in xs.iter("tile"):
+            nm = t.get("name")
+            if nm is None:
+                raise FormatError("<tile> in <subset> has no name", path=path, line=t.line)
+            wanted.add(nm)
+    G = square_group()
+    tiles: list[tuple[str, str, float, int]] = []  # name, symmetry, weight, line
+    seen: dict[str, int] = {}
+    all_names: set[str] = set()
+    for xt in xtiles.iter("tile"):
+        nm = xt.get("name")
+        if not nm or not nm.strip():
+            raise FormatError("<tile> has no name", path=path, line=xt.line)
+        if nm in all_names:
+            raise FormatError(f"tile {nm!r} is defined twice", path=path, line=xt.line)
+        all_names.add(nm)
+        sym = xt.get("symmetry", "X") or "X"
+        if sym not in CARDINALITY:
+            raise FormatError(
+                f"tile {nm!r}: unknown symmetry {sym!r} (use X, L, T, I, \\ or F)",
+                path=path,
+                line=xt.line,
+            )
+        w = _float(xt, "weight", 1.0, path)
+        if wanted is not None and nm not in wanted:
+            continue
+        seen[nm] = len(tiles)
+        tiles.append((nm, sym, w, xt.line))
+    if wanted is not None and wanted - all_names:
+        raise FormatError(
+            f"subset {subset!r} names unknown tiles {sorted(wanted - all_names)}", path=path
+        )
+    if not tiles:
+        raise FormatError("the tileset has no tiles", path=path, line=xtiles.line)
+    stabs = [G.subgroup(_STAB[sym]) for _, sym, _, _ in tiles]
+    order = [[G.index(w) for w in _ORDER[: CARDINALITY[sym]]] for _, sym, _, _ in tiles]
+    orient = Orientations(G, stabs, order)
+    names = [f"{nm} {k}" for nm, sym, _, _ in tiles for k in range(CARDINALITY[sym])]
+    weights = [w for _, sym, w, _ in tiles for _ in range(CARDINALITY[sym])]
+
+    def ref(text: str | None, node: Node, side: str) -> int | None:
+        if text is None:
+            raise FormatError(f"<neighbor> has no {side!r} attribute", path=path, line=node.line)
+        parts = text.split()
+        if not 1 <= len(parts) <= 2:
+            raise FormatError(
+                f"<neighbor> {side}={text!r}: expected 'name' or 'name k'",
+                path=path,
+                line=node.line,
+            )
+        nm = parts[0]
+        if nm not in seen:
+            if nm in all_names:  # outside the chosen subset
+                return None
+            raise FormatError(f"<neighbor> {side}: unknown tile {nm!r}", path=path, line=node.line)
+        t = seen[nm]
+        try:
+            k = int(parts[1]) if len(parts) == 2 else 0
+        except ValueError:
+            raise FormatError(
+                f"<neighbor> {side}={text!r}: orientation {parts[1]!r} is not an integer",
+                path=path,
+                line=node.line,
+            ) from None
+        card = CARDINALITY[tiles[t][1]]
+        if not 0 <= k < card:
+            raise FormatError(
+                f"<neighbor> {side}={text!r}: tile {nm!r} (symmetry {tiles[t][1]}) has "
+                f"orientations 0..{card - 1}",
+                path=path,
+                line=node.line,
+            )
+        return orient.label(t, order[t][k])
+
+    rules = []
+    xn = root.find("neighbors")
+    if xn is None:
+        raise FormatError(f"<{root.tag}> has no <neighbors> element", path=path, line=root.line)
+    for node in xn.iter("neighbor"):
+        a = ref(node.get("left"), node, "left")
+        b = ref(node.get("right"), node, "right")
+        if a is not None and b is not None:
+            rules.append((a, b, (0, 1)))
+    if not rules:
+        warn.add("no <neighbor> rules: no tile may touch another")
+    T = expand_rules(orient, rules)
+    imgs = _images(path, tiles, unique, G, warn) if images else None
+    meta: dict[str, Any] = {
+        "format": "wfc",
+        "source": str(path),
+        "unique": unique,
+        "subset": subset,
+        "tiles": [{"name": nm, "symmetry": sym, "weight": w} for nm, sym, w, _ in tiles],
+        "rules_stated": len(rules),
+        "warnings": warn.items,
+    }
+    stem = Path(str(path)).stem
+    rs = RuleSet(
+        T,
+        names=names,
+        weights=weights,
+        name=stem + (f"[{subset}]" if subset else ""),
+        images=imgs,
+        symmetry=(G, orient.perm),
+        meta=meta,
+    )
+    bad = rs.closure_violations(limit=20)
+    meta["closure_violations"] = bad
+    for msg in bad[:5]:
+        warn.add(f"rule set not closed under the square's symmetries: {msg}")
+    return rs
+
+
+def _images(
+    path: object, tiles: list[tuple[str, str, float, int]], unique: bool, G: Group, warn: _Warnings
+) -> NDArray[np.uint8] | None:
+    p = Path(str(path))
+    if not p.parent.exists():
+        return None
+    folders = [p.parent / p.stem, p.parent]
+    folder = next(
+        (
+            f
+            for f in folders
+            if f.is_dir()
+            and any(
+                (f / (f"{nm}.png" if not unique else f"{nm} 0.png")).is_file() for nm, *_ in tiles
+            )
+        ),
+        None,
+    )
+    if folder is None:
+        return None
+    out: list[NDArray[np.uint8] | None] = []
+    missing = []
+    for nm, sym, _, _ in tiles:
+        card = CARDINALITY[sym]
+        if unique:
+            for k in range(card):
+                f = folder / f"{nm} {k}.png"
+                out.append(load_image(f) if f.is_file() else None)
+                if out[-1] is None:
+                    missing.append(f.name)
+        else:
+            f = folder / f"{nm}.png"
+            if not f.is_file():
+                missing.append(f.name)
+                out.extend([None] * card)
+                continue
+            base = load_image(f)
+            if base.shape[0] != base.shape[1]:
+                raise FormatError(
+                    f"tile image is {base.shape[1]}x{base.shape[0]}, not square", path=f
+                )
+            for w in _STAB[sym]:
+                if not np.array_equal(_transform(base, w), base):
+                    warn.add(
+                        f"tile {nm!r} is declared symmetry {sym} but its image changes under "
+                        f"{'the mirror' if w.endswith('b') else 'a turn'} ({w})"
+                    )
+                    break
+            out.extend(_transform(base, w) for w in _ORDER[:card])
+    shapes = {o.shape for o in out if o is not None}
+    if len(shapes) > 1:
+        raise FormatError(f"tile images have different sizes {sorted(shapes)}", path=folder)
+    if missing:
+        warn.add(f"missing tile images in {folder}: {', '.join(missing[:6])}; drawn as colours")
+    if not shapes:
+        return None
+    h, w, _ = shapes.pop()
+    from csplab.render import palette
+
+    cols = palette(len(out))
+    arr = np.zeros((len(out), h, w, 4), dtype=np.uint8)
+    for i, o in enumerate(out):
+        if o is None:
+            arr[i, :, :, :3] = cols[i]
+            arr[i, :, :, 3] = 255
+        else:
+            arr[i] = o
+    return arr

@@ -1,0 +1,111 @@
+import json
+
+import numpy as np
+import pytest
+
+import csplab
+from csplab.errors import FormatError
+from csplab.io import model_format, read_model
+from csplab.io.debroglie import parse_debroglie, read_debroglie
+
+from ._helpers import DATA, anchor, installed_solvers
+
+
+def load_tiny(**kw):
+    with pytest.warns(UserWarning, match="'path' is not supported"):
+        return read_debroglie(DATA / "tiny_debroglie.json", **kw)
+
+
+def road_sides(name):
+    return {"g": "", "ns": "ns", "ew": "ew"}.get(name, name)
+
+
+def test_tiny_roads_rules_follow_the_geometry():
+    rs = load_tiny()
+    assert model_format(DATA / "tiny_debroglie.json") == "debroglie"
+    assert rs.names == ("g", "ns", "ew", "ne", "se", "sw", "nw")
+    assert rs.weights.tolist() == [2, 1, 1, 1, 1, 1, 2]
+    assert rs.closure_violations() == []
+    s = [road_sides(n) for n in rs.names]
+    Tx = np.array([[("e" in a) == ("w" in b) for b in s] for a in s])
+    Ty = np.array([[("n" in a) == ("s" in b) for b in s] for a in s])  # b above a
+    assert np.array_equal(rs.relations[0], Tx)
+    assert np.array_equal(rs.relations[1], Ty)
+
+
+def test_tiny_constraints():
+    rs = load_tiny()
+    P = rs.problem()
+    assert P.shape == (8, 6)
+    r = csplab.solve(P, "catalog", rng=2)
+    assert r.ok
+    g = r.grid
+    assert (g[0] == 0).all() and (g[-1] == 0).all()  # border xmin, xmax: grass
+    assert rs.names[g[3, 5]] == "ew"  # fixedTile at DeBroglie (3, 0) = top row
+    with pytest.raises(FormatError, match="'path' is not supported"):
+        read_debroglie(DATA / "tiny_debroglie.json", strict=True)
+
+
+def test_comments_inside_strings_are_kept():
+    text = '{"tiles": [{"value": "a//b"}], "adjacencies": [{"left": ["a//b"], "right": ["a//b"]}]}'
+    rs = parse_debroglie(text, path="c.json")
+    assert rs.names == ("a//b",)
+
+
+def test_inconsistent_rotations_are_an_error():
+    cfg = {
+        "symmetry": 8,
+        "tiles": [{"value": 1, "rotateCw": 2}, {"value": 2, "rotateCw": 2}],
+        "adjacencies": [{"left": [1], "right": [2]}],
+    }
+    with pytest.raises(FormatError, match="inconsistent"):
+        parse_debroglie(json.dumps(cfg), path="r.json")
+
+
+@pytest.mark.parametrize(
+    ("cfg", "what"),
+    [
+        ({"adjacencies": [{"left": [1]}]}, "exactly one of"),
+        ({"adjacencies": [{"left": [1], "right": [2]}], "symmetry": 3}, "symmetry"),
+        ({"adjacencies": "x"}, "must be a list"),
+        ({"adjacencies": [{"left": [1], "right": [2]}], "constraints": [{"type": "border"}]},
+         "'tile' or 'tiles'"),
+        ({"adjacencies": [{"left": [1], "right": [[2]]}]}, "number or string"),
+        ({"model": {"type": "overlapping"}, "src": "missing.png"}, "not found"),
+    ],
+)  # fmt: skip
+def test_errors(cfg, what):
+    with pytest.raises(FormatError, match=what):
+        parse_debroglie(json.dumps(cfg), path="bad.json")
+
+
+def test_overlapping_config_uses_the_sample(tmp_path):
+    import shutil
+
+    shutil.copy(DATA / "sample.png", tmp_path / "sample.png")
+    cfg = {"model": {"type": "overlapping", "n": 2}, "src": "sample.png", "width": 9,
+           "height": 7, "symmetry": 2, "periodic": True}  # fmt: skip
+    (tmp_path / "o.json").write_text(json.dumps(cfg))
+    rs = read_model(tmp_path / "o.json")
+    assert rs.meta["format"] == "overlapping" and rs.meta["N"] == 2 and rs.shape == (9, 7)
+
+
+def test_shared_edged_path_file():
+    p = anchor("DeBroglie/edged_path_constraint.json")
+    with pytest.warns(UserWarning, match="edgedPath"):
+        rs = read_model(p)
+    assert rs.K == 16 and rs.shape == (10, 10) and rs.closure_violations() == []
+    assert any("edgedPath" in w and "NOT enforced" in w for w in rs.warnings)
+    with pytest.raises(FormatError, match="edgedPath"):
+        read_debroglie(p, strict=True)
+
+
+@pytest.mark.parametrize("solver", installed_solvers())
+def test_shared_edged_path_every_solver_30x30(solver):
+    p = anchor("DeBroglie/edged_path_constraint.json")
+    with pytest.warns(UserWarning):
+        rs = read_model(p)
+    P = rs.problem((30, 30))
+    r = csplab.solve(P, solver, rng=1)
+    assert r.ok and P.is_solution(r.grid)
+    assert (r.grid[0] == rs.names.index("1")).all()  # the border constraint
