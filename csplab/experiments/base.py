@@ -39,7 +39,9 @@ __all__ = [
     "load_examples",
     "parse_sizes",
     "save_figure",
+    "setting_of",
     "size_for",
+    "split_solver",
 ]
 
 
@@ -83,7 +85,16 @@ def load_examples(specs: Sequence[str]) -> list[tuple[str, ExampleModel]]:
 
     if not specs:
         raise InputError("no example model given")
-    return [(s, load_model(s)) for s in specs]
+    out: list[tuple[str, ExampleModel]] = []
+    for s in specs:
+        m = load_model(s)
+        if not isinstance(m, ExampleModel):
+            raise InputError(
+                f"{s}: experiments take example models (grids); {type(m).__name__} "
+                "tilesets are not supported by the experiment harness yet"
+            )
+        out.append((s, m))
+    return out
 
 
 def background_labels(example: ExampleModel) -> list[int]:
@@ -131,7 +142,7 @@ def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None
     """Rows of dicts -> a GitHub markdown table."""
     if not rows:
         return "(no rows)"
-    cols = list(columns or rows[0].keys())
+    cols = list(columns or dict.fromkeys(k for r in rows for k in r))
     lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
     for r in rows:
         lines.append("| " + " | ".join(_fmt(r.get(c)) for c in cols) + " |")
@@ -193,6 +204,39 @@ class Report:
         paths.append(md)
         self.files += paths
         return paths
+
+
+def split_solver(entry: str) -> tuple[str, dict[str, Any]]:
+    """``"catalog@order=random,choice=weighted"`` -> ``("catalog", {"order": "random", ...})``.
+
+    A solver *entry* is a solver spec optionally followed by ``@`` and options (values
+    parsed as JSON when possible), so one sweep can compare variants of one solver.
+
+    Examples
+    --------
+    >>> split_solver("blocks@block=4,retries=0")
+    ('blocks', {'block': 4, 'retries': 0})
+    >>> split_solver("sat:glucose4")
+    ('sat:glucose4', {})
+    """
+    spec, _, rest = str(entry).partition("@")
+    opts: dict[str, Any] = {}
+    for kv in filter(None, (p.strip() for p in rest.split(","))):
+        k, sep, v = kv.partition("=")
+        if not sep or not k:
+            raise InputError(f"solver entry {entry!r}: options must be key=value")
+        try:
+            opts[k.strip()] = json.loads(v)
+        except json.JSONDecodeError:
+            opts[k.strip()] = v.strip()
+    if not spec:
+        raise InputError(f"solver entry {entry!r} has no solver name")
+    return spec.strip(), opts
+
+
+def setting_of(row: dict[str, Any]) -> str:
+    """The solver entry a stored trial was run with (its ``label``, else its solver spec)."""
+    return str(row["params"].get("label", row["solver"]))
 
 
 # solvers that take the Alg. 3.1 options ``order`` and ``choice``
@@ -257,6 +301,17 @@ class Experiment:
     def seeds(self, config: dict[str, Any]) -> range:
         s0 = int(config.get("seed0", 0))
         return range(s0, s0 + int(config["seeds"]))
+
+    def solver_params(self, config: dict[str, Any], entry: str) -> tuple[str, dict[str, Any]]:
+        """``(solver spec, params)`` for a solver entry: params hold the ``options`` and,
+        for entries with ``@`` options, the entry as ``label``."""
+        spec, extra = split_solver(entry)
+        opts = self.solver_options(config, spec)
+        opts.update(extra)
+        params: dict[str, Any] = {"options": opts}
+        if extra:
+            params["label"] = entry
+        return spec, params
 
     def solver_options(self, config: dict[str, Any], solver: str) -> dict[str, Any]:
         """Common options for a solver: order/choice for the catalog family, time limit,

@@ -24,7 +24,14 @@ from typing import Any, ClassVar
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.experiments.base import Experiment, Report, load_examples, save_figure, size_for
+from csplab.experiments.base import (
+    Experiment,
+    Report,
+    load_examples,
+    save_figure,
+    setting_of,
+    size_for,
+)
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 
@@ -86,8 +93,8 @@ class Fig38(Experiment):
             examples[E.hash()] = E
             for s in config["sizes"]:
                 size = size_for(E, int(s), int(config["nz"]))
-                for solver in config["solvers"]:
-                    params = {"options": self.solver_options(config, solver)}
+                for entry in config["solvers"]:
+                    solver, params = self.solver_params(config, entry)
                     for seed in self.seeds(config):
                         trials.append(
                             Trial(
@@ -103,7 +110,7 @@ class Fig38(Experiment):
         sizes: dict[tuple[str, str, int], str] = {}
         for r in rows:
             nx = int(r["size"].split("x")[0])
-            key = (r["example"], r["solver"], nx)
+            key = (r["example"], setting_of(r), nx)
             groups[key].append(r)
             sizes[key] = r["size"]
         table = []

@@ -30,6 +30,7 @@ import hashlib
 import importlib
 import json
 import socket
+import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable
@@ -118,6 +119,7 @@ class Trial:
 # ------------------------------------------------------------------------------ worker side
 
 _PROBLEMS: OrderedDict[tuple[Any, ...], Problem] = OrderedDict()
+_LOCK = threading.Lock()  # Dask workers may run several trials in threads
 _WARM = False
 
 
@@ -131,26 +133,29 @@ def parse_boundary(text: str) -> Any:
 def problem_for(trial: Trial, example: ExampleModel) -> Problem:
     """The trial's problem, built once per process and kept in a small cache."""
     key = (trial.example_hash, trial.size, trial.boundary, trial.periodic)
-    P = _PROBLEMS.get(key)
-    if P is None:
-        P = Problem.from_example(
-            example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
-        )
+    with _LOCK:
+        P = _PROBLEMS.get(key)
+        if P is not None:
+            _PROBLEMS.move_to_end(key)
+            return P
+    P = Problem.from_example(
+        example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
+    )
+    with _LOCK:
         _PROBLEMS[key] = P
         while len(_PROBLEMS) > 6:
             _PROBLEMS.popitem(last=False)
-    else:
-        _PROBLEMS.move_to_end(key)
     return P
 
 
 def _warmup() -> None:
     global _WARM
-    if not _WARM:
-        from csplab.catalog import jit_warmup
+    with _LOCK:
+        if not _WARM:
+            from csplab.catalog import jit_warmup
 
-        jit_warmup()
-        _WARM = True
+            jit_warmup()
+            _WARM = True
 
 
 def resolve(path: str) -> Callable[..., dict[str, Any]]:
