@@ -85,6 +85,7 @@ def run(
     scheduler: Any = None,
     progress: bool = True,
     report_only: bool = False,
+    figures: bool = True,
     command: str = "",
     **overrides: Any,
 ) -> tuple[RunSummary, Report]:
@@ -104,10 +105,13 @@ def run(
         See :func:`~csplab.experiments.runner.run_trials`.
     report_only : bool
         Do not run anything; report what the store holds.
+    figures : bool
+        Draw the figures (PNG and SVG); tables and CSVs are always written.
     **overrides
         Configuration values (``examples=``, ``sizes=``, ``seeds=`` …).
     """
     exp = get_experiment(name)
+    exp.draw_figures = figures
     config = exp.make_config(quick=quick, **overrides)
     trials, examples = exp.build(config)
     outdir = Path(out) if out is not None else Path("results") / exp.name

@@ -258,6 +258,7 @@ class Experiment:
     defaults: ClassVar[dict[str, Any]] = {}
     quick: ClassVar[dict[str, Any]] = {}
     uses: ClassVar[frozenset[str]] = frozenset()
+    draw_figures: bool = True  # draw figures in :meth:`report` (tests switch them off)
 
     def add_arguments(self, p: argparse.ArgumentParser) -> None:
         """Experiment-specific command-line options (their ``dest`` is the config key)."""

@@ -22,7 +22,7 @@ Examples
 >>> cfg = exp.make_config(quick=True)
 >>> trials, _ = exp.build(cfg)
 >>> sorted({t.options.get("block", (0,))[0] for t in trials if t.solver == "blocks"})
-[1, 2, 4, 8]
+[1, 2, 4, 8, 10]
 """
 
 from __future__ import annotations
@@ -193,7 +193,7 @@ class BlockSize(Experiment):
             "seeds; Alg. 3.1 missed = patterns in Alg. 3.1's successful outputs that this "
             "setting never produced."
         )
-        if table:
+        if table and self.draw_figures:
             rep.figures += self._plot(table, out)
             rep.figures += self._montage(rows, config, out)
         return rep

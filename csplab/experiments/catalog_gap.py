@@ -231,7 +231,7 @@ class CatalogGap(Experiment):
             "emptied a domain at once); immediate = share of bad choices with delay 0."
         )
         pts = [(r["example"], r["size"], r["stats"]) for r in rows if "first_bad" in r["stats"]]
-        if pts:
+        if pts and self.draw_figures:
             rep.figures += self._plot(pts, out)
         return rep
 

@@ -136,7 +136,7 @@ class Fig38(Experiment):
             row = wide.setdefault(t["nx"], {"nx": t["nx"]})
             row[label] = f"{t['rate']:.2f} [{t['lo95']:.2f}, {t['hi95']:.2f}] ({t['trials']})"
         rep.tables["figure as table"] = [wide[k] for k in sorted(wide)]
-        if table:
+        if table and self.draw_figures:
             rep.figures += self._plot(table, curves, config, out)
         rep.notes.append(
             "Success = the solver returned a consistent model (status `solved`); intervals "

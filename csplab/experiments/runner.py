@@ -146,7 +146,10 @@ def run_trials(
     t0 = time.perf_counter()
     bar = _progress(len(todo), experiment, progress)
     try:
-        if scheduler is not None:
+        if not todo:
+            summary.executor = "nothing to run"
+            stream: Stream = iter(())
+        elif scheduler is not None:
             summary.executor = "dask"
             stream = _run_dask(todo, examples, scheduler)
         elif (jobs or os.cpu_count() or 1) <= 1 or len(todo) <= 1:
@@ -246,6 +249,10 @@ def _run_dask(todo: Sequence[Trial], examples: dict[str, ExampleModel], schedule
     as_completed: Any = importlib.import_module("distributed").as_completed
     client, own = _client(scheduler)
     try:
+        try:
+            client.wait_for_workers(1, timeout=120)
+        except TimeoutError:
+            raise InputError("the Dask cluster has no workers (waited 120 s)") from None
         hashes = sorted({t.example_hash for t in todo})
         scattered = dict(
             zip(hashes, client.scatter([examples[h] for h in hashes], broadcast=True), strict=True)

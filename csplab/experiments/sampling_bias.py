@@ -237,7 +237,7 @@ class SamplingBias(Experiment):
         )
         if config.get("skipped_solvers"):
             rep.notes.append("Not installed here, skipped: " + ", ".join(config["skipped_solvers"]))
-        if table:
+        if table and self.draw_figures:
             rep.figures += self._plot(table, label_rows, out)
         return rep
 

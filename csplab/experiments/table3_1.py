@@ -207,7 +207,7 @@ class Table31(Experiment):
                 f"{k} {v[0]} k={v[1]}: {v[2]} / {v[3]}" for k, v in THESIS_TABLE_3_1.items()
             )
         )
-        if long:
+        if long and self.draw_figures:
             rep.figures += self._plot(long, shown, out)
         return rep
 

@@ -1,0 +1,50 @@
+import numpy as np
+
+from csplab import Problem, solve
+from csplab.experiments import ResultsStore, run
+from csplab.io import read_example
+from csplab.testing.brute import solutions
+
+
+def _completable(P, trace, k):
+    part = np.full(P.n, -1)
+    part[trace[:k, 0]] = trace[:k, 1]
+    return next(iter(solutions(P, part.reshape(P.shape), limit=1)), None) is not None
+
+
+def test_first_bad_step_and_per_step_gap_agree_with_brute_force(tmp_path, fallible_npy):
+    db = tmp_path / "r.sqlite"
+    s, rep = run(
+        "catalog_gap", examples=[str(fallible_npy)], sizes=[4, 5], seeds=12, boundary="none",
+        oracle="brute", store=db, out=tmp_path, jobs=1, progress=False,
+    )  # fmt: skip
+    assert not s.errors
+    E = read_example(fallible_npy)
+    with ResultsStore(db) as st:
+        rows = st.rows("catalog_gap")
+    failed = [r for r in rows if r["status"] == "failed"]
+    assert failed and any(r["status"] == "solved" for r in rows)
+    for r in rows:
+        st_ = r["stats"]
+        if r["status"] == "solved":
+            assert st_["bad_choice"] == 0 and st_["gap_steps"] >= 0
+            continue
+        size = tuple(int(v) for v in r["size"].split("x"))
+        P = Problem.from_example(E, size)
+        res = solve(P, "catalog", rng=r["seed"], order="scanline", choice="uniform")
+        k = st_["first_bad"]
+        assert 1 <= k <= st_["fail_step"] == res.trace.shape[0]
+        assert _completable(P, res.trace, k - 1) and not _completable(P, res.trace, k)
+        # the bad step is one where C != C* at the chosen cell
+        assert [k, *st_["_gaps"][-1][1:]][0] == st_["_gaps"][-1][0]
+        assert st_["_gaps"][-1][2] < st_["_gaps"][-1][1]
+    for t in rep.tables["catalog gap"]:
+        assert t["bad_choices"] == t["failed"] - t["unsat_undetected"]
+        assert t["bad_lo95"] <= t["bad_rate"] <= t["bad_hi95"]
+    assert (tmp_path / "catalog_gap.png").exists()
+
+
+def test_quick_default_runs(tmp_path):
+    s, rep = run("catalog_gap", quick=True, store=tmp_path / "r.sqlite", out=tmp_path, jobs=1,
+                 progress=False)  # fmt: skip
+    assert not s.errors and rep.tables["catalog gap"][0]["runs"] == 4
