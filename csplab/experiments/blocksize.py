@@ -98,7 +98,7 @@ class BlockSize(Experiment):
         "size": None,
         "blocks": [1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, "full"],
         "retries": 20,
-        "seeds": 30,
+        "seeds": 20,
         "seed0": 0,
         "order": "scanline",
         "choice": "uniform",

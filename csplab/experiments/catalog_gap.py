@@ -60,9 +60,64 @@ def first_bad_step(oracle: Any, trace: np.ndarray, steps: int) -> int:
     return hi
 
 
+def _exact_gap_available() -> bool:
+    import importlib.util
+
+    try:
+        return importlib.util.find_spec("csplab.exact") is not None and oracle_methods()[0] == "sat"
+    except ImportError:
+        return False
+
+
+def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
+    """The same measure through :func:`csplab.exact.catalog_gap` (incremental SAT, one
+    call per step only when the chosen label differs from the last witness solution)."""
+    from csplab.exact import catalog_gap  # type: ignore[import-not-found,unused-ignore]
+
+    opts = trial.options
+    per_step = bool(trial.params.get("per_step"))
+    v: Any = catalog_gap(
+        problem, rng=trial.seed, order=opts.get("order", "scanline"),
+        choice=opts.get("choice", "uniform"), sizes=per_step,
+    )  # fmt: skip
+    st = v.stats
+    status = st.get("alg31_status", "solved")
+    T = int(st.get("steps_taken", 0))
+    stats: dict[str, Any] = {"steps": T, "cells": problem.n, "oracle": "sat (csplab.exact)",
+                             "oracle_calls": int(st.get("calls", 0))}  # fmt: skip
+    if status == "unsat":
+        return {"status": status, "time_s": float(st.get("time_s", 0.0)), "stats": stats}
+    first_bad: int | None = None
+    if status == "failed":
+        stats["fail_step"] = T
+        if st.get("unsat"):
+            stats["unsat_undetected"] = True
+        elif v.witness is not None:
+            first_bad = int(v.witness["step"]) + 1
+            stats["first_bad"] = first_bad
+            stats["delay"] = T - first_bad
+    stats["good_steps"] = T if status == "solved" else (first_bad - 1 if first_bad else 0)
+    stats["bad_choice"] = int(first_bad is not None)
+    if per_step and (status == "solved" or first_bad is not None):
+        upto = T if first_bad is None else first_bad
+        gaps = []
+        total = 0.0
+        for t, e in enumerate(st["steps"][:upto]):
+            c, cs = int(e[3]), int(e[4])
+            if cs < c:
+                gaps.append([t + 1, c, cs])
+                total += 1 - cs / c
+        stats.update(gap_steps=len(gaps), expected_bad=total, checked_steps=upto, _gaps=gaps)
+    stats["oracle_s"] = float(st.get("time_s", 0.0))
+    return {"status": status, "time_s": float(st.get("time_s", 0.0)), "stats": stats}
+
+
 def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
     """Run Alg. 3.1 and locate its first bad choice (see the module docstring)."""
     import time
+
+    if trial.params.get("oracle") == "sat" and _exact_gap_available():
+        return measure_exact(trial, example, problem)
 
     from csplab.catalog import Propagator
     from csplab.solvers import solve

@@ -48,3 +48,25 @@ def test_quick_default_runs(tmp_path):
     s, rep = run("catalog_gap", quick=True, store=tmp_path / "r.sqlite", out=tmp_path, jobs=1,
                  progress=False)  # fmt: skip
     assert not s.errors and rep.tables["catalog gap"][0]["runs"] == 4
+
+
+def test_sat_oracle_agrees_with_brute_force(tmp_path, fallible_npy):
+    import pytest
+
+    from csplab.experiments.oracle import oracle_methods
+
+    if "sat" not in oracle_methods():
+        pytest.skip("needs csplab's sat solver (issue 3) and python-sat")
+    rows = {}
+    for oracle in ("brute", "sat"):
+        db = tmp_path / f"{oracle}.sqlite"
+        run("catalog_gap", examples=[str(fallible_npy)], sizes=[4, 5], seeds=15,
+            boundary="none", oracle=oracle, store=db, out=tmp_path, jobs=1, progress=False,
+            figures=False)  # fmt: skip
+        with ResultsStore(db) as st:
+            rows[oracle] = {(r["size"], r["seed"]): r["stats"] for r in st.rows("catalog_gap")}
+    assert rows["brute"].keys() == rows["sat"].keys()
+    for k, a in rows["brute"].items():
+        b = rows["sat"][k]
+        for f in ("first_bad", "fail_step", "good_steps", "gap_steps", "_gaps"):
+            assert a.get(f) == b.get(f), (k, f)
