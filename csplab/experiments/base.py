@@ -138,6 +138,13 @@ def _fmt(v: Any) -> str:
     return str(v)
 
 
+def _csv_value(v: Any) -> Any:
+    """Floats with 6 significant digits (the CSVs are read by people too)."""
+    if isinstance(v, float) and math.isfinite(v):
+        return float(f"{v:.6g}")
+    return v
+
+
 def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None = None) -> str:
     """Rows of dicts -> a GitHub markdown table."""
     if not rows:
@@ -197,7 +204,7 @@ class Report:
                 w = csv.DictWriter(f, fieldnames=list(cols))
                 w.writeheader()
                 for r in rows:
-                    w.writerow({k: r.get(k, "") for k in cols})
+                    w.writerow({k: _csv_value(r.get(k, "")) for k in cols})
             paths.append(p)
         md = out / f"{stem}.md"
         md.write_text(self.markdown(out) + "\n", encoding="utf-8")
