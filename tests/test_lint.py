@@ -24,6 +24,6 @@ def test_clean(cmd):
     exe = _tool(cmd[0])
     if exe is None:
         pytest.skip(f"{cmd[0]} not installed")
-    args = [a for a in cmd[1:] if a.startswith("-") or (ROOT / a).exists()]
+    args = cmd[1:2] + [a for a in cmd[2:] if (ROOT / a).exists()]
     r = subprocess.run([exe, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout[-4000:] + r.stderr[-2000:]
