@@ -110,8 +110,10 @@ def background_labels(example: ExampleModel) -> list[int]:
 
 def save_figure(fig: Any, stem: Path) -> list[Path]:
     """Save a matplotlib figure as ``stem.png`` and ``stem.svg`` (reproducible bytes)."""
+    import matplotlib
     import matplotlib.pyplot as plt
 
+    matplotlib.rcParams["svg.hashsalt"] = "csplab"  # stable element ids in the SVG
     stem.parent.mkdir(parents=True, exist_ok=True)
     out = []
     for ext, meta in (("png", {"Software": None}), ("svg", {"Date": None})):

@@ -67,7 +67,7 @@ def _count(db):
 
 def test_kill_with_sigkill_then_resume_stores_every_trial_exactly_once(tmp_path):
     db = tmp_path / "r.sqlite"
-    args = ["fig3_8", "--quick", "--example", "castle", "--sizes", "7,9", "--nz", "4",
+    args = ["fig3_8", "--quick", "--example", "castle", "--sizes", "10,12", "--nz", "4",
             "--seeds", "150", "--store", str(db), "--out", str(tmp_path / "out"),
             "--no-progress"]  # fmt: skip
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
@@ -89,7 +89,7 @@ def test_kill_with_sigkill_then_resume_stores_every_trial_exactly_once(tmp_path)
     assert proc.returncode == -signal.SIGKILL, proc.stderr.read().decode()[-2000:]
     assert 20 <= killed_at < total
     exp = get_experiment("fig3_8")
-    cfg = exp.make_config(quick=True, examples=["castle"], sizes=[7, 9], nz=4, seeds=150)
+    cfg = exp.make_config(quick=True, examples=["castle"], sizes=[10, 12], nz=4, seeds=150)
     trials, examples = exp.build(cfg)
     with ResultsStore(db) as st:
         s = run_trials(trials, examples, st, experiment="fig3_8", jobs=1, progress=False)
