@@ -167,8 +167,10 @@ def run_trials(
                 store.add(trial, outcome, config_hash=chash)
                 summary.ran += 1
                 statuses[str(outcome["status"])] += 1
+            bar.set_postfix_str(
+                ", ".join(f"{k} {v}" for k, v in sorted(statuses.items())), refresh=False
+            )
             bar.update(1)
-            bar.set_postfix_str(", ".join(f"{k} {v}" for k, v in sorted(statuses.items())))
     finally:
         bar.close()
         summary.statuses = dict(statuses)
