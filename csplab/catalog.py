@@ -354,13 +354,16 @@ def alg31_reference(
     """Slow, literal Alg. 3.1 on top of :func:`propagate_reference`.
 
     Draws random numbers exactly as :func:`csplab.solvers.catalog.run_alg31` does for the
-    ``scanline`` and ``random`` orders, so both return the same grid for the same seed.
+    scan orders and ``random``, so both return the same grid for the same seed.
     Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
     """
-    if order not in ("scanline", "random"):
-        raise InputError("the reference Alg. 3.1 supports the scanline and random orders")
+    from csplab.solvers.catalog import scan_order
+
+    if order == "min-entropy":
+        raise InputError("the reference Alg. 3.1 supports the scan and random orders")
     n, K = problem.n, problem.K
-    perm = rng.permutation(n) if order == "random" else np.arange(n)
+    scan = scan_order(problem.shape, order)
+    perm = rng.permutation(n) if scan is None else scan
     ustream = rng.random(n)
     adj = _reference_adjacency(problem)
     C = problem.domains.copy()

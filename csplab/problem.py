@@ -377,13 +377,15 @@ class Problem:
         names: Sequence[str] | None = None,
         name: str = "",
         meta: Mapping[str, Any] | None = None,
+        labels: ArrayLike | None = None,
     ) -> Problem:
         """A grid problem from per-axis transition matrices ``T[d, b, c]``.
 
         ``T[d]`` constrains each cell and its ``+1`` neighbour along axis ``d``; with
         ``periodic`` (all axes or one flag per axis) the last cell also wraps to the first.
         ``fixed``, ``boundary`` and ``mask`` restrict domains as in
-        :meth:`from_example` (which supplies ``T`` from an example model).
+        :meth:`from_example` (which supplies ``T`` from an example model). ``labels`` (bool
+        ``(K,)``) limits the base domains of every cell to the labels in use.
         """
         shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
         T = np.asarray(transitions, dtype=bool)
@@ -407,6 +409,11 @@ class Problem:
                 parts.append(np.stack([src, dst, np.full_like(src, d)], axis=1))
         arcs = np.concatenate(parts) if parts else np.zeros((0, 3), dtype=np.int64)
         base = np.ones((n, K), dtype=bool)
+        if labels is not None:
+            lab = np.asarray(labels, dtype=bool).reshape(-1)
+            if lab.shape != (K,):
+                raise InputError(f"labels must be {K} booleans, got shape {lab.shape}")
+            base &= lab
         unary = _build_unary(shp, K, fixed=fixed, boundary=boundary, mask=mask)
         dom = base.copy()
         for u in unary:
@@ -464,6 +471,9 @@ class Problem:
             along the horizontal axes.
         mask : bool array ``(*shape, K)`` (or broadcastable)
             Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
+
+        Labels that never occur in the example are excluded from every cell (a model
+        consistent with E only uses pieces of E, even in a cell without neighbours).
         """
         shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
         shp = _match_ndim(shp, example.shape)
@@ -490,6 +500,7 @@ class Problem:
             names=example.names,
             name=example.name,
             meta=meta,
+            labels=example.counts() > 0,
         )
 
     # ------------------------------------------------------------------ derived problems

@@ -134,3 +134,10 @@ def test_problem_constructor_validates():
         Problem((2,), np.ones((2, 3), bool), np.ones((1, 2, 2), bool), [])
     P = Problem((3,), np.ones((3, 2), bool), np.ones((1, 2, 2), bool), [[0, 1, 0]])
     assert P.n == 3 and math.prod(P.shape) == 3
+
+
+def test_labels_absent_from_the_example_are_excluded():
+    E = ExampleModel([[0, 3], [3, 0]])  # K = 4, labels 1 and 2 never occur
+    P = Problem.from_example(E, (1, 1))
+    assert P.domains[0].tolist() == [True, False, False, True]
+    assert not P.is_solution([[1]])

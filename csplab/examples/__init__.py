@@ -28,6 +28,13 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "fig3_1b": ("fig3_1b_checkerboard.grid", "E1, Fig. 3.1(b): checkerboard; two solutions"),
     "line": ("fig3_1c_line.grid", "Fig. 3.1(c)/3.12: a line in empty space; infallible"),
     "fig3_1d": ("fig3_1d_unique.grid", "E3, Fig. 3.1(d): no repeated label; no larger model"),
+    "fig3_4a": ("fig3_4a_column.grid", "Fig. 3.4(a)/3.9: a column; infallible, 3x2 not 2x2 proof"),
+    "fig3_5a": ("fig3_5a_fallible.grid", "E_F, Fig. 3.5(a): a 2 forces a 6; fallible, C != C*"),
+    "fig3_15": ("fig3_15_infallible.grid", "E_I, Fig. 3.15: fig3_5a, enclosed 0 -> 9; infallible"),
+    "fig3_6a": ("fig3_6a_pairs.grid", "E_F, Fig. 3.6(a): 2s in pairs; fallible, detected late"),
+    "fig3_16": ("fig3_16_pairs.grid", "E_I, Fig. 3.16: fig3_6a + labels >= 10; infallible"),
+    "fig3_10": ("fig3_10_rectangle.grid", "Fig. 3.10(a): a rectangle; small blocks grow it thin"),
+    "pillar": ("pillar.grid", "3D, 2007 paper Fig. 2: base, shaft, capital; no levitation"),
     "city": ("city3d.grid", "3D, csplab's own: a city block, K=119; Alg. 3.1 never failed"),
     "castle": ("castle3d.grid", "3D, csplab's own: castle walls, towers, K=63; fails often"),
     "canal": ("canal3d.grid", "3D, csplab's own: canal town, bridges, K=80; fails seldom"),
@@ -40,6 +47,9 @@ ALIASES: dict[str, str] = {
     "fig3_1c": "line",
     "fig3_12": "line",
     "E3": "fig3_1d",
+    "fig3_9": "fig3_4a",
+    "pairs": "fig3_6a",
+    "rectangle": "fig3_10",
 }
 
 

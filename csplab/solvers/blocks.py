@@ -71,14 +71,16 @@ def block_starts(n: int, m: int) -> list[int]:
     return starts
 
 
-def trivial_solution(problem: Problem) -> NDArray[np.int32]:
+def trivial_solution(problem: Problem, attempts: int = 5) -> NDArray[np.int32]:
     """A simple consistent grid to start Alg. 3.4 from.
 
     Tries, in order: one label everywhere (empty space: a label that tiles every axis and is
     allowed in every cell), then a stack of uniform layers along each axis, last axis first
     (for grounded examples: ground at the bottom, empty space above), chosen by dynamic
-    programming to respect domains and arcs between consecutive layers. Each candidate is
-    checked with :meth:`Problem.violations`. Raises
+    programming to respect domains and arcs between consecutive layers, and finally (for
+    examples without empty space, such as the checkerboard) up to ``attempts`` runs of
+    Alg. 3.1 with a private generator seeded 0, 1, ... (the caller's random stream is not
+    touched). Each candidate is checked with :meth:`Problem.violations`. Raises
     :class:`~csplab.errors.NoTrivialSolutionError` when none works.
 
     Examples
@@ -137,10 +139,21 @@ def trivial_solution(problem: Problem) -> NDArray[np.int32]:
         lg: NDArray[np.int32] = labels[layer].astype(np.int32).reshape(problem.shape)
         if problem.is_solution(lg):
             return lg
+    # 3. a few runs of Alg. 3.1 on a private generator
+    for seed in range(attempts):
+        r = run_alg31(problem, np.random.default_rng(seed))
+        if r.status == "solved" and problem.is_solution(r.grid):
+            return np.asarray(r.grid, dtype=np.int32)
+        if r.status == "unsat":
+            raise NoTrivialSolutionError(
+                "modify-in-blocks needs a consistent starting model, but the problem is "
+                "unsatisfiable (arc consistency empties a domain before any choice)"
+            )
     raise NoTrivialSolutionError(
         "modify-in-blocks needs a consistent starting model and none was found: no label "
-        "tiles every axis within the domains, and no stack of uniform layers (e.g. ground "
-        "under empty space) fits; pass init=<a consistent grid> or use another solver"
+        f"tiles every axis within the domains, no stack of uniform layers (e.g. ground under "
+        f"empty space) fits, and Alg. 3.1 failed {attempts} times; pass init=<a consistent "
+        "grid> or use another solver"
     )
 
 

@@ -7,8 +7,10 @@ a proof of unsatisfiability (Theorem 3.3.2) and gives ``unsat``.
 
 Options
 -------
-order : {"scanline", "random", "min-entropy"}
+order : {"scanline", "random", "min-entropy", "scan:AXES"}
     ``scanline`` is the thesis' loop order (x outermost, z innermost; default);
+    ``scan:AXES`` scans with the named axes from outermost to innermost, e.g. ``scan:yx``,
+    the order of the thesis' 2D figures (left to right, then bottom to top);
     ``random`` a random permutation; ``min-entropy`` picks the unassigned cell of least
     Shannon entropy (weighted when ``choice="weighted"``) with tiny random tie-breaking, as
     WaveFunctionCollapse does.
@@ -38,12 +40,12 @@ import numpy as np
 from csplab import _kernels as kern
 from csplab.catalog import Propagator
 from csplab.errors import InputError
-from csplab.problem import Problem
+from csplab.problem import AXIS_NAMES, Problem
 from csplab.result import Result, Status
 
-__all__ = ["ORDERS", "CatalogSolver", "run_alg31"]
+__all__ = ["ORDERS", "CatalogSolver", "run_alg31", "scan_order"]
 
-ORDERS = ("scanline", "random", "min-entropy")
+ORDERS = ("scanline", "random", "min-entropy", "scan:AXES")
 CHOICES = ("uniform", "weighted")
 _CHUNK = 4096
 
@@ -64,13 +66,12 @@ def run_alg31(
     (``random`` order only), one uniform per step for the label choice, one tie-breaking
     number per cell (``min-entropy`` only).
     """
-    if order not in ORDERS:
-        raise InputError(f"order must be one of {', '.join(ORDERS)}, not {order!r}")
+    scan = scan_order(problem.shape, order)
     if choice not in CHOICES:
         raise InputError(f"choice must be one of {', '.join(CHOICES)}, not {choice!r}")
     t0 = time.perf_counter()
     n = problem.n
-    perm = rng.permutation(n).astype(np.int64) if order == "random" else None
+    perm = rng.permutation(n).astype(np.int64) if order == "random" else scan
     ustream = rng.random(n)
     noise = rng.random(n) if order == "min-entropy" else np.zeros(n)
     eng = engine if engine is not None else Propagator(problem)
@@ -129,6 +130,33 @@ def run_alg31(
         status, grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
         stats=stats, trace=trace,
     )  # fmt: skip
+
+
+def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:
+    """Cell sequence of a scan order (``None`` for ``random`` and ``min-entropy``).
+
+    Examples
+    --------
+    >>> scan_order((2, 3), "scanline").tolist()
+    [0, 1, 2, 3, 4, 5]
+    >>> scan_order((2, 3), "scan:yx").tolist()       # x fastest: the 2D figures' order
+    [0, 3, 1, 4, 2, 5]
+    """
+    n = int(np.prod(shape))
+    if order == "scanline":
+        return np.arange(n, dtype=np.int64)
+    if order in ("random", "min-entropy"):
+        return None
+    if order.startswith("scan:"):
+        names = order[5:]
+        axes = [AXIS_NAMES.find(a) for a in names]
+        if sorted(axes) != list(range(len(shape))):
+            raise InputError(
+                f"order {order!r}: name each of the {len(shape)} axes "
+                f"({AXIS_NAMES[: len(shape)]}) once, outermost first"
+            )
+        return np.arange(n, dtype=np.int64).reshape(shape).transpose(axes).ravel()
+    raise InputError(f"order must be one of {', '.join(ORDERS)}, not {order!r}")
 
 
 def _entropies(eng: Propagator, weighted: bool) -> np.ndarray:

@@ -52,8 +52,15 @@ def test_trivial_solution_layers_and_errors():
     P = Problem.from_example(E, (4, 4, 3), boundary="auto")
     g = trivial_solution(P)
     assert (g[:, :, 0] == 1).all() and (g[:, :, 1:] == 0).all()
-    with pytest.raises(NoTrivialSolutionError):
-        trivial_solution(Problem.from_example(load_example("E1"), (4, 4)))
+    # no empty space: the checkerboard starts from an Alg. 3.1 run
+    g = trivial_solution(Problem.from_example(load_example("E1"), (4, 4)))
+    assert Problem.from_example(load_example("E1"), (4, 4)).is_solution(g)
+    with pytest.raises(NoTrivialSolutionError, match="unsatisfiable"):
+        trivial_solution(Problem.from_example(load_example("E3"), (5, 5)))
+    # a parity constraint arc consistency cannot see: a checkerboard on an odd torus
+    P = Problem.from_example(load_example("E1"), (3, 3), periodic=True)
+    with pytest.raises(NoTrivialSolutionError, match="failed 5 times"):
+        trivial_solution(P)
 
 
 def test_blocks_from_given_init_and_bad_init():

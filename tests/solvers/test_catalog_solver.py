@@ -102,13 +102,27 @@ def test_time_limit_and_bad_options():
         solve(P, "nonesuch")
 
 
-@given(problems(max_side=4, max_labels=5), st.sampled_from(["scanline", "random"]),
+@given(problems(max_side=4, max_labels=5), st.sampled_from(["scanline", "random", "scan:rev"]),
        st.sampled_from(["uniform", "weighted"]), st.integers(0, 2**31))  # fmt: skip
 def test_compiled_alg31_equals_reference_run(P, order, choice, seed):
     from csplab.catalog import alg31_reference
 
+    if order == "scan:rev":  # innermost axis outermost
+        order = "scan:" + "xyzw"[: P.ndim][::-1]
     status, grid = alg31_reference(P, np.random.default_rng(seed), order=order, choice=choice)
     r = solve(P, "catalog", rng=seed, order=order, choice=choice)
     assert r.status == status
     if status == "solved":
         assert np.array_equal(r.grid, grid)
+
+
+def test_scan_axis_orders():
+    from csplab.solvers.catalog import scan_order
+
+    P = Problem.from_example(load_example("line"), (4, 3))
+    r = solve(P, "catalog", rng=0, order="scan:yx")
+    assert [P.coords(c) for c in r.trace[:, 0]] == [(x, y) for y in range(3) for x in range(4)]
+    with pytest.raises(InputError):
+        scan_order((2, 2), "scan:xx")
+    with pytest.raises(InputError):
+        scan_order((2, 2, 2), "scan:yx")
