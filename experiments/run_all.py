@@ -51,13 +51,18 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
     "fig3_8_2d": (
         "fig3_8",
         {
-            "examples": ["fig3_4a", "fig3_5a", "fig3_6a", "fig3_10", "fig3_15", "fig3_16"],
+            "examples": ["line", "fig3_4a", "fig3_5a", "fig3_15", "fig3_6a", "fig3_16", "fig3_10"],
             "boundary": "none",
+            "order": "scan:yx",
         },
     ),
     "blocksize": ("blocksize", {}),
     "table3_1": ("table3_1", {}),
     "catalog_gap": ("catalog_gap", {}),
+    "catalog_gap_castle": (
+        "catalog_gap",
+        {"examples": ["castle"], "order": "scanline", "boundary": "auto", "sizes": "6:14:2"},
+    ),
     "sampling_bias": ("sampling_bias", {}),
 }
 

@@ -35,8 +35,8 @@ _COMMON: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {
     "boundary": (("--boundary",), {"help": "auto, none, or face=label pairs like z-=1,x-=0"}),
     "periodic": (("--periodic",), {"action": "store_true", "default": None,
                                    "help": "wrap around on every axis"}),
-    "order": (("--order",), {"choices": ["scanline", "random", "min-entropy"],
-                             "help": "cell order of Alg. 3.1"}),
+    "order": (("--order",), {"help": "cell order of Alg. 3.1: scanline, random, "
+                             "min-entropy or scan:AXES such as scan:yx"}),
     "choice": (("--choice",), {"choices": ["uniform", "weighted"], "help": "label choice"}),
     "options": (
         ("--option",),

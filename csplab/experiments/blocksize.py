@@ -22,7 +22,7 @@ Examples
 >>> cfg = exp.make_config(quick=True)
 >>> trials, _ = exp.build(cfg)
 >>> sorted({t.options.get("block", (0,))[0] for t in trials if t.solver == "blocks"})
-[1, 2, 4, 8, 10]
+[2, 3, 4, 12]
 """
 
 from __future__ import annotations
@@ -109,10 +109,10 @@ class BlockSize(Experiment):
         "window": 3,
     }
     quick: ClassVar[dict[str, Any]] = {
-        "examples": ["line"],
-        "size": "10x10",
-        "blocks": [1, 2, 4, 8, "full"],
-        "seeds": 2,
+        "examples": ["fig3_10"],
+        "size": "12x12",
+        "blocks": [2, 3, 4, "full"],
+        "seeds": 3,
     }
     uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"blocks", "retries", "window"}
 

@@ -182,12 +182,12 @@ class CatalogGap(Experiment):
         "failure step, by example and size"
     )
     defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["fig3_5a", "fig3_6a", "castle"],
+        "examples": ["fig3_5a", "fig3_6a"],
         "sizes": "4:12:2",
         "nz": 6,
         "seeds": 100,
         "seed0": 0,
-        "order": "scanline",
+        "order": "scan:yx",
         "choice": "uniform",
         "boundary": "none",
         "periodic": False,
@@ -196,13 +196,7 @@ class CatalogGap(Experiment):
         "oracle": "auto",
         "per_step": True,
     }
-    quick: ClassVar[dict[str, Any]] = {
-        "examples": ["castle"],
-        "sizes": "8",
-        "nz": 4,
-        "seeds": 4,
-        "boundary": "auto",
-    }
+    quick: ClassVar[dict[str, Any]] = {"examples": ["fig3_5a"], "sizes": "4,6", "seeds": 10}
     uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"oracle", "per_step", "nz"}
 
     def add_arguments(self, p: Any) -> None:

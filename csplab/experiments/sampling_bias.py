@@ -122,8 +122,9 @@ class SamplingBias(Experiment):
         "examples": ["line", "fig3_4a", "fig3_5a"],
         "size": "16x5",
         "solvers": [
-            "catalog", "catalog@order=random", "catalog@order=min-entropy",
-            "catalog@choice=weighted", "blocks@block=4", "sat", "cpsat",
+            "catalog", "catalog@order=scan:yx", "catalog@order=random",
+            "catalog@order=min-entropy", "catalog@choice=weighted", "blocks@block=4", "sat",
+            "cpsat",
         ],
         "seeds": 400,
         "seed0": 0,

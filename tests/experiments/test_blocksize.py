@@ -7,7 +7,7 @@ def test_quick_run_is_always_consistent(tmp_path):
     assert not s.errors
     table = rep.tables["block size"]
     assert all(t["consistent"] == 1.0 for t in table)
-    assert [t["m"] for t in table if t["setting"].startswith("blocks")] == [1, 2, 4, 8, 10]
+    assert [t["m"] for t in table if t["setting"].startswith("blocks")] == [2, 3, 4, 12]
     ref = next(t for t in table if t["setting"].startswith("Alg. 3.1"))
     full = next(t for t in table if "(full)" in t["setting"])
     # with the full model as block Alg. 3.4 is Alg. 3.1 (same seeds, no failure here)
@@ -15,11 +15,11 @@ def test_quick_run_is_always_consistent(tmp_path):
     assert (tmp_path / "blocksize_outputs.png").exists()
 
 
-def test_small_blocks_cannot_build_thick_rectangles(tmp_path, rectangle_npy):
+def test_small_blocks_cannot_build_thick_rectangles(tmp_path):
     """Fig. 3.10: with blocks of side m a rectangle's smaller side never exceeds m, while
     Alg. 3.1 builds thicker ones; m = 2 is too small for any 3x3 rectangle."""
     _, rep = run(
-        "blocksize", examples=[str(rectangle_npy)], size="14x14", blocks=[2, 3, 4, "full"],
+        "blocksize", examples=["fig3_10"], size="14x14", blocks=[2, 3, 4, "full"],
         seeds=6, store=tmp_path / "r.sqlite", out=tmp_path, jobs=1, progress=False,
         figures=False,
     )  # fmt: skip
