@@ -165,7 +165,8 @@ class Fig38(Experiment):
             x = [t["nx"] for t in pts]
             y = [t["rate"] for t in pts]
             err = [[t["rate"] - t["lo95"] for t in pts], [t["hi95"] - t["rate"] for t in pts]]
-            label = ex if len(solvers) == 1 else f"{ex} ({solver})"
+            exs = {c[0] for c in curves}
+            label = ex if len(solvers) == 1 else solver if len(exs) == 1 else f"{ex} ({solver})"
             ax.errorbar(
                 x, y, yerr=err, label=label, capsize=3, marker=markers[i % len(markers)],
                 linestyle=styles[solvers.index(solver) % len(styles)], linewidth=1.4,
@@ -177,9 +178,12 @@ class Fig38(Experiment):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
         n = min(t["trials"] for t in table)
+        what = solvers[0] if len(solvers) == 1 else "each solver"
+        one = {c[0] for c in curves}
         ax.set_title(
-            f"Success rate of {', '.join(solvers)} (order {config['order']}, boundary "
-            f"{config['boundary']}, ≥{n} trials/point, 95% Wilson)",
+            f"Success rate of {what}{' on ' + next(iter(one)) if len(one) == 1 else ''}\n"
+            f"(order {config['order']} unless stated, boundary {config['boundary']}, "
+            f"≥{n} trials per point, 95% Wilson intervals)",
             fontsize=9,
         )
         return save_figure(fig, out / self.name)
