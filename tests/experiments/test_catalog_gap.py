@@ -76,3 +76,30 @@ def test_sat_oracle_agrees_with_brute_force(tmp_path, fallible_npy):
         b = rows["sat"][k]
         for f in ("first_bad", "fail_step", "good_steps", "gap_steps", "_gaps"):
             assert a.get(f) == b.get(f), (k, f)
+
+
+def test_fig3_6_inconsistency_can_show_late():
+    """Fig. 3.6: the bottom row 0 0 2 0 2 0 2 0 0 of a 9x3 output (every label taken from the
+    catalog, figure scan order) leaves three 2s that cannot be paired: the model is
+    inconsistent after step 9, but the catalog empties only at step 12."""
+    from csplab.catalog import Propagator
+    from csplab.examples import load_example
+    from csplab.experiments.catalog_gap import first_bad_step
+    from csplab.experiments.oracle import make_oracle
+
+    P = Problem.from_example(load_example("fig3_6a"), (9, 3))
+    eng = Propagator(P)
+    trace = []
+    for x, b in enumerate([0, 0, 2, 0, 2, 0, 2, 0, 0]):
+        c = P.cell((x, 0))
+        assert b in eng.domain(c) and eng.assign(c, b)
+        trace.append((c, b))
+    for x in range(9):  # then the first label of the catalog, left to right
+        c = P.cell((x, 1))
+        b = int(eng.domain(c)[0])
+        trace.append((c, b))
+        if not eng.assign(c, b):
+            break
+    tr = np.array(trace)
+    assert first_bad_step(make_oracle(P, "brute"), tr, len(tr)) == 9
+    assert len(tr) == 12
