@@ -81,6 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--out", default=str(ROOT / "results"))
     p.add_argument("--quick", action="store_true")
     p.add_argument("--report-only", action="store_true")
+    p.add_argument("--rerun", action="store_true", help="run the sweeps' trials again")
     a = p.parse_args(argv)
     installed = {s["name"] for s in available_solvers() if s.get("installed")}
     code = 0
@@ -107,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             summary, report = run(
                 exp, quick=a.quick, store=a.store, out=Path(a.out) / name, jobs=a.jobs,
-                scheduler=a.scheduler, report_only=a.report_only,
+                scheduler=a.scheduler, report_only=a.report_only, rerun=a.rerun,
                 command=f"experiments/run_all.py --only {name}", **over,
             )  # fmt: skip
         except CsplabError as e:

@@ -87,6 +87,9 @@ def _experiment_parser(exp: Any) -> argparse.ArgumentParser:
     )
     h.add_argument("--out", help="report directory (default results/NAME)")
     h.add_argument("--report-only", action="store_true", help="run nothing; report the store")
+    h.add_argument(
+        "--rerun", action="store_true", help="forget this sweep's stored trials and run them again"
+    )
     h.add_argument("--no-progress", action="store_true", help="no progress bar")
     h.add_argument("--no-figures", action="store_true", help="tables and CSVs only")
     h.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -150,7 +153,8 @@ def run(args: argparse.Namespace) -> int:
         kwargs["store"] = a.store
     summary, report = ex.run(
         exp.name, quick=a.quick, out=a.out, jobs=a.jobs, scheduler=a.scheduler,
-        progress=not a.no_progress, report_only=a.report_only, figures=not a.no_figures,
+        progress=not a.no_progress, report_only=a.report_only, rerun=a.rerun,
+        figures=not a.no_figures,
         command="csplab experiment " + shlex.join([args.name, *args.rest]), **kwargs,
         **overrides,
     )  # fmt: skip

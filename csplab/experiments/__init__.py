@@ -85,6 +85,7 @@ def run(
     scheduler: Any = None,
     progress: bool = True,
     report_only: bool = False,
+    rerun: bool = False,
     figures: bool = True,
     command: str = "",
     **overrides: Any,
@@ -100,11 +101,15 @@ def run(
     store : path
         The SQLite results store (default ``results/csplab-experiments.sqlite``).
     out : path, optional
-        Report directory (default ``results/NAME``): ``NAME.md``, CSVs, PNG and SVG.
+        Report directory (default ``results/NAME``): ``NAME.md``, one CSV per table,
+        ``NAME_trials.csv.gz`` (every trial), PNG and SVG.
     jobs, scheduler, progress
         See :func:`~csplab.experiments.runner.run_trials`.
     report_only : bool
         Do not run anything; report what the store holds.
+    rerun : bool
+        Forget this sweep's stored trials first and run them all again (after a fix to a
+        measure, say).
     figures : bool
         Draw the figures (PNG and SVG); tables and CSVs are always written.
     **overrides
@@ -116,6 +121,8 @@ def run(
     trials, examples = exp.build(config)
     outdir = Path(out) if out is not None else Path("results") / exp.name
     with ResultsStore(store) as st:
+        if rerun and not report_only:
+            st.delete(exp.name, [t.key for t in trials])
         if report_only:
             done = st.done_keys(exp.name)
             summary = RunSummary(exp.name, len(trials), sum(t.key in done for t in trials))
@@ -130,7 +137,7 @@ def run(
         report = exp.report(rows, config, outdir)
         report.trials = len(keys)
         report.missing = len(keys) - len(rows)
-        raw = outdir / f"{exp.name}_trials.csv"
+        raw = outdir / f"{exp.name}_trials.csv.gz"
         st.export_csv(raw, exp.name, keys)
         report.files.append(raw)
     report.config = {**config, "config_hash": config_hash(config)}

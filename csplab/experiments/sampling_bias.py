@@ -93,7 +93,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
             "log_count": S.log_count,
             "max_states": max(S.state_counts()),
             "labels": S.label_frequencies().tolist(),
-            "patterns": [[c, pf[c]] for c in sorted(pf)],
+            "_patterns": [[c, pf[c]] for c in sorted(pf)],
         }
         return {"status": "solved", "time_s": time.perf_counter() - t0, "stats": exact}
     if trial.solver == "uniform":
@@ -107,7 +107,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     stats: dict[str, Any] = {}
     if status == "solved":
         stats["labels"] = label_counts(grid, K).tolist()
-        stats["patterns"] = _sparse_patterns(grid, K)
+        stats["_patterns"] = _sparse_patterns(grid, K)
     return {"status": status, "time_s": elapsed, "stats": stats}
 
 
@@ -197,7 +197,7 @@ class SamplingBias(Experiment):
                                  f"{exact['status'] if exact else 'missing'}).")  # fmt: skip
                 continue
             ex_lab = np.asarray(exact["stats"]["labels"], dtype=float)
-            ex_pat = {int(c): float(v) for c, v in exact["stats"]["patterns"]}
+            ex_pat = {int(c): float(v) for c, v in exact["stats"]["_patterns"]}
             settings: dict[str, list[dict[str, Any]]] = defaultdict(list)
             for r in rs:
                 if r["solver"] != "exact":
@@ -327,12 +327,12 @@ def _compare(
                                      "js_patterns")})  # fmt: skip
         res["_labels"] = np.full(ex_lab.shape, nan)
         return res
-    codes = sorted(set(ex_pat) | {int(c) for r in ok for c, _ in r["stats"]["patterns"]})
+    codes = sorted(set(ex_pat) | {int(c) for r in ok for c, _ in r["stats"]["_patterns"]})
     pos = {c: i for i, c in enumerate(codes)}
     P = np.zeros((len(ok), len(codes)))
     L = np.array([r["stats"]["labels"] for r in ok], dtype=float)
     for i, r in enumerate(ok):
-        for c, v in r["stats"]["patterns"]:
+        for c, v in r["stats"]["_patterns"]:
             P[i, pos[int(c)]] = v
     ep = np.zeros(len(codes))
     for c, v in ex_pat.items():

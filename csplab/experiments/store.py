@@ -31,6 +31,7 @@ False
 from __future__ import annotations
 
 import csv
+import gzip
 import json
 import os
 import socket
@@ -190,6 +191,22 @@ class ResultsStore:
             (time.time(), ran, errors, run_id),
         )
 
+    def delete(self, experiment: str, keys: Iterable[str] | None = None) -> int:
+        """Forget stored trials of ``experiment`` (those with the given keys, or all);
+        returns how many were deleted."""
+        if keys is None:
+            cur = self._db.execute("DELETE FROM trials WHERE experiment = ?", (experiment,))
+            return int(cur.rowcount)
+        n = 0
+        self._db.execute("BEGIN")
+        for k in keys:
+            cur = self._db.execute(
+                "DELETE FROM trials WHERE experiment = ? AND trial_key = ?", (experiment, k)
+            )
+            n += int(cur.rowcount)
+        self._db.execute("COMMIT")
+        return n
+
     # ---------------------------------------------------------------- reading
     def done_keys(self, experiment: str) -> set[str]:
         """Keys of the trials of ``experiment`` already stored."""
@@ -244,8 +261,8 @@ class ResultsStore:
         keys: Iterable[str] | None = None,
         stats_keys: Sequence[str] | None = None,
     ) -> int:
-        """Write trials to CSV (one column per stats key, keys starting with ``_`` left out);
-        returns the number of rows."""
+        """Write trials to CSV (gzip-compressed when ``path`` ends in ``.gz``; one column per
+        stats key, keys starting with ``_`` left out); returns the number of rows."""
         rows = self.rows(experiment, keys)
         if stats_keys is None:
             seen: dict[str, None] = {}
@@ -256,7 +273,8 @@ class ResultsStore:
             stats_keys = list(seen)
         base = [c for c in COLUMNS if c != "stats"]
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "w", newline="", encoding="utf-8") as f:
+        opener: Any = gzip.open if str(path).endswith(".gz") else open
+        with opener(path, "wt", newline="", encoding="utf-8") as f:
             w = csv.writer(f)
             w.writerow(base + [f"stats.{k}" for k in stats_keys])
             for r in rows:

@@ -32,6 +32,8 @@ def test_quick_run_json_then_report_only(capsys, tmp_path):
     assert d["tables"]["success rate"][0]["trials"] == 2
     code, out, _ = run(capsys, *args)
     assert code == 0 and "4 already stored" in out and "| nx |" in out
+    code, out, _ = run(capsys, *args, "--rerun")
+    assert code == 0 and "0 already stored, 4 run" in out
     # more seeds, report only: the new trials are missing -> exit 1
     code, out, err = run(capsys, *args[:6], "4", *args[7:], "--report-only")
     assert code == 1 and "4 of 8 trials are missing" in err

@@ -1,4 +1,5 @@
 import csv
+import gzip
 
 import pytest
 
@@ -18,10 +19,10 @@ def test_quick_run_rates_intervals_files_and_resume(tmp_path):
         assert t["rate"] == t["solved"] / t["trials"]
         assert t["lo95"] <= t["rate"] <= t["hi95"]
     assert {t["example"] for t in table} == {"castle", "line"}
-    for f in ("fig3_8.png", "fig3_8.svg", "fig3_8.md", "fig3_8_trials.csv",
+    for f in ("fig3_8.png", "fig3_8.svg", "fig3_8.md", "fig3_8_trials.csv.gz",
               "fig3_8_success_rate.csv"):  # fmt: skip
         assert (tmp_path / "out" / f).stat().st_size > 100
-    raw = list(csv.DictReader(open(tmp_path / "out" / "fig3_8_trials.csv")))
+    raw = list(csv.DictReader(gzip.open(tmp_path / "out" / "fig3_8_trials.csv.gz", "rt")))
     assert len(raw) == 16 and {r["solver"] for r in raw} == {"catalog"}
     # a stored trial is reproduced by its seed
     r = next(r for r in raw if r["example"] == "castle" and r["size"] == "8x8x4")

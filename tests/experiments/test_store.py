@@ -50,6 +50,20 @@ def test_rows_filtered_by_keys_and_csv_export(tmp_path):
     assert "stats._hidden" not in rows[0] and rows[0]["solver"] == "catalog"
 
 
+def test_delete_and_gzip_export(tmp_path):
+    import gzip
+
+    with ResultsStore(tmp_path / "r.sqlite") as st:
+        for s in range(3):
+            st.add(_t(s), {"status": "solved", "time_s": 0, "stats": {}}, config_hash="c")
+        assert st.delete("exp", [_t(0).key, "nokey"]) == 1
+        assert st.count("exp") == 2
+        assert st.export_csv(tmp_path / "o.csv.gz", "exp") == 2
+        assert st.delete("exp") == 2 and st.count() == 0
+    with gzip.open(tmp_path / "o.csv.gz", "rt") as f:
+        assert len(list(csv.DictReader(f))) == 2
+
+
 def test_runs_table_records_sweeps(tmp_path):
     with ResultsStore(tmp_path / "r.sqlite") as st:
         rid = st.start_run("exp", {"a": 1}, "h", trials=5, skipped=2, command="csplab x")
