@@ -3,7 +3,7 @@
 Each example file says which figure it stands for and which property it was designed to
 have; these tests check those properties exactly on small outputs (exhaustive search over
 every choice of Alg. 3.1, exact catalogs C* by backtracking, solution-set enumeration).
-Orders: ``"figure"`` is left to right, then bottom to top (the thesis' 2D figures);
+Orders: ``"scan:yx"`` is left to right, then bottom to top (the thesis' 2D figures);
 ``"scanline"`` is csplab's Alg. 3.1 loop (x outermost).
 """
 
@@ -13,21 +13,27 @@ import numpy as np
 import pytest
 
 from csplab import Problem, solve
+from csplab.analysis import alg31_exhaustive, alg36_failure, corner_condition, prove_infallible
 from csplab.catalog import Propagator
 from csplab.examples import load_example
-from tests._brute import (
-    alg31_failure,
-    alg36_failure,
-    alg36_window_prover,
-    assign_all,
-    catalogs,
-    corner_violations,
-    satisfiable,
-    solutions,
-    successor_violations,
-)
+from tests._brute import assign_all, catalogs, satisfiable, solutions
 
-ORDERS = ["figure", "scanline"]
+FIG = "scan:yx"  # the thesis' 2D figures: left to right, then bottom to top
+ORDERS = [FIG, "scanline"]
+
+
+def alg31_failure(P: Problem, order: str) -> tuple[list | None, int]:
+    v = alg31_exhaustive(P, order)
+    assert v.holds is not None
+    return (None if v.holds else v.witness), v.stats["states"]
+
+
+def corner_holds(name: str) -> bool:
+    return bool(corner_condition(load_example(name)).holds)
+
+
+def window_proof(name: str, region: tuple[int, int]) -> bool | None:
+    return prove_infallible(load_example(name), region, order=FIG, refute=False).holds
 
 
 def problem(name: str, shape: tuple[int, ...], **kw: object) -> Problem:
@@ -71,23 +77,22 @@ def test_fig3_4a_alg31_never_fails(order):
 
 
 def test_fig3_4a_region_proof_fails_with_2x2():
-    T = load_example("fig3_4a").transitions()
-    assert (0, 1, 1) in corner_violations(T)
-    fail = alg36_failure(T, (3, 3), (2, 2))
-    assert fail is not None
-    (px, py), label = fail[-1]
+    v = corner_condition(load_example("fig3_4a"))
+    assert not v.holds and v.witness["labels"] == {"a": 0, "b": 1, "c": 1}
+    fail = alg36_failure(load_example("fig3_4a"), (3, 3), (2, 2), order=FIG)
+    assert fail.holds is False
+    (px, py), label = fail.witness[-1]
     assert label is None  # C_R is empty at p'
-    known = dict(fail[:-1])
+    known = {tuple(c): b for c, b in fail.witness[:-1]}
     # Sec. 3.3.7: the bottom 1 needs a 2 above it, the other 1 needs a 0 to its right
     assert known[(px, py - 1)] == 1 and known[(px - 1, py)] == 1
-    assert alg36_window_prover(T, (2, 2))
+    assert window_proof("fig3_4a", (2, 2)) is None
 
 
 def test_fig3_4a_region_proof_succeeds_with_3x2():
-    T = load_example("fig3_4a").transitions()
-    assert alg36_window_prover(T, (3, 2)) == []
+    assert window_proof("fig3_4a", (3, 2)) is True
     for shape in [(3, 3), (4, 4), (5, 3)]:
-        assert alg36_failure(T, shape, (3, 2)) is None
+        assert alg36_failure(load_example("fig3_4a"), shape, (3, 2), order=FIG).holds
 
 
 # ----------------------------------------------------------------------------- Fig. 3.5(a)
@@ -132,9 +137,9 @@ def test_fig3_5a_catalog_is_not_exact():
 
 
 def test_fig3_5a_is_fallible():
-    fail, _ = alg31_failure(problem("fig3_5a", (3, 3)), "figure")
+    fail, _ = alg31_failure(problem("fig3_5a", (3, 3)), FIG)
     assert fail is not None
-    eng = assign_all(problem("fig3_5a", (3, 3)), dict(fail))
+    eng = assign_all(problem("fig3_5a", (3, 3)), {tuple(c): b for c, b in fail})
     assert not eng.ok
     # csplab's scanline order decides 3 or 7 before it reaches the cell two to the right
     assert alg31_failure(problem("fig3_5a", (4, 4)), "scanline")[0] is None
@@ -151,10 +156,8 @@ def test_fig3_15_is_fig3_5a_with_9_for_enclosed_0():
 
 
 def test_fig3_15_corner_condition():
-    T = load_example("fig3_15").transitions()
-    assert corner_violations(T) == []
-    assert successor_violations(T) == []
-    assert corner_violations(load_example("fig3_5a").transitions())  # the twin violates it
+    assert corner_holds("fig3_15")
+    assert not corner_holds("fig3_5a")  # the twin violates it
 
 
 @pytest.mark.parametrize("order", ORDERS)
@@ -166,8 +169,7 @@ def test_fig3_15_alg31_never_fails(order):
 
 
 def test_fig3_15_region_proof_2x2_and_exact_catalog():
-    T = load_example("fig3_15").transitions()
-    assert alg36_window_prover(T, (2, 2)) == []
+    assert window_proof("fig3_15", (2, 2)) is True
     P = problem("fig3_15", (3, 3))
     C, Cs = catalogs(P, {(0, 0): 2, (1, 0): 9})
     assert np.array_equal(C, Cs)
@@ -217,7 +219,7 @@ def test_fig3_6a_inconsistent_while_catalog_not_empty():
 
 
 def test_fig3_6a_is_fallible():
-    fail, _ = alg31_failure(problem("fig3_6a", (5, 3)), "figure")
+    fail, _ = alg31_failure(problem("fig3_6a", (5, 3)), FIG)
     assert fail is not None
 
 
@@ -258,10 +260,9 @@ def test_fig3_16_alg31_never_fails(order):
 
 
 def test_fig3_16_region_proof_needs_4x2():
-    T = load_example("fig3_16").transitions()
-    assert corner_violations(T)
-    assert alg36_window_prover(T, (3, 2))
-    assert alg36_window_prover(T, (4, 2)) == []
+    assert not corner_holds("fig3_16")
+    assert window_proof("fig3_16", (3, 2)) is None
+    assert window_proof("fig3_16", (4, 2)) is True
 
 
 @pytest.mark.slow

@@ -23,6 +23,9 @@ COMMANDS: dict[str, str] = {
     "check": "csplab.cli.check",
     "info": "csplab.cli.info",
     "show": "csplab.cli.show",
+    "prove": "csplab.cli.prove",
+    "witness": "csplab.cli.witness",
+    "refine": "csplab.cli.refine",
     "experiment": "csplab.cli.experiment",
 }
 

@@ -23,7 +23,7 @@ from numpy.typing import ArrayLike, NDArray
 from csplab.catalog import Propagator
 from csplab.problem import Problem
 
-__all__ = ["count", "exact_catalog", "solutions"]
+__all__ = ["count", "exact_catalog", "satisfiable", "solutions"]
 
 
 def solutions(
@@ -73,3 +73,52 @@ def exact_catalog(problem: Problem, partial: ArrayLike | None = None) -> NDArray
     for g in solutions(problem, partial):
         C[idx, g.reshape(-1)] = True
     return C
+
+
+def satisfiable(
+    problem: Problem, partial: ArrayLike | None = None, max_nodes: int | None = None
+) -> bool | None:
+    """Does a solution extend ``partial`` (-1 = free)? MAC backtracking (smallest domain
+    first); ``None`` when ``max_nodes`` search nodes did not decide it.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, Problem
+    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    >>> satisfiable(P, [[0, -1, -1], [-1, 0, -1], [-1, -1, -1]]), satisfiable(P, [[0, 0, -1],
+    ...     [-1, -1, -1], [-1, -1, -1]])
+    (True, False)
+    """
+    eng = Propagator(problem)
+    if partial is not None:
+        flat = np.asarray(partial).reshape(-1)
+        for c in np.flatnonzero(flat >= 0):
+            if not eng.assign(int(c), int(flat[c])):
+                return False
+    if not eng.ok:
+        return False
+    nodes = 0
+
+    def rec(e: Propagator) -> bool | None:
+        nonlocal nodes
+        nodes += 1
+        if max_nodes is not None and nodes > max_nodes:
+            return None
+        sizes = e.sizes()
+        open_cells = np.flatnonzero(sizes > 1)
+        if open_cells.size == 0:
+            return True
+        c = int(open_cells[np.argmin(sizes[open_cells])])
+        undecided = False
+        for b in e.domain(c):
+            e2 = e.copy()
+            if e2.assign(c, int(b)):
+                r = rec(e2)
+                if r:
+                    return True
+                if r is None:
+                    undecided = True
+                    break
+        return None if undecided else False
+
+    return rec(eng)

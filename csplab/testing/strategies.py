@@ -21,6 +21,7 @@ from csplab.example import ExampleModel
 from csplab.problem import Problem
 
 __all__ = [
+    "analysis_examples",
     "corrupted",
     "example_models",
     "label_grids",
@@ -173,3 +174,15 @@ def tile_rule_sets(draw: Any, max_tiles: int = 4, max_rules: int = 8) -> str:
         lines.append(f'    <neighbor left="{a} {ka}" right="{b} {kb}"/>')
     lines += ["  </neighbors>", "</set>"]
     return "\n".join(lines) + "\n"
+
+
+@st.composite
+def analysis_examples(draw: Any, ndim: int = 2, max_side: int = 4, max_labels: int = 4,
+                      frame: bool | None = None) -> ExampleModel:  # fmt: skip
+    """Small examples for infallibility analysis; with ``frame`` (drawn when ``None``) the
+    grid is surrounded by a layer of empty space 0, as the thesis' examples are (so every
+    output size has the all-empty model)."""
+    g = draw(label_grids(ndim=ndim, max_side=max_side, max_labels=max_labels))
+    if frame if frame is not None else draw(st.booleans()):
+        g = np.pad(g, 1, constant_values=0)
+    return ExampleModel(g)

@@ -1,0 +1,845 @@
+"""Infallibility proofs: the corner condition (Eq. 3.11) and the region prover (Alg. 3.6/3.7).
+
+An example model E is *infallible* (thesis Sec. 3.3.7) when Alg. 3.1, run in a given scan
+order, can never fail on it, whatever the output size and whatever labels it draws.
+
+Reading of Sec. 3.3.7 used here (the seed text lost subscripts; see
+``papers/merrell-2009-thesis/infallibility.md``)
+---------------------------------------------------------------------------------------
+*Scan orders.* A scan visits cells lexicographically with the axes in a fixed order
+(outermost first): ``"scanline"`` is Alg. 3.1's loop (x outermost), ``"scan:yx"`` the
+thesis' 2D figures (left to right, then bottom to top). Random and min-entropy orders have
+no region proof (a later neighbour may already be assigned) and are rejected.
+
+*Alg. 3.6/3.7.* Alg. 3.6 is Alg. 3.1 except that the label at the point ``p`` is drawn
+from ``C_R(p)``: arc consistency (Alg. 3.2/3.3) computed on the region ``R`` only, with
+the labels already assigned inside ``R``. With region size ``r`` per axis, ``R`` is the box
+``p - 1 .. p + r - 2`` on every axis, clipped at the model border (``p`` sits one cell in
+from the minimum corner). Alg. 3.7 prints the loop bound ``p + r - 1``, which would give
+``r + 1`` cells; we read ``r`` as the region's size, as the text says ("R has a size of
+r_x x r_y x r_z") and as the 2x2 discussion requires.
+
+*Theorem 3.3.6, as proven here.* Let ``r_d >= 2``. (i) The box contains ``p - e_d`` for
+every axis, and in a lexicographic scan ``p - e_d`` is assigned before ``p`` while
+``p + e_d`` is not; a label drawn from ``C_R(p)`` agrees with every assigned neighbour, so a
+complete run of Alg. 3.6 is a consistent model. (ii) Arc consistency is monotone: the full
+catalog ``C_{M_t}`` restricted to ``R`` is arc consistent on the smaller problem ``R`` with
+fewer assignments, so ``C_{M_t}(p) ⊆ C_R(p)`` (Eq. 3.10). Hence every prefix of a run of
+Alg. 3.1 is a prefix of a run of Alg. 3.6. (iii) If Alg. 3.6 can never fail, every such
+prefix ``M_t`` completes to a consistent model, so ``C*_{M_t}`` is not empty anywhere, and
+by Theorem 3.3.2 neither is ``C_{M_t}``: Alg. 3.1 never fails, and at the point it is about
+to assign, ``C(p) = C*(p)`` (each label of ``C(p)`` starts a run of Alg. 3.6 that
+completes). This is Lemma 3.3.1 restricted to the point being assigned, which is all
+that infallibility needs.
+
+*Eq. 3.11, corrected.* With ``r = 2`` the region of ``p`` is the unit box with ``p`` at its
+top corner and every other cell already assigned, so ``C_R(p)`` is the set of labels
+agreeing with the backward neighbours of ``p``. Alg. 3.6 never fails iff every labelling
+of the unit box minus its top corner that is consistent on the box's arcs has a
+completion -- in 2D: for all ``a, b, c`` with ``T_y(a, b)`` and ``T_x(a, c)`` there is a
+``d`` with ``T_x(b, d)`` and ``T_y(c, d)`` -- and the same holds on every face of the box
+(clipped regions at the first row and column: every label has a successor along each
+axis). Every such labelling is reachable at a corner of the output, so this is exact.
+:func:`corner_condition` checks it in closed form.
+
+*The prover.* For larger regions the reachable contents of ``R`` depend on the whole run.
+:func:`prove_infallible` over-approximates them soundly. The position of ``p`` relative to
+the output's edges matters only up to a bound, so finitely many *configurations* (distance
+to each lower edge ``0..1+history``, to each upper edge ``0..r-2``, capped) cover every
+point of every output size. For each configuration a *frame* of cells is enumerated: the
+cells before ``p`` in the box ``p - 1 - history .. p + r - 2``. Frame cells are labelled in
+scan order, each with every label of its own ``C_R`` computed from what the frame sees
+(its region intersected with the frame box; cells outside the frame count as
+unassigned). Fewer assignments and a smaller region only enlarge a catalog, so every real
+run restricted to the frame is among the enumerated labellings; if ``C_R(p)`` is never
+empty, Alg. 3.6 never fails and E is infallible. Pruning a labelling where an earlier
+frame cell's catalog is empty is sound (such a run already failed there, which that
+cell's own configuration detects). Memoisation keeps only the labels that still influence
+a later catalog (a fixed cell matters only through arcs to unassigned cells of a later
+region), so equal futures are explored once. A window in which ``C_R(p)`` is empty is
+replayed on a concrete output by exhaustive Alg. 3.6 to show that the failure is real.
+
+Examples
+--------
+>>> from csplab.examples import load_example
+>>> corner_condition(load_example("line")).holds
+True
+>>> v = corner_condition(load_example("fig3_4a"))
+>>> v.holds, v.witness["labels"]
+(False, {'a': 0, 'b': 1, 'c': 1})
+>>> prove_infallible(load_example("fig3_4a"), region=(3, 2), order="scan:yx").holds
+True
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import time
+from collections.abc import Iterator, Mapping, Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from csplab.errors import InputError
+from csplab.example import ExampleModel
+from csplab.problem import AXIS_NAMES, Problem
+from csplab.result import Verdict
+
+__all__ = [
+    "Rules",
+    "alg36_failure",
+    "corner_condition",
+    "prove_infallible",
+    "region_box",
+    "region_catalog",
+    "scan_axes",
+]
+
+Coords = tuple[int, ...]
+
+
+# ----------------------------------------------------------------------------- rules
+
+
+class Rules:
+    """Transition matrices of an example as Python-int bitsets (bit ``c`` = label ``c``).
+
+    ``fwd[d][a]``: labels that may follow ``a`` along ``+d``; ``bwd[d][c]``: labels that
+    may precede ``c``. ``used``: labels that occur in the example (the only labels a cell
+    may take, as in :meth:`Problem.from_example`).
+    """
+
+    def __init__(self, T: ArrayLike, used: ArrayLike | None = None) -> None:
+        Tb = np.asarray(T, dtype=bool)
+        if Tb.ndim != 3 or Tb.shape[1] != Tb.shape[2]:
+            raise InputError(f"transitions must have shape (ndim, K, K), got {Tb.shape}")
+        self.T = Tb
+        self.ndim, self.K = int(Tb.shape[0]), int(Tb.shape[1])
+        u = np.ones(self.K, dtype=bool) if used is None else np.asarray(used, dtype=bool)
+        self.used_mask = u
+        self.used = _to_bits(u)
+        self.fwd = [[_to_bits(Tb[d, a] & u) for a in range(self.K)] for d in range(self.ndim)]
+        self.bwd = [[_to_bits(Tb[d, :, c] & u) for c in range(self.K)] for d in range(self.ndim)]
+        self._union: dict[tuple[int, bool, int], int] = {}
+
+    @classmethod
+    def of(cls, example: ExampleModel | Rules) -> Rules:
+        if isinstance(example, Rules):
+            return example
+        return cls(example.transitions(), example.counts() > 0)
+
+    def union(self, d: int, forward: bool, dom: int) -> int:
+        """Labels supported along axis ``d`` by some label of ``dom`` (forward: as successor)."""
+        key = (d, forward, dom)
+        hit = self._union.get(key)
+        if hit is not None:
+            return hit
+        table = self.fwd[d] if forward else self.bwd[d]
+        out = 0
+        for b in _bits(dom):
+            out |= table[b]
+        if len(self._union) < 2_000_000:
+            self._union[key] = out
+        return out
+
+
+def _to_bits(mask: ArrayLike) -> int:
+    out = 0
+    for b in np.flatnonzero(np.asarray(mask, dtype=bool)):
+        out |= 1 << int(b)
+    return out
+
+
+def _bits(x: int) -> Iterator[int]:
+    while x:
+        low = x & -x
+        yield low.bit_length() - 1
+        x ^= low
+
+
+def _graph_ac(
+    rules: Rules, dom: list[int], arcs: list[list[tuple[int, int, bool]]]
+) -> list[int] | None:
+    """Arc consistency on a tiny graph (``arcs[u]`` = ``(v, axis, v is u + e_axis)``).
+    Returns the domains, or ``None`` on a wipe-out."""
+    queue = list(range(len(dom)))
+    inq = [True] * len(dom)
+    while queue:
+        u = queue.pop()
+        inq[u] = False
+        du = dom[u]
+        for v, d, fwd in arcs[u]:
+            nv = dom[v] & rules.union(d, fwd, du)
+            if nv != dom[v]:
+                if nv == 0:
+                    return None
+                dom[v] = nv
+                if not inq[v]:
+                    inq[v] = True
+                    queue.append(v)
+    return dom
+
+
+# ----------------------------------------------------------------------------- orders, regions
+
+
+def scan_axes(ndim: int, order: str) -> tuple[int, ...]:
+    """Axes of a scan order, outermost first (``"scanline"`` or ``"scan:AXES"``).
+
+    Examples
+    --------
+    >>> scan_axes(2, "scan:yx"), scan_axes(3, "scanline")
+    ((1, 0), (0, 1, 2))
+    """
+    if order == "scanline":
+        return tuple(range(ndim))
+    if order.startswith("scan:"):
+        axes = tuple(AXIS_NAMES.find(a) for a in order[5:])
+        if sorted(axes) == list(range(ndim)):
+            return axes
+        raise InputError(
+            f"order {order!r}: name each of the {ndim} axes ({AXIS_NAMES[:ndim]}) once, "
+            "outermost first"
+        )
+    raise InputError(
+        f"order {order!r} has no region proof: use 'scanline' or 'scan:AXES' (a scan order)"
+    )
+
+
+def _parse_region(region: Sequence[int] | str | int, ndim: int) -> tuple[int, ...]:
+    if isinstance(region, int):
+        r = (region,) * ndim
+    elif isinstance(region, str):
+        try:
+            r = tuple(int(t) for t in region.lower().replace("×", "x").split("x"))
+        except ValueError:
+            raise InputError(f"region {region!r} is not of the form 3x2 or 2x2x2") from None
+    else:
+        r = tuple(int(t) for t in region)
+    if len(r) < ndim:
+        r = r + (2,) * (ndim - len(r))
+    if len(r) != ndim:
+        raise InputError(f"region {region!r} has {len(r)} axes, the example has {ndim}")
+    if any(t < 2 for t in r):
+        raise InputError(f"region {region!r}: Theorem 3.3.6 needs at least 2 cells per axis")
+    return r
+
+
+def region_box(
+    p: Sequence[int], shape: Sequence[int], region: Sequence[int]
+) -> tuple[Coords, Coords]:
+    """The region of Alg. 3.7 at ``p``: inclusive ``(lo, hi)`` corners, clipped to ``shape``.
+
+    Examples
+    --------
+    >>> region_box((0, 3), (5, 5), (3, 2))
+    ((0, 2), (1, 3))
+    """
+    lo = tuple(max(0, int(pd) - 1) for pd in p)
+    hi = tuple(
+        min(int(n) - 1, int(pd) + int(rd) - 2) for pd, n, rd in zip(p, shape, region, strict=True)
+    )
+    return lo, hi
+
+
+def region_catalog(
+    example: ExampleModel,
+    grid: ArrayLike,
+    p: Sequence[int],
+    region: Sequence[int] | str,
+) -> NDArray[np.int64]:
+    """``C_R(p)`` of Alg. 3.7: arc consistency on the region of ``p`` only, with the labels
+    of ``grid`` (``-1`` = unassigned) inside the region. Uses :class:`Propagator` on the
+    region's sub-grid (a literal reference for the prover's own bitset code).
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> g = np.full((3, 3), -1); g[0, 1] = 1; g[1, 0] = 1      # two 1s on a diagonal
+    >>> region_catalog(load_example("fig3_4a"), g, (1, 1), "2x2").tolist()
+    []
+    """
+    from csplab.catalog import Propagator
+
+    G = np.asarray(grid)
+    r = _parse_region(region, G.ndim)
+    lo, hi = region_box(p, G.shape, r)
+    sl = tuple(slice(a, b + 1) for a, b in zip(lo, hi, strict=True))
+    sub = G[sl]
+    fixed = np.where(sub >= 0, sub, -1).astype(np.int64)
+    P = Problem.grid(sub.shape, example.transitions(), fixed=fixed, labels=example.counts() > 0)
+    eng = Propagator(P)
+    if not eng.ok:
+        return np.zeros(0, dtype=np.int64)
+    return eng.domain(P.cell(tuple(int(a) - b for a, b in zip(p, lo, strict=True))))
+
+
+# ----------------------------------------------------------------------------- walks
+
+
+class _Walk:
+    """Cells visited in scan order inside a box ``ext``; each cell's region clipped to it.
+
+    Cell ``i`` of ``cells`` is labelled from the catalog of its region in which the cells
+    ``< i`` are assigned and every other cell of the box is unassigned. Precomputes, per
+    step, the small arc-consistency graph (fixed cells that border no unassigned cell of
+    the region are left out: they cannot change the catalog) and which earlier labels a
+    later step still depends on (the memoisation key).
+    """
+
+    def __init__(
+        self,
+        ext: Coords,
+        cells: list[Coords],
+        region: Coords,
+    ) -> None:
+        self.ext, self.cells, self.region = ext, cells, region
+        index = {c: i for i, c in enumerate(cells)}
+        ndim = len(ext)
+        self.steps: list[tuple[list[int], list[list[tuple[int, int, bool]]], int]] = []
+        relfixed: list[list[int]] = []
+        for i, c in enumerate(cells):
+            lo, hi = region_box(c, ext, region)
+            box = list(itertools.product(*[range(a, b + 1) for a, b in zip(lo, hi, strict=True)]))
+            inbox = set(box)
+
+            def fixed(x: Coords, i: int = i) -> bool:
+                j = index.get(x)
+                return j is not None and j < i
+
+            keep: list[Coords] = []
+            for x in box:
+                if not fixed(x):
+                    keep.append(x)
+                    continue
+                for d in range(ndim):
+                    for s in (-1, 1):
+                        y = (*x[:d], x[d] + s, *x[d + 1 :])
+                        if y in inbox and not fixed(y):
+                            break
+                    else:
+                        continue
+                    keep.append(x)
+                    break
+            pos = {x: k for k, x in enumerate(keep)}
+            arcs: list[list[tuple[int, int, bool]]] = [[] for _ in keep]
+            for x, k in pos.items():
+                for d in range(ndim):
+                    y = (*x[:d], x[d] + 1, *x[d + 1 :])
+                    m = pos.get(y)
+                    if m is not None:
+                        arcs[k].append((m, d, True))
+                        arcs[m].append((k, d, False))
+            src = [index[x] if fixed(x) else -1 for x in keep]
+            self.steps.append((src, arcs, pos[c]))
+            relfixed.append([j for j in src if j >= 0])
+        n = len(cells)
+        # labels of steps < i that some step >= i still depends on
+        self.key_at: list[list[int]] = [[] for _ in range(n + 1)]
+        need: set[int] = set()
+        for i in range(n - 1, -1, -1):
+            need |= set(relfixed[i])
+            self.key_at[i] = sorted(j for j in need if j < i)
+        self._cache: dict[tuple[int, tuple[int, ...]], int] = {}
+
+    def catalog(self, rules: Rules, i: int, labels: Sequence[int]) -> int:
+        src, arcs, target = self.steps[i]
+        key = (i, tuple(labels[j] for j in src if j >= 0))
+        hit = self._cache.get(key)
+        if hit is not None:
+            return hit
+        dom = [rules.used if j < 0 else (1 << labels[j]) for j in src]
+        out = _graph_ac(rules, dom, arcs)
+        res = 0 if out is None else out[target]
+        if len(self._cache) < 4_000_000:
+            self._cache[key] = res
+        return res
+
+
+class _Budget(Exception):
+    pass
+
+
+def _scan_cells(ext: Coords, axes: tuple[int, ...]) -> list[Coords]:
+    cells = list(itertools.product(*[range(e) for e in ext]))
+    cells.sort(key=lambda c: tuple(c[a] for a in axes))
+    return cells
+
+
+# ----------------------------------------------------------------------------- the prover
+
+
+def _configs(ndim: int, region: Coords, history: Coords) -> Iterator[tuple[Coords, Coords]]:
+    lo_ranges = [range(2 + history[d]) for d in range(ndim)]
+    hi_ranges = [range(region[d] - 1) for d in range(ndim)]
+    for lo in itertools.product(*lo_ranges):
+        for hi in itertools.product(*hi_ranges):
+            yield lo, hi
+
+
+def _frame(
+    lo: Coords, hi: Coords, axes: tuple[int, ...], region: Coords
+) -> tuple[_Walk, Coords, Coords]:
+    ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
+    q = lo
+    key_q = tuple(q[a] for a in axes)
+    cells = [c for c in _scan_cells(ext, axes) if tuple(c[a] for a in axes) < key_q]
+    cells.append(q)
+    return _Walk(ext, cells, region), ext, q
+
+
+def prove_infallible(
+    example: ExampleModel,
+    region: Sequence[int] | str | int = 2,
+    *,
+    order: str = "scanline",
+    history: Sequence[int] | int = 1,
+    max_states: int = 5_000_000,
+    realize: bool = True,
+    refute: bool = True,
+) -> Verdict:
+    """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
+
+    Parameters
+    ----------
+    example : ExampleModel
+    region : int, ``"3x2"`` or sequence
+        Region size ``r`` per axis (at least 2; missing trailing axes are 2).
+    order : str
+        A scan order: ``"scanline"`` (x outermost, default) or ``"scan:AXES"``.
+    history : int or sequence
+        Extra cells before the region, per axis, that the frame remembers (more history =
+        a tighter over-approximation and more states).
+    max_states : int
+        Give up (``holds=None``) after this many memoised states.
+    realize : bool
+        When a window with an empty ``C_R`` is found, search a concrete output on which
+        Alg. 3.6 really fails there (exhaustive Alg. 3.6).
+    refute : bool
+        When the proof fails, look for a failing run of Alg. 3.1 on small outputs
+        (:func:`csplab.analysis.witness.find_failure`, exhaustive) to refute infallibility.
+
+    Returns
+    -------
+    Verdict
+        ``holds=True``: Alg. 3.6 cannot fail, so E is infallible (Theorem 3.3.6);
+        ``stats`` has the configuration and state counts and ``witness`` the proof hash and
+        a re-check command. ``holds=False``: E is fallible (``witness["alg31"]`` is a
+        failing run of Alg. 3.1). ``holds=None``: not proven with this region (the
+        Alg. 3.6 failure, real or only possible, is in ``witness``) or the state budget ran
+        out.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> v = prove_infallible(load_example("fig3_4a"), "2x2", order="scan:yx", refute=False)
+    >>> v.holds, v.witness["alg36"]["realized"]
+    (None, True)
+    """
+    t0 = time.perf_counter()
+    rules = Rules.of(example)
+    ndim = rules.ndim
+    axes = scan_axes(ndim, order)
+    r = _parse_region(region, ndim)
+    hist = (int(history),) * ndim if isinstance(history, int) else tuple(int(h) for h in history)
+    if len(hist) != ndim or any(h < 0 for h in hist):
+        raise InputError(f"history needs {ndim} non-negative values, got {history!r}")
+    rtxt = "x".join(map(str, r))
+    stats: dict[str, Any] = {
+        "region": list(r),
+        "order": order,
+        "history": list(hist),
+        "configs": 0,
+        "states": 0,
+        "windows": 0,
+        "K": int(rules.used_mask.sum()),
+    }
+    digest = hashlib.sha256()
+    digest.update(repr((example.hash(), r, order, hist)).encode())
+    failure: dict[str, Any] | None = None
+    try:
+        for lo, hi in _configs(ndim, r, hist):
+            walk, ext, q = _frame(lo, hi, axes, r)
+            stats["configs"] += 1
+            fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"])
+            stats["states"] += nstates
+            stats["windows"] += len(windows)
+            for w in sorted(windows):
+                digest.update(repr((lo, hi, w)).encode())
+            if fail is not None:
+                failure = {
+                    "config": {"lower": list(lo), "upper": list(hi)},
+                    "output": list(ext),
+                    "p": list(q),
+                    "frame": [[list(c), int(b)] for c, b in zip(walk.cells, fail, strict=False)],
+                }
+                break
+    except _Budget:
+        stats["time_s"] = time.perf_counter() - t0
+        return Verdict(
+            None,
+            None,
+            stats,
+            f"undecided: state budget {max_states} reached with {rtxt} regions "
+            f"({stats['states']} states, {stats['configs']} configurations)",
+        )
+    stats["time_s"] = time.perf_counter() - t0
+    if failure is None:
+        h = digest.hexdigest()
+        name = example.name or "MODEL"
+        hs = "x".join(map(str, hist))
+        return Verdict(
+            True,
+            {
+                "sha256": h,
+                "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
+                f"--history {hs} --expect-hash {h}",
+            },
+            stats,
+            f"infallible: Alg. 3.6 with {rtxt} regions ({order}) cannot fail "
+            f"({stats['windows']} windows, {stats['states']} states, "
+            f"{stats['configs']} configurations, {stats['time_s']:.2f} s)",
+        )
+    # the window check failed: is the failure real?
+    wit: dict[str, Any] = {"alg36": failure}
+    failure["realized"] = False
+    if realize:
+        prefer = {tuple(c): b for c, b in failure["frame"]}
+        real = _realize(rules, failure, r, axes, prefer, order)
+        if real is not None:
+            failure["realized"] = True
+            failure["run"] = real
+    msg = (
+        f"not proven: Alg. 3.6 with {rtxt} regions ({order}) "
+        + ("fails (replayed on a " if failure["realized"] else "may fail (window only; ")
+        + "x".join(map(str, failure["output"]))
+        + (" output)" if failure["realized"] else " output not realised)")
+    )
+    if failure["realized"]:
+        alg31 = _as_alg31_failure(example, failure["run"], order)
+        if alg31 is not None:
+            wit["alg31"] = alg31
+            return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
+    if refute:
+        from csplab.analysis.witness import find_failure
+
+        ff = find_failure(
+            example, order=order, max_size=_refute_size(ndim), random_runs=0,
+            max_states=50_000 if ndim <= 2 else 5_000,
+        )  # fmt: skip
+        stats["refute_states"] = ff.stats.get("states", 0)
+        if ff.holds is False:
+            wit["alg31"] = ff.witness
+            return Verdict(False, wit, stats, msg + "; Alg. 3.1 fails too: fallible")
+        size = "x".join(map(str, _refute_size(ndim)))
+        done = "exhaustive" if ff.holds is True else "incomplete search"
+        msg += f"; no failure of Alg. 3.1 found on outputs up to {size} ({done})"
+    return Verdict(None, wit, stats, msg)
+
+
+def _refute_size(ndim: int) -> tuple[int, ...]:
+    return {1: (8,), 2: (5, 4), 3: (3, 2, 2)}.get(ndim, (2,) * ndim)
+
+
+def _enumerate(
+    rules: Rules, walk: _Walk, budget: int
+) -> tuple[list[int] | None, int, set[tuple[int, ...]]]:
+    """DFS over the frame's labellings; returns (failing labels or None, states, windows)."""
+    n = len(walk.cells)
+    seen: set[tuple[int, tuple[int, ...]]] = set()
+    windows: set[tuple[int, ...]] = set()
+    labels: list[int] = []
+    last = n - 1
+    src_q = [j for j in walk.steps[last][0] if j >= 0]
+
+    def rec(i: int) -> list[int] | None:
+        key = (i, tuple(labels[j] for j in walk.key_at[i]))
+        if key in seen:
+            return None
+        seen.add(key)
+        if len(seen) > budget:
+            raise _Budget
+        cat = walk.catalog(rules, i, labels)
+        if i == last:
+            windows.add((*(labels[j] for j in src_q), cat))
+            return list(labels) if cat == 0 else None
+        for b in _bits(cat):
+            labels.append(b)
+            res = rec(i + 1)
+            labels.pop()
+            if res is not None:
+                return res
+        return None
+
+    fail = rec(0)
+    return fail, len(seen), windows
+
+
+# ----------------------------------------------------------------------------- Alg. 3.6 runs
+
+
+def alg36_failure(
+    example: ExampleModel,
+    shape: Sequence[int] | str,
+    region: Sequence[int] | str | int = 2,
+    *,
+    order: str = "scanline",
+    max_states: int = 2_000_000,
+) -> Verdict:
+    """Exhaustive Alg. 3.6 on one output size: does some choice sequence fail?
+
+    Every label of ``C_R`` is tried at every step (memoised on the labels later regions
+    still see). ``holds=True``: Alg. 3.6 never fails on this size; ``False``: ``witness``
+    is a choice sequence ``[[coords, label], ...]`` whose last point has an empty ``C_R``
+    (label ``None``); ``None``: ``max_states`` reached.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> alg36_failure(load_example("fig3_4a"), (3, 3), "2x2", order="scan:yx").holds
+    False
+    """
+    from csplab.problem import parse_shape
+
+    rules = Rules.of(example)
+    shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
+    if len(shp) < rules.ndim:
+        shp = shp + (1,) * (rules.ndim - len(shp))
+    axes = scan_axes(len(shp), order)
+    r = _parse_region(region, len(shp))
+    t0 = time.perf_counter()
+    try:
+        run, states = _alg36_search(rules, shp, r, axes, {}, None, max_states)
+    except _Budget:
+        return Verdict(None, None, {"states": max_states}, "undecided: state budget reached")
+    stats = {"states": states, "time_s": time.perf_counter() - t0, "shape": list(shp)}
+    if run is None:
+        return Verdict(True, None, stats, f"Alg. 3.6 never fails on {shp}")
+    return Verdict(False, run, stats, f"Alg. 3.6 fails on {shp} after {len(run) - 1} choices")
+
+
+def _alg36_search(
+    rules: Rules,
+    shp: Coords,
+    r: Coords,
+    axes: tuple[int, ...],
+    prefer: Mapping[Coords, int],
+    stop: Coords | None,
+    max_states: int,
+) -> tuple[list[list[Any]] | None, int]:
+    cells = _scan_cells(shp, axes)
+    if stop is not None:
+        cells = cells[: cells.index(stop) + 1]
+    walk = _Walk(shp, cells, r)
+    n = len(cells)
+    seen: set[tuple[int, tuple[int, ...]]] = set()
+    labels: list[int] = []
+
+    def rec(i: int) -> list[list[Any]] | None:
+        if i == n:
+            return None
+        key = (i, tuple(labels[j] for j in walk.key_at[i]))
+        if key in seen:
+            return None
+        seen.add(key)
+        if len(seen) > max_states:
+            raise _Budget
+        cat = walk.catalog(rules, i, labels)
+        if cat == 0:
+            return [[list(c), b] for c, b in zip(cells, labels, strict=False)] + [
+                [list(cells[i]), None]
+            ]
+        if stop is not None and i == n - 1:
+            return None
+        opts = list(_bits(cat))
+        want = prefer.get(cells[i])
+        if want is not None and want in opts:
+            opts.remove(want)
+            opts.insert(0, want)
+        for b in opts:
+            labels.append(b)
+            res = rec(i + 1)
+            labels.pop()
+            if res is not None:
+                return res
+        return None
+
+    return rec(0), len(seen)
+
+
+def _realize(
+    rules: Rules,
+    failure: dict[str, Any],
+    r: Coords,
+    axes: tuple[int, ...],
+    prefer: Mapping[Coords, int],
+    order: str,
+) -> dict[str, Any] | None:
+    """A concrete run of Alg. 3.6 failing at the window's point (or earlier), if one exists
+    on the window's output or one a little larger at the lower edges."""
+    out = tuple(failure["output"])
+    p = tuple(failure["p"])
+    hi = tuple(failure["config"]["upper"])
+    ndim = len(out)
+    grow_axes = [d for d in range(ndim) if hi[d] == r[d] - 2]
+    tries = [(0,) * ndim]
+    for g in (1, 2):
+        for d in range(ndim):
+            tries.append(tuple(g if e == d else 0 for e in range(ndim)))
+        for d in grow_axes:
+            tries.append(tuple(-g if e == d else 0 for e in range(ndim)))
+    for delta in tries:
+        shift = tuple(max(0, t) for t in delta)
+        shp = tuple(out[d] + abs(delta[d]) for d in range(ndim))
+        pp = tuple(p[d] + shift[d] for d in range(ndim))
+        pref = {tuple(c[d] + shift[d] for d in range(ndim)): b for c, b in prefer.items()}
+        try:
+            run, _ = _alg36_search(rules, shp, r, axes, pref, pp, 200_000)
+        except _Budget:
+            continue
+        if run is not None:
+            return {"shape": list(shp), "choices": run, "order": order}
+    return None
+
+
+def _as_alg31_failure(
+    example: ExampleModel, run: dict[str, Any], order: str
+) -> dict[str, Any] | None:
+    """If a failing Alg. 3.6 run only used labels of Alg. 3.1's catalog, it is a failing
+    run of Alg. 3.1 too (``C ⊆ C_R``): return it as a witness."""
+    from csplab.catalog import Propagator
+
+    shape = tuple(run["shape"])
+    P = Problem.from_example(example, shape)
+    eng = Propagator(P)
+    choices: list[list[Any]] = []
+    for c, b in run["choices"]:
+        cell = P.cell(tuple(c))
+        if b is None:
+            if eng.domain(cell).size == 0 or not eng.ok:
+                return {"shape": list(shape), "order": order, "choices": choices}
+            return None
+        if not eng.ok or b not in eng.domain(cell):
+            return None
+        choices.append([list(c), int(b)])
+        if not eng.assign(cell, int(b)):
+            return {"shape": list(shape), "order": order, "choices": choices}
+    return None
+
+
+# ----------------------------------------------------------------------------- Eq. 3.11
+
+
+def corner_condition(example: ExampleModel, order: str = "scanline") -> Verdict:
+    """The corner condition (Eq. 3.11, corrected), in 1D, 2D and 3D.
+
+    For every face of the unit box (every non-empty set of axes): each labelling of the
+    box minus its top corner that is consistent on the box's arcs has a label for the top
+    corner. In 2D: every used label has a successor along x and along y, and for all
+    ``a, b, c`` with ``T_y(a, b)`` and ``T_x(a, c)`` some ``d`` has ``T_x(b, d)`` and
+    ``T_y(c, d)``. It holds iff Alg. 3.6 with 2x2(x2) regions cannot fail, which proves
+    E infallible (Theorem 3.3.6). Every scan order visits the top corner of each unit box
+    last, so the condition does not depend on ``order`` (checked to be a scan order).
+
+    Returns a :class:`Verdict`; on failure ``witness`` names the face (``axes``) and the
+    labels: ``{"a": ..}`` (1D), ``{"a", "b" (a + e_second), "c" (a + e_first)}`` (2D), or
+    the three backward neighbours ``u`` of the top corner (3D).
+    """
+    t0 = time.perf_counter()
+    T = example.transitions()
+    ndim = T.shape[0]
+    scan_axes(ndim, order)
+    if ndim > 3:
+        v = prove_infallible(example, 2, order=order, history=0, realize=False, refute=False)
+        return Verdict(v.holds is True, v.witness, v.stats, "corner condition (4D, by prover)")
+    used = example.counts() > 0
+    Tu = T & used[None, :, None] & used[None, None, :]
+    checked = 0
+    # 1D faces
+    for d in range(ndim):
+        bad = np.flatnonzero(used & ~Tu[d].any(axis=1))
+        checked += int(used.sum())
+        if bad.size:
+            return _corner_fail(
+                example, (d,), {"a": int(bad[0])}, checked, t0,
+                f"label {example.label_name(int(bad[0]))} has no successor along "
+                f"{AXIS_NAMES[d]}",
+            )  # fmt: skip
+    # 2D faces: a at the origin, b = a + e_j, c = a + e_i, d at the top
+    for i, j in itertools.combinations(range(ndim), 2):
+        Ti, Tj = Tu[i].astype(np.int64), Tu[j].astype(np.int64)
+        # completions[b, c] = #d with T_i(b, d) and T_j(c, d)
+        comp = Ti @ Tj.T
+        reach = (Tj.T @ Ti) > 0  # reach[b, c]: some a with T_j(a, b), T_i(a, c)
+        checked += int(reach.sum())
+        bad2 = np.argwhere(reach & (comp == 0))
+        if bad2.size:
+            b, c = (int(t) for t in bad2[0])
+            a = int(np.flatnonzero(Tu[j][:, b] & Tu[i][:, c])[0])
+            return _corner_fail(
+                example, (i, j), {"a": a, "b": b, "c": c}, checked, t0,
+                f"T_{AXIS_NAMES[j]}({a}, {b}) and T_{AXIS_NAMES[i]}({a}, {c}) but no d with "
+                f"T_{AXIS_NAMES[i]}({b}, d) and T_{AXIS_NAMES[j]}({c}, d)",
+            )  # fmt: skip
+    if ndim == 3:
+        res = _corner3(Tu)
+        checked += res[1]
+        if res[0] is not None:
+            u = res[0]
+            return _corner_fail(
+                example, (0, 1, 2), {"u": list(u)}, checked, t0,
+                f"backward neighbours {u} of a unit cube's top corner admit no label",
+            )  # fmt: skip
+    return Verdict(
+        True,
+        None,
+        {"checked": checked, "time_s": time.perf_counter() - t0},
+        f"corner condition holds ({checked} corner labellings)",
+    )
+
+
+def _corner3(Tu: NDArray[np.bool_]) -> tuple[tuple[int, int, int] | None, int]:
+    """3D cube: u_d at q - e_d, w_de at q - e_d - e_e, z at q - e_x - e_y - e_z."""
+    K = Tu.shape[1]
+    T = [Tu[d].astype(np.int64) for d in range(3)]
+
+    def W(i: int, j: int) -> NDArray[np.int64]:
+        # W[u_i, u_j, w]: w = q - e_i - e_j with T_j(w, u_i) and T_i(w, u_j)
+        return np.asarray(Tu[j].T[:, None, :] & Tu[i].T[None, :, :], dtype=np.int64)
+
+    def Z(i: int, j: int, k: int) -> NDArray[np.bool_]:
+        # Z[u_i, u_j, z]: some w in W(i, j) with T_k(z, w)
+        w = W(i, j)
+        return np.asarray((w.reshape(K * K, K) @ T[k].T).reshape(K, K, K) > 0, dtype=bool)
+
+    z01, z02, z12 = Z(0, 1, 2), Z(0, 2, 1), Z(1, 2, 0)
+    # completion of the top: d with T_0(u_0, d), T_1(u_1, d), T_2(u_2, d)
+    checked = 0
+    for u0 in range(K):
+        # candidates (u1, u2) with no completion
+        top = T[1][None, :, :] * T[2][:, None, :]  # [u2, u1, d]
+        comp = (top & T[0][u0][None, None, :]).any(axis=2).T  # [u1, u2]
+        ex = (z01[u0][:, None, :] & z02[u0][None, :, :] & z12).any(axis=2)  # [u1, u2]
+        checked += int(ex.sum())
+        bad = np.argwhere(ex & ~comp)
+        if bad.size:
+            return (u0, int(bad[0][0]), int(bad[0][1])), checked
+    return None, checked
+
+
+def _corner_fail(
+    example: ExampleModel,
+    axes: tuple[int, ...],
+    labels: dict[str, Any],
+    checked: int,
+    t0: float,
+    why: str,
+) -> Verdict:
+    return Verdict(
+        False,
+        {"axes": [AXIS_NAMES[a] for a in axes], "labels": labels},
+        {"checked": checked, "time_s": time.perf_counter() - t0},
+        f"corner condition fails on the {''.join(AXIS_NAMES[a] for a in axes)} face: {why}",
+    )

@@ -1,0 +1,87 @@
+"""Helpers shared by the analysis commands ``prove``, ``witness`` and ``refine``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from csplab.cli.common import load_model, model_options
+from csplab.errors import InputError
+from csplab.example import ExampleModel
+from csplab.result import Verdict
+
+ORDER_HELP = (
+    "scan order: scanline (x outermost, Alg. 3.1's loop; default) or scan:AXES, outermost "
+    "first (scan:yx = the thesis' 2D figures: left to right, then bottom to top)"
+)
+
+
+def load_example_model(spec: str, options: list[str] | None = None) -> ExampleModel:
+    model = load_model(spec, model_options(options))
+    if not isinstance(model, ExampleModel):
+        raise InputError(f"{spec}: the analysis commands need an example model, not a tileset")
+    return model
+
+
+def witness_grid(w: dict[str, Any]) -> np.ndarray:
+    """The partial model of a witness (``-1`` = unassigned)."""
+    g = np.full(tuple(w["shape"]), -1, dtype=np.int32)
+    for c, b in w.get("choices", []):
+        if b is not None:
+            g[tuple(c)] = b
+    return g
+
+
+def save_witness(w: dict[str, Any], path: str, example: ExampleModel) -> None:
+    p = Path(path)
+    if p.suffix == ".json":
+        p.write_text(json.dumps(w, default=_plain, indent=1))
+        return
+    if p.suffix != ".png":
+        raise InputError(f"--out {path}: use a .png picture or a .json file")
+    from csplab.render import save_png
+
+    save_png(witness_grid(w), p, names=example.names)
+
+
+def _plain(x: Any) -> Any:
+    if isinstance(x, np.integer):
+        return int(x)
+    if isinstance(x, np.ndarray):
+        return x.tolist()
+    if isinstance(x, ExampleModel):
+        return x.labels.tolist()
+    raise TypeError(type(x))
+
+
+def print_verdict(v: Verdict, as_json: bool) -> None:
+    if as_json:
+        d = v.to_dict()
+        if isinstance(v.witness, dict):
+            d["witness"] = json.loads(json.dumps(v.witness, default=_plain))
+        print(json.dumps(d))
+    else:
+        print(v.message)
+
+
+def describe_run(w: dict[str, Any], example: ExampleModel) -> str:
+    """Lines describing a failing run: size, seed, choices, first step outside C*."""
+    lines = [f"  output {'x'.join(map(str, w['shape']))}, order {w.get('order', 'scanline')}"]
+    if w.get("seed") is not None:
+        lines[0] += f", seed {w['seed']}"
+    ch = w.get("choices", [])
+    shown = ch if len(ch) <= 30 else ch[-30:]
+    if len(ch) > 30:
+        lines.append(f"  ... {len(ch) - 30} earlier choices")
+    for i, (c, b) in enumerate(shown, start=len(ch) - len(shown) + 1):
+        lab = "(empty catalog)" if b is None else example.label_name(int(b))
+        lines.append(f"  {i:4d}. {tuple(c)} <- {lab}")
+    if w.get("first_outside_cstar") is not None:
+        lines.append(
+            f"  the model became inconsistent at choice {w['first_outside_cstar']} (label "
+            f"outside C*); C was wiped out {w.get('detection_delay', 0)} choices later"
+        )
+    return "\n".join(lines)

@@ -1,0 +1,121 @@
+"""Failure witnesses of Alg. 3.1 (csplab.analysis.witness): thesis rows I4, I7 and soundness."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from csplab import Problem, solve
+from csplab.analysis import alg31_exhaustive, find_failure, replay
+from csplab.analysis.witness import first_outside_exact
+from csplab.catalog import Propagator
+from csplab.errors import InputError
+from csplab.examples import load_example
+from csplab.testing.brute import exact_catalog, satisfiable
+from csplab.testing.strategies import analysis_examples
+
+FIG = "scan:yx"
+
+
+def prefix_grid(shape, choices, t):
+    g = np.full(shape, -1)
+    for c, b in choices[:t]:
+        g[tuple(c)] = b
+    return g
+
+
+def test_fig3_5a_witness_like_fig3_5efg():  # I4
+    E = load_example("fig3_5a")
+    v = find_failure(E, order=FIG, max_size=(3, 3))
+    assert v.holds is False
+    w = v.witness
+    assert replay(E, w).holds
+    # the last label was outside C* but inside C, and C emptied at once (Fig. 3.5(e-g))
+    assert w["first_outside_cstar"] == w["fail_step"] and w["detection_delay"] == 0
+    P = Problem.from_example(E, tuple(w["shape"]))
+    t = w["fail_step"] - 1
+    partial = prefix_grid(P.shape, w["choices"], t)
+    eng = Propagator(P.with_fixed(partial))
+    cell = P.cell(tuple(w["choices"][t][0]))
+    C = set(eng.domain(cell).tolist())
+    Cs = set(np.flatnonzero(exact_catalog(P, partial)[cell]).tolist())
+    assert Cs < C and w["choices"][t][1] in C - Cs
+
+
+def test_fig3_5a_scanline_has_no_small_failure():
+    # csplab's scanline order decides the 3 or 7 above a 2 first: no failure up to 4x4
+    v = find_failure(load_example("fig3_5a"), order="scanline", max_size=(4, 4), random_runs=0)
+    assert v.holds is True and v.stats["states"] > 1000
+
+
+def test_fig3_5a_random_order_witness_has_a_seed():
+    E = load_example("fig3_5a")
+    v = find_failure(E, order="random", max_size=(6, 3), random_runs=100, rng=3)
+    assert v.holds is False
+    assert "seed" in v.witness and replay(E, v.witness).holds
+    r = solve(Problem.from_example(E, tuple(v.witness["shape"])), "catalog",
+              rng=v.witness["seed"], order="random")  # fmt: skip
+    assert r.status == "failed"
+
+
+def test_fig3_6a_late_detection():  # I7
+    E = load_example("fig3_6a")
+    P = Problem.from_example(E, (9, 3))
+    v = alg31_exhaustive(P, FIG, late=True)
+    assert v.holds is False
+    w = {"shape": [9, 3], "order": FIG, "choices": v.witness}
+    assert replay(E, w).holds
+    t = v.stats["first_outside_cstar"]
+    assert t < len(v.witness)  # C not yet empty when the model became inconsistent
+    assert satisfiable(P, prefix_grid(P.shape, v.witness, t - 1)) is True
+    assert satisfiable(P, prefix_grid(P.shape, v.witness, t)) is False
+    eng = Propagator(P.with_fixed(prefix_grid(P.shape, v.witness, t)))
+    assert eng.ok
+    assert first_outside_exact(P, v.witness) == t
+    # the bottom row holds three 2s that cannot be paired (Fig. 3.6(b))
+    row = [b for c, b in v.witness if c[1] == 0]
+    assert row.count(2) % 2 == 1
+
+
+def test_fig3_6a_is_fallible_in_figure_order():
+    v = find_failure(load_example("fig3_6a"), order=FIG, max_size=(5, 3), random_runs=0)
+    assert v.holds is False and replay(load_example("fig3_6a"), v.witness).holds
+
+
+def test_bad_orders():
+    with pytest.raises(InputError):
+        alg31_exhaustive(Problem.from_example(load_example("line"), (2, 2)), "random")
+    with pytest.raises(InputError):
+        find_failure(load_example("line"), order="diagonal")
+
+
+def test_replay_rejects_a_non_failing_run():
+    E = load_example("line")
+    w = {"shape": [2, 2], "order": FIG, "choices": [[[0, 0], 0], [[1, 0], 0]]}
+    assert replay(E, w).holds is False
+    w2 = {"shape": [2, 2], "order": FIG, "choices": [[[1, 0], 0]]}
+    assert "out of order" in replay(E, w2).message
+
+
+# ----------------------------------------------------------------------------- soundness
+
+
+@settings(max_examples=40)
+@given(analysis_examples(max_side=3, max_labels=4), st.sampled_from([FIG, "scanline"]))
+def test_find_failure_witnesses_replay_and_bounds_hold(E, order):
+    v = find_failure(E, order=order, max_size=(3, 3), random_runs=0, max_states=20_000)
+    if v.holds is False:
+        assert replay(E, v.witness).holds
+        t = v.witness.get("first_outside_cstar")
+        if t is not None:
+            P = Problem.from_example(E, tuple(v.witness["shape"]))
+            ch = v.witness["choices"]
+            assert satisfiable(P, prefix_grid(P.shape, ch, t - 1)) is True
+            assert satisfiable(P, prefix_grid(P.shape, ch, t)) is False
+    elif v.holds is True:
+        for shape in [(2, 2), (3, 2), (2, 3), (3, 3)]:
+            P = Problem.from_example(E, shape)
+            for seed in range(5):
+                assert solve(P, "catalog", rng=seed, order=order).status == "solved"
