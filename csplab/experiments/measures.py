@@ -16,6 +16,8 @@ Examples
 True
 >>> pattern_counts(np.array([[0, 1], [1, 0]]), 2, K=2).nonzero()[0].tolist()
 [6]
+>>> unpack_grid(pack_grid(g)).tolist() == g.tolist()
+True
 """
 
 from __future__ import annotations
@@ -33,9 +35,11 @@ __all__ = [
     "components",
     "label_counts",
     "objects",
+    "pack_grid",
     "pack_hashes",
     "pattern_counts",
     "pattern_hashes",
+    "unpack_grid",
     "unpack_hashes",
 ]
 
@@ -127,6 +131,21 @@ def pack_hashes(h: NDArray[np.uint64]) -> str:
 def unpack_hashes(text: str) -> NDArray[np.uint64]:
     raw = zlib.decompress(base64.b64decode(text))
     return np.frombuffer(raw, dtype="<u8").astype(np.uint64)
+
+
+def pack_grid(grid: ArrayLike) -> str:
+    """A label grid -> compact text (shape, int32 labels, zlib, base64) for a stats JSON."""
+    g = np.ascontiguousarray(np.asarray(grid, dtype="<i4"))
+    head = ",".join(str(s) for s in g.shape).encode() + b";"
+    return base64.b64encode(zlib.compress(head + g.tobytes(), 6)).decode()
+
+
+def unpack_grid(text: str) -> NDArray[np.int32]:
+    """Inverse of :func:`pack_grid`."""
+    raw = zlib.decompress(base64.b64decode(text))
+    head, _, body = raw.partition(b";")
+    shape = tuple(int(s) for s in head.decode().split(","))
+    return np.frombuffer(body, dtype="<i4").astype(np.int32).reshape(shape)
 
 
 def label_counts(grid: ArrayLike, K: int) -> NDArray[np.int64]:
