@@ -32,3 +32,27 @@ def test_small_blocks_cannot_build_thick_rectangles(tmp_path):
         assert table[m]["a31_missed"] > 0  # some of Alg. 3.1's 3x3 patterns are out of reach
     assert table[2]["largest_max"] == 0 and table[2]["union"] == 1
     assert table[3]["largest_max"] > 0
+
+
+def test_alg31_can_build_the_large_square_of_fig3_10h():
+    """Fig. 3.10(h): the large square is consistent and Alg. 3.1 reaches it with positive
+    probability (each of its labels is in the catalog when its cell comes up), while blocks
+    of side m keep the smaller side of every rectangle at most m (test above)."""
+    import numpy as np
+
+    from csplab import Problem
+    from csplab.catalog import Propagator
+    from csplab.examples import load_example
+
+    E = load_example("fig3_10").labels
+    M = np.zeros((14, 14), dtype=np.int32)
+    M[1:13, 1:13] = E[2, 2]  # interior
+    M[1:13, 1], M[1:13, 12], M[1, 1:13], M[12, 1:13] = E[2, 1], E[2, 4], E[1, 2], E[4, 2]
+    M[1, 1], M[12, 1], M[1, 12], M[12, 12] = E[1, 1], E[4, 1], E[1, 4], E[4, 4]
+    P = Problem.from_example(load_example("fig3_10"), (14, 14))
+    assert P.is_solution(M)
+    eng = Propagator(P)
+    for cell in range(P.n):  # Alg. 3.1's scan-line order
+        b = int(M.reshape(-1)[cell])
+        assert b in eng.domain(cell)
+        assert eng.assign(cell, b)
