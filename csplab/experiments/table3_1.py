@@ -170,7 +170,9 @@ class Table31(Experiment):
             comp = "x".join(map(str, _shape_2d_or_3d(E, config["compare"])))
             shown[ex] = (disp, comp)
             row: dict[str, Any] = {"example": ex, "k": E.K, "output size": disp}
-            for label, size in (("displayed", disp), ("compare", comp)):
+            cs = config["compare"]
+            row["compare size"] = comp
+            for label, size in (("displayed", disp), (cs, comp)):
                 cat = next((x for x in long if (x["example"], x["size"], x["solver"])
                             == (ex, size, "catalog")), None)  # fmt: skip
                 blk = next((x for x in long if (x["example"], x["size"], x["solver"])
@@ -181,16 +183,14 @@ class Table31(Experiment):
                     method, t = "Alg. 3.4 (blocks)", blk["median_s"]
                 else:
                     method, t = "–", float("nan")
-                row[f"{label} method"] = method
-                row[f"time {size} (s)"] = t
+                row[f"method {label}"] = method
+                row[f"time {label} (s)"] = t
                 if cat is not None:
-                    row[f"Alg. 3.1 solved {size}"] = f"{cat['solved']}/{cat['trials']}"
+                    row[f"Alg. 3.1 solved {label}"] = f"{cat['solved']}/{cat['trials']}"
             for x in long:
                 if x["example"] == ex and x["size"] == comp:
-                    row[f"{x['solver']} {comp} (s)"] = (
-                        x["median_s"] if x["solved"] else float("nan")
-                    )
-                    row[f"{x['solver']} solved"] = f"{x['solved']}/{x['trials']}"
+                    row[f"{x['solver']} {cs} (s)"] = x["median_s"] if x["solved"] else float("nan")
+                    row[f"{x['solver']} solved {cs}"] = f"{x['solved']}/{x['trials']}"
             wide.append(row)
         rep.tables["per solver"] = long
         rep.tables["Table 3.1"] = wide

@@ -11,9 +11,11 @@ def test_quick_table_columns_follow_the_thesis_rule(tmp_path):
     (row,) = rep.tables["Table 3.1"]
     assert row["k"] == load_example("castle").K and row["output size"] == "14x14x6"
     long = {(x["size"], x["solver"]): x for x in rep.tables["per solver"]}
-    for label, size in (("displayed", "14x14x6"), ("compare", "10x10x6")):
+    for label, size in (("displayed", "14x14x6"), ("10x10x6", "10x10x6")):
         cat = long[(size, "catalog")]
         want = "Alg. 3.1" if cat["solved"] == cat["trials"] else "Alg. 3.4 (blocks)"
-        assert row[f"{label} method"] == want
+        assert row[f"method {label}"] == want
+        method = "catalog" if want == "Alg. 3.1" else "blocks"
+        assert row[f"time {label} (s)"] == long[(size, method)]["median_s"]
         assert long[(size, "blocks")]["solved"] == 3  # Alg. 3.4 always returns a model
     assert (tmp_path / "table3_1.png").exists() and (tmp_path / "table3_1.md").exists()
