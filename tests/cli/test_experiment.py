@@ -65,3 +65,28 @@ def test_options_that_do_not_apply_are_rejected(capsys):
     assert e.value.code == 2
     code, _, err = run(capsys, "experiment", "fig9_9")
     assert code == 2 and "unknown experiment" in err
+
+
+def test_original_model_in_merrells_format(capsys, tmp_path):
+    """Users have the thesis' models as Merrell-format .txt files: --example takes them."""
+    from csplab.examples import load_example
+
+    path = tmp_path / "castle.txt"
+    load_example("castle").save(path)
+    code, out, _ = run(capsys, "experiment", "fig3_8", "--example", str(path), "--sizes", "6",
+                       "--nz", "4", "--seeds", "3", "--store", str(tmp_path / "r.sqlite"),
+                       "--out", str(tmp_path / "o"), "--jobs", "1", "--no-progress",
+                       "--no-figures", "--json")  # fmt: skip
+    d = json.loads(out)
+    assert code == 0 and d["ran"] == 3
+    (row,) = d["tables"]["success rate"]
+    assert row["example"] == str(path) and row["size"] == "6x6x4"
+    # trials are identified by the example's content hash, not by its name or path
+    grid = tmp_path / "castle.grid"
+    load_example("castle").save(grid)
+    args = ["--sizes", "6", "--nz", "4", "--seeds", "3", "--store", str(tmp_path / "s.sqlite"),
+            "--out", str(tmp_path / "o"), "--jobs", "1", "--no-progress", "--no-figures",
+            "--json"]  # fmt: skip
+    run(capsys, "experiment", "fig3_8", "--example", "castle", *args)
+    code, out, _ = run(capsys, "experiment", "fig3_8", "--example", str(grid), *args)
+    assert code == 0 and json.loads(out)["skipped"] == 3
