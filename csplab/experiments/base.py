@@ -249,7 +249,7 @@ def setting_of(row: dict[str, Any]) -> str:
 
 
 # solvers that take the Alg. 3.1 options ``order`` and ``choice``
-ORDER_SOLVERS = frozenset({"catalog", "blocks", "perfect"})
+ORDER_SOLVERS = frozenset({"catalog", "blocks", "perfect", "hybrid"})
 
 
 class Experiment:
