@@ -144,14 +144,15 @@ def run_trials(
     )
     statuses: Counter[str] = Counter()
     t0 = time.perf_counter()
+    client, own = _client(scheduler) if scheduler is not None and todo else (None, False)
     bar = _progress(len(todo), experiment, progress)
     try:
         if not todo:
             summary.executor = "nothing to run"
             stream: Stream = iter(())
-        elif scheduler is not None:
+        elif client is not None:
             summary.executor = "dask"
-            stream = _run_dask(todo, examples, scheduler)
+            stream = _run_dask(todo, examples, client)
         elif (jobs or os.cpu_count() or 1) <= 1 or len(todo) <= 1:
             summary.executor = "this process"
             stream = _run_serial(todo, examples)
@@ -173,6 +174,8 @@ def run_trials(
             bar.update(1)
     finally:
         bar.close()
+        if own and client is not None:
+            client.close()
         summary.statuses = dict(statuses)
         summary.time_s = time.perf_counter() - t0
         store.finish_run(run_id, ran=summary.ran, errors=len(summary.errors))
@@ -247,48 +250,43 @@ def _client(scheduler: Any) -> tuple[Any, bool]:
         raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
 
 
-def _run_dask(todo: Sequence[Trial], examples: dict[str, ExampleModel], scheduler: Any) -> Stream:
+def _run_dask(todo: Sequence[Trial], examples: dict[str, ExampleModel], client: Any) -> Stream:
     as_completed: Any = importlib.import_module("distributed").as_completed
-    client, own = _client(scheduler)
     try:
-        try:
-            client.wait_for_workers(1, timeout=120)
-        except TimeoutError:
-            raise InputError("the Dask cluster has no workers (waited 120 s)") from None
-        hashes = sorted({t.example_hash for t in todo})
-        scattered = dict(
-            zip(hashes, client.scatter([examples[h] for h in hashes], broadcast=True), strict=True)
-        )
-        nworkers = max(1, sum(client.nthreads().values()))
-        it = iter(todo)
-        futs: dict[str, Trial] = {}
+        client.wait_for_workers(1, timeout=120)
+    except TimeoutError:
+        raise InputError("the Dask cluster has no workers (waited 120 s)") from None
+    hashes = sorted({t.example_hash for t in todo})
+    scattered = dict(
+        zip(hashes, client.scatter([examples[h] for h in hashes], broadcast=True), strict=True)
+    )
+    nworkers = max(1, sum(client.nthreads().values()))
+    it = iter(todo)
+    futs: dict[str, tuple[Trial, Any]] = {}
 
-        def submit() -> Any:
-            t = next(it, None)
-            if t is None:
-                return None
-            f = client.submit(
-                execute, t, scattered[t.example_hash], key=f"csplab-{t.experiment}-{t.key}",
-                pure=False,
-            )  # fmt: skip
-            futs[f.key] = t
-            return f
+    def submit() -> Any:
+        t = next(it, None)
+        if t is None:
+            return None
+        f = client.submit(
+            execute, t, scattered[t.example_hash], key=f"csplab-{t.experiment}-{t.key}",
+            pure=False,
+        )  # fmt: skip
+        futs[f.key] = (t, f)
+        return f
 
-        first = [f for f in (submit() for _ in range(4 * nworkers)) if f is not None]
-        ac = as_completed(first)
-        try:
-            for fut in ac:
-                t = futs.pop(fut.key)
-                if fut.status == "error":
-                    yield t, None, _describe(fut.exception())
-                else:
-                    yield t, fut.result(), None
-                nxt = submit()
-                if nxt is not None:
-                    ac.add(nxt)
-        except BaseException:
-            client.cancel([f for f in ac.futures])
-            raise
-    finally:
-        if own:
-            client.close()
+    first = [f for f in (submit() for _ in range(4 * nworkers)) if f is not None]
+    ac = as_completed(first)
+    try:
+        for fut in ac:
+            t, _ = futs.pop(fut.key)
+            if fut.status == "error":
+                yield t, None, _describe(fut.exception())
+            else:
+                yield t, fut.result(), None
+            nxt = submit()
+            if nxt is not None:
+                ac.add(nxt)
+    except BaseException:
+        client.cancel([f for _, f in futs.values()])
+        raise
