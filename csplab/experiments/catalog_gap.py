@@ -291,7 +291,8 @@ class CatalogGap(Experiment):
         import matplotlib.pyplot as plt
 
         fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-        keys = list(dict.fromkeys(f"{e} {s}" for e, s, _ in pts))
+        keys = [f"{e} {s}" for e, s in sorted({(e, s) for e, s, _ in pts},
+                                                key=lambda k: (k[0], _cells(k[1])))]  # fmt: skip
         hi = max(st["fail_step"] for _, _, st in pts)
         for k in keys:
             sel = [st for e, s, st in pts if f"{e} {s}" == k]
@@ -304,7 +305,9 @@ class CatalogGap(Experiment):
         axes[0].set_yscale("log")
         axes[0].legend(fontsize=6, ncol=2)
         delays = [st["delay"] for _, _, st in pts]
-        axes[1].hist(delays, bins=min(40, max(5, len(set(delays)))), color="tab:gray")
+        top = max(delays)
+        axes[1].hist(delays, bins=np.arange(-0.5, max(top, 4) + 1.5, max(1, (top + 1) // 40 or 1)),
+                     color="tab:gray", rwidth=0.9)  # fmt: skip
         axes[1].set_xlabel("delay = failure step − first bad step")
         axes[1].set_ylabel("failed runs")
         for ax in axes:
