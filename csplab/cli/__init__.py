@@ -30,6 +30,7 @@ COMMANDS: dict[str, str] = {
     "refine": "csplab.cli.refine",
     "reduction": "csplab.cli.reduction",
     "count": "csplab.cli.count",
+    "experiment": "csplab.cli.experiment",
 }
 
 

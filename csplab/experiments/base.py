@@ -1,0 +1,360 @@
+"""The :class:`Experiment` base class, reports, and helpers shared by the experiments.
+
+An experiment is a grid of trials (example × size × solver × parameters × seed) plus a
+report that turns the stored outcomes into tables and figures. Its configuration is a plain
+JSON dict: the class' ``defaults``, updated by ``quick`` for ``--quick`` runs and by the
+user's overrides. The same configuration always yields the same trials (and trial keys).
+
+Examples
+--------
+>>> parse_sizes("5:20:5")
+[5, 10, 15, 20]
+>>> parse_sizes("4,8,16")
+[4, 8, 16]
+>>> from csplab.examples import load_example
+>>> size_for(load_example("castle"), 12, nz=10), size_for(load_example("line"), 12, nz=10)
+((12, 12, 10), (12, 12))
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from csplab.errors import InputError
+from csplab.example import ExampleModel
+from csplab.experiments.trial import Trial
+
+__all__ = [
+    "Experiment",
+    "Report",
+    "background_labels",
+    "load_examples",
+    "parse_sizes",
+    "save_figure",
+    "setting_of",
+    "size_for",
+    "split_solver",
+]
+
+
+def parse_sizes(text: str | Sequence[int]) -> list[int]:
+    """``"5:50:5"`` (inclusive range), ``"5,10,20"`` or a list -> sorted unique sizes."""
+    if not isinstance(text, str):
+        vals = [int(v) for v in text]
+    elif ":" in text:
+        parts = text.split(":")
+        try:
+            nums = [int(p) for p in [*parts, "1"][:3]] if len(parts) in (2, 3) else [0, 0, 0]
+            lo, hi, step = nums
+        except ValueError:
+            raise InputError(f"sizes {text!r}: use START:STOP[:STEP] or a comma list") from None
+        if len(parts) not in (2, 3) or step < 1 or lo > hi:
+            raise InputError(f"sizes {text!r}: use START:STOP[:STEP] with START <= STOP")
+        vals = list(range(lo, hi + 1, step))
+    else:
+        try:
+            vals = [int(v) for v in text.replace(" ", "").split(",") if v]
+        except ValueError:
+            raise InputError(f"sizes {text!r}: use START:STOP[:STEP] or a comma list") from None
+    if not vals or min(vals) < 1:
+        raise InputError(f"sizes {text!r} must be positive integers")
+    return sorted(set(vals))
+
+
+def size_for(example: ExampleModel, s: int, nz: int) -> tuple[int, ...]:
+    """The output size ``nx = ny = s`` (and ``nz`` for 3D examples that are more than one
+    layer thick) for an example."""
+    if example.ndim == 1:
+        return (s,)
+    if example.ndim == 2 or (example.ndim == 3 and example.shape[2] == 1):
+        return (s, s) if example.ndim == 2 else (s, s, 1)
+    return (s, s, nz, *example.shape[3:])
+
+
+def load_examples(specs: Sequence[str]) -> list[tuple[str, ExampleModel]]:
+    """Built-in names or model files -> ``(spec, ExampleModel)``; bad input raises one line."""
+    from csplab.cli.common import load_model
+
+    if not specs:
+        raise InputError("no example model given")
+    out: list[tuple[str, ExampleModel]] = []
+    for s in specs:
+        m = load_model(s)
+        if not isinstance(m, ExampleModel):
+            raise InputError(
+                f"{s}: experiments take example models (grids); {type(m).__name__} "
+                "tilesets are not supported by the experiment harness yet"
+            )
+        out.append((s, m))
+    return out
+
+
+def background_labels(example: ExampleModel) -> list[int]:
+    """Labels that count as 'nothing built': the empty space and ground labels of
+    ``boundary="auto"``, else the most frequent label."""
+    from csplab.problem import auto_boundary
+
+    try:
+        return sorted(set(auto_boundary(example).values()))
+    except InputError:
+        return [int(np.argmax(example.counts()))]
+
+
+def save_figure(fig: Any, stem: Path) -> list[Path]:
+    """Save a matplotlib figure as ``stem.png`` and ``stem.svg`` (reproducible bytes)."""
+    import matplotlib
+    import matplotlib.pyplot as plt
+
+    matplotlib.rcParams["svg.hashsalt"] = "csplab"  # stable element ids in the SVG
+    stem.parent.mkdir(parents=True, exist_ok=True)
+    out = []
+    for ext, meta in (("png", {"Software": None}), ("svg", {"Date": None})):
+        p = stem.with_suffix(f".{ext}")
+        fig.savefig(p, dpi=130, bbox_inches="tight", metadata=meta)
+        out.append(p)
+    plt.close(fig)
+    return out
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "–"
+        if v == 0:
+            return "0"
+        if abs(v) >= 100:
+            return f"{v:.0f}"
+        if abs(v) >= 1:
+            return f"{v:.3g}" if abs(v) < 10 else f"{v:.1f}"
+        return f"{v:.3g}"
+    if v is None:
+        return "–"
+    return str(v)
+
+
+def _csv_value(v: Any) -> Any:
+    """Floats with 6 significant digits (the CSVs are read by people too)."""
+    if isinstance(v, float) and math.isfinite(v):
+        return float(f"{v:.6g}")
+    return v
+
+
+def markdown_table(rows: Sequence[dict[str, Any]], columns: Sequence[str] | None = None) -> str:
+    """Rows of dicts -> a GitHub markdown table."""
+    if not rows:
+        return "(no rows)"
+    cols = list(columns or dict.fromkeys(k for r in rows for k in r))
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for r in rows:
+        lines.append("| " + " | ".join(_fmt(r.get(c)) for c in cols) + " |")
+    return "\n".join(lines)
+
+
+@dataclass
+class Report:
+    """Tables (name -> rows), figures and notes produced from stored outcomes."""
+
+    experiment: str
+    title: str
+    config: dict[str, Any]
+    tables: dict[str, list[dict[str, Any]]] = field(default_factory=dict)
+    figures: list[Path] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    missing: int = 0
+    trials: int = 0
+
+    def markdown(self, relative_to: Path | None = None) -> str:
+        out = [f"# {self.title}", ""]
+        cfg = json.dumps(self.config, sort_keys=True)
+        out += [f"Configuration: `{cfg}`", ""]
+        if self.missing:
+            out += [f"**{self.missing} of {self.trials} trials are not in the store yet.**", ""]
+        for note in self.notes:
+            out += [note, ""]
+        for name, rows in self.tables.items():
+            out += [f"## {name}", "", markdown_table(rows), ""]
+        for f in self.figures:
+            if f.suffix == ".png":
+                rel = f.relative_to(relative_to) if relative_to else f
+                out += [f"![{f.stem}]({rel.as_posix()})", ""]
+        return "\n".join(out)
+
+    def write(self, out: Path, stem: str) -> list[Path]:
+        """Write ``stem.md`` and one CSV per table into ``out``; returns the paths."""
+        import csv
+
+        out.mkdir(parents=True, exist_ok=True)
+        paths = []
+        for name, rows in self.tables.items():
+            if not rows:
+                continue
+            p = out / f"{stem}_{name.lower().replace(' ', '_').replace('.', '')}.csv"
+            cols: dict[str, None] = {}
+            for r in rows:
+                for k in r:
+                    cols.setdefault(k, None)
+            with open(p, "w", newline="", encoding="utf-8") as f:
+                w = csv.DictWriter(f, fieldnames=list(cols))
+                w.writeheader()
+                for r in rows:
+                    w.writerow({k: _csv_value(r.get(k, "")) for k in cols})
+            paths.append(p)
+        md = out / f"{stem}.md"
+        md.write_text(self.markdown(out) + "\n", encoding="utf-8")
+        paths.append(md)
+        self.files += paths
+        return paths
+
+
+def split_solver(entry: str) -> tuple[str, dict[str, Any]]:
+    """``"catalog@order=random,choice=weighted"`` -> ``("catalog", {"order": "random", ...})``.
+
+    A solver *entry* is a solver spec optionally followed by ``@`` and options (values
+    parsed as JSON when possible), so one sweep can compare variants of one solver.
+
+    Examples
+    --------
+    >>> split_solver("blocks@block=4,retries=0")
+    ('blocks', {'block': 4, 'retries': 0})
+    >>> split_solver("sat:glucose4")
+    ('sat:glucose4', {})
+    """
+    spec, _, rest = str(entry).partition("@")
+    opts: dict[str, Any] = {}
+    for kv in filter(None, (p.strip() for p in rest.split(","))):
+        k, sep, v = kv.partition("=")
+        if not sep or not k:
+            raise InputError(f"solver entry {entry!r}: options must be key=value")
+        try:
+            opts[k.strip()] = json.loads(v)
+        except json.JSONDecodeError:
+            opts[k.strip()] = v.strip()
+    if not spec:
+        raise InputError(f"solver entry {entry!r} has no solver name")
+    return spec.strip(), opts
+
+
+def setting_of(row: dict[str, Any]) -> str:
+    """The solver entry a stored trial was run with (its ``label``, else its solver spec)."""
+    return str(row["params"].get("label", row["solver"]))
+
+
+# solvers that take the Alg. 3.1 options ``order`` and ``choice``
+ORDER_SOLVERS = frozenset({"catalog", "blocks", "perfect", "hybrid"})
+
+
+class Experiment:
+    """Base class: subclasses set the class attributes and implement :meth:`build` and
+    :meth:`report`.
+
+    ``uses`` names the common options (``examples``, ``sizes``, ``size``, ``solvers``,
+    ``seeds``, ``seed0``, ``boundary``, ``order``, ``choice``, ``options``,
+    ``time_limit``, ``periodic``) the experiment reads; the CLI rejects the others.
+    """
+
+    name: ClassVar[str] = ""
+    title: ClassVar[str] = ""
+    description: ClassVar[str] = ""
+    defaults: ClassVar[dict[str, Any]] = {}
+    quick: ClassVar[dict[str, Any]] = {}
+    uses: ClassVar[frozenset[str]] = frozenset()
+    draw_figures: bool = True  # draw figures in :meth:`report` (tests switch them off)
+
+    def add_arguments(self, p: argparse.ArgumentParser) -> None:
+        """Experiment-specific command-line options (their ``dest`` is the config key)."""
+
+    def make_config(self, quick: bool = False, **overrides: Any) -> dict[str, Any]:
+        """Defaults, then the ``--quick`` values, then non-``None`` overrides."""
+        cfg: dict[str, Any] = json.loads(json.dumps(self.defaults))
+        if quick:
+            cfg.update(json.loads(json.dumps(self.quick)))
+        unknown = set(overrides) - set(cfg)
+        if unknown:
+            raise InputError(
+                f"experiment {self.name!r} has no option(s) {', '.join(sorted(unknown))}; "
+                f"it has {', '.join(sorted(cfg))}"
+            )
+        for k, v in overrides.items():
+            if v is not None:
+                cfg[k] = v
+        cfg["quick"] = bool(quick)
+        self.validate(cfg)
+        return cfg
+
+    def validate(self, config: dict[str, Any]) -> None:
+        """Raise :class:`InputError` for a bad configuration (subclasses extend)."""
+        if "seeds" in config and int(config["seeds"]) < 1:
+            raise InputError("seeds must be >= 1")
+        if "sizes" in config:
+            config["sizes"] = parse_sizes(config["sizes"])
+
+    def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
+        """The trials of the sweep and the example models they use (by hash)."""
+        raise NotImplementedError
+
+    def report(
+        self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path
+    ) -> Report:  # pragma: no cover - abstract
+        """Tables and figures from the stored outcomes of the sweep's trials."""
+        raise NotImplementedError
+
+    # helpers ------------------------------------------------------------------------
+    def seeds(self, config: dict[str, Any]) -> range:
+        s0 = int(config.get("seed0", 0))
+        return range(s0, s0 + int(config["seeds"]))
+
+    def solver_trials(
+        self, config: dict[str, Any], spec: str, example: ExampleModel, size: tuple[int, ...]
+    ) -> list[Trial]:
+        """One trial per configured solver entry and seed for ``example`` at ``size``."""
+        out: list[Trial] = []
+        for entry in config["solvers"]:
+            solver, params = self.solver_params(config, entry)
+            for seed in self.seeds(config):
+                out.append(
+                    Trial(
+                        self.name, spec, example.hash(), size, solver, params, seed,
+                        config["boundary"], bool(config["periodic"]),
+                    )
+                )  # fmt: skip
+        return out
+
+    def solver_params(self, config: dict[str, Any], entry: str) -> tuple[str, dict[str, Any]]:
+        """``(solver spec, params)`` for a solver entry: params hold the ``options`` and,
+        for entries with ``@`` options, the entry as ``label``."""
+        spec, extra = split_solver(entry)
+        opts = self.solver_options(config, spec)
+        opts.update(extra)
+        params: dict[str, Any] = {"options": opts}
+        if extra:
+            params["label"] = entry
+        return spec, params
+
+    def solver_options(self, config: dict[str, Any], solver: str) -> dict[str, Any]:
+        """Common options for a solver: order/choice for the catalog family, time limit,
+        and ``options``."""
+        opts: dict[str, Any] = {}
+        name = solver.partition(":")[0]
+        if name in ORDER_SOLVERS:
+            if config.get("order"):
+                opts["order"] = config["order"]
+            if config.get("choice"):
+                opts["choice"] = config["choice"]
+        if config.get("time_limit") is not None:
+            opts["time_limit"] = float(config["time_limit"])
+        for k, v in (config.get("options") or {}).items():
+            target, dot, key = k.rpartition(".")
+            if not dot:
+                opts[k] = v
+            elif target == name:
+                opts[key] = v
+        return opts

@@ -1,0 +1,295 @@
+"""The SQLite results store: one row per finished trial, written the moment it finishes.
+
+A trial is identified by its *key*: a hash of everything that determines its outcome
+(experiment, example content hash, size, boundary, periodicity, solver spec, parameters,
+seed). The ``trials`` table has a unique index on ``(experiment, trial_key)``, so a trial is
+stored at most once whatever happens; re-running a sweep asks :meth:`ResultsStore.done_keys`
+which trials exist and runs only the others. Each insert is its own transaction (SQLite's
+write-ahead log), so a run killed with SIGKILL leaves every finished trial intact and no
+half-written row.
+
+Every row carries the provenance a reader needs: the config hash of the sweep that produced
+it, the example and its hash, the csplab version, the git revision of the code and the host
+that ran it.
+
+Examples
+--------
+>>> import tempfile, os
+>>> from csplab.experiments.trial import Trial
+>>> path = os.path.join(tempfile.mkdtemp(), "r.sqlite")
+>>> st = ResultsStore(path)
+>>> t = Trial("demo", "line", "h0", (6, 4), "catalog", {}, seed=3)
+>>> st.add(t, {"status": "solved", "time_s": 0.01, "stats": {"assigned": 24}}, config_hash="c1")
+True
+>>> st.add(t, {"status": "solved", "time_s": 0.02, "stats": {}}, config_hash="c1")  # once only
+False
+>>> len(st.rows("demo")), st.rows("demo")[0]["stats"]["assigned"]
+(1, 24)
+>>> st.close()
+"""
+
+from __future__ import annotations
+
+import csv
+import gzip
+import json
+import os
+import socket
+import sqlite3
+import subprocess
+import time
+from collections.abc import Iterable, Sequence
+from functools import lru_cache
+from pathlib import Path
+from typing import Any
+
+from csplab.experiments.trial import Trial
+
+__all__ = ["ResultsStore", "git_revision"]
+
+_SCHEMA = """
+CREATE TABLE IF NOT EXISTS trials (
+    id INTEGER PRIMARY KEY,
+    experiment TEXT NOT NULL,
+    trial_key TEXT NOT NULL,
+    config_hash TEXT NOT NULL,
+    example TEXT NOT NULL,
+    example_hash TEXT NOT NULL,
+    size TEXT NOT NULL,
+    boundary TEXT NOT NULL,
+    periodic INTEGER NOT NULL,
+    solver TEXT NOT NULL,
+    params TEXT NOT NULL,
+    seed INTEGER NOT NULL,
+    status TEXT NOT NULL,
+    time_s REAL NOT NULL,
+    stats TEXT NOT NULL,
+    csplab_version TEXT NOT NULL,
+    git_rev TEXT NOT NULL,
+    host TEXT NOT NULL,
+    finished_at REAL NOT NULL,
+    UNIQUE (experiment, trial_key)
+);
+CREATE TABLE IF NOT EXISTS runs (
+    id INTEGER PRIMARY KEY,
+    experiment TEXT NOT NULL,
+    config_hash TEXT NOT NULL,
+    config TEXT NOT NULL,
+    command TEXT NOT NULL,
+    started_at REAL NOT NULL,
+    finished_at REAL,
+    trials INTEGER NOT NULL,
+    skipped INTEGER NOT NULL,
+    ran INTEGER,
+    errors INTEGER,
+    git_rev TEXT NOT NULL,
+    host TEXT NOT NULL
+);
+"""
+
+# columns of a trial row, in CSV order
+COLUMNS: tuple[str, ...] = (
+    "experiment", "trial_key", "config_hash", "example", "example_hash", "size", "boundary",
+    "periodic", "solver", "params", "seed", "status", "time_s", "stats", "csplab_version",
+    "git_rev", "host", "finished_at",
+)  # fmt: skip
+
+
+@lru_cache(maxsize=1)
+def git_revision() -> str:
+    """The git revision of the csplab source tree (``+dirty`` when modified), else ``"-"``."""
+    here = Path(__file__).resolve().parent
+    try:
+        rev = subprocess.run(
+            ["git", "rev-parse", "--short=12", "HEAD"], cwd=here, capture_output=True,
+            text=True, timeout=10, check=True,
+        ).stdout.strip()  # fmt: skip
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no", "--", "."],
+            cwd=here.parent, capture_output=True, text=True, timeout=10,
+        ).stdout.strip()  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return "-"
+    return rev + ("+dirty" if dirty else "") if rev else "-"
+
+
+class ResultsStore:
+    """A SQLite file holding the trials of any number of experiments.
+
+    Parameters
+    ----------
+    path : str or Path
+        The database file (created with its parent directory when missing).
+    """
+
+    def __init__(self, path: str | os.PathLike[str]) -> None:
+        self.path = Path(path)
+        if str(path) != ":memory:":
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        self._db = sqlite3.connect(str(path), timeout=60.0, isolation_level=None)
+        self._db.execute("PRAGMA journal_mode=WAL")
+        self._db.execute("PRAGMA synchronous=NORMAL")
+        self._db.executescript(_SCHEMA)
+
+    # ---------------------------------------------------------------- writing
+    def add(
+        self,
+        trial: Trial,
+        outcome: dict[str, Any],
+        *,
+        config_hash: str,
+        git_rev: str | None = None,
+        version: str | None = None,
+    ) -> bool:
+        """Store one finished trial; ``False`` when it was already there (kept unchanged).
+
+        ``outcome`` has ``status``, ``time_s``, ``stats`` and optionally ``host``.
+        """
+        from csplab import __version__
+
+        cur = self._db.execute(
+            "INSERT OR IGNORE INTO trials (experiment, trial_key, config_hash, example, "
+            "example_hash, size, boundary, periodic, solver, params, seed, status, time_s, "
+            "stats, csplab_version, git_rev, host, finished_at) "
+            "VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (
+                trial.experiment, trial.key, config_hash, trial.example, trial.example_hash,
+                trial.size_text, trial.boundary, int(trial.periodic), trial.solver,
+                json.dumps(trial.params, sort_keys=True), int(trial.seed),
+                str(outcome["status"]), float(outcome.get("time_s", 0.0)),
+                json.dumps(outcome.get("stats", {}), sort_keys=True),
+                version or __version__, git_rev or git_revision(),
+                str(outcome.get("host") or socket.gethostname()), time.time(),
+            ),
+        )  # fmt: skip
+        return cur.rowcount == 1
+
+    def start_run(
+        self,
+        experiment: str,
+        config: dict[str, Any],
+        config_hash: str,
+        *,
+        trials: int,
+        skipped: int,
+        command: str = "",
+    ) -> int:
+        """Record the start of a sweep; returns its run id."""
+        cur = self._db.execute(
+            "INSERT INTO runs (experiment, config_hash, config, command, started_at, trials, "
+            "skipped, git_rev, host) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            (
+                experiment, config_hash, json.dumps(config, sort_keys=True), command, time.time(),
+                trials, skipped, git_revision(), socket.gethostname(),
+            ),
+        )  # fmt: skip
+        return int(cur.lastrowid or 0)
+
+    def finish_run(self, run_id: int, *, ran: int, errors: int) -> None:
+        self._db.execute(
+            "UPDATE runs SET finished_at = ?, ran = ?, errors = ? WHERE id = ?",
+            (time.time(), ran, errors, run_id),
+        )
+
+    def delete(self, experiment: str, keys: Iterable[str] | None = None) -> int:
+        """Forget stored trials of ``experiment`` (those with the given keys, or all);
+        returns how many were deleted."""
+        if keys is None:
+            cur = self._db.execute("DELETE FROM trials WHERE experiment = ?", (experiment,))
+            return int(cur.rowcount)
+        n = 0
+        self._db.execute("BEGIN")
+        for k in keys:
+            cur = self._db.execute(
+                "DELETE FROM trials WHERE experiment = ? AND trial_key = ?", (experiment, k)
+            )
+            n += int(cur.rowcount)
+        self._db.execute("COMMIT")
+        return n
+
+    # ---------------------------------------------------------------- reading
+    def done_keys(self, experiment: str) -> set[str]:
+        """Keys of the trials of ``experiment`` already stored."""
+        cur = self._db.execute("SELECT trial_key FROM trials WHERE experiment = ?", (experiment,))
+        return {r[0] for r in cur.fetchall()}
+
+    def count(self, experiment: str | None = None) -> int:
+        if experiment is None:
+            return int(self._db.execute("SELECT COUNT(*) FROM trials").fetchone()[0])
+        cur = self._db.execute("SELECT COUNT(*) FROM trials WHERE experiment = ?", (experiment,))
+        return int(cur.fetchone()[0])
+
+    def rows(
+        self, experiment: str | None = None, keys: Iterable[str] | None = None
+    ) -> list[dict[str, Any]]:
+        """Stored trials as dicts (``params`` and ``stats`` decoded), oldest first.
+
+        ``keys`` restricts the result to those trial keys (the trials of one sweep).
+        """
+        sql = f"SELECT {', '.join(COLUMNS)} FROM trials"
+        args: tuple[Any, ...] = ()
+        if experiment is not None:
+            sql += " WHERE experiment = ?"
+            args = (experiment,)
+        cur = self._db.execute(sql + " ORDER BY id", args)
+        wanted = None if keys is None else set(keys)
+        out = []
+        for r in cur.fetchall():
+            d = dict(zip(COLUMNS, r, strict=True))
+            if wanted is not None and d["trial_key"] not in wanted:
+                continue
+            d["params"] = json.loads(d["params"])
+            d["stats"] = json.loads(d["stats"])
+            d["periodic"] = bool(d["periodic"])
+            out.append(d)
+        return out
+
+    def runs(self, experiment: str | None = None) -> list[dict[str, Any]]:
+        sql = "SELECT * FROM runs" + (" WHERE experiment = ?" if experiment else "")
+        cur = self._db.execute(sql + " ORDER BY id", (experiment,) if experiment else ())
+        names = [c[0] for c in cur.description]
+        return [dict(zip(names, r, strict=True)) for r in cur.fetchall()]
+
+    def experiments(self) -> list[str]:
+        cur = self._db.execute("SELECT DISTINCT experiment FROM trials ORDER BY experiment")
+        return [r[0] for r in cur.fetchall()]
+
+    def export_csv(
+        self,
+        path: str | os.PathLike[str],
+        experiment: str | None = None,
+        keys: Iterable[str] | None = None,
+        stats_keys: Sequence[str] | None = None,
+    ) -> int:
+        """Write trials to CSV (gzip-compressed when ``path`` ends in ``.gz``; one column per
+        stats key, keys starting with ``_`` left out); returns the number of rows."""
+        rows = self.rows(experiment, keys)
+        if stats_keys is None:
+            seen: dict[str, None] = {}
+            for r in rows:
+                for k in r["stats"]:
+                    if not k.startswith("_"):
+                        seen.setdefault(k, None)
+            stats_keys = list(seen)
+        base = [c for c in COLUMNS if c != "stats"]
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        opener: Any = gzip.open if str(path).endswith(".gz") else open
+        with opener(path, "wt", newline="", encoding="utf-8") as f:
+            w = csv.writer(f)
+            w.writerow(base + [f"stats.{k}" for k in stats_keys])
+            for r in rows:
+                vals = [json.dumps(r[c], sort_keys=True) if c == "params" else r[c] for c in base]
+                for k in stats_keys:
+                    v = r["stats"].get(k, "")
+                    vals.append(json.dumps(v) if isinstance(v, list | dict) else v)
+                w.writerow(vals)
+        return len(rows)
+
+    def close(self) -> None:
+        self._db.close()
+
+    def __enter__(self) -> ResultsStore:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

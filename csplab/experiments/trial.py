@@ -1,0 +1,212 @@
+"""One trial of an experiment, and the function that runs it in a worker process.
+
+A :class:`Trial` is plain data (picklable, JSON-describable): which example (by name or path
+and by content hash), which output size, boundary and periodicity, which solver spec, which
+parameters and which seed. Its :attr:`Trial.key` is a hash of all of that, so the same trial
+always has the same key and a results store can tell which trials of a sweep are missing.
+
+:func:`execute` runs a trial: it builds the :class:`~csplab.problem.Problem` (cached per
+process), warms up the compiled kernels once per process, and calls the experiment's
+*measure* function named by ``trial.measure`` (``"module:function"``), which returns
+``{"status", "time_s", "stats"}``. The outcome is the same wherever it runs (local pool,
+Dask worker, this process) because every random choice is drawn from ``rng=trial.seed``.
+
+Examples
+--------
+>>> from csplab.examples import load_example
+>>> E = load_example("line")
+>>> t = Trial("demo", "line", E.hash(), (8, 5), "catalog", {"options": {}}, seed=1,
+...           measure="csplab.experiments.trial:measure_solve")
+>>> out = execute(t, E)
+>>> out["status"], out["stats"]["assigned"]
+('solved', 40)
+>>> t.key == Trial.from_dict(t.to_dict()).key
+True
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import json
+import socket
+import threading
+import time
+from collections import OrderedDict
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.example import ExampleModel
+from csplab.problem import Problem
+
+__all__ = ["Trial", "execute", "grid_digest", "measure_solve", "problem_for"]
+
+
+def _canon(x: Any) -> str:
+    return json.dumps(x, sort_keys=True, separators=(",", ":"), default=str)
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One point of an experiment grid with one seed.
+
+    Attributes
+    ----------
+    experiment : str
+    example : str
+        Built-in example name or model file path (for reports; the content is identified by
+        ``example_hash``).
+    example_hash : str
+        :meth:`ExampleModel.hash` of the example.
+    size : tuple of int
+        Output size.
+    solver : str
+        Solver spec (``"catalog"``, ``"blocks"``, ``"sat:cadical195"`` ...).
+    params : dict
+        JSON-serialisable parameters: ``options`` (solver options) and anything the
+        measure function reads.
+    seed : int
+    boundary : str
+        ``"auto"``, ``"none"`` or ``"face=label,..."``.
+    periodic : bool
+    measure : str
+        ``"module:function"`` computing the outcome.
+    """
+
+    experiment: str
+    example: str
+    example_hash: str
+    size: tuple[int, ...]
+    solver: str
+    params: dict[str, Any] = field(default_factory=dict)
+    seed: int = 0
+    boundary: str = "none"
+    periodic: bool = False
+    measure: str = "csplab.experiments.trial:measure_solve"
+
+    @property
+    def key(self) -> str:
+        """A hash of everything that determines the outcome (not the example's name)."""
+        d = self.to_dict()
+        d.pop("example")
+        return hashlib.sha256(_canon(d).encode()).hexdigest()[:24]
+
+    @property
+    def size_text(self) -> str:
+        return "x".join(str(s) for s in self.size)
+
+    @property
+    def options(self) -> dict[str, Any]:
+        """Solver options (``params["options"]``)."""
+        return dict(self.params.get("options", {}))
+
+    def to_dict(self) -> dict[str, Any]:
+        d = asdict(self)
+        d["size"] = list(self.size)
+        return d
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Trial:
+        d = dict(d)
+        d["size"] = tuple(int(s) for s in d["size"])
+        return cls(**d)
+
+
+# ------------------------------------------------------------------------------ worker side
+
+_PROBLEMS: OrderedDict[tuple[Any, ...], Problem] = OrderedDict()
+_LOCK = threading.Lock()  # Dask workers may run several trials in threads
+_WARM = False
+
+
+def parse_boundary(text: str) -> Any:
+    """``"auto"``/``"none"`` or ``"z-=1,x-=0"`` -> what :meth:`Problem.from_example` takes."""
+    from csplab.cli.common import parse_boundary as parse
+
+    return parse(text)
+
+
+def problem_for(trial: Trial, example: ExampleModel) -> Problem:
+    """The trial's problem, built once per process and kept in a small cache."""
+    key = (trial.example_hash, trial.size, trial.boundary, trial.periodic)
+    with _LOCK:
+        P = _PROBLEMS.get(key)
+        if P is not None:
+            _PROBLEMS.move_to_end(key)
+            return P
+    P = Problem.from_example(
+        example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
+    )
+    with _LOCK:
+        _PROBLEMS[key] = P
+        while len(_PROBLEMS) > 6:
+            _PROBLEMS.popitem(last=False)
+    return P
+
+
+def _warmup() -> None:
+    global _WARM
+    with _LOCK:
+        if not _WARM:
+            from csplab.catalog import jit_warmup
+
+            jit_warmup()
+            _WARM = True
+
+
+def resolve(path: str) -> Callable[..., dict[str, Any]]:
+    """Import ``"module:function"``."""
+    mod, _, fn = path.partition(":")
+    f: Callable[..., dict[str, Any]] = getattr(importlib.import_module(mod), fn)
+    return f
+
+
+def execute(trial: Trial, example: ExampleModel) -> dict[str, Any]:
+    """Run one trial; returns ``{"status", "time_s", "stats", "host"}``.
+
+    The problem is built outside the timed part; ``time_s`` is what the measure function
+    reports (normally the solver's wall time).
+    """
+    _warmup()
+    if example.hash() != trial.example_hash:
+        from csplab.errors import InputError
+
+        raise InputError(f"example {trial.example!r} does not match the trial's example hash")
+    problem = problem_for(trial, example)
+    t0 = time.perf_counter()
+    out = resolve(trial.measure)(trial, example, problem)
+    out.setdefault("time_s", time.perf_counter() - t0)
+    out.setdefault("stats", {})
+    out["host"] = socket.gethostname()
+    return out
+
+
+def grid_digest(grid: NDArray[np.integer[Any]]) -> str:
+    """A short hash of a label grid (shape and labels): equal outputs have equal digests."""
+    g = np.ascontiguousarray(np.asarray(grid, dtype=np.int32))
+    h = hashlib.sha256(str(g.shape).encode())
+    h.update(g.tobytes())
+    return h.hexdigest()[:16]
+
+
+# stats a solver returns that are worth keeping in the store (the rest is dropped)
+KEEP_STATS = (
+    "assigned", "fail_cell", "steps", "removals", "blocks_tried", "blocks_accepted",
+    "retries", "acceptance_rate", "final_violations", "nodes", "conflicts", "restarts",
+    "encode_s", "solve_s", "sat_calls", "backend", "init",
+)  # fmt: skip
+
+
+def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
+    """The default measure: solve once with ``rng=trial.seed``; status, time, main stats and
+    a digest of the output grid."""
+    from csplab.solvers import solve
+
+    r = solve(problem, trial.solver, rng=trial.seed, **trial.options)
+    stats = {k: r.stats[k] for k in KEEP_STATS if k in r.stats}
+    stats["grid"] = grid_digest(r.grid)
+    return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
