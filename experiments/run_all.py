@@ -42,10 +42,10 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
         "fig3_8",
         {
             "examples": ["castle"],
-            "sizes": "5:30:5",
-            "seeds": 100,
+            "sizes": "5:25:5",
+            "seeds": 30,
             "solvers": ["catalog", "perfect", "hybrid", "backtrack", "sat", "cpsat"],
-            "time_limit": 120.0,
+            "time_limit": 60.0,
         },
     ),
     "fig3_8_2d": (
@@ -57,7 +57,7 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
         },
     ),
     "blocksize": ("blocksize", {}),
-    "table3_1": ("table3_1", {}),
+    "table3_1": ("table3_1", {"seeds": 3, "time_limit": 60.0}),
     "catalog_gap": ("catalog_gap", {}),
     "catalog_gap_castle": (
         "catalog_gap",
