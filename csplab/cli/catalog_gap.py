@@ -29,7 +29,8 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
     add_problem_args(p, size_required=True)
     add_fixed_args(p)
     p.add_argument("--seed", type=int, help="random seed of Alg. 3.1 (default: fresh, printed)")
-    p.add_argument("--order", choices=["scanline", "random", "min-entropy"], default="scanline")
+    p.add_argument("--order", default="scanline", help="cell order of Alg. 3.1: scanline, "
+                   "random, min-entropy or scan:AXES (e.g. scan:yx)")  # fmt: skip
     p.add_argument("--choice", choices=["uniform", "weighted"], default="uniform")
     p.add_argument("--backend", help="pysat backend (default cadical195)")
     p.add_argument("--sizes", action="store_true", help="also count |C(p)| and |C*(p)|")

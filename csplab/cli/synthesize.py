@@ -26,7 +26,9 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
     add_problem_args(p)
     p.add_argument("--solver", default="catalog", help="solver name (see `csplab info`)")
     p.add_argument(
-        "--order", choices=["scanline", "random", "min-entropy"], help="cell order (Alg. 3.1)"
+        "--order",
+        help="cell order (Alg. 3.1): scanline, random, min-entropy or scan:AXES "
+        "(e.g. scan:yx, x fastest: the thesis' 2D figures)",
     )
     p.add_argument("--choice", choices=["uniform", "weighted"], help="label choice (Alg. 3.1)")
     p.add_argument("--block", help="block size for --solver blocks, e.g. 10 or 10x10x10")

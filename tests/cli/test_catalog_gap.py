@@ -37,3 +37,15 @@ def test_no_gap_on_an_infallible_example(capsys):
 def test_bad_input(capsys):
     code, _, err = run(capsys, "catalog-gap", "line", "--size", "5x4", "--seed", "-1")
     assert code == 2 and err.startswith("csplab: error:")
+
+
+def test_scan_axes_orders_on_the_command_line(tmp_path, capsys):
+    """The thesis' 2D figures scan x fastest (``scan:yx``); Fig. 3.5 replays in that order."""
+    code, out, _ = run(capsys, "catalog-gap", "fig3_5a", "--size", "4x4", "--seed", "8",
+                       "--order", "scan:yx", "--steps", "summary")  # fmt: skip
+    assert code == 1 and "gap: step 2: label 1 at (2, 0)" in out
+    code, out, _ = run(capsys, "synthesize", "line", "--size", "6x4", "--order", "scan:yx",
+                       "--seed", "0", "--out", str(tmp_path / "o.npy"))  # fmt: skip
+    assert code == 0
+    code, _, err = run(capsys, "synthesize", "line", "--size", "6x4", "--order", "scan:xx")
+    assert code == 2 and "name each of the 2 axes" in err
