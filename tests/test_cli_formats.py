@@ -50,7 +50,8 @@ def test_sample_png_overlapping(tmp_path, capsys):
     assert code == 0
     from PIL import Image
 
-    assert Image.open(png).size[0] % 20 == 0
+    with Image.open(png) as im:
+        assert im.size[0] % 20 == 0
 
 
 def test_3d_exports_and_show(tmp_path, capsys):
