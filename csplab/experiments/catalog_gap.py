@@ -60,10 +60,6 @@ def first_bad_step(oracle: Any, trace: np.ndarray, steps: int) -> int:
     return hi
 
 
-def _exact_gap_available() -> bool:
-    return oracle_methods()[0] == "sat"  # csplab.exact needs python-sat
-
-
 def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
     """The same measure through :func:`csplab.exact.catalog_gap` (incremental SAT, one
     call per step only when the chosen label differs from the last witness solution)."""
@@ -111,7 +107,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     """Run Alg. 3.1 and locate its first bad choice (see the module docstring)."""
     import time
 
-    if trial.params.get("oracle") == "sat" and _exact_gap_available():
+    if trial.params.get("oracle") == "sat":
         return measure_exact(trial, example, problem)
 
     from csplab.catalog import Propagator
@@ -124,48 +120,43 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     if r.status == "unsat":
         return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
     t0 = time.perf_counter()
-    oracle = make_oracle(problem, trial.params["oracle"])
-    try:
-        first_bad: int | None = None
-        if r.status == "failed":
-            stats["fail_step"] = T
-            if not oracle.completable([], []):
-                stats["unsat_undetected"] = True  # unsatisfiable, yet C was not empty
-            else:
-                first_bad = first_bad_step(oracle, trace, T)
-                stats["first_bad"] = first_bad
-                stats["delay"] = T - first_bad
-        good_steps = T if r.status == "solved" else (first_bad - 1 if first_bad else 0)
-        stats["good_steps"] = good_steps
-        stats["bad_choice"] = int(first_bad is not None)
-        if trial.params.get("per_step") and (r.status == "solved" or first_bad is not None):
-            eng = Propagator(problem)
-            upto = T if first_bad is None else first_bad
-            gaps: list[list[int]] = []
-            total_gap = 0.0
-            for t in range(upto):
-                x, b = int(trace[t, 0]), int(trace[t, 1])
-                cand = eng.domain(x)
-                cells = [*trace[:t, 0].tolist(), x]
-                labels = trace[:t, 1].tolist()
-                star = [int(c) for c in cand if oracle.completable(cells, [*labels, int(c)])]
-                if len(star) < cand.size:
-                    gaps.append([t + 1, int(cand.size), len(star)])
-                    total_gap += 1 - len(star) / cand.size
-                if b not in star and first_bad is not None and t + 1 != first_bad:
-                    raise InputError(
-                        f"per-step C* disagrees with the binary search at step {t + 1}"
-                    )
-                eng.assign(x, b)
-            stats["gap_steps"] = len(gaps)
-            stats["expected_bad"] = total_gap
-            stats["checked_steps"] = upto
-            stats["_gaps"] = gaps
-        stats["oracle"] = oracle.name
-        stats["oracle_calls"] = oracle.calls
-        stats["oracle_s"] = time.perf_counter() - t0
-    finally:
-        oracle.close()
+    oracle = make_oracle(problem)
+    first_bad: int | None = None
+    if r.status == "failed":
+        stats["fail_step"] = T
+        if not oracle.completable([], []):
+            stats["unsat_undetected"] = True  # unsatisfiable, yet C was not empty
+        else:
+            first_bad = first_bad_step(oracle, trace, T)
+            stats["first_bad"] = first_bad
+            stats["delay"] = T - first_bad
+    good_steps = T if r.status == "solved" else (first_bad - 1 if first_bad else 0)
+    stats["good_steps"] = good_steps
+    stats["bad_choice"] = int(first_bad is not None)
+    if trial.params.get("per_step") and (r.status == "solved" or first_bad is not None):
+        eng = Propagator(problem)
+        upto = T if first_bad is None else first_bad
+        gaps: list[list[int]] = []
+        total_gap = 0.0
+        for t in range(upto):
+            x, b = int(trace[t, 0]), int(trace[t, 1])
+            cand = eng.domain(x)
+            cells = [*trace[:t, 0].tolist(), x]
+            labels = trace[:t, 1].tolist()
+            star = [int(c) for c in cand if oracle.completable(cells, [*labels, int(c)])]
+            if len(star) < cand.size:
+                gaps.append([t + 1, int(cand.size), len(star)])
+                total_gap += 1 - len(star) / cand.size
+            if b not in star and first_bad is not None and t + 1 != first_bad:
+                raise InputError(f"per-step C* disagrees with the binary search at step {t + 1}")
+            eng.assign(x, b)
+        stats["gap_steps"] = len(gaps)
+        stats["expected_bad"] = total_gap
+        stats["checked_steps"] = upto
+        stats["_gaps"] = gaps
+    stats["oracle"] = oracle.name
+    stats["oracle_calls"] = oracle.calls
+    stats["oracle_s"] = time.perf_counter() - t0
     return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
 
 
