@@ -115,13 +115,14 @@ class RegularGrammar:
             raise InputError(f"Theorem 5.2.3 needs a 1D example, got shape {example.shape}")
         T = example.transitions()[0]
         K = example.K
-        occurs = example.counts() > 0  # as Problem.from_example: absent labels never
+        # as Problem.from_example: labels absent from E never occur in a model
+        present = np.flatnonzero(example.counts() > 0).tolist()
         rules: dict[str, tuple[tuple[int, str | None], ...]] = {}
-        for b in np.flatnonzero(occurs).tolist():
+        for b in present:
             rhs: list[tuple[int, str | None]] = [(b, None)]
             rhs += [(b, f"A_{c}") for c in range(K) if T[b, c]]
             rules[f"A_{b}"] = tuple(rhs)
-        rules["S"] = tuple(r for b in np.flatnonzero(occurs).tolist() for r in rules[f"A_{b}"])
+        rules["S"] = tuple(r for b in present for r in rules[f"A_{b}"])
         return cls(K, {"S": rules["S"], **{k: v for k, v in rules.items() if k != "S"}})
 
     def to_text(self) -> str:

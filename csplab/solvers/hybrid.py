@@ -49,6 +49,7 @@ from csplab.result import Result
 from csplab.solvers.catalog import CHOICES, ORDERS, run_alg31
 from csplab.solvers.perfect import _SAT_KEYS, _Pool, choose_from_exact
 from csplab.solvers.sat import SatOracle
+from csplab.solvers.sat import backends as sat_backends
 
 __all__ = ["HybridSolver"]
 
@@ -65,11 +66,7 @@ class HybridSolver:
         "redraw it from C*, resume"
     )
 
-    @staticmethod
-    def backends() -> list[str]:
-        from csplab.solvers.sat import backends
-
-        return backends()
+    backends = staticmethod(sat_backends)  # the sat solver's backends
 
     def solve(
         self,

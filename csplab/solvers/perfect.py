@@ -45,6 +45,7 @@ from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result
 from csplab.solvers.sat import SatOracle
+from csplab.solvers.sat import backends as sat_backends
 
 __all__ = ["PerfectSolver", "label_order"]
 
@@ -119,11 +120,7 @@ class PerfectSolver:
         "Alg. 3.1 choosing only from the exact catalog C* (incremental SAT); never fails"
     )
 
-    @staticmethod
-    def backends() -> list[str]:
-        from csplab.solvers.sat import backends
-
-        return backends()
+    backends = staticmethod(sat_backends)  # the sat solver's backends
 
     def solve(
         self,
