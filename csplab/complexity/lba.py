@@ -37,6 +37,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -193,6 +194,15 @@ class LBA:
     def symbols(self) -> tuple[str, ...]:
         """Tape symbols with the end markers."""
         return (LEFT, *self.tape_alphabet, RIGHT)
+
+    @functools.cached_property
+    def construction(self) -> LBAConstruction:
+        """Theorem 5.2.4's labels and matrices for this automaton, built once.
+
+        The cache lives on the automaton it describes (so it dies with it and cannot be
+        confused with another object); :func:`dataclasses.replace` gives a fresh one.
+        """
+        return build_construction(self)
 
     def step_bound(self, n: int) -> int:
         """The declared bound on the number of steps for inputs of length ``n``."""
@@ -418,18 +428,12 @@ def build_construction(lba: LBA) -> LBAConstruction:
     return LBAConstruction(lba, tuple(name(k) for k in keys), index, T)
 
 
-_CACHE: dict[int, LBAConstruction] = {}
-
-
 def lba_problem(lba: LBA, word: str, rows: int | None = None) -> tuple[Problem, LBAConstruction]:
     """The incomplete model of Theorem 5.2.4: ``|word| + 2`` wide, ``rows`` high (default
     ``2 max_steps(|word|) + 2``), row 1 (the top, ``y = rows - 1``) fixed to
     ``< (w1, q0) w2 .. >``, everything else free."""
     w = lba.check_word(word)
-    con = _CACHE.get(id(lba))
-    if con is None or con.lba is not lba:
-        con = build_construction(lba)
-        _CACHE[id(lba)] = con
+    con = lba.construction
     H = 2 * lba.step_bound(len(w)) + 2 if rows is None else int(rows)
     if H < 1:
         raise InputError("rows must be positive")
