@@ -40,6 +40,7 @@ from csplab.experiments.base import (
     Report,
     background_labels,
     load_examples,
+    new_figure,
     save_figure,
 )
 from csplab.experiments.fig3_8 import check_boundary
@@ -216,13 +217,8 @@ class BlockSize(Experiment):
         return rep
 
     def _plot(self, table: list[dict[str, Any]], out: Path) -> list[Path]:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         exs = list(dict.fromkeys(t["example"] for t in table))
-        fig, axes = plt.subplots(2, 2, figsize=(9, 6.4))
+        fig, axes = new_figure(2, 2, figsize=(9, 6.4))
         for ex in exs:
             pts = [t for t in table if t["example"] == ex and t["setting"].startswith("blocks")]
             ref = [t for t in table if t["example"] == ex and not t["setting"].startswith("blocks")]
@@ -257,11 +253,6 @@ class BlockSize(Experiment):
 
     def _montage(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> list[Path]:
         """Outputs of the first seed at a few block sizes (re-run from their seeds)."""
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         from csplab.experiments.base import load_examples
         from csplab.experiments.trial import Trial, problem_for
         from csplab.render import render
@@ -299,7 +290,7 @@ class BlockSize(Experiment):
             return []
         cols = min(5, len(panels))
         nrow = (len(panels) + cols - 1) // cols
-        fig, axes = plt.subplots(nrow, cols, figsize=(2.6 * cols, 2.7 * nrow), squeeze=False)
+        fig, axes = new_figure(nrow, cols, figsize=(2.6 * cols, 2.7 * nrow), squeeze=False)
         for ax in axes.ravel():
             ax.axis("off")
         for ax, (title, img) in zip(axes.ravel(), panels, strict=False):

@@ -35,7 +35,14 @@ import numpy as np
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.experiments.base import Experiment, Report, load_examples, save_figure, size_for
+from csplab.experiments.base import (
+    Experiment,
+    Report,
+    load_examples,
+    new_figure,
+    save_figure,
+    size_for,
+)
 from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.oracle import make_oracle, oracle_methods
 from csplab.experiments.stats import median_iqr, wilson
@@ -271,12 +278,7 @@ class CatalogGap(Experiment):
         return rep
 
     def _plot(self, pts: list[tuple[str, str, dict[str, Any]]], out: Path) -> list[Path]:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+        fig, axes = new_figure(1, 2, figsize=(10, 4))
         keys = [f"{e} {s}" for e, s in sorted({(e, s) for e, s, _ in pts},
                                                 key=lambda k: (k[0], _cells(k[1])))]  # fmt: skip
         hi = max(st["fail_step"] for _, _, st in pts)

@@ -28,6 +28,7 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     load_examples,
+    new_figure,
     save_figure,
     setting_of,
     size_for,
@@ -143,12 +144,7 @@ class Fig38(Experiment):
         config: dict[str, Any],
         out: Path,
     ) -> list[Path]:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(6.4, 4.2))
+        fig, ax = new_figure(figsize=(6.4, 4.2))
         solvers = sorted({c[1] for c in curves})
         styles = ["-", "--", ":", "-."]
         markers = "osd^v<>"

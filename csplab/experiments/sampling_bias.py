@@ -33,6 +33,7 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     load_examples,
+    new_figure,
     save_figure,
     setting_of,
     split_solver,
@@ -245,13 +246,8 @@ class SamplingBias(Experiment):
     def _plot(
         self, table: list[dict[str, Any]], labels: dict[str, dict[str, np.ndarray]], out: Path
     ) -> list[Path]:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
         exs = list(dict.fromkeys(t["example"] for t in table))
-        fig, axes = plt.subplots(len(exs), 2, figsize=(11, 3.2 * len(exs)), squeeze=False)
+        fig, axes = new_figure(len(exs), 2, figsize=(11, 3.2 * len(exs)), squeeze=False)
         for i, ex in enumerate(exs):
             ts = [t for t in table if t["example"] == ex]
             x = np.arange(len(ts))

@@ -25,7 +25,14 @@ from typing import Any, ClassVar
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.experiments.base import Experiment, Report, load_examples, save_figure, setting_of
+from csplab.experiments.base import (
+    Experiment,
+    Report,
+    load_examples,
+    new_figure,
+    save_figure,
+    setting_of,
+)
 from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
@@ -206,15 +213,11 @@ class Table31(Experiment):
     def _plot(
         self, long: list[dict[str, Any]], sizes: dict[str, tuple[str, str]], out: Path
     ) -> list[Path]:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
         import numpy as np
 
         exs = list(sizes)
         solvers = list(dict.fromkeys(x["solver"] for x in long))
-        fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
+        fig, axes = new_figure(1, 2, figsize=(10, 3.8))
         w = 0.8 / max(1, len(solvers))
         for ax, which in zip(axes, (1, 0), strict=True):
             for j, s in enumerate(solvers):
