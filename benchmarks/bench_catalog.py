@@ -2,7 +2,7 @@
 
 Prints, per example: K, the median wall time of a full Alg. 3.1 run from a warm start (JIT
 already loaded), the success count, and the ratio against the slow reference implementation
-(:func:`csplab.catalog.alg31_reference`, pure Python arc consistency) run in the same
+(:func:`csplab.engine.alg31.alg31_reference`, pure Python arc consistency) run in the same
 process on the same problems with the same seeds -- at a reduced size, because the reference
 would take hours at 40x40x10 -- after checking that both produce identical grids.
 The JIT compile (or numba cache load) time of the first call is reported separately.
@@ -44,11 +44,11 @@ def main() -> None:
     t0 = time.perf_counter()
     import csplab
     from csplab import _kernels as kern
-    from csplab.catalog import alg31_reference, jit_warmup
+    from csplab.engine.alg31 import alg31_reference, jit_warmup
 
     t_import = time.perf_counter() - t0
     with tempfile.TemporaryDirectory() as tmp:  # a cold compile in a fresh numba cache
-        code = "from csplab.catalog import jit_warmup; print(jit_warmup())"
+        code = "from csplab.engine.alg31 import jit_warmup; print(jit_warmup())"
         env = {**os.environ, "NUMBA_CACHE_DIR": tmp, "PYTHONPATH": str(Path(__file__).parents[1])}
         out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                              text=True, check=True)  # fmt: skip

@@ -83,7 +83,7 @@ def main() -> None:
     args = ap.parse_args()
 
     import csplab
-    from csplab.catalog import jit_warmup
+    from csplab.engine.alg31 import jit_warmup
     from csplab.solvers import available_solvers
     from csplab.testing.synthetic import box_town
 

@@ -27,7 +27,7 @@ True
 
 from __future__ import annotations
 
-import time
+import weakref
 from collections import deque
 from typing import Any
 
@@ -40,13 +40,13 @@ from csplab.problem import Problem
 
 __all__ = [
     "Propagator",
-    "alg31_reference",
     "assign",
     "initial_catalog",
-    "jit_warmup",
     "pack",
     "propagate",
     "propagate_reference",
+    "reference_adjacency",
+    "reference_fixpoint",
     "unpack",
 ]
 
@@ -306,14 +306,14 @@ def propagate_reference(
     Same contract as :func:`propagate`; used to test the compiled kernel.
     """
     C = _check_catalog(problem, catalog).copy()
-    adj = _reference_adjacency(problem)
+    adj = reference_adjacency(problem)
     if not C.any(axis=1).all():
         return C, False
-    ok = _reference_fixpoint(C, adj, range(problem.n) if changed is None else np.ravel(changed))
+    ok = reference_fixpoint(C, adj, range(problem.n) if changed is None else np.ravel(changed))
     return C, ok
 
 
-def _reference_adjacency(problem: Problem) -> list[list[tuple[int, NDArray[np.bool_]]]]:
+def reference_adjacency(problem: Problem) -> list[list[tuple[int, NDArray[np.bool_]]]]:
     rel = problem.relations
     adj: list[list[tuple[int, NDArray[np.bool_]]]] = [[] for _ in range(problem.n)]
     for s, d, r in problem.arcs.tolist():
@@ -324,7 +324,7 @@ def _reference_adjacency(problem: Problem) -> list[list[tuple[int, NDArray[np.bo
     return adj
 
 
-def _reference_fixpoint(
+def reference_fixpoint(
     C: NDArray[np.bool_], adj: list[list[tuple[int, NDArray[np.bool_]]]], changed: Any
 ) -> bool:
     """Alg. 3.2 lines 7-16 with Alg. 3.3 (statement 3.6), a stack of cells; in place."""
@@ -347,74 +347,12 @@ def _reference_fixpoint(
     return True
 
 
-def alg31_reference(
-    problem: Problem, rng: np.random.Generator, *, order: str = "scanline",
-    choice: str = "uniform",
-) -> tuple[str, NDArray[np.int32]]:  # fmt: skip
-    """Slow, literal Alg. 3.1 on top of :func:`propagate_reference`.
-
-    Draws random numbers exactly as :func:`csplab.solvers.catalog.run_alg31` does for the
-    scan orders and ``random``, so both return the same grid for the same seed.
-    Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
-    """
-    from csplab.solvers.catalog import scan_order
-
-    if order == "min-entropy":
-        raise InputError("the reference Alg. 3.1 supports the scan and random orders")
-    n, K = problem.n, problem.K
-    scan = scan_order(problem.shape, order)
-    perm = rng.permutation(n) if scan is None else scan
-    ustream = rng.random(n)
-    adj = _reference_adjacency(problem)
-    C = problem.domains.copy()
-    grid = np.full(n, -1, dtype=np.int32)
-    if not C.any(axis=1).all() or not _reference_fixpoint(C, adj, range(n)):
-        return "unsat", grid.reshape(problem.shape)
-    w = problem.weights
-    for t in range(n):
-        p = int(perm[t])
-        labels = np.flatnonzero(C[p])
-        if labels.size == 0:  # Alg. 3.1 line 9
-            return "failed", grid.reshape(problem.shape)
-        u = ustream[t]
-        if choice == "weighted" and w[labels].sum() > 0:
-            pos = labels[w[labels] > 0]
-            cum = np.cumsum(w[pos])
-            b = int(pos[min(int(np.searchsorted(cum, u * cum[-1], side="right")), pos.size - 1)])
-        else:
-            b = int(labels[min(int(u * labels.size), labels.size - 1)])
-        grid[p] = b
-        C[p] = False  # statement 3.7
-        C[p, b] = True
-        if not _reference_fixpoint(C, adj, [p]):
-            return "failed", grid.reshape(problem.shape)
-    assert K == C.shape[1]
-    return "solved", grid.reshape(problem.shape)
-
-
-_COMPILED_CACHE: dict[int, tuple[Problem, _Compiled]] = {}
+# the compiled arrays of a problem live as long as the problem (keyed weakly by the object)
+_COMPILED: weakref.WeakKeyDictionary[Problem, _Compiled] = weakref.WeakKeyDictionary()
 
 
 def _compiled_for(problem: Problem) -> _Compiled:
-    hit = _COMPILED_CACHE.get(id(problem))
-    if hit is not None and hit[0] is problem:
-        return hit[1]
-    comp = _Compiled(problem)
-    if len(_COMPILED_CACHE) > 8:
-        _COMPILED_CACHE.clear()
-    _COMPILED_CACHE[id(problem)] = (problem, comp)
+    comp = _COMPILED.get(problem)
+    if comp is None:
+        comp = _COMPILED[problem] = _Compiled(problem)
     return comp
-
-
-def jit_warmup() -> float:
-    """Compile (or load from numba's on-disk cache) every kernel; returns seconds spent."""
-    t0 = time.perf_counter()
-    from csplab.example import ExampleModel
-    from csplab.solvers.catalog import run_alg31
-
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
-    rng = np.random.default_rng(0)
-    for order in ("scanline", "min-entropy"):
-        for choice in ("uniform", "weighted"):
-            run_alg31(P, rng, order=order, choice=choice)
-    return time.perf_counter() - t0

@@ -26,7 +26,7 @@ Every cell gets an at-least-one clause. At-most-one (``amo``):
     No clauses up front. With the support encoding a model whose cells each hold one true
     label is a solution; a cell with several true labels gets an at-most-one constraint
     added and the solver runs again (counterexample-guided refinement, done by
-    :class:`csplab.solvers.sat.SatOracle`). With the direct encoding any true label of each
+    :class:`csplab.engine.sat.SatOracle`). With the direct encoding any true label of each
     cell gives a solution, so no refinement is ever needed.
 a :class:`pysat.card.EncType` name (``"seqcounter"``, ``"ladder"``, ``"bitwise"``, ...)
     Built once per domain size as a template from :mod:`pysat.card` and instantiated for

@@ -15,7 +15,7 @@ Methods
     one axis (2D strips) or two (3D rods) are counted in time linear in the length.
     Domains are first made arc consistent (Theorem 3.3.2: no solution is lost).
 ``"enumerate"``
-    SAT with blocking clauses (:func:`csplab.solvers.sat.enumerate_solutions`): tiny problems.
+    SAT with blocking clauses (:func:`csplab.engine.sat.enumerate_solutions`): tiny problems.
 ``"ganak"``
     The exact #SAT solver Ganak (``pip install pyganak``, extra ``count``) on the support
     encoding (:func:`csplab.cnf.encode` with an exact at-most-one), projected on the label
@@ -268,7 +268,7 @@ def _open_cells(enc: Encoding) -> int:
 
 
 def _count_enumerate(problem: Problem, limit: int) -> tuple[int, dict[str, Any]]:
-    from csplab.solvers.sat import enumerate_solutions
+    from csplab.engine.sat import enumerate_solutions
 
     n = 0
     for _ in enumerate_solutions(problem, limit=limit + 1):

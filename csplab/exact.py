@@ -42,11 +42,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.catalog import propagate
+from csplab.engine.sat import SatOracle, preferred_labels
 from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Verdict
 from csplab.rng import RngLike, make_rng
-from csplab.solvers.sat import SatOracle, preferred_labels
 
 __all__ = ["ExactCatalog", "catalog_gap", "exact_catalog", "explain_unsat", "is_consistent"]
 
@@ -227,7 +227,7 @@ def catalog_gap(
     >>> catalog_gap(P, rng=1).holds                # the checkerboard never goes wrong
     True
     """
-    from csplab.solvers.catalog import run_alg31
+    from csplab.engine.alg31 import run_alg31
 
     t0 = time.perf_counter()
     deadline = None if time_limit is None else t0 + float(time_limit)

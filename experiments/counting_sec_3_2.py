@@ -26,7 +26,7 @@ import numpy as np
 from csplab import ExampleModel, Problem, example_names, load_example
 from csplab.complexity.grammar import RegularGrammar, abc_example, abc_rows_ok
 from csplab.count import count_solutions, entropy_per_cell, lower_bound_3_2_1
-from csplab.solvers.sat import enumerate_solutions
+from csplab.engine.sat import enumerate_solutions
 
 OUT = Path(__file__).resolve().parent / "results" / "issue5"
 

@@ -28,7 +28,7 @@ def _reference_count(P, c):
     2001 (both must then agree that there are more than 2000) and Ganak when installed."""
     if int(c) <= 2000:
         return brute.count(P)
-    from csplab.solvers.sat import enumerate_solutions
+    from csplab.engine.sat import enumerate_solutions
 
     assert sum(1 for _ in enumerate_solutions(P, limit=2001)) == 2001
     return int(count_solutions(P, "ganak")) if HAS_GANAK else int(c)

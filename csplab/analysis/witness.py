@@ -5,7 +5,7 @@ replaying the choices in the scan order, each label is in the catalog C when it 
 chosen and the last one wipes the catalog out (``kind="failed"``), or the output size has
 no consistent model at all and arc consistency empties C before any choice
 (``kind="unsat"``, no choices). Random-order witnesses also carry the ``seed`` of
-:func:`csplab.solvers.catalog.run_alg31` that produced them. :func:`replay` re-checks a
+:func:`csplab.engine.alg31.run_alg31` that produced them. :func:`replay` re-checks a
 witness.
 
 :func:`find_failure` looks for the smallest output and the shortest prefix that fail:
@@ -41,12 +41,12 @@ from typing import Any
 import numpy as np
 
 from csplab.catalog import Propagator
+from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.problem import Problem, parse_shape
 from csplab.result import Verdict
 from csplab.rng import make_rng
-from csplab.solvers.catalog import run_alg31, scan_order
 from csplab.testing.brute import satisfiable
 
 __all__ = ["alg31_exhaustive", "find_failure", "first_outside_exact", "replay"]

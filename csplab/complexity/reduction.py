@@ -338,7 +338,7 @@ def verify_instance(
 
     out["catalog_nonempty"] = bool(Propagator(P).ok)
     if alg31:
-        from csplab.solvers.catalog import run_alg31
+        from csplab.engine.alg31 import run_alg31
 
         t0 = time.perf_counter()
         res = run_alg31(P, gen, order="scanline")

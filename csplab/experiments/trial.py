@@ -152,7 +152,7 @@ def _warmup() -> None:
     global _WARM
     with _LOCK:
         if not _WARM:
-            from csplab.catalog import jit_warmup
+            from csplab.engine.alg31 import jit_warmup
 
             jit_warmup()
             _WARM = True

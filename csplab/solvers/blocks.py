@@ -43,10 +43,10 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.solvers.catalog import run_alg31
 
 __all__ = ["BlocksSolver", "block_starts", "trivial_solution"]
 

@@ -52,10 +52,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from csplab.cnf import DeadlineExceeded, encode
+from csplab.engine.sat import preferred_labels
 from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.sat import preferred_labels
 
 __all__ = ["CpsatSolver"]
 

@@ -43,13 +43,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
+from csplab.engine.alg31 import CHOICES, ORDERS, run_alg31
+from csplab.engine.completability import WitnessPool, choose_from_exact
+from csplab.engine.sat import SAT_STAT_KEYS, SatOracle
+from csplab.engine.sat import backends as sat_backends
 from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.catalog import CHOICES, ORDERS, run_alg31
-from csplab.solvers.perfect import _SAT_KEYS, _Pool, choose_from_exact
-from csplab.solvers.sat import SatOracle
-from csplab.solvers.sat import backends as sat_backends
 
 __all__ = ["HybridSolver"]
 
@@ -144,7 +144,7 @@ class HybridSolver:
                 dom[p, bad] = False
                 eng = Propagator(problem, domains=dom)
                 labels = eng.domain(p) if eng.ok else np.zeros(0, dtype=np.int64)
-                pool = _Pool(n, 1)
+                pool = WitnessPool(n, 1)
                 b2 = choose_from_exact(oracle, pool, p, labels, w, rng, stats, deadline)
                 if b2 is None:
                     if deadline is not None and time.perf_counter() > deadline:
@@ -155,7 +155,7 @@ class HybridSolver:
                 stats["repairs"] += 1
         finally:
             if oracle is not None:
-                stats["sat"] = {k: oracle.stats[k] for k in _SAT_KEYS if k in oracle.stats}
+                stats["sat"] = {k: oracle.stats[k] for k in SAT_STAT_KEYS if k in oracle.stats}
                 oracle.close()
 
     @staticmethod

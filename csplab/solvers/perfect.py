@@ -41,72 +41,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
+from csplab.engine.completability import WitnessPool, choose_from_exact
+from csplab.engine.sat import SAT_STAT_KEYS, SatOracle
+from csplab.engine.sat import backends as sat_backends
 from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.sat import SatOracle
-from csplab.solvers.sat import backends as sat_backends
 
-__all__ = ["PerfectSolver", "label_order"]
-
-_SAT_KEYS = ("backend", "vars", "clauses", "encode_s", "load_s", "solve_s", "calls")
-
-
-def label_order(
-    labels: NDArray[np.int64], weights: NDArray[np.float64] | None, rng: np.random.Generator
-) -> NDArray[np.int64]:
-    """A random order of ``labels``: uniform, or weighted sampling without replacement
-    (the first element of the order that lies in a subset S is then a uniform, or
-    weight-proportional, draw from S)."""
-    if weights is None:
-        return labels[rng.permutation(labels.size)]
-    w = np.asarray(weights, dtype=np.float64)[labels]
-    keys = np.where(w > 0, rng.exponential(size=labels.size) / np.where(w > 0, w, 1.0), np.inf)
-    return labels[np.argsort(keys, kind="stable")]
-
-
-class _Pool:
-    """Witness solutions consistent with the partial model so far."""
-
-    def __init__(self, n: int, size: int) -> None:
-        self.rows = np.zeros((0, n), dtype=np.int32)
-        self.size = max(1, size)
-
-    def has(self, cell: int, label: int) -> bool:
-        return bool(np.any(self.rows[:, cell] == label))
-
-    def add(self, grid: NDArray[np.int32]) -> None:
-        self.rows = np.concatenate([grid.reshape(1, -1), self.rows])[: self.size]
-
-    def fix(self, cell: int, label: int) -> None:
-        self.rows = self.rows[self.rows[:, cell] == label]
-
-
-def choose_from_exact(
-    oracle: SatOracle, pool: _Pool, cell: int, labels: NDArray[np.int64],
-    weights: NDArray[np.float64] | None, rng: np.random.Generator, stats: dict[str, Any],
-    deadline: float | None,
-) -> int | None:  # fmt: skip
-    """A label of C*(cell) drawn as described in the module docstring.
-
-    Rejected labels are added as negative unit clauses. Returns None on timeout (or, which
-    cannot happen when the partial model is consistent, if no label is in C*).
-    """
-    for b in label_order(labels, weights, rng).tolist():
-        if pool.has(cell, b):
-            return int(b)
-        lit = oracle.literal(cell, b)
-        st = oracle.solve([lit], deadline=deadline)
-        stats["sat_calls"] += 1
-        if st == "timeout":
-            return None
-        if st == "sat":
-            assert oracle.grid is not None
-            pool.add(oracle.grid.reshape(-1))
-            return int(b)
-        stats["rejected"] += 1
-        oracle.add_clause([-lit])
-    return None
+__all__ = ["PerfectSolver"]
 
 
 class PerfectSolver:
@@ -162,7 +104,7 @@ class PerfectSolver:
                 return _result("unsat", grid, problem, stats, t0)
             if st == "timeout":
                 return _result("timeout", grid, problem, stats, t0)
-            wit = _Pool(n, pool)
+            wit = WitnessPool(n, pool)
             assert o.grid is not None
             wit.add(o.grid.reshape(-1))
             for p in perm.tolist():
@@ -182,7 +124,7 @@ class PerfectSolver:
                 stats["assigned"] += 1
                 if not eng.assign(p, b):  # impossible: M_t stays completable
                     raise CsplabError("perfect: arc consistency failed after a C* choice (a bug)")
-            stats["sat"] = {k: o.stats[k] for k in _SAT_KEYS if k in o.stats}
+            stats["sat"] = {k: o.stats[k] for k in SAT_STAT_KEYS if k in o.stats}
         return _result("solved", grid, problem, stats, t0)
 
 

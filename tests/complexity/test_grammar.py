@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from csplab import ExampleModel, Problem
 from csplab.complexity.grammar import RegularGrammar, abc_example, abc_figure, abc_rows_ok
 from csplab.count import count_solutions
-from csplab.solvers.sat import enumerate_solutions
+from csplab.engine.sat import enumerate_solutions
 from csplab.testing.strategies import example_models
 
 FACES = {f: 0 for f in ("x-", "x+", "y-", "y+")}

@@ -105,7 +105,7 @@ def test_time_limit_and_bad_options():
 @given(problems(max_side=4, max_labels=5), st.sampled_from(["scanline", "random", "scan:rev"]),
        st.sampled_from(["uniform", "weighted"]), st.integers(0, 2**31))  # fmt: skip
 def test_compiled_alg31_equals_reference_run(P, order, choice, seed):
-    from csplab.catalog import alg31_reference
+    from csplab.engine.alg31 import alg31_reference
 
     if order == "scan:rev":  # innermost axis outermost
         order = "scan:" + "xyzw"[: P.ndim][::-1]
@@ -117,7 +117,7 @@ def test_compiled_alg31_equals_reference_run(P, order, choice, seed):
 
 
 def test_scan_axis_orders():
-    from csplab.solvers.catalog import scan_order
+    from csplab.engine.alg31 import scan_order
 
     P = Problem.from_example(load_example("line"), (4, 3))
     r = solve(P, "catalog", rng=0, order="scan:yx")

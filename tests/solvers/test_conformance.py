@@ -96,7 +96,7 @@ def test_complete_solvers_agree(P, seed):
 @pytest.mark.skipif("sat" not in _INSTALLED, reason="python-sat not installed")
 @given(P=csp_problems(max_cells=9), amo=st.sampled_from(["lazy", "seqcounter", "pairwise"]))
 def test_sat_enumeration_matches_brute_force_counts(P, amo):
-    from csplab.solvers.sat import enumerate_solutions
+    from csplab.engine.sat import enumerate_solutions
 
     grids = list(enumerate_solutions(P, amo=amo))
     assert len(grids) == count(P)

@@ -10,7 +10,7 @@ from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
 
 pytest.importorskip("pysat")
-from csplab.solvers.sat import SatOracle, backends, enumerate_solutions
+from csplab.engine.sat import SatOracle, backends, enumerate_solutions
 
 CHECKER = ExampleModel([[0, 1], [1, 0]])
 ODD_CYCLE = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)

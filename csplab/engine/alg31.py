@@ -1,0 +1,258 @@
+"""Merrell's Alg. 3.1 (with the catalog of Alg. 3.2/3.3) as one compiled run: the engine
+behind the ``catalog``, ``blocks`` and ``hybrid`` solvers, the catalog gap, the witness
+search and the reduction checks.
+
+:func:`run_alg31` assigns every cell a label drawn from the arc-consistent catalog C and
+updates C after each assignment (the loop is :func:`csplab._kernels.alg31`); it returns a
+:class:`~csplab.result.Result` whose ``trace`` lists the ``(cell, label)`` choices, 0-based
+in step order. :func:`scan_order` is the one parser of the order vocabulary.
+
+Orders (:data:`ORDERS`): ``scanline`` is the thesis' loop order (x outermost, z innermost);
+``scan:AXES`` scans with the named axes from outermost to innermost, e.g. ``scan:yx``, the
+order of the thesis' 2D figures; ``random`` a random permutation; ``min-entropy`` the
+unassigned cell of least Shannon entropy (weighted when ``choice="weighted"``) with tiny
+random tie-breaking, as WaveFunctionCollapse does. Choices (:data:`CHOICES`): ``uniform``
+over the catalog (thesis) or ``weighted`` by the problem's label weights.
+
+Examples
+--------
+>>> import numpy as np
+>>> from csplab import ExampleModel, Problem
+>>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 3))
+>>> r = run_alg31(P, np.random.default_rng(1))
+>>> r.status, r.trace.shape
+('solved', (12, 2))
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab import _kernels as kern
+from csplab.catalog import Propagator, reference_adjacency, reference_fixpoint
+from csplab.errors import InputError
+from csplab.problem import AXIS_NAMES, Problem
+from csplab.result import Result, Status
+
+__all__ = [
+    "CHOICES",
+    "ORDERS",
+    "alg31_reference",
+    "check_order",
+    "jit_warmup",
+    "run_alg31",
+    "scan_order",
+]
+
+ORDERS = ("scanline", "random", "min-entropy", "scan:AXES")
+CHOICES = ("uniform", "weighted")
+_CHUNK = 4096
+
+
+def run_alg31(
+    problem: Problem,
+    rng: np.random.Generator,
+    *,
+    order: str = "scanline",
+    choice: str = "uniform",
+    time_limit: float | None = None,
+    engine: Propagator | None = None,
+) -> Result:
+    """Run Alg. 3.1 once on ``problem`` with randomness from ``rng``.
+
+    ``engine`` may supply an already propagated :class:`~csplab.catalog.Propagator` for the
+    problem (it is consumed). Random numbers are drawn in this order: the cell permutation
+    (``random`` order only), one uniform per step for the label choice, one tie-breaking
+    number per cell (``min-entropy`` only).
+    """
+    scan = scan_order(problem.shape, order)
+    if choice not in CHOICES:
+        raise InputError(f"choice must be one of {', '.join(CHOICES)}, not {choice!r}")
+    t0 = time.perf_counter()
+    n = problem.n
+    perm = rng.permutation(n).astype(np.int64) if order == "random" else scan
+    ustream = rng.random(n)
+    noise = rng.random(n) if order == "min-entropy" else np.zeros(n)
+    eng = engine if engine is not None else Propagator(problem)
+    grid = np.full(n, -1, dtype=np.int32)
+    stats: dict[str, Any] = {"order": order, "choice": choice}
+    if not eng.ok:
+        stats.update(assigned=0, steps=int(eng.stats[0]), removals=int(eng.stats[1]))
+        stats["fail_cell"] = list(problem.coords(eng.wiped)) if eng.wiped >= 0 else None
+        stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
+        return Result(
+            "unsat", grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
+            stats=stats, trace=np.zeros((0, 2), dtype=np.int64),
+        )  # fmt: skip
+    c = eng.c
+    weighted = choice == "weighted"
+    use_heap = order == "min-entropy"
+    if use_heap:
+        heap = np.arange(n, dtype=np.int64)
+        hpos = np.zeros(n, dtype=np.int64)
+        hkey = _entropies(eng, weighted) + 1e-6 * noise
+        kern.heap_build(heap, hpos, hkey, n)
+    else:
+        heap = np.zeros(0, dtype=np.int64)
+        hpos = np.zeros(0, dtype=np.int64)
+        hkey = np.zeros(0, dtype=np.float64)
+    order_arr = perm if perm is not None else np.arange(n, dtype=np.int64)
+    trace_cell = np.full(n, -1, dtype=np.int64)
+    trace_label = np.full(n, -1, dtype=np.int64)
+    state = np.array([0, n if use_heap else 0, -1], dtype=np.int64)
+    deadline = None if time_limit is None else t0 + float(time_limit)
+    status: Status
+    while True:
+        code = kern.alg31(
+            eng.bits, eng.prev, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, eng._queue, eng._inq,
+            order_arr, use_heap, ustream, noise, c.weights, c.wlogw, weighted, grid,
+            trace_cell, trace_label, state, _CHUNK if deadline is not None else n + 1,
+            eng.stats, heap, hpos, hkey,
+        )  # fmt: skip
+        if code == 0:
+            status = "solved"
+            break
+        if code == 1:
+            status = "failed"
+            eng.ok = False
+            eng.wiped = int(state[2])
+            break
+        if deadline is not None and time.perf_counter() > deadline:
+            status = "timeout"
+            break
+    steps = int(state[0])
+    stats.update(assigned=steps, steps=int(eng.stats[0]), removals=int(eng.stats[1]))
+    if status == "failed":
+        stats["fail_cell"] = list(problem.coords(int(state[2])))
+    trace = np.stack([trace_cell[:steps], trace_label[:steps]], axis=1)
+    return Result(
+        status, grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
+        stats=stats, trace=trace,
+    )  # fmt: skip
+
+
+def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:
+    """Cell sequence of a scan order (``None`` for ``random`` and ``min-entropy``).
+
+    Examples
+    --------
+    >>> scan_order((2, 3), "scanline").tolist()
+    [0, 1, 2, 3, 4, 5]
+    >>> scan_order((2, 3), "scan:yx").tolist()       # x fastest: the 2D figures' order
+    [0, 3, 1, 4, 2, 5]
+    """
+    n = int(np.prod(shape))
+    if order == "scanline":
+        return np.arange(n, dtype=np.int64)
+    if order in ("random", "min-entropy"):
+        return None
+    if order.startswith("scan:"):
+        names = order[5:]
+        axes = [AXIS_NAMES.find(a) for a in names]
+        if sorted(axes) != list(range(len(shape))):
+            raise InputError(
+                f"order {order!r}: name each of the {len(shape)} axes "
+                f"({AXIS_NAMES[: len(shape)]}) once, outermost first"
+            )
+        return np.arange(n, dtype=np.int64).reshape(shape).transpose(axes).ravel()
+    raise InputError(f"order must be one of {', '.join(ORDERS)}, not {order!r}")
+
+
+def _entropies(eng: Propagator, weighted: bool) -> np.ndarray:
+    C = eng.catalog()
+    if not weighted:
+        cnt = C.sum(axis=1)
+        return np.asarray(np.log(np.maximum(cnt, 1)), dtype=np.float64)
+    w = eng.c.weights
+    s = C @ w
+    sl = C @ eng.c.wlogw
+    cnt = C.sum(axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        h = np.where(s > 0, np.log(np.where(s > 0, s, 1.0)) - sl / np.where(s > 0, s, 1.0),
+                     np.log(np.maximum(cnt, 1)))  # fmt: skip
+    return np.asarray(h, dtype=np.float64)
+
+
+def check_order(
+    order: str, allowed: tuple[str, ...] = ORDERS, shape: tuple[int, ...] | None = None
+) -> str:
+    """Validate ``order`` against the kinds in ``allowed`` (``"scan:AXES"`` admits every
+    ``scan:...`` order); with ``shape``, also check that a scan names each axis once.
+
+    Examples
+    --------
+    >>> check_order("scan:yx", shape=(3, 4))
+    'scan:yx'
+    >>> check_order("min-entropy", ("scanline", "random"))
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: order must be one of scanline, random, not 'min-entropy'
+    """
+    if not isinstance(order, str):
+        raise InputError(f"order must be a string such as 'scanline', not {order!r}")
+    kind = "scan:AXES" if order.startswith("scan:") else order
+    if kind not in allowed:
+        raise InputError(f"order must be one of {', '.join(allowed)}, not {order!r}")
+    if shape is not None and kind == "scan:AXES":
+        scan_order(shape, order)
+    return order
+
+
+def alg31_reference(
+    problem: Problem, rng: np.random.Generator, *, order: str = "scanline",
+    choice: str = "uniform",
+) -> tuple[str, NDArray[np.int32]]:  # fmt: skip
+    """Slow, literal Alg. 3.1 on top of :func:`propagate_reference`.
+
+    Draws random numbers exactly as :func:`run_alg31` does for the
+    scan orders and ``random``, so both return the same grid for the same seed.
+    Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
+    """
+    if order == "min-entropy":
+        raise InputError("the reference Alg. 3.1 supports the scan and random orders")
+    n, K = problem.n, problem.K
+    scan = scan_order(problem.shape, order)
+    perm = rng.permutation(n) if scan is None else scan
+    ustream = rng.random(n)
+    adj = reference_adjacency(problem)
+    C = problem.domains.copy()
+    grid = np.full(n, -1, dtype=np.int32)
+    if not C.any(axis=1).all() or not reference_fixpoint(C, adj, range(n)):
+        return "unsat", grid.reshape(problem.shape)
+    w = problem.weights
+    for t in range(n):
+        p = int(perm[t])
+        labels = np.flatnonzero(C[p])
+        if labels.size == 0:  # Alg. 3.1 line 9
+            return "failed", grid.reshape(problem.shape)
+        u = ustream[t]
+        if choice == "weighted" and w[labels].sum() > 0:
+            pos = labels[w[labels] > 0]
+            cum = np.cumsum(w[pos])
+            b = int(pos[min(int(np.searchsorted(cum, u * cum[-1], side="right")), pos.size - 1)])
+        else:
+            b = int(labels[min(int(u * labels.size), labels.size - 1)])
+        grid[p] = b
+        C[p] = False  # statement 3.7
+        C[p, b] = True
+        if not reference_fixpoint(C, adj, [p]):
+            return "failed", grid.reshape(problem.shape)
+    assert K == C.shape[1]
+    return "solved", grid.reshape(problem.shape)
+
+
+def jit_warmup() -> float:
+    """Compile (or load from numba's on-disk cache) every kernel; returns seconds spent."""
+    t0 = time.perf_counter()
+    from csplab.example import ExampleModel
+
+    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
+    rng = np.random.default_rng(0)
+    for order in ("scanline", "min-entropy"):
+        for choice in ("uniform", "weighted"):
+            run_alg31(P, rng, order=order, choice=choice)
+    return time.perf_counter() - t0
