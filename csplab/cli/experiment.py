@@ -4,6 +4,11 @@
 experiment's options. Exit 0 when every trial of the sweep is in the store and the report
 was written, 1 when trials raised errors (or, with ``--report-only``, are missing), 2 on bad
 input.
+
+Stored trials are reused; when some of them were computed by other code (another
+``csplab/`` source tree or csplab version than the running one) one warning line on stderr
+says how many and from which revisions, and ``--rerun-stale`` runs just those again
+(``--rerun`` runs the whole sweep again).
 """
 
 from __future__ import annotations
@@ -90,6 +95,12 @@ def _experiment_parser(exp: Any) -> argparse.ArgumentParser:
     h.add_argument(
         "--rerun", action="store_true", help="forget this sweep's stored trials and run them again"
     )
+    h.add_argument(
+        "--rerun-stale",
+        action="store_true",
+        help="run again only the stored trials that other code computed (another csplab/ "
+        "source tree or version)",
+    )
     h.add_argument("--no-progress", action="store_true", help="no progress bar")
     h.add_argument("--no-figures", action="store_true", help="tables and CSVs only")
     h.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -154,7 +165,7 @@ def run(args: argparse.Namespace) -> int:
     summary, report = ex.run(
         exp.name, quick=a.quick, out=a.out, jobs=a.jobs, scheduler=a.scheduler,
         progress=not a.no_progress, report_only=a.report_only, rerun=a.rerun,
-        figures=not a.no_figures,
+        rerun_stale=a.rerun_stale, figures=not a.no_figures,
         command="csplab experiment " + shlex.join([args.name, *args.rest]), **kwargs,
         **overrides,
     )  # fmt: skip
@@ -163,7 +174,7 @@ def run(args: argparse.Namespace) -> int:
             json.dumps(
                 {
                     "experiment": exp.name, "trials": summary.total, "skipped": summary.skipped,
-                    "ran": summary.ran, "statuses": summary.statuses,
+                    "ran": summary.ran, "statuses": summary.statuses, "stale": summary.stale,
                     "errors": [f"{t.key}: {e}" for t, e in summary.errors],
                     "missing": report.missing, "files": [str(f) for f in report.files],
                     "figures": [str(f) for f in report.figures], "tables": report.tables,
@@ -185,4 +196,6 @@ def run(args: argparse.Namespace) -> int:
         if report.missing:
             print(f"{report.missing} of {report.trials} trials are missing from the store",
                   file=sys.stderr)  # fmt: skip
+    if summary.stale:  # reused trials computed by other code: say so, never silently
+        print(f"csplab: warning: {summary.stale_line()}", file=sys.stderr)
     return 1 if summary.errors or report.missing else 0

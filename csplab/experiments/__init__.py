@@ -37,8 +37,8 @@ from pathlib import Path
 from typing import Any
 
 from csplab.errors import InputError
-from csplab.experiments.base import Experiment, Report
-from csplab.experiments.runner import RunSummary, config_hash, run_trials
+from csplab.experiments.base import Experiment, Report, provenance_note
+from csplab.experiments.runner import RunSummary, config_hash, run_trials, stale_counts
 from csplab.experiments.store import ResultsStore
 
 __all__ = [
@@ -86,6 +86,7 @@ def run(
     progress: bool = True,
     report_only: bool = False,
     rerun: bool = False,
+    rerun_stale: bool = False,
     figures: bool = True,
     command: str = "",
     **overrides: Any,
@@ -110,6 +111,11 @@ def run(
     rerun : bool
         Forget this sweep's stored trials first and run them all again (after a fix to a
         measure, say).
+    rerun_stale : bool
+        Forget and run again only this sweep's stored trials that other code computed
+        (another ``csplab/`` source tree or csplab version; see
+        :meth:`~csplab.experiments.store.ResultsStore.stale`). Without it such trials are
+        reused and counted in ``summary.stale``.
     figures : bool
         Draw the figures (PNG and SVG); tables and CSVs are always written.
     **overrides
@@ -123,10 +129,13 @@ def run(
     with ResultsStore(store) as st:
         if rerun and not report_only:
             st.delete(exp.name, [t.key for t in trials])
+        elif rerun_stale and not report_only:
+            st.delete(exp.name, list(st.stale(exp.name, [t.key for t in trials])))
         if report_only:
             done = st.done_keys(exp.name)
             summary = RunSummary(exp.name, len(trials), sum(t.key in done for t in trials))
             summary.executor = "nothing (report only)"
+            summary.stale = stale_counts(st, exp.name, [t.key for t in trials if t.key in done])
         else:
             summary = run_trials(
                 trials, examples, st, experiment=exp.name, config=config, jobs=jobs,
@@ -135,6 +144,9 @@ def run(
         keys = {t.key for t in trials}
         rows = st.rows(exp.name, keys)
         report = exp.report(rows, config, outdir)
+        note = provenance_note(rows)
+        if note:
+            report.notes.append(note)
         report.trials = len(keys)
         report.missing = len(keys) - len(rows)
         raw = outdir / f"{exp.name}_trials.csv.gz"

@@ -39,6 +39,7 @@ __all__ = [
     "load_examples",
     "new_figure",
     "parse_sizes",
+    "provenance_note",
     "save_figure",
     "setting_of",
     "size_for",
@@ -159,6 +160,33 @@ def save_figure(fig: Any, stem: Path) -> list[Path]:
 
         plt.close(fig)
     return out
+
+
+def provenance_note(rows: Sequence[dict[str, Any]]) -> str | None:
+    """A report note naming the code revisions that computed ``rows`` when there are
+    several (``None`` when one revision computed them all).
+
+    The note depends only on the stored rows, so redrawing a report at another commit
+    gives the same text; whether the running code is one of them is said on stderr by
+    ``csplab experiment`` (see :meth:`~csplab.experiments.runner.RunSummary.stale_line`).
+    """
+    from collections import Counter
+
+    from csplab.experiments.store import code_label, same_code
+
+    found = Counter((str(r["git_rev"]), str(r["csplab_version"])) for r in rows)
+    if len(found) <= 1:
+        return None
+    revs = found.most_common()
+    parts = ", ".join(f"{n} by {code_label(*rv)}" for rv, n in revs)
+    first_rev, first_ver = revs[0][0]
+    same = all(ver == first_ver and same_code(rev, first_rev) for (rev, ver), _ in revs)
+    tail = (
+        " (their csplab/ sources are identical)"
+        if same
+        else "; `--rerun-stale` runs again those not computed by the running code"
+    )
+    return f"The trials were computed by {len(revs)} revisions of csplab: {parts}{tail}."
 
 
 def _fmt(v: Any) -> str:

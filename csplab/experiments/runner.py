@@ -39,22 +39,26 @@ import os
 import sys
 import time
 from collections import Counter
-from collections.abc import Iterator, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from typing import Any
 
-from csplab.errors import DependencyError, InputError
+from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.experiments.store import ResultsStore
+from csplab.experiments.store import ResultsStore, code_label, code_revision
 from csplab.experiments.trial import Trial, execute
 
-__all__ = ["RunSummary", "config_hash", "run_trials"]
+__all__ = ["RunSummary", "config_hash", "run_trials", "stale_counts"]
 
 
 @dataclass
 class RunSummary:
-    """What a sweep did: how many trials it had, skipped (already stored), ran, and errors."""
+    """What a sweep did: how many trials it had, skipped (already stored), ran, and errors.
+
+    ``stale`` counts the skipped trials that other code computed (see
+    :meth:`~csplab.experiments.store.ResultsStore.stale`), by code revision.
+    """
 
     experiment: str
     total: int
@@ -64,14 +68,39 @@ class RunSummary:
     statuses: dict[str, int] = field(default_factory=dict)
     time_s: float = 0.0
     executor: str = ""
+    stale: dict[str, int] = field(default_factory=dict)
 
     def line(self) -> str:
         st = ", ".join(f"{k} {v}" for k, v in sorted(self.statuses.items()))
+        n_stale = sum(self.stale.values())
+        old = f" ({n_stale} by other code)" if n_stale else ""
         return (
-            f"{self.experiment}: {self.total} trials, {self.skipped} already stored, "
+            f"{self.experiment}: {self.total} trials, {self.skipped} already stored{old}, "
             f"{self.ran} run ({st or 'none'}) on {self.executor} in {self.time_s:.1f} s"
             + (f", {len(self.errors)} errors" if self.errors else "")
         )
+
+    def stale_line(self) -> str:
+        """One line saying which stored trials other code computed ("" when none)."""
+        if not self.stale:
+            return ""
+        n = sum(self.stale.values())
+        items = list(self.stale.items())
+        parts = ", ".join(f"{v} by {k}" for k, v in items[:3])
+        if len(items) > 3:
+            parts += f" and {sum(v for _, v in items[3:])} by {len(items) - 3} more"
+        return (
+            f"{self.experiment}: {n} of the {self.skipped} stored trials of this sweep were "
+            f"computed by other code ({parts}; this is {code_label(*code_revision())}); "
+            "--rerun-stale runs them again, --rerun the whole sweep"
+        )
+
+
+def stale_counts(store: ResultsStore, experiment: str, keys: Iterable[str]) -> dict[str, int]:
+    """``code label -> number`` of the stored trials among ``keys`` computed by other code
+    than the running one, most frequent first."""
+    found = Counter(code_label(*p) for p in store.stale(experiment, keys).values())
+    return dict(found.most_common())
 
 
 def config_hash(config: dict[str, Any]) -> str:
@@ -139,6 +168,7 @@ def run_trials(
     done = store.done_keys(experiment)
     todo = _order([t for t in unique if t.key not in done])
     summary = RunSummary(experiment, len(unique), len(unique) - len(todo))
+    summary.stale = stale_counts(store, experiment, [t.key for t in unique if t.key in done])
     run_id = store.start_run(
         experiment, cfg, chash, trials=len(unique), skipped=summary.skipped, command=command
     )
@@ -234,12 +264,9 @@ def _run_pool(todo: Sequence[Trial], examples: dict[str, ExampleModel], n: int) 
 
 
 def _client(scheduler: Any) -> tuple[Any, bool]:
-    try:
-        distributed: Any = importlib.import_module("distributed")
-    except ImportError:
-        raise DependencyError(
-            "--scheduler needs Dask distributed; install with pip install 'csplab[dask]'"
-        ) from None
+    from csplab.deps import require
+
+    distributed: Any = require("distributed", "dask", "--scheduler (a Dask cluster)")
     if isinstance(scheduler, distributed.Client):
         return scheduler, False
     if not isinstance(scheduler, str) or not scheduler:

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import csv
 import gzip
+import hashlib
 import json
 import os
 import socket
@@ -45,7 +46,14 @@ from typing import Any
 
 from csplab.experiments.trial import Trial
 
-__all__ = ["ResultsStore", "git_revision"]
+__all__ = [
+    "ResultsStore",
+    "code_label",
+    "code_revision",
+    "git_revision",
+    "is_current",
+    "same_code",
+]
 
 _SCHEMA = """
 CREATE TABLE IF NOT EXISTS trials (
@@ -97,20 +105,81 @@ COLUMNS: tuple[str, ...] = (
 
 @lru_cache(maxsize=1)
 def git_revision() -> str:
-    """The git revision of the csplab source tree (``+dirty`` when modified), else ``"-"``."""
-    here = Path(__file__).resolve().parent
+    """The git revision of the csplab source tree, else ``"-"`` (not a git checkout).
+
+    ``REV`` (12 hex digits) when the files under ``csplab/`` are those of the commit;
+    ``REV+dirty.HASH`` when they differ from it (uncommitted edits or new untracked files),
+    with ``HASH`` a short hash of the differences, so two different sets of uncommitted
+    edits are two different revisions.
+    """
+    pkg = Path(__file__).resolve().parents[1]  # the csplab package directory
+
+    def git(*args: str) -> bytes:
+        return subprocess.run(
+            ["git", *args], cwd=pkg, capture_output=True, timeout=30, check=True
+        ).stdout
+
     try:
-        rev = subprocess.run(
-            ["git", "rev-parse", "--short=12", "HEAD"], cwd=here, capture_output=True,
-            text=True, timeout=10, check=True,
-        ).stdout.strip()  # fmt: skip
-        dirty = subprocess.run(
-            ["git", "status", "--porcelain", "--untracked-files=no", "--", "."],
-            cwd=here.parent, capture_output=True, text=True, timeout=10,
-        ).stdout.strip()  # fmt: skip
-    except (OSError, subprocess.SubprocessError):
+        rev = git("rev-parse", "--short=12", "HEAD").decode().strip()
+        diff = git("diff", "HEAD", "--binary", "--", ".")
+        new = git("ls-files", "--others", "--exclude-standard", "-z", "--", ".")
+    except (OSError, subprocess.SubprocessError, UnicodeDecodeError):
         return "-"
-    return rev + ("+dirty" if dirty else "") if rev else "-"
+    if not rev:
+        return "-"
+    if not diff and not new:
+        return rev
+    h = hashlib.sha256(diff)
+    for name in sorted(filter(None, new.split(b"\0"))):
+        h.update(b"\0" + name + b"\0")
+        try:
+            h.update((pkg / os.fsdecode(name)).read_bytes())
+        except OSError:
+            pass
+    return f"{rev}+dirty.{h.hexdigest()[:8]}"
+
+
+def code_revision() -> tuple[str, str]:
+    """``(git revision, csplab version)`` of the running code: what :meth:`ResultsStore.add`
+    stores by default."""
+    from csplab import __version__
+
+    return git_revision(), __version__
+
+
+def code_label(git_rev: str, version: str) -> str:
+    """``"git REV (csplab VERSION)"``, how messages name a code revision."""
+    return f"git {git_rev} (csplab {version})"
+
+
+@lru_cache(maxsize=256)
+def same_code(rev_a: str, rev_b: str) -> bool:
+    """True when two stored git revisions hold the same ``csplab/`` sources.
+
+    Equal strings are the same code; two different clean commits are compared with
+    ``git diff --quiet A B -- csplab`` (so a commit that changes only documentation, tests
+    or papers does not make stored trials stale). An uncommitted (``+dirty``) or unknown
+    (``-``) revision equals only itself, and so does a commit this checkout does not have.
+    """
+    if rev_a == rev_b:
+        return True
+    if "-" in (rev_a, rev_b) or "+" in rev_a or "+" in rev_b:
+        return False
+    pkg = Path(__file__).resolve().parents[1]
+    try:
+        r = subprocess.run(
+            ["git", "diff", "--quiet", rev_a, rev_b, "--", "."],
+            cwd=pkg, capture_output=True, timeout=30,
+        )  # fmt: skip
+    except (OSError, subprocess.SubprocessError):
+        return False
+    return r.returncode == 0
+
+
+def is_current(git_rev: str, version: str) -> bool:
+    """Was a trial stored with this provenance computed by the running code?"""
+    rev, ver = code_revision()
+    return version == ver and same_code(git_rev, rev)
 
 
 class ResultsStore:
@@ -212,6 +281,26 @@ class ResultsStore:
         """Keys of the trials of ``experiment`` already stored."""
         cur = self._db.execute("SELECT trial_key FROM trials WHERE experiment = ?", (experiment,))
         return {r[0] for r in cur.fetchall()}
+
+    def provenance(
+        self, experiment: str, keys: Iterable[str] | None = None
+    ) -> dict[str, tuple[str, str]]:
+        """``trial key -> (git_rev, csplab_version)`` of the stored trials of
+        ``experiment`` (those with the given keys, or all)."""
+        cur = self._db.execute(
+            "SELECT trial_key, git_rev, csplab_version FROM trials WHERE experiment = ?",
+            (experiment,),
+        )
+        wanted = None if keys is None else set(keys)
+        return {k: (r, v) for k, r, v in cur.fetchall() if wanted is None or k in wanted}
+
+    def stale(
+        self, experiment: str, keys: Iterable[str] | None = None
+    ) -> dict[str, tuple[str, str]]:
+        """The stored trials (key -> ``(git_rev, csplab_version)``) computed by other code
+        than the running one (see :func:`is_current`): a resumed sweep reports them, and
+        ``--rerun-stale`` runs them again."""
+        return {k: p for k, p in self.provenance(experiment, keys).items() if not is_current(*p)}
 
     def count(self, experiment: str | None = None) -> int:
         if experiment is None:
