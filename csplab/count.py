@@ -41,7 +41,6 @@ Examples
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import time
 from collections.abc import Sequence
@@ -52,7 +51,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
-from csplab.errors import DependencyError, InputError
+from csplab.deps import available, require
+from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.rng import RngLike, make_rng
 
@@ -282,9 +282,7 @@ def _count_enumerate(problem: Problem, limit: int) -> tuple[int, dict[str, Any]]
 
 
 def _count_ganak(problem: Problem, seed: int) -> tuple[int, dict[str, Any]]:
-    if importlib.util.find_spec("pyganak") is None:
-        raise DependencyError("method 'ganak' needs pyganak; pip install 'csplab[count]'")
-    from pyganak import Counter
+    Counter = require("pyganak", "count", "count method 'ganak'").Counter
 
     enc = _counting_cnf(problem)
     stats = {"vars": enc.nvars, "clauses": enc.nclauses, "open_cells": _open_cells(enc)}
@@ -303,9 +301,7 @@ def _count_ganak(problem: Problem, seed: int) -> tuple[int, dict[str, Any]]:
 def _count_approxmc(
     problem: Problem, seed: int, epsilon: float, delta: float
 ) -> tuple[int, dict[str, Any]]:
-    if importlib.util.find_spec("pyapproxmc") is None:
-        raise DependencyError("method 'approxmc' needs pyapproxmc; pip install 'csplab[count]'")
-    from pyapproxmc import Counter
+    Counter = require("pyapproxmc", "count", "count method 'approxmc'").Counter
 
     enc = _counting_cnf(problem)
     stats: dict[str, Any] = {"epsilon": epsilon, "delta": delta, "vars": enc.nvars}
@@ -373,7 +369,7 @@ def count_solutions(
                     f"(reached {e.states}); the model is too wide: raise max_states or use "
                     "method='ganak'"
                 ) from None
-        method = "ganak" if importlib.util.find_spec("pyganak") is not None else "enumerate"
+        method = "ganak" if available("pyganak") else "enumerate"
     if method == "enumerate":
         val, st = _count_enumerate(problem, limit)
     elif method == "ganak":

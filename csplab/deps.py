@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import sys
 from types import ModuleType
 
 from csplab.errors import DependencyError
@@ -39,7 +40,15 @@ EXTRAS: dict[str, str] = {
 
 
 def available(module: str) -> bool:
-    """True when ``module`` can be imported (without importing it)."""
+    """True when ``module`` can be imported (without importing it).
+
+    A module or parent package set to ``None`` in :data:`sys.modules` (how Python, and the
+    tests, block an import) is unavailable even when it is installed.
+    """
+    parts = module.split(".")
+    for i in range(1, len(parts) + 1):
+        if sys.modules.get(".".join(parts[:i]), importlib) is None:
+            return False
     try:
         return importlib.util.find_spec(module) is not None
     except (ImportError, ValueError):  # a parent package is missing or broken
@@ -59,8 +68,15 @@ def require(module: str, extra: str | None = None, what: str | None = None) -> M
         What needs it (``"solver 'sat'"``), for the message.
     """
     top = module.split(".")[0]
-    if not available(top):
-        extra = extra or EXTRAS.get(top, "all")
-        who = what or "this feature"
+    extra = extra or EXTRAS.get(top, "all")
+    who = what or "this feature"
+    if not available(module):
         raise DependencyError(f"{who} needs {top}; install it with pip install 'csplab[{extra}]'")
-    return importlib.import_module(module)
+    try:
+        return importlib.import_module(module)
+    except ImportError as e:  # installed but broken (a missing shared library, say)
+        first = (str(e).strip().splitlines() or [type(e).__name__])[0]
+        raise DependencyError(
+            f"{who} needs {top}, which is installed but does not import ({first}); "
+            f"reinstall it with pip install --force-reinstall 'csplab[{extra}]'"
+        ) from None

@@ -18,11 +18,11 @@ Examples
 
 from __future__ import annotations
 
-import importlib.util
 from collections.abc import Sequence
 
 import numpy as np
 
+from csplab.deps import available
 from csplab.errors import InputError
 from csplab.problem import Problem
 
@@ -53,7 +53,7 @@ class BruteOracle:
 
 def oracle_methods() -> list[str]:
     """The oracles usable here, best first (``"sat"`` needs python-sat)."""
-    return ["sat", "brute"] if importlib.util.find_spec("pysat") else ["brute"]
+    return ["sat", "brute"] if available("pysat") else ["brute"]
 
 
 def make_oracle(problem: Problem, method: str = "brute") -> BruteOracle:

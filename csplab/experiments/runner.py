@@ -44,7 +44,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from dataclasses import dataclass, field
 from typing import Any
 
-from csplab.errors import InputError
+from csplab.errors import CsplabError, DependencyError, InputError
 from csplab.example import ExampleModel
 from csplab.experiments.store import ResultsStore, code_label, code_revision
 from csplab.experiments.trial import Trial, execute
@@ -167,6 +167,7 @@ def run_trials(
         raise InputError(f"no example model given for hash(es) {sorted(missing_ex)}")
     done = store.done_keys(experiment)
     todo = _order([t for t in unique if t.key not in done])
+    _check_dependencies(todo)
     summary = RunSummary(experiment, len(unique), len(unique) - len(todo))
     summary.stale = stale_counts(store, experiment, [t.key for t in unique if t.key in done])
     run_id = store.start_run(
@@ -210,6 +211,21 @@ def run_trials(
         summary.time_s = time.perf_counter() - t0
         store.finish_run(run_id, ran=summary.ran, errors=len(summary.errors))
     return summary
+
+
+def _check_dependencies(todo: Sequence[Trial]) -> None:
+    """One :class:`DependencyError` line, before anything runs, when a solver of the trials
+    to run needs a package that is not installed (an unknown solver is left to its trials,
+    which report it)."""
+    from csplab.solvers import get_solver
+
+    for spec in sorted({t.solver for t in todo}):
+        try:
+            get_solver(spec)
+        except DependencyError:
+            raise
+        except CsplabError:
+            pass
 
 
 Stream = Iterator[tuple[Trial, dict[str, Any] | None, str | None]]
