@@ -35,19 +35,19 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np
 
-DEFAULT_SOLVERS = [
-    ("catalog", {}),
-    ("blocks", {}),
-    ("sat", {}),
-    ("sat", {"supports": "forward"}),
-    ("sat", {"loader": "api"}),
-    ("sat:glucose4", {}),
-    ("cpsat", {}),
-    ("cpsat", {"model": "table"}),
-    ("backtrack", {}),
-    ("hybrid", {}),
-    ("perfect", {}),
-]
+
+def default_solvers() -> list[tuple[str, dict[str, Any]]]:
+    """Every registered solver with each option variant it declares in ``bench``
+    (``backend`` in a variant selects ``name:backend``)."""
+    from csplab.solvers import solver_class, solver_names
+
+    out = []
+    for name in solver_names():
+        for variant in solver_class(name).bench:
+            opts = dict(variant)
+            backend = opts.pop("backend", None)
+            out.append((f"{name}:{backend}" if backend else name, opts))
+    return out
 
 
 def _label(spec: str, opts: dict[str, Any]) -> str:
@@ -106,7 +106,7 @@ def main() -> None:
               "csplab.testing.synthetic)")  # fmt: skip
         examples = [(f"box_town_{m}", box_town(m, rng=0)) for m in (2, 4)]
     installed = {s["name"] for s in available_solvers() if s.get("installed")}
-    specs = DEFAULT_SOLVERS
+    specs = default_solvers()
     if args.solvers:
         specs = [(s, {}) for s in args.solvers]
     specs = [(s, o) for s, o in specs if s.split(":")[0] in installed]

@@ -28,11 +28,18 @@ def run(args: argparse.Namespace) -> int:
     print(f"csplab {__version__}")
     print("solvers:")
     for s in solvers:
-        mark = "installed" if s.get("installed") else "missing: " + ", ".join(s.get("requires", []))
+        mark = (
+            "installed"
+            if s.get("installed")
+            else f"missing: pip install 'csplab[{s.get('extra') or s['name']}]'"
+        )
         kind = "complete" if s.get("complete") else "incomplete"
         print(f"  {s['name']:<10} {kind:<10} {mark:<12} {s.get('description', s.get('error', ''))}")
         if s.get("backends"):
             print(f"  {'':<10} backends: {', '.join(s['backends'])}")
+        for o in s.get("options", []):
+            vals = f" ({'|'.join(o['values'])})" if o.get("values") else ""
+            print(f"  {'':<10} {o['name']}={o['default']!r}{vals}: {o['doc']}")
     print("built-in examples:")
     for name, desc in examples:
         print(f"  {name:<14} {desc}")

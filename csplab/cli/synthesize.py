@@ -24,15 +24,31 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         "problem is unsatisfiable, 2 on bad input.",
     )
     add_problem_args(p)
-    p.add_argument("--solver", default="catalog", help="solver name (see `csplab info`)")
+    from csplab.solvers import option_values, solver_names, solvers_taking
+
+    p.add_argument(
+        "--solver",
+        default="catalog",
+        help=f"{' | '.join(solver_names())}, or NAME:BACKEND (`csplab info` lists the "
+        "backends and every solver's options)",
+    )
     p.add_argument(
         "--order",
-        help="cell order (Alg. 3.1): scanline, random, min-entropy or scan:AXES "
-        "(e.g. scan:yx, x fastest: the thesis' 2D figures)",
+        help=f"cell order: {', '.join(option_values('order'))} (scan:AXES e.g. scan:yx, x "
+        f"fastest: the thesis' 2D figures); for {', '.join(solvers_taking('order'))}",
     )
-    p.add_argument("--choice", choices=["uniform", "weighted"], help="label choice (Alg. 3.1)")
-    p.add_argument("--block", help="block size for --solver blocks, e.g. 10 or 10x10x10")
-    p.add_argument("--retries", type=int, help="retries per block for --solver blocks")
+    p.add_argument(
+        "--choice",
+        choices=option_values("choice"),
+        help=f"label choice; for {', '.join(solvers_taking('choice'))}",
+    )
+    p.add_argument(
+        "--block",
+        help=f"block size, e.g. 10 or 10x10x10; for {', '.join(solvers_taking('block'))}",
+    )
+    p.add_argument(
+        "--retries", type=int, help=f"retries; for {', '.join(solvers_taking('retries'))}"
+    )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument(
@@ -52,19 +68,28 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
 
 
 def _options(args: argparse.Namespace) -> dict[str, Any]:
+    from csplab.solvers import solver_names, solvers_taking
+
     opts: dict[str, Any] = {}
     if args.order:
         opts["order"] = args.order
     if args.choice:
         opts["choice"] = args.choice
     if args.block:
-        if not args.solver.startswith("blocks"):
-            raise InputError("--block only applies to --solver blocks")
         opts["block"] = parse_shape(args.block, what="--block")
     if args.retries is not None:
         opts["retries"] = args.retries
     if args.time_limit is not None:
         opts["time_limit"] = args.time_limit
+    from csplab.solvers import solver_class
+
+    name = args.solver.partition(":")[0]
+    for flag in ("order", "choice", "block", "retries", "time_limit"):
+        if flag in opts and name in solver_names() and not solver_class(name).takes(flag):
+            raise InputError(
+                f"--{flag.replace('_', '-')} does not apply to --solver {name} "
+                f"(it applies to {', '.join(solvers_taking(flag))})"
+            )
     for kv in args.option:
         key, sep, val = kv.partition("=")
         if not sep:

@@ -81,54 +81,46 @@ def run_alg31(
     grid = np.full(n, -1, dtype=np.int32)
     stats: dict[str, Any] = {"order": order, "choice": choice}
     if not eng.ok:
-        stats.update(assigned=0, steps=int(eng.stats[0]), removals=int(eng.stats[1]))
+        stats.update(assigned=0, revisions=int(eng.stats[0]), removals=int(eng.stats[1]))
         stats["fail_cell"] = list(problem.coords(eng.wiped)) if eng.wiped >= 0 else None
         stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
         return Result(
             "unsat", grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
             stats=stats, trace=np.zeros((0, 2), dtype=np.int64),
         )  # fmt: skip
-    c = eng.c
     weighted = choice == "weighted"
-    use_heap = order == "min-entropy"
-    if use_heap:
-        heap = np.arange(n, dtype=np.int64)
-        hpos = np.zeros(n, dtype=np.int64)
-        hkey = _entropies(eng, weighted) + 1e-6 * noise
-        kern.heap_build(heap, hpos, hkey, n)
-    else:
-        heap = np.zeros(0, dtype=np.int64)
-        hpos = np.zeros(0, dtype=np.int64)
-        hkey = np.zeros(0, dtype=np.float64)
-    order_arr = perm if perm is not None else np.arange(n, dtype=np.int64)
-    trace_cell = np.full(n, -1, dtype=np.int64)
-    trace_label = np.full(n, -1, dtype=np.int64)
-    state = np.array([0, n if use_heap else 0, -1], dtype=np.int64)
+    heap: kern.Heap | None = None
+    if order == "min-entropy":
+        heap = kern.Heap(
+            heap=np.arange(n, dtype=np.int64), pos=np.zeros(n, dtype=np.int64),
+            key=_entropies(eng, weighted) + 1e-6 * noise, noise=noise,
+        )  # fmt: skip
+        kern.heap_build(heap.heap, heap.pos, heap.key, n)
+    run = kern.Run(
+        order=perm if perm is not None else np.arange(n, dtype=np.int64), ustream=ustream,
+        grid=grid, trace_cell=np.full(n, -1, dtype=np.int64),
+        trace_label=np.full(n, -1, dtype=np.int64),
+        state=np.array([0, n if heap is not None else 0, -1], dtype=np.int64),
+    )  # fmt: skip
     deadline = None if time_limit is None else t0 + float(time_limit)
     status: Status
     while True:
-        code = kern.alg31(
-            eng.bits, eng.prev, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, eng._queue, eng._inq,
-            order_arr, use_heap, ustream, noise, c.weights, c.wlogw, weighted, grid,
-            trace_cell, trace_label, state, _CHUNK if deadline is not None else n + 1,
-            eng.stats, heap, hpos, hkey,
-        )  # fmt: skip
-        if code == 0:
+        code = eng.alg31(run, heap, weighted=weighted,
+                         max_steps=_CHUNK if deadline is not None else None)  # fmt: skip
+        if code is kern.Code.SOLVED:
             status = "solved"
             break
-        if code == 1:
+        if code is kern.Code.FAILED:
             status = "failed"
-            eng.ok = False
-            eng.wiped = int(state[2])
             break
         if deadline is not None and time.perf_counter() > deadline:
             status = "timeout"
             break
-    steps = int(state[0])
-    stats.update(assigned=steps, steps=int(eng.stats[0]), removals=int(eng.stats[1]))
+    steps = run.steps
+    stats.update(assigned=steps, revisions=int(eng.stats[0]), removals=int(eng.stats[1]))
     if status == "failed":
-        stats["fail_cell"] = list(problem.coords(int(state[2])))
-    trace = np.stack([trace_cell[:steps], trace_label[:steps]], axis=1)
+        stats["fail_cell"] = list(problem.coords(run.fail_cell))
+    trace = np.stack([run.trace_cell[:steps], run.trace_label[:steps]], axis=1)
     return Result(
         status, grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
         stats=stats, trace=trace,

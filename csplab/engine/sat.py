@@ -54,7 +54,7 @@ __all__ = [
 
 DEFAULT_BACKEND = "cadical195"
 # the oracle figures the sat-based solvers report under stats["sat"]
-SAT_STAT_KEYS = ("backend", "vars", "clauses", "encode_s", "load_s", "solve_s", "calls")
+SAT_STAT_KEYS = ("backend", "vars", "clauses", "encode_s", "load_s", "solve_s", "sat_calls")
 
 # canonical pysat names csplab supports (each tested by the conformance suite)
 _SUPPORTED = (
@@ -251,7 +251,7 @@ class SatOracle:
             self.enc = encode(Problem((1,), [[True]], [[[True]]], []))  # a trivial stand-in
         self.top = self.enc.nvars
         self.stats: dict[str, Any] = dict(self.enc.stats)
-        self.stats.update(backend=self.backend, refinements=0, calls=0, solve_s=0.0)
+        self.stats.update(backend=self.backend, refinements=0, sat_calls=0, solve_s=0.0)
         self.grid: NDArray[np.int32] | None = None
         self._amo_done = np.zeros(problem.n, dtype=bool)
         self._fast: tuple[Any, Any, Any, Any] | None = None
@@ -418,7 +418,7 @@ class SatOracle:
         t0 = time.perf_counter()
         try:
             while True:
-                self.stats["calls"] += 1
+                self.stats["sat_calls"] += 1
                 r = self._raw(assume, deadline)
                 if r is None:
                     return "timeout"

@@ -313,10 +313,6 @@ def setting_of(row: dict[str, Any]) -> str:
     return str(row["params"].get("label", row["solver"]))
 
 
-# solvers that take the Alg. 3.1 options ``order`` and ``choice``
-ORDER_SOLVERS = frozenset({"catalog", "blocks", "perfect", "hybrid"})
-
-
 class Experiment:
     """Base class: subclasses set the class attributes and implement :meth:`build` and
     :meth:`report`.
@@ -405,11 +401,14 @@ class Experiment:
         return spec, params
 
     def solver_options(self, config: dict[str, Any], solver: str) -> dict[str, Any]:
-        """Common options for a solver: order/choice for the catalog family, time limit,
+        """Common options for a solver: order/choice for solvers that declare ``alg31`` (they run
+        Alg. 3.1 and take its vocabulary), the time limit,
         and ``options``."""
+        from csplab.solvers import solver_class
+
         opts: dict[str, Any] = {}
         name = solver.partition(":")[0]
-        if name in ORDER_SOLVERS:
+        if solver_class(name).alg31:
             if config.get("order"):
                 opts["order"] = config["order"]
             if config.get("choice"):

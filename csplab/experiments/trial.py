@@ -193,12 +193,17 @@ def grid_digest(grid: NDArray[np.integer[Any]]) -> str:
     return h.hexdigest()[:16]
 
 
-# stats a solver returns that are worth keeping in the store (the rest is dropped)
-KEEP_STATS = (
-    "assigned", "fail_cell", "steps", "removals", "blocks_tried", "blocks_accepted",
-    "retries", "acceptance_rate", "final_violations", "nodes", "conflicts", "restarts",
-    "encode_s", "solve_s", "sat_calls", "backend", "init",
-)  # fmt: skip
+def kept_stats(stats: dict[str, Any]) -> dict[str, Any]:
+    """The stats of a solver worth storing: every name of the glossary
+    (:data:`csplab.solvers.STATS`) whose value is a scalar or a short list (a cell)."""
+    from csplab.solvers import STATS
+
+    def small(v: Any) -> bool:
+        if isinstance(v, list | tuple):
+            return len(v) <= 4 and all(isinstance(x, int | float) for x in v)
+        return v is None or isinstance(v, int | float | str | bool | np.integer | np.floating)
+
+    return {k: v for k, v in stats.items() if k in STATS and small(v)}
 
 
 def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
@@ -207,6 +212,6 @@ def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict
     from csplab.solvers import solve
 
     r = solve(problem, trial.solver, rng=trial.seed, **trial.options)
-    stats = {k: r.stats[k] for k in KEEP_STATS if k in r.stats}
+    stats = kept_stats(r.stats)
     stats["grid"] = grid_digest(r.grid)
     return {"status": r.status, "time_s": float(r.time_s), "stats": stats}

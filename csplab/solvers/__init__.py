@@ -1,12 +1,17 @@
 """Solver registry and :func:`solve`.
 
 Solvers are looked up by name in one lazy table (modules are imported on first use);
-``"name:backend"`` passes ``backend`` to the solver (``"sat:cadical195"``). Adding a solver
-touches two files: its module here and the table below.
+``"name:backend"`` passes ``backend`` to the solver (``"sat:cadical195"``). A solver is a
+subclass of :class:`~csplab.solvers.base.Solver` that declares its name, completeness,
+dependencies, options and backends once (:mod:`csplab.solvers.base`); the CLI's choices,
+``csplab info``, the experiments, the solver benchmark, the conformance suite and the README
+solver table (:func:`markdown_table`) are derived from the declarations.
 
-Every solver class has ``name``, ``complete`` (can prove unsatisfiability), ``requires``
-(importable modules it needs), ``description`` and ``solve(problem, *, rng, seed, backend,
-**options) -> Result``.
+Adding a solver touches its module and one line of :data:`REGISTRY` (plus an extra in
+``pyproject.toml`` if it needs a package); :func:`register` adds one at run time, and
+installed packages can add their own through the ``csplab.solvers`` entry-point group, and
+the environment variable ``CSPLAB_SOLVERS="name=module:Class,..."`` adds solvers to a
+process and its workers.
 
 Examples
 --------
@@ -15,24 +20,43 @@ Examples
 >>> r = solve(P, "catalog", rng=3)
 >>> r.status, P.is_solution(r.grid)
 ('solved', True)
+>>> "backtrack" in solver_names()
+True
 """
 
 from __future__ import annotations
 
 import importlib
-import importlib.util
+import os
 import time
-from typing import Any, ClassVar, Protocol
+from importlib.metadata import entry_points
+from typing import Any
 
-from csplab.errors import CsplabError, InputError, UnknownSolverError
+from csplab.deps import available
+from csplab.errors import CsplabError, DependencyError, InputError, UnknownSolverError
 from csplab.problem import Problem
 from csplab.result import STATUSES, Result
 from csplab.rng import RngLike, make_rng
+from csplab.solvers.base import STATS, Option, Solver
 
-__all__ = ["Solver", "available_solvers", "get_solver", "solve", "solver_names"]
+__all__ = [
+    "REGISTRY",
+    "STATS",
+    "Option",
+    "Solver",
+    "available_solvers",
+    "get_solver",
+    "markdown_table",
+    "option_values",
+    "register",
+    "solve",
+    "solver_class",
+    "solver_names",
+    "solvers_taking",
+]
 
-# name -> "module:Class"
-_REGISTRY: dict[str, str] = {
+# name -> "module:Class": the one place a solver is registered
+REGISTRY: dict[str, str] = {
     "catalog": "csplab.solvers.catalog:CatalogSolver",
     "blocks": "csplab.solvers.blocks:BlocksSolver",
     "sat": "csplab.solvers.sat:SatSolver",
@@ -41,30 +65,44 @@ _REGISTRY: dict[str, str] = {
     "perfect": "csplab.solvers.perfect:PerfectSolver",
     "hybrid": "csplab.solvers.hybrid:HybridSolver",
 }
+_PLUGINS_LOADED = False
 
 
-class Solver(Protocol):
-    """What a solver class provides."""
+_ENV = "CSPLAB_SOLVERS"  # "name=module:Class,..." registered in this process and its children
 
-    name: ClassVar[str]
-    complete: ClassVar[bool]
-    requires: ClassVar[tuple[str, ...]]
-    description: ClassVar[str]
 
-    def solve(
-        self,
-        problem: Problem,
-        *,
-        rng: Any,
-        seed: int | None,
-        backend: str | None = None,
-        **options: Any,
-    ) -> Result: ...
+def _load_plugins() -> None:
+    global _PLUGINS_LOADED
+    for item in filter(None, os.environ.get(_ENV, "").split(",")):
+        name, sep, target = item.partition("=")
+        if sep and ":" in target:
+            REGISTRY.setdefault(name.strip(), target.strip())
+    if _PLUGINS_LOADED:
+        return
+    _PLUGINS_LOADED = True
+    for ep in entry_points(group="csplab.solvers"):
+        REGISTRY.setdefault(ep.name, ep.value)
+
+
+def register(name: str, target: str) -> None:
+    """Register a solver class ``"module:Class"`` under ``name`` at run time.
+
+    The registration is also put into the environment variable ``CSPLAB_SOLVERS``, so the
+    worker processes of an experiment (started later, from this process) see it too.
+    """
+    if not name or any(c in name for c in ":@=,"):
+        raise InputError(f"solver name {name!r} may not be empty or contain : @ = ,")
+    if target.count(":") != 1:
+        raise InputError(f"solver target {target!r} must be 'module:Class'")
+    REGISTRY[name] = target
+    items = [i for i in os.environ.get(_ENV, "").split(",") if i and not i.startswith(name + "=")]
+    os.environ[_ENV] = ",".join([*items, f"{name}={target}"])
 
 
 def solver_names() -> list[str]:
     """Registered solver names."""
-    return list(_REGISTRY)
+    _load_plugins()
+    return list(REGISTRY)
 
 
 def _split(spec: str) -> tuple[str, str | None]:
@@ -74,50 +112,111 @@ def _split(spec: str) -> tuple[str, str | None]:
     return name, (backend or None)
 
 
-def get_solver(spec: str) -> tuple[type[Solver], str | None]:
-    """The solver class and backend for a spec such as ``"sat:glucose4"``."""
-    name, backend = _split(spec)
-    target = _REGISTRY.get(name)
+def solver_class(name: str) -> type[Solver]:
+    """The class registered as ``name`` (imported, dependencies not checked)."""
+    _load_plugins()
+    target = REGISTRY.get(name)
     if target is None:
         raise UnknownSolverError(
-            f"unknown solver {name!r}; available: {', '.join(sorted(_REGISTRY))}"
+            f"unknown solver {name!r}; available: {', '.join(sorted(REGISTRY))}"
         )
     modname, clsname = target.split(":")
-    cls: type[Solver] = getattr(importlib.import_module(modname), clsname)
-    missing = [m for m in cls.requires if importlib.util.find_spec(m) is None]
-    if missing:
-        from csplab.errors import DependencyError
+    cls = getattr(importlib.import_module(modname), clsname)
+    if not (isinstance(cls, type) and all(hasattr(cls, a) for a in ("validate", "run", "options"))):
+        raise CsplabError(f"{target} is not a csplab.solvers.base.Solver subclass")
+    return cls
 
+
+def _missing(cls: type[Solver]) -> list[str]:
+    return [m for m in cls.requires if not available(m)]
+
+
+def get_solver(spec: str) -> tuple[type[Solver], str | None]:
+    """The solver class and backend for a spec such as ``"sat:glucose4"``; a missing
+    dependency is one :class:`~csplab.errors.DependencyError` line naming the extra."""
+    name, backend = _split(spec)
+    cls = solver_class(name)
+    missing = _missing(cls)
+    if missing:
         raise DependencyError(
-            f"solver {name!r} needs {', '.join(missing)}; install with "
-            f"pip install 'csplab[{getattr(cls, 'extra', name)}]'"
+            f"solver {name!r} needs {', '.join(missing)}; install it with "
+            f"pip install 'csplab[{cls.extra or name}]'"
         )
     return cls, backend
 
 
+def _option_info(o: Option) -> dict[str, Any]:
+    d: dict[str, Any] = {"name": o.name, "type": o.kind.__name__, "default": o.default,
+                         "doc": o.doc}  # fmt: skip
+    if o.values is not None:
+        d["values"] = list(o.values)
+    if o.minimum is not None:
+        d["minimum"] = o.minimum
+    return d
+
+
 def available_solvers() -> list[dict[str, Any]]:
-    """Name, description, completeness and whether dependencies are installed, per solver."""
+    """Per solver: name, description, completeness, options, dependencies and whether they
+    are installed (and its backends when they are)."""
     out = []
-    for name, target in _REGISTRY.items():
-        modname, clsname = target.split(":")
+    for name in solver_names():
         try:
-            cls = getattr(importlib.import_module(modname), clsname)
-        except ImportError as e:  # the module itself needs something missing
+            cls = solver_class(name)
+        except (ImportError, CsplabError) as e:  # the module itself needs something missing
             out.append({"name": name, "installed": False, "error": str(e)})
             continue
-        missing = [m for m in cls.requires if importlib.util.find_spec(m) is None]
-        info = {
+        missing = _missing(cls)
+        info: dict[str, Any] = {
             "name": name,
             "description": cls.description,
             "complete": cls.complete,
             "requires": list(cls.requires),
+            "extra": cls.extra,
             "installed": not missing,
+            "options": [_option_info(o) for o in cls.options],
         }
-        backends = getattr(cls, "backends", None)
-        if callable(backends) and not missing:
-            info["backends"] = backends()
+        if cls.backends is not None and not missing:
+            info["backends"] = cls.backends()
         out.append(info)
     return out
+
+
+def solvers_taking(option: str) -> list[str]:
+    """The solvers that declare ``option`` (importable ones only)."""
+    out = []
+    for name in solver_names():
+        try:
+            if solver_class(name).takes(option):
+                out.append(name)
+        except (ImportError, CsplabError):
+            continue
+    return out
+
+
+def option_values(option: str) -> list[str]:
+    """Every value any solver allows for the ``str`` option ``option`` (first seen first)."""
+    vals: dict[str, None] = {}
+    for name in solvers_taking(option):
+        o = solver_class(name).option(option)
+        for v in o.values if o is not None and o.values else ():
+            vals.setdefault(v)
+    return list(vals)
+
+
+def markdown_table() -> str:
+    """The README solver table, from the declarations (``python -m csplab.solvers``)."""
+    rows = ["| name | algorithm | complete | options | notes |", "|---|---|---|---|---|"]
+    for name in solver_names():
+        cls = solver_class(name)
+        spec = f"`{name}[:backend]`" if cls.backends is not None else f"`{name}`"
+        opts = ", ".join(
+            f"`{o.name}`" + (f" ({'/'.join(o.values)})" if o.values else "") for o in cls.options
+        )
+        rows.append(
+            f"| {spec} | {cls.description} | {'yes' if cls.complete else 'no'} | {opts} | "
+            f"{cls.notes} |"
+        )
+    return "\n".join(rows)
 
 
 def solve(problem: Problem, solver: str = "catalog", rng: RngLike = None, **options: Any) -> Result:

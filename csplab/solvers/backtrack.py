@@ -1,12 +1,13 @@
 """Solver ``backtrack``: complete depth-first search maintaining arc consistency (MAC).
 
 Each decision assigns a label to a cell and runs the catalog's arc consistency (the
-revision of Alg. 3.2/3.3, compiled, with a trail for undo: :mod:`csplab._search`); a
-wipe-out undoes the decision and tries the cell's next label; when a cell has no label
-left the search backtracks chronologically to the previous decision. Restarts follow the
-Luby sequence (``restart`` failures times 1, 1, 2, 1, 1, 2, 4, ...), each run with fresh
-random choices; since the cutoffs grow without bound the search stays complete. Exhausting
-the tree (or an arc-consistency wipe-out before any decision) proves unsatisfiability.
+revision of Alg. 3.2/3.3, compiled, with a trail for undo: :meth:`Propagator.mac_search
+<csplab.catalog.Propagator.mac_search>`); a wipe-out undoes the decision and tries the
+cell's next label; when a cell has no label left the search backtracks chronologically to
+the previous decision. Restarts follow the Luby sequence (``restart`` failures times 1, 1,
+2, 1, 1, 2, 4, ...), each run with fresh random choices; since the cutoffs grow without
+bound the search stays complete. Exhausting the tree (or an arc-consistency wipe-out before
+any decision) proves unsatisfiability.
 
 With ``order="scanline"`` and no restarts this is exactly Alg. 3.1 plus chronological
 backtracking: the same cell order and uniform label choice from the catalog.
@@ -41,15 +42,14 @@ Examples
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
-from csplab import _search as ks
-from csplab.catalog import Propagator, unpack
-from csplab.errors import InputError
+from csplab.catalog import Code, Propagator, Search
 from csplab.problem import Problem
 from csplab.result import Result, Status
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Option, Solver, order_option
 
 __all__ = ["BacktrackSolver", "luby"]
 
@@ -76,41 +76,40 @@ def luby(i: int) -> int:
             k += 1
 
 
-class BacktrackSolver:
+class BacktrackSolver(Solver):
     """Complete: MAC depth-first search with restarts (compiled)."""
 
-    name: ClassVar[str] = "backtrack"
-    complete: ClassVar[bool] = True
-    requires: ClassVar[tuple[str, ...]] = ()
-    description: ClassVar[str] = (
-        "MAC: depth-first search maintaining arc consistency, chronological "
-        "backtracking, Luby restarts; orders min-domain/scanline"
+    name = "backtrack"
+    complete = True
+    description = "depth-first search maintaining arc consistency (MAC), compiled, with a trail"
+    notes = (
+        '`order="min-domain"` or `"scanline"` (= Alg. 3.1 + chronological backtracking); '
+        "Luby restarts (`restart=100` failures); `node_limit`, `time_limit`"
     )
+    options = (
+        order_option(("min-domain", "scanline"), "min-domain",
+                     "variable order: smallest domain first, or the scanline (Alg. 3.1 order)"),
+        CHOICE,
+        Option("restart", int, 100, "failures before the first Luby restart (0: never)",
+               minimum=0),
+        Option("node_limit", int, None, "search nodes before giving up (status timeout)",
+               minimum=0, nullable=True),
+        TIME_LIMIT,
+    )  # fmt: skip
 
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
-        order: str = "min-domain",
-        choice: str = "uniform",
-        restart: int = 100,
-        node_limit: int | None = None,
-        time_limit: float | None = None,
-        **options: Any,
+        backend: str | None,
+        order: str,
+        choice: str,
+        restart: int,
+        node_limit: int | None,
+        time_limit: float | None,
     ) -> Result:
-        if backend is not None:
-            raise InputError(f"solver 'backtrack' has no backends (got {backend!r})")
-        if options:
-            raise InputError(f"unknown option(s) for solver 'backtrack': {', '.join(options)}")
-        if order not in ("min-domain", "scanline"):
-            raise InputError(f"order must be 'min-domain' or 'scanline', not {order!r}")
-        if choice not in ("uniform", "weighted"):
-            raise InputError(f"choice must be 'uniform' or 'weighted', not {choice!r}")
-        if int(restart) < 0 or (node_limit is not None and int(node_limit) < 0):
-            raise InputError("restart and node_limit must be >= 0")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n
@@ -118,72 +117,46 @@ class BacktrackSolver:
         grid = np.full(problem.shape, -1, dtype=np.int32)
         stats: dict[str, Any] = {"order": order, "choice": choice, "restart": int(restart)}
         if not eng.ok:
-            stats.update(nodes=0, fails=0, restarts=0)
+            stats.update(nodes=0, conflicts=0, restarts=0)
             stats["proof"] = "arc-consistency wipe-out before any decision (Theorem 3.3.2)"
             stats["fail_cell"] = list(problem.coords(eng.wiped))
             return Result("unsat", grid, "backtrack", time_s=time.perf_counter() - t0,
                           stats=stats)  # fmt: skip
-        c = eng.c
-        dom = eng.bits
-        W = dom.shape[1]
-        cap = max(4 * n, 1024)
-        tcell = np.zeros(cap, dtype=np.int64)
-        tbits = np.zeros((cap, W), dtype=np.uint64)
-        stamp = np.full(n, -1, dtype=np.int64)
-        lv_cell = np.zeros(n + 2, dtype=np.int64)
-        lv_cand = np.zeros((n + 2, W), dtype=np.uint64)
-        lv_trail = np.zeros(n + 2, dtype=np.int64)
-        lv_scan = np.zeros(n + 2, dtype=np.int64)
-        state = np.zeros(9, dtype=np.int64)
-        state[ks.NEED] = 1
-        state[ks.RNG] = int(rng.integers(0, 2**63 - 1))
-        scan_order = np.arange(n, dtype=np.int64)
-        counters = np.zeros(2, dtype=np.int64)
+        search = Search.new(n, eng.c.W, seed=int(rng.integers(0, 2**63 - 1)))
         restarts = 0
         cutoff = int(restart) * luby(1) if restart else 0
         status: Status
         while True:
             budget = _CHUNK_NODES
             if node_limit is not None:
-                budget = min(budget, int(node_limit) - int(state[ks.NODES]))
+                budget = min(budget, int(node_limit) - search.nodes)
                 if budget <= 0:
                     status, stats["limit"] = "timeout", "nodes"
                     break
-            code = ks.mac_search(
-                dom, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, eng._queue, eng._inq,
-                stamp, state, tcell, tbits, lv_cell, lv_cand, lv_trail, lv_scan,
-                order == "scanline", scan_order, c.weights, choice == "weighted",
-                budget, cutoff, counters,
-            )  # fmt: skip
-            if code == 0:
+            code = eng.mac_search(search, scan=order == "scanline", weighted=choice == "weighted",
+                                  max_nodes=budget, restart_fails=cutoff)  # fmt: skip
+            if code is Code.SOLVED:
                 status = "solved"
                 break
-            if code == 1:
+            if code is Code.EXHAUSTED:
                 status = "unsat"
                 stats["proof"] = (
-                    f"search tree exhausted ({int(state[ks.NODES])} decisions, "
-                    f"restart run {restarts + 1})"
+                    f"search tree exhausted ({search.nodes} decisions, restart run {restarts + 1})"
                 )
                 break
-            if code == 2:
+            if code is Code.RESTART:
                 restarts += 1
-                ks._undo(dom, int(lv_trail[1]), state, tcell, tbits)
-                state[ks.LEVEL] = 0
-                state[ks.NEED] = 1
-                state[ks.SCAN] = 0
-                state[ks.FAILS_RUN] = 0
+                eng.mac_restart(search)
                 cutoff = int(restart) * luby(restarts + 1)
-            elif code == 4:
-                cap *= 2
-                tcell = np.concatenate([tcell, np.zeros(cap - tcell.size, dtype=np.int64)])
-                tbits = np.concatenate([tbits, np.zeros((cap - tbits.shape[0], W), np.uint64)])
+            elif code is Code.GROW:
+                search = search.grown()
             if deadline is not None and time.perf_counter() > deadline:
                 status, stats["limit"] = "timeout", "time"
                 break
         if status == "solved":
-            grid = unpack(dom, problem.K).argmax(axis=1).astype(np.int32).reshape(problem.shape)
+            grid = eng.catalog().argmax(axis=1).astype(np.int32).reshape(problem.shape)
         stats.update(
-            nodes=int(state[ks.NODES]), fails=int(state[ks.FAILS]), restarts=restarts,
-            propagations=int(counters[0]), removals=int(counters[1]),
+            nodes=search.nodes, conflicts=search.fails, restarts=restarts,
+            propagations=int(search.counters[0]), removals=int(search.counters[1]),
         )  # fmt: skip
         return Result(status, grid, "backtrack", time_s=time.perf_counter() - t0, stats=stats)

@@ -38,7 +38,7 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Sequence
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -47,6 +47,7 @@ from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result, Status
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Option, Solver, order_option
 
 __all__ = ["BlocksSolver", "block_starts", "trivial_solution"]
 
@@ -201,7 +202,7 @@ def run_blocks(
     idx = np.arange(problem.n, dtype=np.int64).reshape(problem.shape)
     starts = [block_starts(s, b) for s, b in zip(problem.shape, m, strict=True)]
     tried = accepted = retry_count = 0
-    steps = 0
+    revisions = 0
     deadline = None if time_limit is None else t0 + float(time_limit)
     status: Status = "solved"
     for _sweep in range(sweeps):
@@ -216,7 +217,7 @@ def run_blocks(
             for attempt in range(retries + 1):
                 left = None if deadline is None else max(0.0, deadline - time.perf_counter())
                 r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left)
-                steps += int(r.stats.get("steps", 0))
+                revisions += int(r.stats.get("revisions", 0))
                 if r.status == "solved":
                     grid[cells] = r.grid.reshape(-1)
                     accepted += 1
@@ -239,9 +240,8 @@ def run_blocks(
         "retries": retry_count,
         "acceptance_rate": accepted / tried if tried else 1.0,
         "final_violations": final,
-        "consistent": final == 0,
         "init": init_kind,
-        "steps": steps,
+        "revisions": revisions,
         "order": order,
         "choice": choice,
     }
@@ -250,30 +250,52 @@ def run_blocks(
     return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
 
 
-class BlocksSolver:
+def _block_arg(value: Any) -> int | tuple[int, ...]:
+    if isinstance(value, str):
+        from csplab.problem import parse_shape
+
+        shp = parse_shape(value, what="block")
+        return shp[0] if len(shp) == 1 else shp
+    if isinstance(value, int | np.integer) and not isinstance(value, bool):
+        if value < 1:
+            raise InputError(f"must be positive, not {value!r}")
+        return int(value)
+    if isinstance(value, Sequence) and all(isinstance(v, int | np.integer) for v in value):
+        return tuple(int(v) for v in value)
+    raise InputError(f"must be a positive int or one per axis, e.g. 10 or 10x10x4, not {value!r}")
+
+
+class BlocksSolver(Solver):
     """Alg. 3.4: modify a consistent model in overlapping blocks (never inconsistent)."""
 
-    name: ClassVar[str] = "blocks"
-    complete: ClassVar[bool] = False
-    requires: ClassVar[tuple[str, ...]] = ()
-    description: ClassVar[str] = (
-        "Merrell Alg. 3.4: modify a trivial solution in overlapping blocks, "
-        "retry or revert failed blocks"
+    name = "blocks"
+    alg31 = True
+    complete = False
+    description = "Merrell Alg. 3.4, modify in overlapping blocks"
+    notes = (
+        "starts from a trivial solution (empty space, or ground under empty space) or `init=`; "
+        "`block=10`, `retries=20`; the output is always consistent"
     )
+    options = (
+        Option("block", object, 10, "block size per axis (an int or one per axis, e.g. 10x10x4)",
+               convert=_block_arg),
+        Option("retries", int, 20, "extra Alg. 3.1 attempts per block after a failure",
+               minimum=0),
+        Option("init", object, None, "a consistent starting grid (default: a trivial solution)",
+               nullable=True),
+        Option("sweeps", int, 1, "passes over all blocks", minimum=1),
+        order_option(doc="cell order of Alg. 3.1 inside each block"),
+        CHOICE,
+        TIME_LIMIT,
+    )  # fmt: skip
 
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
+        backend: str | None,
         **options: Any,
     ) -> Result:
-        if backend is not None:
-            raise InputError(f"solver 'blocks' has no backends (got {backend!r})")
-        allowed = {"block", "retries", "init", "sweeps", "order", "choice", "time_limit"}
-        unknown = set(options) - allowed
-        if unknown:
-            raise InputError(f"unknown option(s) for solver 'blocks': {', '.join(sorted(unknown))}")
         return run_blocks(problem, rng, **options)

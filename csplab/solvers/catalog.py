@@ -32,43 +32,39 @@ Examples
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
-
 import numpy as np
 
 from csplab.engine.alg31 import run_alg31
-from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Solver, order_option
 
 __all__ = ["CatalogSolver"]
 
 
-class CatalogSolver:
+class CatalogSolver(Solver):
     """Alg. 3.1: assign every cell from the arc-consistent catalog (incomplete)."""
 
-    name: ClassVar[str] = "catalog"
-    complete: ClassVar[bool] = False
-    requires: ClassVar[tuple[str, ...]] = ()
-    description: ClassVar[str] = (
-        "Merrell Alg. 3.1: assign cells from the arc-consistent catalog; "
-        "orders scanline/random/min-entropy"
+    name = "catalog"
+    alg31 = True
+    complete = False
+    description = "Merrell Alg. 3.1 with the catalog of Alg. 3.2/3.3 (arc consistency)"
+    notes = (
+        "orders `scanline` (thesis loop order, default), `random`, `min-entropy` (WFC-style), "
+        "`scan:AXES`; label choice `uniform` (thesis) or `weighted`; `failed` = gave up, "
+        "`unsat` only when arc consistency wipes out before any choice"
     )
+    options = (order_option(), CHOICE, TIME_LIMIT)
 
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
-        order: str = "scanline",
-        choice: str = "uniform",
-        time_limit: float | None = None,
-        **options: Any,
+        backend: str | None,
+        order: str,
+        choice: str,
+        time_limit: float | None,
     ) -> Result:
-        if backend is not None:
-            raise InputError(f"solver 'catalog' has no backends (got {backend!r})")
-        if options:
-            raise InputError(f"unknown option(s) for solver 'catalog': {', '.join(options)}")
         return run_alg31(problem, rng, order=order, choice=choice, time_limit=time_limit)

@@ -47,15 +47,16 @@ Examples
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
 from csplab.cnf import DeadlineExceeded, encode
+from csplab.deps import require
 from csplab.engine.sat import preferred_labels
-from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result
+from csplab.solvers.base import TIME_LIMIT, Option, Solver
 
 __all__ = ["CpsatSolver"]
 
@@ -71,44 +72,44 @@ def _check(deadline: float | None) -> None:
         raise _Deadline
 
 
-class CpsatSolver:
+class CpsatSolver(Solver):
     """Complete: OR-Tools CP-SAT (one-hot Boolean or table model)."""
 
-    name: ClassVar[str] = "cpsat"
-    complete: ClassVar[bool] = True
-    requires: ClassVar[tuple[str, ...]] = ("ortools",)
-    extra: ClassVar[str] = "cpsat"
-    description: ClassVar[str] = (
-        "OR-Tools CP-SAT; model=onehot (Booleans + support clauses) or table "
-        "(AddAllowedAssignments per arc); seeded, diverse via solution hints"
+    name = "cpsat"
+    complete = True
+    requires = ("ortools",)
+    extra = "cpsat"
+    description = "OR-Tools CP-SAT"
+    notes = (
+        '`model="onehot"` (Booleans + the support clauses, default) or `"table"` '
+        "(`AddAllowedAssignments` per arc); presolve off by default (it expands the tables); "
+        "diverse outputs from random solution hints; `num_workers`, `time_limit`"
     )
+    options = (
+        Option("model", str, "onehot", "one Boolean per label and the support clauses, or "
+               "one integer per cell with a table per arc", values=("onehot", "table")),
+        Option("diversity", str, "hint", "how seeds vary the output: random solution hints, "
+               "random polarity, or none", values=("hint", "polarity", "none")),
+        Option("num_workers", int, 1, "CP-SAT search workers (1 is deterministic)", minimum=1),
+        Option("presolve", bool, False, "CP-SAT presolve (expands the tables: slow here)"),
+        TIME_LIMIT,
+    )  # fmt: skip
+    bench = ({}, {"model": "table"})
 
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
-        model: str = "onehot",
-        diversity: str = "hint",
-        num_workers: int = 1,
-        presolve: bool = False,
-        time_limit: float | None = None,
-        **options: Any,
+        backend: str | None,
+        model: str,
+        diversity: str,
+        num_workers: int,
+        presolve: bool,
+        time_limit: float | None,
     ) -> Result:
-        if backend is not None:
-            raise InputError(f"solver 'cpsat' has no backends (got {backend!r})")
-        if options:
-            raise InputError(f"unknown option(s) for solver 'cpsat': {', '.join(options)}")
-        if model not in ("onehot", "table"):
-            raise InputError(f"model must be 'onehot' or 'table', not {model!r}")
-        if diversity not in ("hint", "polarity", "none"):
-            raise InputError(f"diversity must be 'hint', 'polarity' or 'none', not {diversity!r}")
-        if int(num_workers) < 1:
-            raise InputError("num_workers must be >= 1")
-        from ortools.sat.python import cp_model
-
+        cp_model = require("ortools.sat.python.cp_model", "cpsat", "solver 'cpsat'")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         rseed = int(rng.integers(2**31 - 1))
@@ -164,9 +165,9 @@ class CpsatSolver:
             prm.max_time_in_seconds = left
         code = s.Solve(m)
         stats["solve_s"] = time.perf_counter() - t1
-        stats["cp_status"] = s.StatusName(code)
+        stats["solver_status"] = s.StatusName(code)
         stats["conflicts"] = int(s.NumConflicts())
-        stats["branches"] = int(s.NumBranches())
+        stats["decisions"] = int(s.NumBranches())
         if code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
             values = np.asarray(list(s.response_proto.solution), dtype=np.int64)
             out = read(values).reshape(problem.shape)
@@ -219,7 +220,7 @@ class CpsatSolver:
     @staticmethod
     def _table(m: Any, enc: Any, pref: Any, deadline: float | None) -> Any:
         """One integer variable per cell and ``AddAllowedAssignments`` per arc."""
-        from ortools.sat.python import cp_model
+        cp_model = require("ortools.sat.python.cp_model", "cpsat", "solver 'cpsat'")
 
         P = enc.problem
         C = enc.catalog

@@ -37,53 +37,54 @@ Examples
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
-from csplab.engine.alg31 import CHOICES, ORDERS, run_alg31
+from csplab.engine.alg31 import run_alg31
 from csplab.engine.completability import WitnessPool, choose_from_exact
 from csplab.engine.sat import SAT_STAT_KEYS, SatOracle
 from csplab.engine.sat import backends as sat_backends
-from csplab.errors import CsplabError, InputError
+from csplab.errors import CsplabError
 from csplab.problem import Problem
-from csplab.result import Result
+from csplab.result import Result, Status
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Solver, order_option
 
 __all__ = ["HybridSolver"]
 
 
-class HybridSolver:
+class HybridSolver(Solver):
     """Complete: Alg. 3.1, with SAT-guided repair of the first bad choice after a failure."""
 
-    name: ClassVar[str] = "hybrid"
-    complete: ClassVar[bool] = True
-    requires: ClassVar[tuple[str, ...]] = ("pysat",)
-    extra: ClassVar[str] = "sat"
-    description: ClassVar[str] = (
-        "Alg. 3.1; on failure, SAT binary search for the first choice outside C*, "
+    name = "hybrid"
+    alg31 = True
+    complete = True
+    requires = ("pysat",)
+    extra = "sat"
+    description = (
+        "Alg. 3.1; after a failure, binary search (SAT) for the first choice outside C*, "
         "redraw it from C*, resume"
     )
+    notes = (
+        "as fast as Alg. 3.1 when it succeeds (no SAT solver is created), never fails; samples "
+        "the same distribution as `perfect` (chi-square-tested)"
+    )
+    options = (order_option(), CHOICE, TIME_LIMIT)
+    backends = staticmethod(sat_backends)
 
-    backends = staticmethod(sat_backends)  # the sat solver's backends
-
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
-        order: str = "scanline",
-        choice: str = "uniform",
-        time_limit: float | None = None,
-        **options: Any,
+        backend: str | None,
+        order: str,
+        choice: str,
+        time_limit: float | None,
     ) -> Result:
-        if options:
-            raise InputError(f"unknown option(s) for solver 'hybrid': {', '.join(options)}")
-        if order not in ORDERS or choice not in CHOICES:
-            raise InputError(f"order must be one of {ORDERS} and choice one of {CHOICES}")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n
@@ -96,7 +97,7 @@ class HybridSolver:
             while True:
                 left = None if deadline is None else deadline - time.perf_counter()
                 if left is not None and left <= 0:
-                    return self._result("timeout", fixed, problem, stats, t0)
+                    return self.result("timeout", fixed, problem, stats, t0)
                 dom = problem.domains.copy()
                 idx = np.flatnonzero(fixed >= 0)
                 dom[idx] = False
@@ -107,13 +108,12 @@ class HybridSolver:
                               engine=eng)  # fmt: skip
                 if r.status == "solved":
                     stats["fixed_by_repair"] = int(idx.size)
-                    return Result("solved", r.grid, "hybrid", time_s=time.perf_counter() - t0,
-                                  stats=stats)  # fmt: skip
+                    return self.result("solved", r.grid, problem, stats, t0)
                 if r.status == "timeout":
-                    return self._result("timeout", fixed, problem, stats, t0)
+                    return self.result("timeout", fixed, problem, stats, t0)
                 if r.status == "unsat" and idx.size == 0:
                     stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
-                    return self._result("unsat", fixed, problem, stats, t0)
+                    return self.result("unsat", fixed, problem, stats, t0)
                 if oracle is None:
                     oracle = SatOracle(problem, backend=backend, deadline=deadline,
                                        seed=int(rng.integers(2**31 - 1)))  # fmt: skip
@@ -122,14 +122,14 @@ class HybridSolver:
                     if st != "sat":
                         if st == "unsat":
                             stats["proof"] = f"refutation by {oracle.backend}"
-                        return self._result(st if st == "timeout" else "unsat", fixed, problem,
-                                            stats, t0)  # fmt: skip
+                        end: Status = "timeout" if st == "timeout" else "unsat"
+                        return self.result(end, fixed, problem, stats, t0)
                 trace = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
                 if r.status != "failed" or trace.shape[0] == 0:
                     raise CsplabError("hybrid: Alg. 3.1 failed on a consistent prefix (a bug)")
                 k = self._first_bad(oracle, trace, fixed, stats, deadline)
                 if k is None:
-                    return self._result("timeout", fixed, problem, stats, t0)
+                    return self.result("timeout", fixed, problem, stats, t0)
                 # fix the consistent prefix, then redraw step k from C*
                 for p, b in trace[:k].tolist():
                     if fixed[p] < 0:
@@ -148,7 +148,7 @@ class HybridSolver:
                 b2 = choose_from_exact(oracle, pool, p, labels, w, rng, stats, deadline)
                 if b2 is None:
                     if deadline is not None and time.perf_counter() > deadline:
-                        return self._result("timeout", fixed, problem, stats, t0)
+                        return self.result("timeout", fixed, problem, stats, t0)
                     raise CsplabError("hybrid: no label of C* at a consistent step (a bug)")
                 fixed[p] = b2
                 oracle.add_clause([oracle.literal(p, b2)])
@@ -175,9 +175,3 @@ class HybridSolver:
             else:
                 hi = mid
         return hi - 1
-
-    @staticmethod
-    def _result(status: Any, fixed: NDArray[np.int64], problem: Problem,
-                stats: dict[str, Any], t0: float) -> Result:  # fmt: skip
-        grid = fixed.astype(np.int32).reshape(problem.shape)
-        return Result(status, grid, "hybrid", time_s=time.perf_counter() - t0, stats=stats)

@@ -35,54 +35,53 @@ Examples
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
+from csplab.engine.alg31 import scan_order
 from csplab.engine.completability import WitnessPool, choose_from_exact
 from csplab.engine.sat import SAT_STAT_KEYS, SatOracle
 from csplab.engine.sat import backends as sat_backends
-from csplab.errors import CsplabError, InputError
+from csplab.errors import CsplabError
 from csplab.problem import Problem
 from csplab.result import Result
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Option, Solver, order_option
 
 __all__ = ["PerfectSolver"]
 
 
-class PerfectSolver:
+class PerfectSolver(Solver):
     """Complete: Alg. 3.1 drawing every label from C* (SAT-checked)."""
 
-    name: ClassVar[str] = "perfect"
-    complete: ClassVar[bool] = True
-    requires: ClassVar[tuple[str, ...]] = ("pysat",)
-    extra: ClassVar[str] = "sat"
-    description: ClassVar[str] = (
-        "Alg. 3.1 choosing only from the exact catalog C* (incremental SAT); never fails"
-    )
+    name = "perfect"
+    alg31 = True
+    complete = True
+    requires = ("pysat",)
+    extra = "sat"
+    description = "Alg. 3.1 choosing every label from the exact catalog C* (SAT-checked)"
+    notes = "never fails on a satisfiable problem; the upper reference for success rates; costly"
+    options = (
+        order_option(("scanline", "random", "scan:AXES")),
+        CHOICE,
+        Option("pool", int, 16, "witness solutions kept (labels known to be in C*)", minimum=1),
+        TIME_LIMIT,
+    )  # fmt: skip
+    backends = staticmethod(sat_backends)
 
-    backends = staticmethod(sat_backends)  # the sat solver's backends
-
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
-        order: str = "scanline",
-        choice: str = "uniform",
-        pool: int = 16,
-        time_limit: float | None = None,
-        **options: Any,
+        backend: str | None,
+        order: str,
+        choice: str,
+        pool: int,
+        time_limit: float | None,
     ) -> Result:
-        if options:
-            raise InputError(f"unknown option(s) for solver 'perfect': {', '.join(options)}")
-        if order not in ("scanline", "random"):
-            raise InputError(f"order must be 'scanline' or 'random', not {order!r}")
-        if choice not in ("uniform", "weighted"):
-            raise InputError(f"choice must be 'uniform' or 'weighted', not {choice!r}")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n
@@ -92,8 +91,9 @@ class PerfectSolver:
         eng = Propagator(problem)
         if not eng.ok:
             stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
-            return _result("unsat", grid, problem, stats, t0)
-        perm = rng.permutation(n) if order == "random" else np.arange(n)
+            return self.result("unsat", grid, problem, stats, t0)
+        scan = scan_order(problem.shape, order)
+        perm = rng.permutation(n) if scan is None else scan
         w = problem.weights if choice == "weighted" else None
         with SatOracle(problem, backend=backend, deadline=deadline,
                        seed=int(rng.integers(2**31 - 1))) as o:  # fmt: skip
@@ -101,22 +101,22 @@ class PerfectSolver:
             stats["sat_calls"] += 1
             if st == "unsat":
                 stats["proof"] = f"refutation by {o.backend}"
-                return _result("unsat", grid, problem, stats, t0)
+                return self.result("unsat", grid, problem, stats, t0)
             if st == "timeout":
-                return _result("timeout", grid, problem, stats, t0)
+                return self.result("timeout", grid, problem, stats, t0)
             wit = WitnessPool(n, pool)
             assert o.grid is not None
             wit.add(o.grid.reshape(-1))
             for p in perm.tolist():
                 if deadline is not None and time.perf_counter() > deadline:
-                    return _result("timeout", grid, problem, stats, t0)
+                    return self.result("timeout", grid, problem, stats, t0)
                 labels = eng.domain(p)
                 if labels.size == 1:
                     b = int(labels[0])
                 else:
                     pick = choose_from_exact(o, wit, p, labels, w, rng, stats, deadline)
                     if pick is None:
-                        return _result("timeout", grid, problem, stats, t0)
+                        return self.result("timeout", grid, problem, stats, t0)
                     b = pick
                     o.add_clause([o.literal(p, b)])
                 grid[p] = b
@@ -125,10 +125,4 @@ class PerfectSolver:
                 if not eng.assign(p, b):  # impossible: M_t stays completable
                     raise CsplabError("perfect: arc consistency failed after a C* choice (a bug)")
             stats["sat"] = {k: o.stats[k] for k in SAT_STAT_KEYS if k in o.stats}
-        return _result("solved", grid, problem, stats, t0)
-
-
-def _result(status: Any, grid: NDArray[np.int32], problem: Problem, stats: dict[str, Any],
-            t0: float) -> Result:  # fmt: skip
-    return Result(status, grid.reshape(problem.shape), "perfect",
-                  time_s=time.perf_counter() - t0, stats=stats)  # fmt: skip
+        return self.result("solved", grid, problem, stats, t0)

@@ -6,11 +6,11 @@ work too). The work is done by the incremental oracle :class:`csplab.engine.sat.
 (encoding, the fast CaDiCaL loader, deadlines); this module is the adapter.
 
 Diversity: before solving, every cell gets a preferred label drawn from the catalog with
-the rng (``phase="uniform"``, the default, like Alg. 3.1's uniform choice, or
+the rng (``choice="uniform"``, the default, like Alg. 3.1's uniform choice, or
 ``"weighted"`` by the example's label frequencies) and the solver's decision phases are set
 to it; CaDiCaL is also seeded. Two seeds' outputs differ in 30-46% of the cells at
 40×40×10 (``benchmarks/bench_solvers.py``; Alg. 3.1: 16-30%); ``"weighted"`` phases give
-mostly empty space and much less variety; ``phase="none"`` keeps the solver's own phases.
+mostly empty space and much less variety; ``choice="none"`` keeps the solver's own phases.
 
 Status ``unsat`` comes only with a proof: the SAT solver's refutation, or an arc-consistency
 wipe-out before any choice (what unit propagation on the support encoding also derives).
@@ -43,15 +43,14 @@ Examples
 from __future__ import annotations
 
 import time
-from typing import Any, ClassVar
 
 import numpy as np
 
 from csplab.cnf import AMO_ENCODINGS
 from csplab.engine.sat import SatOracle, backends, preferred_labels
-from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result, Status
+from csplab.solvers.base import TIME_LIMIT, Option, Solver
 
 __all__ = ["SatSolver"]
 
@@ -59,42 +58,56 @@ __all__ = ["SatSolver"]
 # ----------------------------------------------------------------------------- solver
 
 
-class SatSolver:
+class SatSolver(Solver):
     """Complete: CNF encoding + a pysat backend."""
 
-    name: ClassVar[str] = "sat"
-    complete: ClassVar[bool] = True
-    requires: ClassVar[tuple[str, ...]] = ("pysat",)
-    extra: ClassVar[str] = "sat"
-    description: ClassVar[str] = (
-        "CNF (support encoding, lazy at-most-one) solved by python-sat; sat:BACKEND"
+    name = "sat"
+    complete = True
+    requires = ("pysat",)
+    extra = "sat"
+    description = (
+        "CNF on the arc-consistent catalog, solved by python-sat (`sat:cadical195` default, "
+        "`sat:glucose4`, … `csplab info` lists the backends)"
     )
+    notes = (
+        'support encoding (unit propagation = arc consistency) or `encoding="direct"`; '
+        '`supports="forward"` halves the clauses; at-most-one `amo="lazy"` (added only '
+        "for cells a model labels twice) or any `pysat.card` encoding; diverse outputs from "
+        'random decision phases (`choice="uniform"`/`"weighted"`, `"none"` keeps the '
+        'solver\'s); clauses go to CaDiCaL through a compiled loader (`loader="api"` for '
+        "pysat's); `unsat` = the solver's refutation"
+    )
+    options = (
+        Option("encoding", str, "support", "support clauses (= arc consistency) or direct "
+               "(conflict clauses: forward checking)", values=("support", "direct")),
+        Option("supports", str, "both", "support clauses in both directions of each arc or "
+               "forward only (half the clauses, weaker)", values=("both", "forward")),
+        Option("amo", str, "lazy", "at-most-one per cell: lazy (added for cells a model "
+               "labels twice) or a pysat.card encoding", values=AMO_ENCODINGS),
+        Option("choice", str, "uniform", "decision phases: a label per cell drawn uniformly "
+               "or by weight from the catalog, or none (the solver's own)",
+               values=("uniform", "weighted", "none")),
+        Option("loader", str, "auto", "clause loading: auto (compiled CaDiCaL loader when "
+               "available) or api (pysat's Python API)", values=("auto", "api")),
+        TIME_LIMIT,
+    )  # fmt: skip
+    backends = staticmethod(backends)
+    bench = ({}, {"supports": "forward"}, {"loader": "api"}, {"backend": "glucose4"})
 
-    @staticmethod
-    def backends() -> list[str]:
-        return backends()
-
-    def solve(
+    def run(
         self,
         problem: Problem,
         *,
         rng: np.random.Generator,
         seed: int | None,
-        backend: str | None = None,
-        encoding: str = "support",
-        supports: str = "both",
-        amo: str = "lazy",
-        phase: str = "uniform",
-        time_limit: float | None = None,
-        loader: str = "auto",
-        **options: Any,
+        backend: str | None,
+        encoding: str,
+        supports: str,
+        amo: str,
+        choice: str,
+        loader: str,
+        time_limit: float | None,
     ) -> Result:
-        if options:
-            raise InputError(f"unknown option(s) for solver 'sat': {', '.join(options)}")
-        if phase not in ("weighted", "uniform", "none"):
-            raise InputError(f"phase must be 'weighted', 'uniform' or 'none', not {phase!r}")
-        if amo not in AMO_ENCODINGS:
-            raise InputError(f"amo must be one of {', '.join(AMO_ENCODINGS)}")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         cseed = int(rng.integers(2**31 - 1))
@@ -104,7 +117,7 @@ class SatSolver:
             loader=loader, deadline=deadline, seed=cseed,
         ) as o:  # fmt: skip
             stats = o.stats
-            stats.update(encoding=encoding, supports=supports, amo=amo, phase=phase)
+            stats.update(encoding=encoding, supports=supports, amo=amo, choice=choice)
             status = "timeout"
             if o.timed_out:
                 pass
@@ -115,8 +128,8 @@ class SatSolver:
                 )
                 stats["fail_cell"] = list(problem.coords(o.enc.wiped))
             else:
-                if phase != "none":
-                    w = problem.weights if phase == "weighted" else None
+                if choice != "none":
+                    w = problem.weights if choice == "weighted" else None
                     o.set_phases(preferred_labels(o.enc.catalog, w, rng))
                 status = o.solve(deadline=deadline)
                 stats.update(o.solver_stats())

@@ -32,7 +32,7 @@ def test_synthesize_with_exact_solvers(tmp_path, capsys, solver):
 def test_unsat_exit_code_and_solver_options(capsys):
     code, stdout, _ = run(capsys, "synthesize", "fig3_1d", "--size", "5x5", "--solver", "sat")
     assert code == 1 and stdout.startswith("unsat")
-    opts = ["--option", "amo=ladder", "--option", "phase=weighted", "--json"]
+    opts = ["--option", "amo=ladder", "--option", "choice=weighted", "--json"]
     code, stdout, _ = run(capsys, "synthesize", "line", "--size", "6x6", "--solver", "sat", *opts)
     assert code == 0 and json.loads(stdout)["stats"]["amo"] == "ladder"
     code, _, err = run(capsys, "synthesize", "line", "--size", "6x6", "--solver", "sat:kissat")

@@ -27,7 +27,7 @@ from hypothesis import strategies as st
 
 from csplab import Problem, solve
 from csplab.errors import InputError, NoTrivialSolutionError
-from csplab.solvers import available_solvers, get_solver
+from csplab.solvers import STATS, available_solvers, get_solver
 from csplab.testing.brute import count, solutions
 from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
@@ -81,10 +81,22 @@ def _satisfiable(P: Problem) -> bool:
     return next(solutions(P, limit=1), None) is not None
 
 
+def check_solver_on(spec, opts, P, seed):
+    """Every conformance rule for one solver on one problem (also used for solvers
+    registered by tests); stats must use the glossary names."""
+    status = _check_one(spec, opts, P, seed, _satisfiable(P))
+    r = _run(spec, opts, P, seed)
+    if r is not None:
+        cls = get_solver(spec)[0]
+        unknown = set(r.stats) - set(STATS) - {o.name for o in cls.options}
+        assert not unknown, (spec, "stats outside the glossary", unknown)
+    return status
+
+
 @pytest.mark.parametrize(("spec", "opts"), SPECS, ids=IDS)
 @given(P=csp_problems(), seed=st.integers(0, 2**31))
 def test_solver_conforms(spec, opts, P, seed):
-    _check_one(spec, opts, P, seed, _satisfiable(P))
+    check_solver_on(spec, opts, P, seed)
 
 
 @given(P=csp_problems(), seed=st.integers(0, 2**31))

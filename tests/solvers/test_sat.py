@@ -50,8 +50,9 @@ def test_enumeration_matches_brute_force_counts(P, amo, encoding, backend):
 
 
 @given(csp_problems(), st.sampled_from([{}, {"supports": "forward"}, {"encoding": "direct"},
-                                        {"amo": "bitwise"}, {"phase": "none"},
-                                        {"phase": "weighted"}]), st.integers(0, 2**31))  # fmt: skip
+                                        {"amo": "bitwise"}, {"choice": "none"},
+                                        {"choice": "weighted"}]),
+       st.integers(0, 2**31))  # fmt: skip
 def test_options_solve_correctly(P, opts, seed):
     r = solve(P, "sat", rng=seed, **opts)
     assert r.status in ("solved", "unsat")
@@ -75,7 +76,7 @@ def test_outputs_differ_across_seeds_and_repeat_for_a_seed():
     assert np.array_equal(g[0], solve(P, "sat", rng=0).grid)
     ham = [np.mean(g[i] != g[j]) for i in range(4) for j in range(i + 1, 4)]
     assert min(ham) > 0.02
-    same = [solve(P, "sat", rng=s, phase="none").grid for s in range(2)]
+    same = [solve(P, "sat", rng=s, choice="none").grid for s in range(2)]
     assert all(P.is_solution(x) for x in same)
 
 
@@ -97,7 +98,7 @@ def test_lazy_at_most_one_refinement_is_used_when_needed():
     # forward supports leave multi-labelled cells possible: refinement must repair them
     P = Problem.from_example(box_town(1, rng=1), (10, 10, 6))
     for s in range(3):
-        r = solve(P, "sat", rng=s, supports="forward", phase="none")
+        r = solve(P, "sat", rng=s, supports="forward", choice="none")
         assert r.status == "solved" and r.stats["refinements"] >= 0
 
 

@@ -1,0 +1,304 @@
+"""The solver contract: a solver declares itself once, here is what it declares.
+
+A solver is a subclass of :class:`Solver` that sets the class attributes below and
+implements :meth:`Solver.run`. Everything else is derived from the declaration: option
+validation (types, allowed values, defaults, unknown names), the ``order``/``choice``
+vocabulary, ``time_limit``, the registry's ``available_solvers()`` and ``csplab info``,
+the CLI's choices, the experiments' solver capabilities, the solver benchmark and the
+README solver table (:func:`csplab.solvers.markdown_table`).
+
+============  ==================================================================
+attribute     meaning
+============  ==================================================================
+name          registry name (``csplab synthesize --solver NAME``)
+complete      can prove unsatisfiability (and never gives up on a satisfiable one)
+description   one line: the algorithm
+notes         a few sentences for the README table (defaults, measured facts)
+requires      importable modules it needs; ``extra`` the pip extra that installs them
+options       :class:`Option` declarations (use :func:`order_option`,
+              :data:`CHOICE`, :data:`TIME_LIMIT` for the shared vocabulary)
+backends      a callable listing the ``name:backend`` values, or ``None``
+alg31         runs Alg. 3.1 and takes its ``order``/``choice`` vocabulary (the
+              experiments pass their ``--order``/``--choice`` to these solvers)
+bench         option variants ``benchmarks/bench_solvers.py`` times
+============  ==================================================================
+
+Stats: a solver's ``Result.stats`` uses the names of :data:`STATS` (one name per concept);
+the conformance suite checks it.
+
+Examples
+--------
+>>> from csplab.solvers import solver_class
+>>> cls = solver_class("catalog")
+>>> [o.name for o in cls.options]
+['order', 'choice', 'time_limit']
+>>> cls.validate({"order": "scan:yx"})["choice"]
+'uniform'
+>>> cls.validate({"order": "zigzag"})
+Traceback (most recent call last):
+...
+csplab.errors.InputError: solver 'catalog': order must be one of scanline, random, ...
+"""
+
+from __future__ import annotations
+
+import time
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.engine.alg31 import CHOICES, ORDERS, check_order
+from csplab.errors import InputError
+from csplab.problem import Problem
+from csplab.result import Result, Status
+
+__all__ = [
+    "CHOICE",
+    "STATS",
+    "TIME_LIMIT",
+    "Option",
+    "Solver",
+    "order_option",
+]
+
+_MISSING = object()
+
+
+@dataclass(frozen=True)
+class Option:
+    """One solver option: name, type, default, allowed values and one line of documentation.
+
+    ``kind`` is ``int``, ``float``, ``str``, ``bool`` or ``object`` (anything, checked by
+    ``convert``); ``values`` lists the allowed values of a ``str`` option (``"scan:AXES"``
+    admits every ``scan:...`` order); ``minimum`` bounds numbers; ``nullable`` admits
+    ``None``; ``convert`` turns a value into the solver's form (and raises
+    :class:`InputError` for bad ones).
+    """
+
+    name: str
+    kind: type
+    default: Any
+    doc: str
+    values: tuple[str, ...] | None = None
+    minimum: float | None = None
+    nullable: bool = False
+    convert: Callable[[Any], Any] | None = None
+
+    def check(self, value: Any, solver: str) -> Any:
+        """``value`` converted and validated, or an :class:`InputError` naming the solver."""
+        where = f"solver {solver!r}: {self.name}"
+        if value is None:
+            if self.nullable or self.default is None:
+                return None
+            raise InputError(f"{where} may not be None")
+        if self.convert is not None:
+            try:
+                return self.convert(value)
+            except InputError as e:
+                raise InputError(f"{where}: {e}") from None
+        if self.kind is bool:
+            if isinstance(value, bool | np.bool_):
+                return bool(value)
+            if isinstance(value, str) and value.lower() in ("true", "false", "1", "0"):
+                return value.lower() in ("true", "1")
+            raise InputError(f"{where} must be true or false, not {value!r}")
+        if self.kind in (int, float):
+            if isinstance(value, bool) or not isinstance(value, int | float | np.number | str):
+                raise InputError(f"{where} must be a number, not {value!r}")
+            try:
+                num = self.kind(value)
+            except (TypeError, ValueError):
+                raise InputError(f"{where} must be a number, not {value!r}") from None
+            if self.kind is int and float(value) != num:
+                raise InputError(f"{where} must be a whole number, not {value!r}")
+            if self.minimum is not None and num < self.minimum:
+                raise InputError(f"{where} must be at least {self.minimum:g}, not {value!r}")
+            return num
+        if self.kind is str:
+            if not isinstance(value, str):
+                raise InputError(f"{where} must be a string, not {value!r}")
+            if self.values is not None:
+                kind = "scan:AXES" if value.startswith("scan:") else value
+                if kind not in self.values:
+                    raise InputError(
+                        f"{where} must be one of {', '.join(self.values)}, not {value!r}"
+                    )
+            return value
+        return value
+
+    def describe(self) -> str:
+        """``name=default (a|b|c): doc`` for help texts and the README."""
+        vals = f" ({'|'.join(self.values)})" if self.values else ""
+        return f"{self.name}={self.default!r}{vals}: {self.doc}"
+
+
+def _check_order_value(allowed: tuple[str, ...]) -> Callable[[Any], str]:
+    def conv(value: Any) -> str:
+        if not isinstance(value, str):
+            raise InputError(f"must be a string such as 'scanline', not {value!r}")
+        try:
+            return check_order(value, allowed)
+        except InputError as e:
+            raise InputError(str(e).removeprefix("order ")) from None
+
+    return conv
+
+
+def order_option(
+    orders: tuple[str, ...] = ORDERS, default: str = "scanline", doc: str | None = None
+) -> Option:
+    """The shared ``order`` option restricted to the order kinds a solver supports
+    (:data:`csplab.engine.alg31.ORDERS`, plus solver-specific ones such as ``min-domain``)."""
+    return Option(
+        "order", str, default,
+        doc or "cell order: scanline (thesis), random, min-entropy (WFC), scan:AXES (scan:yx)",
+        values=orders, convert=_check_order_value(orders),
+    )  # fmt: skip
+
+
+CHOICE = Option(
+    "choice", str, "uniform",
+    "label choice: uniform over the candidates (thesis) or weighted by label frequencies",
+    values=CHOICES,
+)  # fmt: skip
+TIME_LIMIT = Option(
+    "time_limit", float, None, "seconds for the whole call; status timeout when exceeded",
+    minimum=0.0, nullable=True,
+)  # fmt: skip
+
+# One name per concept for Result.stats (the conformance suite checks every solver's keys).
+STATS: dict[str, str] = {
+    "order": "the cell order used",
+    "choice": "the label choice used",
+    "assigned": "cells assigned by the algorithm's own choices",
+    "revisions": "arc-consistency revisions (queue pops of the AC engine)",
+    "removals": "labels removed by arc consistency",
+    "fail_cell": "coordinates of the cell whose domain emptied",
+    "proof": "why the status is unsat (a wipe-out before any choice, a refutation by ...)",
+    "violations": "violated constraints of the returned grid (0 when solved)",
+    "final_violations": "violations of the final grid (modify in blocks)",
+    "blocks_tried": "blocks attempted (Alg. 3.4)",
+    "blocks_accepted": "blocks whose new labels were kept (Alg. 3.4)",
+    "acceptance_rate": "blocks_accepted / blocks_tried",
+    "retries": "extra Alg. 3.1 runs after a failure",
+    "sweeps": "passes over the blocks",
+    "init": "how the starting model of modify-in-blocks was built",
+    "block": "block size used",
+    "nodes": "search nodes",
+    "conflicts": "conflicts (search dead ends)",
+    "restarts": "search restarts",
+    "decisions": "search decisions",
+    "propagations": "propagated literals or domain changes",
+    "sat_calls": "calls of a SAT or ASP solver",
+    "rejected": "labels found outside C* by a SAT call",
+    "repairs": "failed Alg. 3.1 runs repaired from C* (hybrid)",
+    "alg31_runs": "runs of Alg. 3.1 (hybrid)",
+    "fixed_by_repair": "cells fixed by repairs before the final run (hybrid)",
+    "backend": "the backend solver",
+    "encoding": "the CNF encoding",
+    "supports": "support clauses in both directions or forward only",
+    "amo": "the at-most-one encoding",
+    "loader": "how clauses reached the SAT solver",
+    "vars": "variables of the encoding",
+    "clauses": "clauses of the encoding",
+    "literals": "literals of the encoding",
+    "x_vars": "cell-label variables of the encoding",
+    "aux_vars": "auxiliary variables of the encoding (at-most-one)",
+    "support_clauses": "support (or conflict) clauses of the encoding",
+    "alo_clauses": "at-least-one clauses of the encoding",
+    "empty_clause": "arc consistency wiped out before encoding (the CNF is the empty clause)",
+    "ac_s": "seconds spent on arc consistency before encoding",
+    "refinements": "lazy at-most-one refinements",
+    "encode_s": "seconds spent encoding",
+    "load_s": "seconds spent loading clauses into the solver",
+    "ground_s": "seconds spent grounding (ASP)",
+    "build_s": "seconds spent building the model (CP-SAT)",
+    "solve_s": "seconds spent searching",
+    "free_s": "seconds spent freeing the solver",
+    "model": "the model flavour (CP-SAT)",
+    "diversity": "how outputs are diversified across seeds",
+    "sat": "figures of the SAT oracle used (a dict with these names)",
+    "atoms": "ground atoms (ASP)",
+    "rules": "ground rules (ASP)",
+    "choices": "choices (ASP)",
+    "solver_status": "the backend's own status name",
+    "solver_stats": "the backend's own statistics (a dict, backend names)",
+}
+
+
+class Solver(ABC):
+    """Base class of every solver (see the module docstring)."""
+
+    name: ClassVar[str]
+    complete: ClassVar[bool]
+    description: ClassVar[str]
+    notes: ClassVar[str] = ""
+    requires: ClassVar[tuple[str, ...]] = ()
+    extra: ClassVar[str | None] = None
+    options: ClassVar[tuple[Option, ...]] = (TIME_LIMIT,)
+    backends: ClassVar[Callable[[], list[str]] | None] = None
+    bench: ClassVar[tuple[dict[str, Any], ...]] = ({},)
+    alg31: ClassVar[bool] = False
+
+    @classmethod
+    def option(cls, name: str) -> Option | None:
+        """The declaration of option ``name`` (``None`` if the solver has none)."""
+        return next((o for o in cls.options if o.name == name), None)
+
+    @classmethod
+    def takes(cls, name: str) -> bool:
+        """Whether the solver has option ``name``."""
+        return cls.option(name) is not None
+
+    @classmethod
+    def validate(cls, options: Mapping[str, Any], backend: str | None = None) -> dict[str, Any]:
+        """Every declared option, converted and checked, defaults filled in."""
+        if backend is not None and cls.backends is None:
+            raise InputError(f"solver {cls.name!r} has no backends (got {backend!r})")
+        known = {o.name for o in cls.options}
+        unknown = [k for k in options if k not in known]
+        if unknown:
+            raise InputError(
+                f"unknown option(s) for solver {cls.name!r}: {', '.join(unknown)}; "
+                f"it takes {', '.join(sorted(known)) or 'none'}"
+            )
+        return {
+            o.name: o.check(options[o.name], cls.name) if o.name in options else o.default
+            for o in cls.options
+        }
+
+    def solve(
+        self,
+        problem: Problem,
+        *,
+        rng: np.random.Generator,
+        seed: int | None,
+        backend: str | None = None,
+        **options: Any,
+    ) -> Result:
+        """Validate ``options`` against the declaration, then :meth:`run`."""
+        opts = self.validate(options, backend)
+        return self.run(problem, rng=rng, seed=seed, backend=backend, **opts)
+
+    @abstractmethod
+    def run(self, *args: Any, **kwargs: Any) -> Result:
+        """Solve: called as ``run(problem, *, rng, seed, backend, **options)`` with every
+        declared option validated (each solver spells out its own keywords)."""
+
+    @classmethod
+    def result(
+        cls,
+        status: Status,
+        grid: NDArray[np.integer[Any]],
+        problem: Problem,
+        stats: dict[str, Any],
+        t0: float,
+    ) -> Result:
+        """A :class:`Result` of this solver: the grid as int32 of the problem's shape,
+        the time since ``t0``."""
+        g = np.asarray(grid, dtype=np.int32).reshape(problem.shape)
+        return Result(status, g, cls.name, time_s=time.perf_counter() - t0, stats=stats)
