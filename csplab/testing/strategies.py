@@ -1,5 +1,9 @@
 """Hypothesis strategies for csplab objects: example models and problems.
 
+The module imports without hypothesis (a test dependency, ``pip install 'csplab[test]'``):
+hypothesis is imported when a strategy is first built, and a missing one is one
+:class:`~csplab.errors.DependencyError` line.
+
 Examples
 --------
 >>> from hypothesis import given, settings
@@ -12,13 +16,54 @@ Examples
 
 from __future__ import annotations
 
-from typing import Any
+import functools
+import inspect
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
-from hypothesis import strategies as st
 
 from csplab.example import ExampleModel
 from csplab.problem import Problem
+
+if TYPE_CHECKING:
+    from hypothesis.strategies import SearchStrategy
+
+T = TypeVar("T")
+
+
+def _hypothesis_strategies() -> Any:
+    from csplab.deps import require
+
+    return require("hypothesis.strategies", "test", "csplab.testing.strategies")
+
+
+class _LazyStrategies:
+    """``hypothesis.strategies``, imported on first use."""
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(_hypothesis_strategies(), name)
+
+
+st: Any = _LazyStrategies()
+
+
+def _composite(f: Callable[..., T]) -> Callable[..., SearchStrategy[T]]:
+    """``hypothesis.strategies.composite``, applied when the strategy is first built."""
+    built: Callable[..., SearchStrategy[T]] | None = None
+
+    @functools.wraps(f)
+    def make(*args: Any, **kwargs: Any) -> SearchStrategy[T]:
+        nonlocal built
+        if built is None:
+            built = _hypothesis_strategies().composite(f)
+        assert built is not None
+        return built(*args, **kwargs)
+
+    sig = inspect.signature(f)  # the signature without ``draw``, as composite gives it
+    make.__signature__ = sig.replace(parameters=list(sig.parameters.values())[1:])  # type: ignore[attr-defined]
+    return make
+
 
 __all__ = [
     "analysis_examples",
@@ -33,7 +78,7 @@ __all__ = [
 ]
 
 
-@st.composite
+@_composite
 def shapes(draw: Any, ndim: int | None = None, min_side: int = 1, max_side: int = 4,
            max_ndim: int = 3) -> tuple[int, ...]:  # fmt: skip
     """Grid shapes with 1 to ``max_ndim`` axes."""
@@ -41,7 +86,7 @@ def shapes(draw: Any, ndim: int | None = None, min_side: int = 1, max_side: int 
     return tuple(draw(st.integers(min_side, max_side)) for _ in range(d))
 
 
-@st.composite
+@_composite
 def label_grids(draw: Any, ndim: int | None = None, max_side: int = 5, max_labels: int = 5,
                 max_ndim: int = 3) -> np.ndarray:  # fmt: skip
     """Integer label grids; labels ``0..max_labels-1``, label 0 more frequent (empty space)."""
@@ -59,7 +104,7 @@ def label_grids(draw: Any, ndim: int | None = None, max_side: int = 5, max_label
     return np.array(vals, dtype=np.int32).reshape(shp)
 
 
-@st.composite
+@_composite
 def example_models(draw: Any, ndim: int | None = None, max_side: int = 5, max_labels: int = 5,
                    max_ndim: int = 3) -> ExampleModel:  # fmt: skip
     """Random example models (1D to ``max_ndim``-D)."""
@@ -67,7 +112,7 @@ def example_models(draw: Any, ndim: int | None = None, max_side: int = 5, max_la
     return ExampleModel(g)
 
 
-@st.composite
+@_composite
 def problems(
     draw: Any,
     ndim: int | None = None,
@@ -103,7 +148,7 @@ def problems(
     return Problem.from_example(E, shp, periodic=per, fixed=fx, mask=mk)
 
 
-@st.composite
+@_composite
 def random_problems(draw: Any, max_side: int = 4, max_labels: int = 4, max_ndim: int = 3,
                     density: tuple[float, float] = (0.2, 0.9)) -> Problem:  # fmt: skip
     """Grid problems with random transition matrices (not from an example)."""
@@ -117,7 +162,7 @@ def random_problems(draw: Any, max_side: int = 4, max_labels: int = 4, max_ndim:
     return Problem.grid(shp, T, periodic=per)
 
 
-@st.composite
+@_composite
 def corrupted(draw: Any, data: bytes, max_edits: int = 3) -> bytes:
     """``data`` damaged by 1 to ``max_edits`` edits: truncation, byte flips, deleted or
     duplicated lines, deleted or duplicated ``key="value"`` attributes (for fuzzing file
@@ -155,7 +200,7 @@ def corrupted(draw: Any, data: bytes, max_edits: int = 3) -> bytes:
     return bytes(out)
 
 
-@st.composite
+@_composite
 def tile_rule_sets(draw: Any, max_tiles: int = 4, max_rules: int = 8) -> str:
     """Random valid WaveFunctionCollapse simple-tiled XML (no images)."""
     syms = ["X", "L", "T", "I", "\\", "F"]
@@ -177,7 +222,7 @@ def tile_rule_sets(draw: Any, max_tiles: int = 4, max_rules: int = 8) -> str:
     return "\n".join(lines) + "\n"
 
 
-@st.composite
+@_composite
 def analysis_examples(draw: Any, ndim: int = 2, max_side: int = 4, max_labels: int = 4,
                       frame: bool | None = None) -> ExampleModel:  # fmt: skip
     """Small examples for infallibility analysis; with ``frame`` (drawn when ``None``) the
@@ -189,7 +234,7 @@ def analysis_examples(draw: Any, ndim: int = 2, max_side: int = 4, max_labels: i
     return ExampleModel(g)
 
 
-@st.composite
+@_composite
 def csp_problems(draw: Any, max_side: int = 3, max_labels: int = 4, max_ndim: int = 3,
                  max_cells: int = 12) -> Problem:  # fmt: skip
     """Small problems of every kind for solver conformance: from example models (periodic
