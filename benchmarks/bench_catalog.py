@@ -43,6 +43,7 @@ def main() -> None:
 
     t0 = time.perf_counter()
     import csplab
+    import csplab.grids
     from csplab import _kernels as kern
     from csplab.engine.alg31 import alg31_reference, jit_warmup
 
@@ -64,8 +65,8 @@ def main() -> None:
         args.examples
         or [n for n in csplab.example_names() if n in ("castle", "city", "towers")][:2]
     )
-    size = csplab.problem.parse_shape(args.size)
-    rsize = csplab.problem.parse_shape(args.ref_size)
+    size = csplab.grids.parse_shape(args.size)
+    rsize = csplab.grids.parse_shape(args.ref_size)
     header = (
         f"{'example':<10} {'K':>4} {'size':>10} {'median s':>9} {'solved s':>9} {'min s':>7}"
         f" {'solved':>7}"

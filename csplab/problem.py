@@ -43,7 +43,7 @@ from csplab.errors import InputError
 if TYPE_CHECKING:
     from csplab.example import ExampleModel
 
-__all__ = ["AXIS_NAMES", "Problem", "Unary", "Violations", "parse_shape"]
+__all__ = ["AXIS_NAMES", "Problem", "Unary", "Violations"]
 
 AXIS_NAMES = "xyzw"
 UnaryKind = Literal["fixed", "boundary", "mask", "domain"]
@@ -111,49 +111,6 @@ class Violations:
                 f"{int(lab[s])} then {int(lab[d])} never occurs"
             )
         return "\n".join(lines)
-
-
-def parse_shape(text: str | Sequence[int], *, what: str = "size") -> tuple[int, ...]:
-    """Parse ``"40x40x10"`` (or a sequence) into a shape tuple of positive ints.
-
-    Examples
-    --------
-    >>> parse_shape("40x40x10")
-    (40, 40, 10)
-    >>> parse_shape([5, 6])
-    (5, 6)
-    """
-    if isinstance(text, str):
-        parts = text.lower().replace("×", "x").replace(",", "x").split("x")
-        try:
-            shape = tuple(int(p) for p in parts)
-        except ValueError:
-            raise InputError(
-                f"{what} {text!r} is not of the form NxM or NxMxL (positive integers)"
-            ) from None
-    else:
-        try:
-            shape = tuple(int(p) for p in text)
-        except (TypeError, ValueError):
-            raise InputError(f"{what} {text!r} is not a sequence of integers") from None
-    if not 1 <= len(shape) <= 4 or any(s < 1 for s in shape):
-        raise InputError(f"{what} {text!r} must have 1 to 4 positive extents")
-    if math.prod(shape) > 200_000_000:
-        raise InputError(f"{what} {text!r} has too many cells")
-    return shape
-
-
-def _face_list(ndim: int) -> list[str]:
-    return [f"{AXIS_NAMES[d]}{s}" for d in range(ndim) for s in "-+"]
-
-
-def _as_flag_tuple(value: bool | Sequence[bool], ndim: int, what: str) -> tuple[bool, ...]:
-    if isinstance(value, bool | np.bool_):
-        return (bool(value),) * ndim
-    flags = tuple(bool(v) for v in value)
-    if len(flags) != ndim:
-        raise InputError(f"{what} needs {ndim} flags (one per axis), got {len(flags)}")
-    return flags
 
 
 class Problem:
@@ -364,144 +321,22 @@ class Problem:
 
     # ------------------------------------------------------------------ building
     @classmethod
-    def grid(
-        cls,
-        shape: Sequence[int] | str,
-        transitions: ArrayLike,
-        *,
-        periodic: bool | Sequence[bool] = False,
-        fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
-        boundary: Mapping[str, int] | None = None,
-        mask: ArrayLike | None = None,
-        weights: ArrayLike | None = None,
-        names: Sequence[str] | None = None,
-        name: str = "",
-        meta: Mapping[str, Any] | None = None,
-        labels: ArrayLike | None = None,
-    ) -> Problem:
-        """A grid problem from per-axis transition matrices ``T[d, b, c]``.
+    def grid(cls, shape: Sequence[int] | str, transitions: ArrayLike, **options: Any) -> Problem:
+        """A grid problem from per-axis transition matrices (:func:`csplab.grids.grid`)."""
+        from csplab.grids import grid
 
-        ``T[d]`` constrains each cell and its ``+1`` neighbour along axis ``d``; with
-        ``periodic`` (all axes or one flag per axis) the last cell also wraps to the first.
-        ``fixed``, ``boundary`` and ``mask`` restrict domains as in
-        :meth:`from_example` (which supplies ``T`` from an example model). ``labels`` (bool
-        ``(K,)``) limits the base domains of every cell to the labels in use.
-        """
-        shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
-        T = np.asarray(transitions, dtype=bool)
-        ndim = len(shp)
-        if T.ndim != 3 or T.shape[0] != ndim or T.shape[1] != T.shape[2]:
-            raise InputError(
-                f"transitions must have shape ({ndim}, K, K) for a {ndim}-D grid, got {T.shape}"
-            )
-        K = T.shape[1]
-        per = _as_flag_tuple(periodic, ndim, "periodic")
-        n = math.prod(shp)
-        idx = np.arange(n, dtype=np.int64).reshape(shp)
-        parts = []
-        for d in range(ndim):
-            a = np.moveaxis(idx, d, 0)
-            if shp[d] > 1:
-                src, dst = a[:-1].ravel(), a[1:].ravel()
-                parts.append(np.stack([src, dst, np.full_like(src, d)], axis=1))
-            if per[d]:
-                src, dst = a[-1].ravel(), a[0].ravel()
-                parts.append(np.stack([src, dst, np.full_like(src, d)], axis=1))
-        arcs = np.concatenate(parts) if parts else np.zeros((0, 3), dtype=np.int64)
-        base = np.ones((n, K), dtype=bool)
-        if labels is not None:
-            lab = np.asarray(labels, dtype=bool).reshape(-1)
-            if lab.shape != (K,):
-                raise InputError(f"labels must be {K} booleans, got shape {lab.shape}")
-            base &= lab
-        unary = _build_unary(shp, K, fixed=fixed, boundary=boundary, mask=mask)
-        dom = base.copy()
-        for u in unary:
-            dom[u.cells] &= u.allowed
-        m = dict(meta or {})
-        m.setdefault("periodic", per)
-        if boundary is not None:
-            m.setdefault("boundary", dict(boundary))
-        return cls(
-            shp,
-            dom,
-            T,
-            arcs,
-            weights=weights,
-            names=names,
-            relation_names=tuple(f"T_{AXIS_NAMES[d]}" for d in range(ndim)),
-            unary=unary,
-            base_domains=base,
-            name=name,
-            meta=m,
-        )
+        return grid(shape, transitions, **options)
 
     @classmethod
     def from_example(
-        cls,
-        example: ExampleModel,
-        shape: Sequence[int] | str,
-        *,
-        periodic: bool | Sequence[bool] = False,
-        fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
-        boundary: Mapping[str, int] | Literal["auto", "none"] | None = None,
-        mask: ArrayLike | None = None,
+        cls, example: ExampleModel, shape: Sequence[int] | str, **options: Any
     ) -> Problem:
-        """The model-synthesis problem for example ``E`` and output size ``shape``.
+        """The model-synthesis problem for an example model and an output size
+        (:func:`csplab.grids.from_example`: ``periodic``, ``fixed``, ``boundary``,
+        ``mask``)."""
+        from csplab.grids import from_example
 
-        Parameters
-        ----------
-        example : ExampleModel
-        shape : sequence of int or str
-            Output size, e.g. ``(40, 40, 10)`` or ``"40x40x10"``. It may omit trailing axes
-            along which the example has extent 1 (a 2D size for an ``nz = 1`` model).
-        periodic : bool or sequence of bool
-            Wrap around on all axes or on the flagged ones (toroidal output).
-        fixed : int array with -1 for free cells, or mapping ``{coords: label}``
-            Pre-assigned cells.
-        boundary : mapping ``{face: label}``, ``"auto"`` or ``None``/``"none"``
-            Label the outer layer of the model (Sec. 3.3.6, Fig. 3.11). Faces are ``"x-"``,
-            ``"x+"``, ``"y-"``, ... . Where faces meet, the bottom face (the ``-`` face of the
-            last axis) wins, then faces later in the order ``x-, x+, y-, y+, ...``.
-            ``"auto"`` puts on the bottom face the example's most frequent bottom-layer
-            label that tiles itself along the other axes (the ground), and on every other
-            face the example's empty-space label: the label that tiles itself along every
-            axis and is most frequent on the example's outer layer (bottom excluded); for an
-            example whose empty space is one layer thin, a top-layer label that tiles itself
-            along the horizontal axes.
-        mask : bool array ``(*shape, K)`` (or broadcastable)
-            Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
-
-        Labels that never occur in the example are excluded from every cell (a model
-        consistent with E only uses pieces of E, even in a cell without neighbours).
-        """
-        shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
-        shp = _match_ndim(shp, example.shape)
-        if isinstance(boundary, str):
-            if boundary == "auto":
-                boundary = auto_boundary(example, len(shp))
-            elif boundary == "none":
-                boundary = None
-            else:
-                raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
-        T = example.transitions()
-        if T.shape[0] < len(shp):
-            pad = np.zeros((len(shp) - T.shape[0], example.K, example.K), dtype=bool)
-            T = np.concatenate([T, pad])
-        meta = {"example": example.name, "example_hash": example.hash()}
-        return cls.grid(
-            shp,
-            T,
-            periodic=periodic,
-            fixed=fixed,
-            boundary=boundary,
-            mask=mask,
-            weights=example.label_weights(),
-            names=example.names,
-            name=example.name,
-            meta=meta,
-            labels=example.counts() > 0,
-        )
+        return from_example(example, shape, **options)
 
     # ------------------------------------------------------------------ derived problems
     def restrict(
@@ -513,29 +348,36 @@ class Problem:
         al = al.reshape(self.n, self.K)
         cells = np.flatnonzero(~al.all(axis=1)).astype(np.int64)
         u = Unary(kind, key, cells, al[cells].copy())
-        return self._with_unary([u])
+        return self.with_unary([u])
 
     def with_fixed(self, fixed: ArrayLike | Mapping[Sequence[int], int]) -> Problem:
         """A copy with some cells pre-assigned (same forms as in :meth:`from_example`)."""
-        return self._with_unary(_build_unary(self.shape, self.K, fixed=fixed))
+        from csplab.grids import build_unary
 
-    def _with_unary(self, extra: Sequence[Unary]) -> Problem:
+        return self.with_unary(build_unary(self.shape, self.K, fixed=fixed))
+
+    def _replace(self, **changes: Any) -> Problem:
+        """A new problem with the given constructor arguments changed (the one way every
+        derived problem is built; a finished problem is never mutated)."""
+        args: dict[str, Any] = dict(
+            shape=self.shape, domains=self.domains, relations=self.relations, arcs=self.arcs,
+            weights=self.weights, names=self.names, relation_names=self.relation_names,
+            unary=self.unary, base_domains=self.base_domains, name=self.name, meta=self.meta,
+        )  # fmt: skip
+        args.update(changes)
+        return Problem(**args)
+
+    def with_unary(self, extra: Sequence[Unary]) -> Problem:
+        """A copy with more unary restrictions (each remembered, for explanations)."""
         dom = self.domains.copy()
         for u in extra:
             dom[u.cells] &= u.allowed
-        return Problem(
-            self.shape,
-            dom,
-            self.relations,
-            self.arcs,
-            weights=self.weights,
-            names=self.names,
-            relation_names=self.relation_names,
-            unary=(*self.unary, *extra),
-            base_domains=self.base_domains,
-            name=self.name,
-            meta=self.meta,
-        )
+        return self._replace(domains=dom, unary=(*self.unary, *extra))
+
+    def with_mask(self, mask: ArrayLike) -> Problem:
+        """A copy with per-cell allowed labels ``mask`` (bool ``(*shape, K)`` or
+        broadcastable), recorded as one ``mask`` restriction (Sec. 3.5.3)."""
+        return self.restrict(mask, kind="mask")
 
     def without_unary(self, keep: Sequence[int] = ()) -> Problem:
         """A copy with only the unary restrictions whose indices are in ``keep``."""
@@ -543,19 +385,7 @@ class Problem:
         dom = self.base_domains.copy()
         for u in kept:
             dom[u.cells] &= u.allowed
-        return Problem(
-            self.shape,
-            dom,
-            self.relations,
-            self.arcs,
-            weights=self.weights,
-            names=self.names,
-            relation_names=self.relation_names,
-            unary=kept,
-            base_domains=self.base_domains,
-            name=self.name,
-            meta=self.meta,
-        )
+        return self._replace(domains=dom, unary=kept)
 
     def add_arcs(
         self, relation: ArrayLike, src: ArrayLike, dst: ArrayLike, name: str | None = None
@@ -574,18 +404,10 @@ class Problem:
         if self.relation_names is not None or name is not None:
             old = self.relation_names or tuple(f"R{i}" for i in range(self.R))
             rn = (*old, name or f"R{self.R}")
-        return Problem(
-            self.shape,
-            self.domains,
-            np.concatenate([self.relations, R[None]]),
-            np.concatenate([self.arcs, np.stack([s, d, r], axis=1)]),
-            weights=self.weights,
-            names=self.names,
+        return self._replace(
+            relations=np.concatenate([self.relations, R[None]]),
+            arcs=np.concatenate([self.arcs, np.stack([s, d, r], axis=1)]),
             relation_names=rn,
-            unary=self.unary,
-            base_domains=self.base_domains,
-            name=self.name,
-            meta=self.meta,
         )
 
     def subproblem(
@@ -631,173 +453,3 @@ class Problem:
         )
 
 
-# ---------------------------------------------------------------------- helpers
-
-
-def _match_ndim(shape: tuple[int, ...], ex_shape: tuple[int, ...]) -> tuple[int, ...]:
-    if len(shape) == len(ex_shape):
-        return shape
-    if len(shape) < len(ex_shape):
-        if all(s == 1 for s in ex_shape[len(shape) :]):
-            return shape + (1,) * (len(ex_shape) - len(shape))
-        raise InputError(
-            f"size {'x'.join(map(str, shape))} has {len(shape)} axes but the example has "
-            f"shape {'x'.join(map(str, ex_shape))}"
-        )
-    raise InputError(
-        f"size {'x'.join(map(str, shape))} has more axes than the example "
-        f"({'x'.join(map(str, ex_shape))})"
-    )
-
-
-def _build_unary(
-    shape: tuple[int, ...],
-    K: int,
-    *,
-    fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
-    boundary: Mapping[str, int] | None = None,
-    mask: ArrayLike | None = None,
-) -> list[Unary]:
-    n = math.prod(shape)
-    ndim = len(shape)
-    out: list[Unary] = []
-    if boundary is not None:
-        faces = _face_list(ndim)
-        bottom = f"{AXIS_NAMES[ndim - 1]}-"
-        unknown = [f for f in boundary if f not in faces]
-        if unknown:
-            raise InputError(f"unknown boundary face(s) {unknown}; faces are {faces}")
-        order = [f for f in faces if f != bottom] + [bottom]
-        owner = np.full(shape, -1, dtype=np.int64)  # index into order
-        for j, f in enumerate(order):
-            if f in boundary:
-                d, side = AXIS_NAMES.index(f[0]), f[1]
-                sl: list[slice | int] = [slice(None)] * ndim
-                sl[d] = 0 if side == "-" else shape[d] - 1
-                owner[tuple(sl)] = j
-        flat_owner = owner.ravel()
-        for j, f in enumerate(order):
-            if f not in boundary:
-                continue
-            b = _check_label(boundary[f], K, f"boundary[{f!r}]")
-            cells = np.flatnonzero(flat_owner == j).astype(np.int64)
-            allowed = np.zeros((cells.size, K), dtype=bool)
-            allowed[:, b] = True
-            out.append(Unary("boundary", f, cells, allowed))
-    if fixed is not None:
-        if isinstance(fixed, Mapping):
-            items: list[tuple[int, tuple[int, ...], Any]] = []
-            for coords, b in fixed.items():
-                c = tuple(int(i) for i in (coords if isinstance(coords, Sequence) else (coords,)))
-                if len(c) != ndim or any(not 0 <= ci < si for ci, si in zip(c, shape, strict=True)):
-                    raise InputError(f"fixed cell {c} is outside the grid {shape}")
-                items.append((int(np.ravel_multi_index(c, shape)), c, b))
-        else:
-            arr = np.asarray(fixed)
-            if arr.shape != shape:
-                raise InputError(f"fixed array has shape {arr.shape}, expected {shape}")
-            if not np.issubdtype(arr.dtype, np.integer):
-                raise InputError(f"fixed array must hold integers (-1 = free), got {arr.dtype}")
-            flat = arr.reshape(-1)
-            if np.any(flat < -1):
-                raise InputError("fixed array may only hold labels and -1 for free cells")
-            items = [
-                (int(c), tuple(int(i) for i in np.unravel_index(int(c), shape)), int(flat[c]))
-                for c in np.flatnonzero(flat >= 0)
-            ]
-        for cell, where, label in items:
-            lb = _check_label(label, K, f"fixed label at {where}")
-            allowed = np.zeros((1, K), dtype=bool)
-            allowed[0, lb] = True
-            out.append(Unary("fixed", where, np.array([cell], dtype=np.int64), allowed))
-    if mask is not None:
-        m = np.asarray(mask)
-        if m.dtype != bool:
-            raise InputError(f"mask must be boolean, got dtype {m.dtype}")
-        try:
-            m = np.broadcast_to(m, (*shape, K)).reshape(n, K)
-        except ValueError:
-            raise InputError(
-                f"mask of shape {np.shape(mask)} does not fit ({shape}, K={K})"
-            ) from None
-        for mc in np.flatnonzero(~m.all(axis=1)):
-            mcoords = tuple(int(i) for i in np.unravel_index(int(mc), shape))
-            out.append(
-                Unary("mask", mcoords, np.array([mc], dtype=np.int64), m[mc : mc + 1].copy())
-            )
-    return out
-
-
-def _check_label(b: Any, K: int, what: str) -> int:
-    try:
-        lb = int(b)
-    except (TypeError, ValueError):
-        raise InputError(f"{what} must be a label id, got {b!r}") from None
-    if not 0 <= lb < K:
-        raise InputError(f"{what} = {lb} is outside the label range 0..{K - 1}")
-    return lb
-
-
-def auto_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, int]:
-    """The ``boundary="auto"`` labelling for an example (see :meth:`Problem.from_example`).
-
-    Returns a mapping face -> label. Raises :class:`~csplab.errors.InputError` when the
-    example has no empty-space label (one that tiles itself along every axis) or, for 2D and
-    higher, no ground label (a bottom-layer label that tiles itself along the other axes).
-
-    Examples
-    --------
-    >>> from csplab.example import ExampleModel
-    >>> E = ExampleModel([[1, 0, 0], [1, 0, 0], [1, 0, 0]])   # ground 1 at y = 0
-    >>> auto_boundary(E)
-    {'x-': 0, 'x+': 0, 'y+': 0, 'y-': 1}
-    """
-    ndim = example.ndim if ndim is None else ndim
-    T = example.transitions()
-    lab = example.labels
-    K = example.K
-    diag = np.stack([np.diagonal(T[d]) for d in range(example.ndim)])  # (ndim, K)
-    self_tiling = diag.all(axis=0)
-    # outer layer minus the bottom face
-    outer = np.zeros(lab.shape, dtype=bool)
-    for d in range(example.ndim):
-        sl: list[slice | int] = [slice(None)] * example.ndim
-        if d != example.ndim - 1 or example.ndim == 1:
-            sl[d] = 0
-            outer[tuple(sl)] = True
-        sl[d] = lab.shape[d] - 1
-        outer[tuple(sl)] = True
-    counts_outer = np.bincount(lab[outer], minlength=K)
-    counts_all = np.bincount(lab.ravel(), minlength=K)
-    cand = np.flatnonzero(self_tiling & (counts_all > 0))
-    if cand.size == 0 and example.ndim >= 2:
-        # a thin example (empty space only one layer deep): fall back to labels on the top
-        # layer that tile themselves along the horizontal axes
-        top = np.take(lab, lab.shape[-1] - 1, axis=example.ndim - 1)
-        on_top = np.bincount(top.ravel(), minlength=K) > 0
-        cand = np.flatnonzero(diag[:-1].all(axis=0) & on_top)
-    if cand.size == 0:
-        raise InputError(
-            f"boundary='auto': example {example.name or ''} has no empty-space label "
-            "(no label is adjacent to itself along every axis); give boundary labels explicitly"
-        )
-    empty = int(cand[np.lexsort((-counts_all[cand], -counts_outer[cand]))[0]])
-    faces = _face_list(ndim)
-    result = {f: empty for f in faces}
-    if ndim >= 2 and example.ndim >= 2:
-        last = example.ndim - 1
-        bottom_layer = np.take(lab, 0, axis=last)
-        cb = np.bincount(bottom_layer.ravel(), minlength=K)
-        tiles_sideways = diag[:last].all(axis=0)
-        gcand = np.flatnonzero(tiles_sideways & (cb > 0))
-        if gcand.size == 0:
-            raise InputError(
-                "boundary='auto': no label on the example's bottom layer tiles itself along "
-                "the horizontal axes, so there is no ground label; give boundary labels "
-                "explicitly"
-            )
-        ground = int(gcand[np.argmax(cb[gcand])])
-        bottom = f"{AXIS_NAMES[ndim - 1]}-"
-        del result[bottom]
-        result[bottom] = ground
-    return result

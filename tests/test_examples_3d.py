@@ -8,7 +8,7 @@ import pytest
 import csplab
 from csplab import Problem
 from csplab.examples import EXAMPLES, build3d, load_example
-from csplab.problem import auto_boundary
+from csplab.grids import auto_boundary
 
 NAMES = list(build3d.EXAMPLES3D)
 SIZE = (40, 40, 10)

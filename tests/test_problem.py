@@ -6,7 +6,7 @@ from hypothesis import given
 
 from csplab import ExampleModel, Problem
 from csplab.errors import InputError
-from csplab.problem import auto_boundary, parse_shape
+from csplab.grids import auto_boundary, parse_shape
 from csplab.testing.strategies import problems
 
 

@@ -601,7 +601,7 @@ def alg36_failure(
     >>> alg36_failure(load_example("fig3_4a"), (3, 3), "2x2", order="scan:yx").holds
     False
     """
-    from csplab.problem import parse_shape
+    from csplab.grids import parse_shape
 
     rules = Rules.of(example)
     shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)

@@ -154,7 +154,7 @@ def closed_boundary(example: ExampleModel) -> dict[str, int]:
     """Empty space on every face except the bottom (the ``-`` face of the last axis):
     outputs in which no structure is cut off by an edge, except where it stands on the
     ground."""
-    from csplab.problem import auto_boundary
+    from csplab.grids import auto_boundary
 
     b = auto_boundary(example)
     b.pop(f"{AXIS_NAMES[example.ndim - 1]}-", None)

@@ -44,7 +44,8 @@ from csplab.catalog import Propagator
 from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.problem import Problem, parse_shape
+from csplab.grids import parse_shape
+from csplab.problem import Problem
 from csplab.result import Verdict
 from csplab.rng import make_rng
 from csplab.testing.brute import satisfiable

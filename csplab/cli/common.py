@@ -16,8 +16,9 @@ from numpy.typing import NDArray
 
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
+from csplab.grids import parse_boundary, parse_shape
 from csplab.io.ruleset import RuleSet
-from csplab.problem import Problem, parse_shape
+from csplab.problem import Problem
 
 __all__ = [
     "Model",
@@ -123,21 +124,6 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
         "strict=true (DeBroglie)",
     )
     p.set_defaults(_size_required=size_required)
-
-
-def parse_boundary(text: str | None) -> Any:
-    if text is None or text in ("auto", "none"):
-        return text
-    out: dict[str, int] = {}
-    for part in text.split(","):
-        face, sep, lab = part.partition("=")
-        if not sep:
-            raise InputError(f"--boundary {text!r}: use auto, none or face=label,face=label")
-        try:
-            out[face.strip()] = int(lab)
-        except ValueError:
-            raise InputError(f"--boundary {text!r}: label {lab!r} is not an integer") from None
-    return out
 
 
 def problem_from_args(

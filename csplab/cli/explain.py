@@ -93,22 +93,22 @@ def problem_with_fixed(args: argparse.Namespace) -> tuple[Any, Problem]:
     Fixed cells and mask cells become one unary restriction each (so an explanation can
     name them one by one).
     """
-    from csplab.problem import _build_unary
+    from csplab.grids import build_unary
 
     model = load_model(args.model, model_options(args.model_option))
     problem = problem_from_args(args, model)
     extra = []
     if getattr(args, "fixed", None):
         fixed = load_fixed(args.fixed, problem.shape)
-        extra += _build_unary(problem.shape, problem.K, fixed=fixed)
+        extra += build_unary(problem.shape, problem.K, fixed=fixed)
     if getattr(args, "mask", None):
         try:
             mask = np.load(args.mask, allow_pickle=False)
         except (OSError, ValueError) as e:
             raise FormatError(f"not a numpy file ({e})", path=args.mask) from None
-        extra += _build_unary(problem.shape, problem.K, mask=mask)
+        extra += build_unary(problem.shape, problem.K, mask=mask)
     if extra:
-        problem = problem._with_unary(extra)
+        problem = problem.with_unary(extra)
     return model, problem
 
 

@@ -10,7 +10,7 @@ from typing import Any
 
 from csplab.cli.common import add_problem_args, load_model, model_options, problem_from_args
 from csplab.errors import InputError
-from csplab.problem import parse_shape
+from csplab.grids import parse_shape
 
 OUT_EXT = (".npy", ".txt", ".grid", ".png", ".vox", ".obj")
 

@@ -102,7 +102,7 @@ def load_examples(specs: Sequence[str]) -> list[tuple[str, ExampleModel]]:
 def background_labels(example: ExampleModel) -> list[int]:
     """Labels that count as 'nothing built': the empty space and ground labels of
     ``boundary="auto"``, else the most frequent label."""
-    from csplab.problem import auto_boundary
+    from csplab.grids import auto_boundary
 
     try:
         return sorted(set(auto_boundary(example).values()))

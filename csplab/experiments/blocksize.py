@@ -54,7 +54,8 @@ from csplab.experiments.measures import (
 )
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial, grid_digest
-from csplab.problem import Problem, parse_shape
+from csplab.grids import parse_shape
+from csplab.problem import Problem
 
 __all__ = ["BlockSize", "measure"]
 

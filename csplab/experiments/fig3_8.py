@@ -42,7 +42,7 @@ __all__ = ["Fig38"]
 def check_boundary(example: ExampleModel, boundary: str, spec: str) -> None:
     """Fail early (one line) when ``boundary="auto"`` cannot label this example."""
     if boundary == "auto":
-        from csplab.problem import auto_boundary
+        from csplab.grids import auto_boundary
 
         try:
             auto_boundary(example)

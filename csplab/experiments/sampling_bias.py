@@ -43,7 +43,8 @@ from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
 from csplab.experiments.trial import Trial
 from csplab.experiments.uniform import StripSampler
-from csplab.problem import Problem, parse_shape
+from csplab.grids import parse_shape
+from csplab.problem import Problem
 
 __all__ = ["SamplingBias", "measure"]
 

@@ -36,7 +36,7 @@ from csplab.experiments.base import (
 from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
-from csplab.problem import parse_shape
+from csplab.grids import parse_shape
 
 __all__ = ["THESIS_TABLE_3_1", "Table31"]
 

@@ -125,7 +125,7 @@ _WARM = False
 
 def parse_boundary(text: str) -> Any:
     """``"auto"``/``"none"`` or ``"z-=1,x-=0"`` -> what :meth:`Problem.from_example` takes."""
-    from csplab.cli.common import parse_boundary as parse
+    from csplab.grids import parse_boundary as parse
 
     return parse(text)
 

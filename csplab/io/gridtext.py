@@ -29,15 +29,26 @@ True
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from csplab.errors import FormatError
 from csplab.example import ExampleModel
-from csplab.problem import parse_shape
+from csplab.grids import parse_shape
+from csplab.io.common import KIND, NO, SURE, Output, read_text, text_lines
 
-__all__ = ["MAGIC", "format_grid", "parse_grid", "read_grid", "write_grid"]
+__all__ = [
+    "MAGIC",
+    "format_grid",
+    "grid_safe_names",
+    "parse_grid",
+    "read_grid",
+    "sniff",
+    "write_grid",
+    "write_output",
+]
 
 MAGIC = "# csplab grid v1"
 _HEADER = re.compile(r"^\s*(shape|labels|weights|name)\s*:(.*)$", re.IGNORECASE)
@@ -197,13 +208,29 @@ def parse_grid(text: str, *, path: object = "<string>", name: str = "") -> Examp
         raise FormatError(str(e), path=path) from None
 
 
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for the magic line, :data:`~csplab.io.common.KIND`
+    for four numeric rows of one length (a bare grid; Merrell's header lines are free text).
+
+    Examples
+    --------
+    >>> sniff(b"# csplab grid v1\\n0\\n"), sniff(b"0 1\\n1 0\\n0 1\\n1 0\\n"), sniff(b"<set>")
+    (3, 2, 0)
+    """
+    lines = text_lines(head, 4)
+    if lines and lines[0].strip().lower().startswith(MAGIC[:12]):
+        return SURE
+    rows = [ln.split() for ln in lines]
+    if len(rows) == 4 and all(r and all(t.lstrip("-").isdigit() for t in r) for r in rows):
+        if len({len(r) for r in rows}) == 1:
+            return KIND
+    return NO
+
+
 def read_grid(path: str | Path) -> ExampleModel:
+    """Read a grid-format file."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8", errors="replace")
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_grid(text, path=p, name=p.stem)
+    return parse_grid(read_text(p), path=p, name=p.stem)
 
 
 def format_grid(example: ExampleModel, comments: str = "") -> str:
@@ -236,3 +263,38 @@ def format_grid(example: ExampleModel, comments: str = "") -> str:
 
 def write_grid(example: ExampleModel, path: str | Path, comments: str = "") -> None:
     Path(path).write_text(format_grid(example, comments), encoding="utf-8")
+
+
+def grid_safe_names(names: Sequence[str]) -> list[str]:
+    """Label names usable as tokens of the grid format: no whitespace or ``#``, not a
+    number (tokens that are numbers mean label ids), all different.
+
+    Examples
+    --------
+    >>> grid_safe_names(["corner 1", "1", "#_0", "corner_1"])
+    ['corner_1', 't1', '__0', 'corner_1.3']
+    """
+    out: list[str] = []
+    seen: set[str] = set()
+    for i, n in enumerate(names):
+        t = re.sub(r"[\s#]+", "_", str(n)) or f"label{i}"
+        if t.lstrip("-").isdigit():
+            t = "t" + t
+        if t in seen:
+            t = f"{t}.{i}"
+        seen.add(t)
+        out.append(t)
+    return out
+
+
+def write_output(out: Output, path: Path) -> None:
+    """The grid (no unassigned cells) in the grid format; label names are made
+    :func:`grid_safe_names`."""
+    ex = out.to_example()
+    if ex.names is not None:
+        safe = grid_safe_names(ex.names)
+        if safe != list(ex.names):
+            ex = ExampleModel(
+                ex.labels, names=safe, weights=ex.weights, name=ex.name, metadata=ex.metadata
+            )
+    write_grid(ex, path)

@@ -32,14 +32,15 @@ from __future__ import annotations
 import io
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import InputError
-from csplab.problem import AXIS_NAMES, Problem, Unary, parse_shape
+from csplab.grids import parse_shape
+from csplab.problem import AXIS_NAMES, Problem, Unary
 
 if TYPE_CHECKING:
     from PIL import Image
@@ -324,6 +325,7 @@ class RuleSet:
             "format": self.meta.get("format"),
             "source": self.meta.get("source"),
             "rule_set": self.name,
+            "model": self,  # lets Result._repr_png_ draw the tiles
         }
         P = Problem.grid(
             shp,
@@ -339,8 +341,7 @@ class RuleSet:
         )
         unary = self._unaries(ops, shp)
         if unary:
-            P = P._with_unary(unary)
-        P.meta["model"] = self  # lets Result._repr_png_ draw the tiles
+            P = P.with_unary(unary)
         return P
 
     def _unaries(self, ops: Sequence[DomainOp], shp: tuple[int, ...]) -> list[Unary]:
@@ -459,17 +460,3 @@ def _gray() -> NDArray[np.uint8]:
     p = palette(256)
     p[0] = 0
     return p
-
-
-@dataclass
-class _Warnings:
-    """Collects loader warnings (also emitted as :class:`UserWarning`)."""
-
-    path: object
-    items: list[str] = field(default_factory=list)
-
-    def add(self, message: str) -> None:
-        import warnings
-
-        self.items.append(message)
-        warnings.warn(f"{self.path}: {message}", UserWarning, stacklevel=3)

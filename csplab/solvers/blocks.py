@@ -252,7 +252,7 @@ def run_blocks(
 
 def _block_arg(value: Any) -> int | tuple[int, ...]:
     if isinstance(value, str):
-        from csplab.problem import parse_shape
+        from csplab.grids import parse_shape
 
         shp = parse_shape(value, what="block")
         return shp[0] if len(shp) == 1 else shp
