@@ -1,4 +1,4 @@
-"""Compiled kernels (numba) for the catalog: bitset arc consistency and Alg. 3.1.
+"""Compiled kernels (numba): bitset arc consistency, Alg. 3.1, MAC search and the CNF encoders.
 
 Domains are bitsets ``uint64 (n, W)`` with ``W = ceil(K / 64)``. Each arc ``(u, v, r)`` is
 stored twice in a CSR adjacency: at ``u`` as ``(v, 2r)`` and at ``v`` as ``(u, 2r + 1)``.
@@ -9,14 +9,183 @@ Revising ``v`` from ``u`` (statement 3.6): ``D(v) &= OR_{a in D(u)} sup[s, a]``,
 OR early once it covers ``D(v)``. A FIFO queue of changed cells runs this to the fixpoint
 (Alg. 3.2/3.3 with a queue instead of a stack; the fixpoint is the same).
 
-All randomness is drawn by the caller from a numpy Generator and passed in as arrays, so
-the kernels are deterministic.
+All randomness is drawn by the caller from a numpy Generator and passed in as arrays (or, for
+the MAC search, as a splitmix64 seed in its state), so the kernels are deterministic.
+
+Arguments travel in bundles (:class:`typing.NamedTuple` s of arrays, which numba compiles as
+structs; fields are read once at the top of each kernel): :class:`Arcs`, the static arrays
+of a compiled problem; :class:`AcState`, the mutable arc-consistency state of one
+:class:`csplab.catalog.Propagator`; :class:`Heap`, the min-entropy heap; :class:`Run`, one
+Alg. 3.1 run; :class:`Search`, one MAC search. Kernels return a :class:`Code` (as an int:
+numba returns ints; callers wrap it with ``Code(...)`` and compare by name). Only
+:mod:`csplab.catalog` calls the propagation kernels: :class:`~csplab.catalog.Propagator` has
+one method per kernel (``propagate``, ``alg31``, ``mac_search``, ``mac_restart``).
+
+Kernel cache rule
+-----------------
+**Every ``@njit`` function that calls another csplab ``@njit`` function lives in this file.**
+numba's on-disk cache (``cache=True``) keys a compiled function on its own source file only
+(path and modification time): a caller in another file that inlined or linked a helper from
+this one would keep its stale machine code after the helper changed. With every caller and
+every helper in one file, editing any of them invalidates all of them together.
+``tests/test_catalog.py::test_njit_callers_of_csplab_kernels_live_in_kernels`` enforces the
+rule (``@njit`` functions elsewhere, such as the ctypes feeders of
+:mod:`csplab.engine.sat`, may call only non-csplab functions).
+
+The two arc revisions (:func:`propagate`, :func:`propagate_trail`) are copies on purpose:
+moving the loop into a shared ``@njit`` helper (inlined or not) made Alg. 3.1 30-40% slower
+at 40x40x10 (castle, city; A/B of both kernels in one process, 16 shuffled rounds, identical
+copies within 5-9%).
 """
 
 from __future__ import annotations
 
+from enum import IntEnum
+from typing import NamedTuple
+
 import numpy as np
 from numba import njit
+from numpy.typing import NDArray
+
+# ----------------------------------------------------------------------------- return codes
+
+
+class Code(IntEnum):
+    """What a kernel run ended with (:func:`alg31`, :func:`mac_search`)."""
+
+    SOLVED = 0  #: every cell has a label
+    FAILED = 1  #: Alg. 3.1: a domain emptied (``Run.state[2]`` is that cell)
+    PAUSED = 2  #: the step or node budget of this call is used up: call again to resume
+    EXHAUSTED = 3  #: MAC: the search tree is exhausted, the problem is unsatisfiable
+    RESTART = 4  #: MAC: the failure cutoff of this run is reached (restart, then resume)
+    GROW = 5  #: MAC: the trail is nearly full (``Search.grown()``, then resume)
+
+
+# numba compiles module-level ints as constants; the enum stays on the Python side
+_SOLVED = int(Code.SOLVED)
+_FAILED = int(Code.FAILED)
+_PAUSED = int(Code.PAUSED)
+_EXHAUSTED = int(Code.EXHAUSTED)
+_RESTART = int(Code.RESTART)
+_GROW = int(Code.GROW)
+
+# ----------------------------------------------------------------------------- bundles
+
+
+class Arcs(NamedTuple):
+    """The static arrays of a compiled problem (built once per problem, never written)."""
+
+    full: NDArray[np.uint64]  #: ``(W,)`` bitset of every label
+    ptr: NDArray[np.int64]  #: ``(n + 1,)`` CSR row starts of the arcs of each cell
+    nbr: NDArray[np.int64]  #: neighbour of each arc end
+    sidx: NDArray[np.int64]  #: support index of each arc end (``2r`` or ``2r + 1``)
+    sup: NDArray[np.uint64]  #: ``(2R, K, W)`` supports of each label
+    supall: NDArray[np.uint64]  #: ``(2R, W)`` union of the supports of all labels
+    weights: NDArray[np.float64]  #: ``(K,)`` label weights
+    wlogw: NDArray[np.float64]  #: ``(K,)`` ``w log w`` (0 where ``w = 0``)
+
+
+class AcState(NamedTuple):
+    """The mutable arc-consistency state of one propagator."""
+
+    dom: NDArray[np.uint64]  #: ``(n, W)`` the catalog as bitsets
+    prev: NDArray[np.uint64]  #: ``(n, W)`` ``D(u)`` when ``u`` was last processed (0: unknown)
+    queue: NDArray[np.int64]  #: ``(n,)`` FIFO ring of cells (empty between calls)
+    inq: NDArray[np.bool_]  #: ``(n,)`` queue membership (all False between calls)
+    stats: NDArray[np.int64]  #: ``[queue pops, label removals]``
+
+
+class Heap(NamedTuple):
+    """Indexed min-heap of cells by entropy key (``min-entropy`` order; empty arrays: none)."""
+
+    heap: NDArray[np.int64]  #: cells in heap order
+    pos: NDArray[np.int64]  #: position of each cell in ``heap`` (-1: popped)
+    key: NDArray[np.float64]  #: entropy + tie-breaking noise of each cell
+    noise: NDArray[np.float64]  #: ``(n,)`` tie-breaking numbers in [0, 1)
+
+    @staticmethod
+    def empty() -> Heap:
+        z = np.zeros(0, dtype=np.int64)
+        return Heap(z, z, np.zeros(0, dtype=np.float64), np.zeros(0, dtype=np.float64))
+
+
+class Run(NamedTuple):
+    """One Alg. 3.1 run: ``state = [step, heap_size, fail_cell]``."""
+
+    order: NDArray[np.int64]  #: cell of each step (scan orders, ``random``)
+    ustream: NDArray[np.float64]  #: one uniform per step for the label choice
+    grid: NDArray[np.int32]  #: ``(n,)`` the labels assigned so far (-1: none)
+    trace_cell: NDArray[np.int64]  #: cell of each step
+    trace_label: NDArray[np.int64]  #: label of each step
+    state: NDArray[np.int64]  #: ``[step, heap_size, fail_cell]``
+
+    @property
+    def steps(self) -> int:
+        return int(self.state[0])
+
+    @property
+    def fail_cell(self) -> int:
+        return int(self.state[2])
+
+
+# MAC search state slots (Search.state)
+LEVEL, NEED, EPOCH, TLEN, NODES, FAILS, FAILS_RUN, RNG, SCAN = range(9)
+
+
+class Search(NamedTuple):
+    """One MAC search (:func:`mac_search`), resumable.
+
+    ``state = [level, need_choose, epoch, trail_len, nodes, fails, fails_since_restart, rng,
+    scan_pos]``. Level ``L >= 1`` is a decision on cell ``lv_cell[L]`` whose untried labels are
+    ``lv_cand[L]``; ``lv_trail[L]`` is the trail length before its first attempt. The trail
+    ``(tcell, tbits)`` holds the old domains of the cells changed since each decision.
+    """
+
+    stamp: NDArray[np.int64]  #: ``(n,)`` epoch in which a cell was last saved on the trail
+    state: NDArray[np.int64]  #: the 9 slots above
+    tcell: NDArray[np.int64]  #: trail: cell
+    tbits: NDArray[np.uint64]  #: trail: its domain before the change
+    lv_cell: NDArray[np.int64]
+    lv_cand: NDArray[np.uint64]
+    lv_trail: NDArray[np.int64]
+    lv_scan: NDArray[np.int64]
+    order: NDArray[np.int64]  #: cell sequence of the ``scanline`` order
+    counters: NDArray[np.int64]  #: ``[queue pops, label removals]`` of the search
+
+    @staticmethod
+    def new(n: int, W: int, seed: int) -> Search:
+        """A search at the root of ``n`` cells of ``W`` words, random numbers from ``seed``."""
+        cap = max(4 * n, 1024)
+        state = np.zeros(9, dtype=np.int64)
+        state[NEED] = 1
+        state[RNG] = seed
+        return Search(
+            stamp=np.full(n, -1, dtype=np.int64), state=state,
+            tcell=np.zeros(cap, dtype=np.int64), tbits=np.zeros((cap, W), dtype=np.uint64),
+            lv_cell=np.zeros(n + 2, dtype=np.int64),
+            lv_cand=np.zeros((n + 2, W), dtype=np.uint64),
+            lv_trail=np.zeros(n + 2, dtype=np.int64), lv_scan=np.zeros(n + 2, dtype=np.int64),
+            order=np.arange(n, dtype=np.int64), counters=np.zeros(2, dtype=np.int64),
+        )  # fmt: skip
+
+    def grown(self) -> Search:
+        """The same search with a trail twice as long (after :attr:`Code.GROW`)."""
+        cap = 2 * self.tcell.size
+        tcell = np.concatenate([self.tcell, np.zeros(cap - self.tcell.size, dtype=np.int64)])
+        W = self.tbits.shape[1]
+        tbits = np.concatenate([self.tbits, np.zeros((cap - self.tbits.shape[0], W), np.uint64)])
+        return self._replace(tcell=tcell, tbits=tbits)
+
+    @property
+    def nodes(self) -> int:
+        """Decisions so far (all runs)."""
+        return int(self.state[NODES])
+
+    @property
+    def fails(self) -> int:
+        """Wiped-out decisions so far (all runs)."""
+        return int(self.state[FAILS])
+
 
 # ----------------------------------------------------------------------------- bit helpers
 
@@ -172,26 +341,12 @@ def heap_pop(heap: np.ndarray, pos: np.ndarray, key: np.ndarray, size: int) -> i
 
 @njit(cache=True)
 def propagate(
-    dom: np.ndarray,
-    prev: np.ndarray,
-    full: np.ndarray,
-    ptr: np.ndarray,
-    nbr: np.ndarray,
-    sidx: np.ndarray,
-    sup: np.ndarray,
-    supall: np.ndarray,
-    queue: np.ndarray,
-    inq: np.ndarray,
+    arcs: Arcs,
+    ac: AcState,
     start: np.ndarray,
     nstart: int,
-    stats: np.ndarray,
-    heap: np.ndarray,
-    hpos: np.ndarray,
-    hkey: np.ndarray,
+    hp: Heap,
     hsize: int,
-    noise: np.ndarray,
-    weights: np.ndarray,
-    wlogw: np.ndarray,
     weighted: bool,
 ) -> int:
     """Arc consistency from the cells ``start[:nstart]``; returns the wiped-out cell or -1.
@@ -203,6 +358,11 @@ def propagate(
     ``stats[1]`` label removals. When ``hsize > 0`` the min-entropy heap keys of changed cells
     are updated. The queue is left empty on return (also after a wipe-out).
     """
+    dom, prev, queue, inq, stats = ac.dom, ac.prev, ac.queue, ac.inq, ac.stats
+    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
+    sup, supall = arcs.sup, arcs.supall
+    weights, wlogw = arcs.weights, arcs.wlogw
+    heap, hpos, hkey, noise = hp.heap, hp.pos, hp.key, hp.noise
     n = dom.shape[0]
     W = dom.shape[1]
     head = 0
@@ -374,45 +534,34 @@ def choose_label(dom: np.ndarray, v: int, u: float, weights: np.ndarray, weighte
 
 @njit(cache=True)
 def alg31(
-    dom: np.ndarray,
-    prev: np.ndarray,
-    full: np.ndarray,
-    ptr: np.ndarray,
-    nbr: np.ndarray,
-    sidx: np.ndarray,
-    sup: np.ndarray,
-    supall: np.ndarray,
-    queue: np.ndarray,
-    inq: np.ndarray,
-    order: np.ndarray,
+    arcs: Arcs,
+    ac: AcState,
+    run: Run,
+    hp: Heap,
     use_heap: bool,
-    ustream: np.ndarray,
-    noise: np.ndarray,
-    weights: np.ndarray,
-    wlogw: np.ndarray,
     weighted: bool,
-    grid: np.ndarray,
-    trace_cell: np.ndarray,
-    trace_label: np.ndarray,
-    state: np.ndarray,
     max_steps: int,
-    stats: np.ndarray,
-    heap: np.ndarray,
-    hpos: np.ndarray,
-    hkey: np.ndarray,
 ) -> int:
-    """Run Alg. 3.1 from step ``state[0]`` for at most ``max_steps`` assignments.
+    """Run Alg. 3.1 from step ``run.state[0]`` for at most ``max_steps`` assignments.
 
-    ``state = [step, heap_size, fail_cell]``. Returns 0 when every cell is assigned,
-    1 on failure (a domain emptied: ``state[2]`` is that cell), 2 when paused.
-    The catalog must already be arc consistent when the run starts.
+    ``state = [step, heap_size, fail_cell]``. Returns :attr:`Code.SOLVED` when every cell is
+    assigned, :attr:`Code.FAILED` when a domain emptied (``state[2]`` is that cell),
+    :attr:`Code.PAUSED` when ``max_steps`` were made. The cells come from ``run.order`` or,
+    with ``use_heap``, from the entropy heap ``hp``. The catalog must already be arc
+    consistent when the run starts.
     """
+    dom = ac.dom
+    stats = ac.stats
+    order, ustream, grid, state = run.order, run.ustream, run.grid, run.state
+    trace_cell, trace_label = run.trace_cell, run.trace_label
+    heap, hpos, hkey = hp.heap, hp.pos, hp.key
+    weights = arcs.weights
     n = dom.shape[0]
     start = np.empty(1, dtype=np.int64)
     steps_here = 0
     while state[0] < n:
         if steps_here >= max_steps:
-            return 2
+            return _PAUSED
         t = state[0]
         if use_heap:
             hsize = state[1]
@@ -423,7 +572,7 @@ def alg31(
         b = choose_label(dom, p, ustream[t], weights, weighted)
         if b < 0:
             state[2] = p
-            return 1
+            return _FAILED
         grid[p] = b
         trace_cell[t] = p
         trace_label[t] = b
@@ -439,11 +588,413 @@ def alg31(
                 changed = True
         if changed:
             start[0] = p
-            wiped = propagate(
-                dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
-                heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw, weighted,
-            )  # fmt: skip
+            wiped = propagate(arcs, ac, start, 1, hp, state[1] if use_heap else 0, weighted)
             if wiped >= 0:
                 state[2] = wiped
-                return 1
-    return 0
+                return _FAILED
+    return _SOLVED
+
+
+# ----------------------------------------------------------------------------- MAC search
+
+
+@njit(cache=True)
+def _rand(state: np.ndarray) -> float:
+    """splitmix64 uniform in [0, 1) from ``state[RNG]``."""
+    z = np.uint64(state[RNG]) + np.uint64(0x9E3779B97F4A7C15)
+    state[RNG] = np.int64(z)
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    z = z ^ (z >> np.uint64(31))
+    return float(z >> np.uint64(11)) / 9007199254740992.0
+
+
+@njit(cache=True)
+def _save(dom: np.ndarray, v: int, stamp: np.ndarray, state: np.ndarray,
+          tcell: np.ndarray, tbits: np.ndarray) -> None:  # fmt: skip
+    if stamp[v] != state[EPOCH]:
+        stamp[v] = state[EPOCH]
+        t = state[TLEN]
+        tcell[t] = v
+        for w in range(dom.shape[1]):
+            tbits[t, w] = dom[v, w]
+        state[TLEN] = t + 1
+
+
+@njit(cache=True)
+def _undo(dom: np.ndarray, to: int, state: np.ndarray, tcell: np.ndarray,
+          tbits: np.ndarray) -> None:  # fmt: skip
+    t = state[TLEN]
+    while t > to:
+        t -= 1
+        v = tcell[t]
+        for w in range(dom.shape[1]):
+            dom[v, w] = tbits[t, w]
+    state[TLEN] = to
+
+
+@njit(cache=True)
+def propagate_trail(arcs: Arcs, ac: AcState, start: int, se: Search) -> int:
+    """Arc consistency from cell ``start`` saving old domains on the trail; wiped cell or -1.
+
+    The revision of :func:`propagate` without its delta step (``ac.prev`` is not used);
+    ``se.counters`` counts queue pops and label removals.
+    """
+    dom, queue, inq = ac.dom, ac.queue, ac.inq
+    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
+    sup, supall = arcs.sup, arcs.supall
+    stamp, state, tcell, tbits, counters = se.stamp, se.state, se.tcell, se.tbits, se.counters
+    n = dom.shape[0]
+    W = dom.shape[1]
+    head = 0
+    tail = 1
+    count = 1
+    queue[0] = start
+    inq[start] = True
+    acc = np.empty(W, dtype=np.uint64)
+    wiped = -1
+    while count > 0:
+        u = queue[head]
+        head += 1
+        if head == n:
+            head = 0
+        count -= 1
+        inq[u] = False
+        counters[0] += 1
+        isfull = True
+        for w in range(W):
+            if dom[u, w] != full[w]:
+                isfull = False
+                break
+        for e in range(ptr[u], ptr[u + 1]):
+            v = nbr[e]
+            s = sidx[e]
+            if isfull:
+                for w in range(W):
+                    acc[w] = supall[s, w]
+            else:
+                for w in range(W):
+                    acc[w] = 0
+                covered = False
+                for w in range(W):
+                    x = dom[u, w]
+                    while x:
+                        a = w * 64 + ctz64(x)
+                        x &= x - np.uint64(1)
+                        cov = True
+                        for w2 in range(W):
+                            acc[w2] |= sup[s, a, w2]
+                            if dom[v, w2] & ~acc[w2]:
+                                cov = False
+                        if cov:
+                            covered = True
+                            break
+                    if covered:
+                        break
+                if covered:
+                    continue
+            changed = False
+            for w in range(W):
+                if dom[v, w] & ~acc[w]:
+                    changed = True
+                    break
+            if not changed:
+                continue
+            _save(dom, v, stamp, state, tcell, tbits)
+            empty = True
+            for w in range(W):
+                old = dom[v, w]
+                new = old & acc[w]
+                counters[1] += popcount64(old ^ new)
+                dom[v, w] = new
+                if new:
+                    empty = False
+            if empty:
+                wiped = v
+                break
+            if not inq[v]:
+                inq[v] = True
+                queue[tail] = v
+                tail += 1
+                if tail == n:
+                    tail = 0
+                count += 1
+        if wiped >= 0:
+            break
+    while count > 0:
+        inq[queue[head]] = False
+        head += 1
+        if head == n:
+            head = 0
+        count -= 1
+    return wiped
+
+
+@njit(cache=True)
+def _pick_label(cand: np.ndarray, weights: np.ndarray, weighted: bool, u: float) -> int:
+    W = cand.shape[0]
+    if weighted:
+        tot = 0.0
+        for w in range(W):
+            x = cand[w]
+            while x:
+                a = w * 64 + ctz64(x)
+                x &= x - np.uint64(1)
+                tot += weights[a]
+        if tot > 0.0:
+            target = u * tot
+            cum = 0.0
+            last = -1
+            for w in range(W):
+                x = cand[w]
+                while x:
+                    a = w * 64 + ctz64(x)
+                    x &= x - np.uint64(1)
+                    if weights[a] > 0.0:
+                        cum += weights[a]
+                        last = a
+                        if cum > target:
+                            return a
+            if last >= 0:
+                return last
+    c = 0
+    for w in range(W):
+        c += popcount64(cand[w])
+    j = int(u * c)
+    if j >= c:
+        j = c - 1
+    for w in range(W):
+        x = cand[w]
+        k = popcount64(x)
+        if j < k:
+            for _ in range(j):
+                x &= x - np.uint64(1)
+            return w * 64 + ctz64(x)
+        j -= k
+    return -1
+
+
+@njit(cache=True)
+def _choose_cell(dom: np.ndarray, scan: bool, order: np.ndarray, state: np.ndarray) -> int:
+    n = dom.shape[0]
+    if scan:
+        p = state[SCAN]
+        while p < n:
+            v = order[p]
+            if domain_size(dom, v) > 1:
+                state[SCAN] = p
+                return int(v)
+            p += 1
+        state[SCAN] = n
+        return -1
+    best = -1
+    bsize = 1 << 30
+    ties = 0
+    for v in range(n):
+        s = domain_size(dom, v)
+        if s <= 1:
+            continue
+        if s < bsize:
+            bsize = s
+            best = v
+            ties = 1
+        elif s == bsize:
+            ties += 1
+            if _rand(state) * ties < 1.0:
+                best = v
+    return best
+
+
+@njit(cache=True)
+def mac_search(
+    arcs: Arcs, ac: AcState, se: Search, scan: bool, weighted: bool, max_nodes: int,
+    restart_fails: int,
+) -> int:  # fmt: skip
+    """Run (or resume) a MAC search on the domains ``ac.dom`` (see :class:`Search`).
+
+    Each decision assigns a label (uniform, or by weight) to a cell (the first unassigned one
+    of ``se.order`` with ``scan``, else one of fewest labels) and runs
+    :func:`propagate_trail`; a wipe-out tries the cell's next label; a cell without labels
+    left backtracks chronologically. Returns :attr:`Code.SOLVED` (``ac.dom`` holds one label
+    per cell), :attr:`Code.EXHAUSTED` (no solution; the domains are back at the root),
+    :attr:`Code.RESTART` after ``restart_fails`` failures in this run (0: never; call
+    :func:`mac_restart`), :attr:`Code.PAUSED` after ``max_nodes`` decisions in this call,
+    :attr:`Code.GROW` when the trail is nearly full (resume with ``se.grown()``).
+    """
+    dom = ac.dom
+    state, tcell, tbits, lv_cell = se.state, se.tcell, se.tbits, se.lv_cell
+    lv_cand, lv_trail, lv_scan = se.lv_cand, se.lv_trail, se.lv_scan
+    stamp, order = se.stamp, se.order
+    weights = arcs.weights
+    n, W = dom.shape
+    nodes_here = 0
+    while True:
+        L = state[LEVEL]
+        if state[NEED] == 1:
+            if nodes_here >= max_nodes:
+                return _PAUSED
+            if tcell.shape[0] - state[TLEN] < n + 1:
+                return _GROW
+            v = _choose_cell(dom, scan, order, state)
+            if v < 0:
+                return _SOLVED
+            L += 1
+            state[LEVEL] = L
+            lv_cell[L] = v
+            lv_trail[L] = state[TLEN]
+            lv_scan[L] = state[SCAN]
+            for w in range(W):
+                lv_cand[L, w] = dom[v, w]
+            state[NEED] = 0
+            nodes_here += 1
+            state[NODES] += 1
+        # try the next untried label at level L
+        _undo(dom, lv_trail[L], state, tcell, tbits)
+        state[SCAN] = lv_scan[L]
+        empty = True
+        for w in range(W):
+            if lv_cand[L, w]:
+                empty = False
+                break
+        if empty:
+            # every label failed: backtrack to the parent decision
+            state[LEVEL] = L - 1
+            if L - 1 == 0:
+                _undo(dom, lv_trail[L], state, tcell, tbits)
+                return _EXHAUSTED
+            continue
+        if tcell.shape[0] - state[TLEN] < n + 1:
+            return _GROW
+        v = lv_cell[L]
+        b = _pick_label(lv_cand[L], weights, weighted, _rand(state))
+        wb = b // 64
+        bit = np.uint64(1) << np.uint64(b - wb * 64)
+        lv_cand[L, wb] &= ~bit
+        state[EPOCH] += 1
+        _save(dom, v, stamp, state, tcell, tbits)
+        for w in range(W):
+            dom[v, w] = bit if w == wb else np.uint64(0)
+        wiped = propagate_trail(arcs, ac, v, se)
+        if wiped >= 0:
+            state[FAILS] += 1
+            state[FAILS_RUN] += 1
+            if restart_fails > 0 and state[FAILS_RUN] >= restart_fails:
+                return _RESTART
+            continue
+        state[NEED] = 1
+
+
+@njit(cache=True)
+def mac_restart(ac: AcState, se: Search) -> None:
+    """Undo every decision of ``se`` (the domains go back to the root) for a new run."""
+    state = se.state
+    _undo(ac.dom, se.lv_trail[1], state, se.tcell, se.tbits)
+    state[LEVEL] = 0
+    state[NEED] = 1
+    state[SCAN] = 0
+    state[FAILS_RUN] = 0
+
+
+# ----------------------------------------------------------------------------- CNF encoders
+
+
+@njit(cache=True)
+def support_clauses(
+    bits: np.ndarray,
+    arcs: Arcs,
+    isconst: np.ndarray,
+    vid: np.ndarray,
+    forward_only: bool,
+    fill: bool,
+    lits: np.ndarray,
+    starts: np.ndarray,
+) -> tuple[int, int]:
+    """Support clauses of every non-constant cell; returns ``(clauses, literals)``.
+
+    With ``fill=False`` only counts (``lits``/``starts`` are not touched). Used by
+    :func:`csplab.cnf.encode`.
+    """
+    ptr, nbr, sidx, sup = arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup
+    n, W = bits.shape
+    nl = 0
+    nc = 0
+    for v in range(n):
+        if isconst[v]:
+            continue
+        for e in range(ptr[v], ptr[v + 1]):
+            s = sidx[e]
+            if forward_only and (s & 1) == 1:
+                continue
+            u = nbr[e]
+            for w in range(W):
+                x = bits[v, w]
+                while x:
+                    b = w * 64 + ctz64(x)
+                    x &= x - np.uint64(1)
+                    covered = True
+                    for w2 in range(W):
+                        if bits[u, w2] & ~sup[s, b, w2]:
+                            covered = False
+                            break
+                    if covered:
+                        continue
+                    if fill:
+                        starts[nc] = nl
+                        lits[nl] = -vid[v, b]
+                    nl += 1
+                    for w2 in range(W):
+                        y = bits[u, w2] & sup[s, b, w2]
+                        while y:
+                            c = w2 * 64 + ctz64(y)
+                            y &= y - np.uint64(1)
+                            if fill:
+                                lits[nl] = vid[u, c]
+                            nl += 1
+                    nc += 1
+    if fill:
+        starts[nc] = nl
+    return nc, nl
+
+
+@njit(cache=True)
+def direct_clauses(
+    bits: np.ndarray,
+    arcs: Arcs,
+    isconst: np.ndarray,
+    vid: np.ndarray,
+    fill: bool,
+    lits: np.ndarray,
+) -> int:
+    """Binary conflict clauses (each arc once, from its source); returns the count.
+
+    A constant cell (arc consistent, so compatible with all of its neighbours' labels) needs
+    none. Used by :func:`csplab.cnf.encode`.
+    """
+    ptr, nbr, sidx, sup = arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup
+    n, W = bits.shape
+    nc = 0
+    for v in range(n):
+        if isconst[v]:
+            continue
+        for e in range(ptr[v], ptr[v + 1]):
+            s = sidx[e]
+            if (s & 1) == 1:
+                continue
+            u = nbr[e]
+            for w in range(W):
+                x = bits[v, w]
+                while x:
+                    b = w * 64 + ctz64(x)
+                    x &= x - np.uint64(1)
+                    if isconst[u]:
+                        continue
+                    for w2 in range(W):
+                        y = bits[u, w2] & ~sup[s, b, w2]
+                        while y:
+                            c = w2 * 64 + ctz64(y)
+                            y &= y - np.uint64(1)
+                            if fill:
+                                lits[2 * nc] = -vid[v, b]
+                                lits[2 * nc + 1] = -vid[u, c]
+                            nc += 1
+    return nc

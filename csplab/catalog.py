@@ -9,7 +9,10 @@ occurs in some solution.
 
 :func:`propagate` runs the compiled bitset kernel of :mod:`csplab._kernels`;
 :func:`propagate_reference` is a slow, literal transcription of Alg. 3.2/3.3 kept for tests.
-:class:`Propagator` is the stateful engine solvers use (assign, propagate, save/restore).
+:class:`Propagator` is the stateful engine solvers use (assign, propagate, save/restore,
+and one method per compiled kernel: Alg. 3.1, MAC search); :class:`Run`, :class:`Heap` and
+:class:`Search` are the argument bundles of those kernels and :class:`Code` their return
+codes (defined in :mod:`csplab._kernels`).
 
 Examples
 --------
@@ -35,11 +38,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab import _kernels as kern
+from csplab._kernels import Code, Heap, Run, Search
 from csplab.errors import InputError
 from csplab.problem import Problem
 
 __all__ = [
+    "Code",
+    "Heap",
     "Propagator",
+    "Run",
+    "Search",
     "assign",
     "initial_catalog",
     "pack",
@@ -108,6 +116,11 @@ class _Compiled:
         self.weights = np.ascontiguousarray(w)
         with np.errstate(divide="ignore", invalid="ignore"):
             self.wlogw = np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0)
+        # the same arrays as one kernel argument
+        self.arcs = kern.Arcs(
+            self.full, self.ptr, self.nbr, self.sidx, self.sup, self.supall, self.weights,
+            self.wlogw,
+        )  # fmt: skip
 
 
 class Propagator:
@@ -115,7 +128,10 @@ class Propagator:
 
     The state is the packed catalog ``bits`` (``uint64 (n, W)``). :meth:`assign` and
     :meth:`restrict` shrink it and propagate; :meth:`save`/:meth:`load` copy it for
-    backtracking.
+    backtracking. The compiled kernels of :mod:`csplab._kernels` that work on this state are
+    called only through the methods here, one per kernel: :meth:`propagate` (arc
+    consistency), :meth:`alg31` (Alg. 3.1), :meth:`mac_search` and :meth:`mac_restart`
+    (the ``backtrack`` solver).
 
     Parameters
     ----------
@@ -150,8 +166,6 @@ class Propagator:
         self._queue = np.zeros(max(n, 1), dtype=np.int64)
         self._inq = np.zeros(max(n, 1), dtype=np.bool_)
         self.stats = np.zeros(2, dtype=np.int64)  # pops, removals
-        self._nohp = np.zeros(0, dtype=np.int64)
-        self._nohk = np.zeros(0, dtype=np.float64)
         self.ok = bool(np.all(self.bits.any(axis=1))) if n else True
         self.wiped: int = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
         if propagate_initial and self.ok:
@@ -167,12 +181,7 @@ class Propagator:
             if changed is None
             else np.ascontiguousarray(np.asarray(changed, dtype=np.int64).ravel())
         )
-        c = self.c
-        wiped = kern.propagate(
-            self.bits, self.prev, c.full, c.ptr, c.nbr, c.sidx, c.sup, c.supall, self._queue,
-            self._inq, start, start.size, self.stats, self._nohp, self._nohp, self._nohk, 0,
-            self._nohk, c.weights, c.wlogw, False,
-        )  # fmt: skip
+        wiped = kern.propagate(self.c.arcs, self._ac(), start, start.size, _NO_HEAP, 0, False)
         if wiped >= 0:
             self.ok = False
             self.wiped = int(wiped)
@@ -208,6 +217,56 @@ class Propagator:
             self.wiped = int(cell)
             return False
         return self.propagate([cell])
+
+    # --------------------------------------------------------------- kernels
+    def _ac(self) -> kern.AcState:
+        """The mutable state as one kernel argument (built per call: arrays may be replaced)."""
+        return kern.AcState(self.bits, self.prev, self._queue, self._inq, self.stats)
+
+    def alg31(
+        self, run: Run, heap: Heap | None = None, *, weighted: bool = False,
+        max_steps: int | None = None,
+    ) -> Code:  # fmt: skip
+        """Run (or resume) Alg. 3.1 on this catalog: :func:`csplab._kernels.alg31`.
+
+        The cells come from ``run.order``, or from the entropy ``heap`` when one is given;
+        labels are drawn uniformly or, with ``weighted``, by the problem's weights. Stops
+        after ``max_steps`` assignments (default: none) with :attr:`~csplab._kernels.Code.PAUSED`.
+        On :attr:`~csplab._kernels.Code.FAILED` the engine is marked wiped out (``ok``,
+        ``wiped``). The catalog must be arc consistent (``ok``) when the run starts.
+        """
+        n = self.c.n
+        code = kern.alg31(
+            self.c.arcs, self._ac(), run, _NO_HEAP if heap is None else heap,
+            heap is not None, weighted, n + 1 if max_steps is None else int(max_steps),
+        )  # fmt: skip
+        result = Code(code)
+        if result is Code.FAILED:
+            self.ok = False
+            self.wiped = run.fail_cell
+        return result
+
+    def mac_search(
+        self, search: Search, *, scan: bool = False, weighted: bool = False,
+        max_nodes: int, restart_fails: int = 0,
+    ) -> Code:  # fmt: skip
+        """Run (or resume) a MAC search on this catalog: :func:`csplab._kernels.mac_search`.
+
+        ``search`` (:meth:`csplab._kernels.Search.new`) holds the decisions and the trail;
+        the catalog is changed in place and stays inside the catalog at the first call (the
+        trail only restores), so :meth:`propagate` remains valid afterwards. Codes:
+        ``SOLVED`` (the catalog holds one label per cell), ``EXHAUSTED`` (unsatisfiable; the
+        catalog is back at the root), ``RESTART`` (call :meth:`mac_restart`), ``PAUSED``
+        (``max_nodes`` decisions made), ``GROW`` (continue with ``search.grown()``).
+        """
+        code = kern.mac_search(
+            self.c.arcs, self._ac(), search, scan, weighted, int(max_nodes), int(restart_fails)
+        )
+        return Code(code)
+
+    def mac_restart(self, search: Search) -> None:
+        """Undo every decision of ``search`` (:func:`csplab._kernels.mac_restart`)."""
+        kern.mac_restart(self._ac(), search)
 
     # --------------------------------------------------------------- state
     def save(self) -> tuple[NDArray[np.uint64], NDArray[np.uint64], bool, int]:
@@ -346,6 +405,8 @@ def reference_fixpoint(
                 return False
     return True
 
+
+_NO_HEAP = Heap.empty()  # read-only: kernels touch the heap only when its size is > 0
 
 # the compiled arrays of a problem live as long as the problem (keyed weakly by the object)
 _COMPILED: weakref.WeakKeyDictionary[Problem, _Compiled] = weakref.WeakKeyDictionary()

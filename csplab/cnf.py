@@ -1,5 +1,9 @@
 """CNF encodings of a :class:`~csplab.problem.Problem`, built with numpy and numba.
 
+The clause loops are the compiled :func:`csplab._kernels.support_clauses` and
+:func:`csplab._kernels.direct_clauses` (kept in :mod:`csplab._kernels` with the helpers they
+inline: see its kernel cache rule).
+
 One Boolean variable ``x[v, b]`` means "cell ``v`` has label ``b``". Variables exist only
 for pairs in the arc-consistent catalog C of the problem (Alg. 3.2; pruning is sound by
 Theorem 3.3.2), and only for cells with more than one label left: a cell with a single
@@ -54,10 +58,9 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike, NDArray
 
-from csplab._kernels import ctz64
+from csplab import _kernels as kern
 from csplab.catalog import Propagator
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -84,114 +87,6 @@ AMO_ENCODINGS = (
     "sortnetwrk",
     "cardnetwrk",
 )
-
-
-# ----------------------------------------------------------------------------- kernels
-
-
-@njit(cache=True)
-def _support_clauses(
-    bits: np.ndarray,
-    isconst: np.ndarray,
-    vid: np.ndarray,
-    ptr: np.ndarray,
-    nbr: np.ndarray,
-    sidx: np.ndarray,
-    sup: np.ndarray,
-    forward_only: bool,
-    fill: bool,
-    lits: np.ndarray,
-    starts: np.ndarray,
-) -> tuple[int, int]:
-    """Support clauses of every non-constant cell; returns ``(clauses, literals)``.
-
-    With ``fill=False`` only counts (``lits``/``starts`` are not touched).
-    """
-    n, W = bits.shape
-    nl = 0
-    nc = 0
-    for v in range(n):
-        if isconst[v]:
-            continue
-        for e in range(ptr[v], ptr[v + 1]):
-            s = sidx[e]
-            if forward_only and (s & 1) == 1:
-                continue
-            u = nbr[e]
-            for w in range(W):
-                x = bits[v, w]
-                while x:
-                    b = w * 64 + ctz64(x)
-                    x &= x - np.uint64(1)
-                    covered = True
-                    for w2 in range(W):
-                        if bits[u, w2] & ~sup[s, b, w2]:
-                            covered = False
-                            break
-                    if covered:
-                        continue
-                    if fill:
-                        starts[nc] = nl
-                        lits[nl] = -vid[v, b]
-                    nl += 1
-                    for w2 in range(W):
-                        y = bits[u, w2] & sup[s, b, w2]
-                        while y:
-                            c = w2 * 64 + ctz64(y)
-                            y &= y - np.uint64(1)
-                            if fill:
-                                lits[nl] = vid[u, c]
-                            nl += 1
-                    nc += 1
-    if fill:
-        starts[nc] = nl
-    return nc, nl
-
-
-@njit(cache=True)
-def _direct_clauses(
-    bits: np.ndarray,
-    isconst: np.ndarray,
-    vid: np.ndarray,
-    ptr: np.ndarray,
-    nbr: np.ndarray,
-    sidx: np.ndarray,
-    sup: np.ndarray,
-    fill: bool,
-    lits: np.ndarray,
-) -> int:
-    """Binary conflict clauses (each arc once, from its source); returns the count.
-
-    A constant cell (arc consistent, so compatible with all of its neighbours' labels) needs
-    none.
-    """
-    n, W = bits.shape
-    nc = 0
-    for v in range(n):
-        if isconst[v]:
-            continue
-        for e in range(ptr[v], ptr[v + 1]):
-            s = sidx[e]
-            if (s & 1) == 1:
-                continue
-            u = nbr[e]
-            for w in range(W):
-                x = bits[v, w]
-                while x:
-                    b = w * 64 + ctz64(x)
-                    x &= x - np.uint64(1)
-                    if isconst[u]:
-                        continue
-                    for w2 in range(W):
-                        y = bits[u, w2] & ~sup[s, b, w2]
-                        while y:
-                            c = w2 * 64 + ctz64(y)
-                            y &= y - np.uint64(1)
-                            if fill:
-                                lits[2 * nc] = -vid[v, b]
-                                lits[2 * nc + 1] = -vid[u, c]
-                            nc += 1
-    return nc
 
 
 # ----------------------------------------------------------------------------- encoding
@@ -352,23 +247,21 @@ def encode(
     dummy_s = np.zeros(1, dtype=np.int64)
     if encoding == "support":
         fwd = supports == "forward"
-        nc, nl = _support_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, fwd,
-                                  False, dummy_l, dummy_s)  # fmt: skip
+        nc, nl = kern.support_clauses(eng.bits, c.arcs, single, var, fwd, False, dummy_l, dummy_s)
         _check_size(nl, encoding)
         _check_deadline(deadline)
         lits = np.empty(nl, dtype=np.int32)
         starts = np.empty(nc + 1, dtype=np.int64)
-        _support_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, fwd, True, lits,
-                         starts)  # fmt: skip
+        kern.support_clauses(eng.bits, c.arcs, single, var, fwd, True, lits, starts)
         parts_l.append(lits)
         parts_s.append(np.diff(starts))
         stats["support_clauses"] = nc
     else:
-        nc = _direct_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, False, dummy_l)
+        nc = kern.direct_clauses(eng.bits, c.arcs, single, var, False, dummy_l)
         _check_size(2 * nc, encoding)
         _check_deadline(deadline)
         lits = np.empty(2 * nc, dtype=np.int32)
-        _direct_clauses(eng.bits, single, var, c.ptr, c.nbr, c.sidx, c.sup, True, lits)
+        kern.direct_clauses(eng.bits, c.arcs, single, var, True, lits)
         parts_l.append(lits)
         parts_s.append(np.full(nc, 2, dtype=np.int64))
         stats["conflict_clauses"] = nc
