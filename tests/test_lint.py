@@ -17,8 +17,12 @@ def _tool(name):
 
 @pytest.mark.parametrize(
     "cmd",
-    [["ruff", "check", "csplab", "tests", "benchmarks", "experiments"], ["mypy"]],
-    ids=["ruff", "mypy"],
+    [
+        ["ruff", "check", "csplab", "tests", "benchmarks", "experiments"],
+        ["mypy"],
+        ["lint-imports"],
+    ],
+    ids=["ruff", "mypy", "import-layers"],
 )
 def test_clean(cmd):
     exe = _tool(cmd[0])
@@ -27,3 +31,36 @@ def test_clean(cmd):
     args = cmd[1:2] + [a for a in cmd[2:] if (ROOT / a).exists()]
     r = subprocess.run([exe, *args], cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout[-4000:] + r.stderr[-2000:]
+
+
+def _private_imports():
+    """(file, line, what) for every import of a ``_private`` name or module of another
+    package (``from csplab.x import _y`` where the importer is not in ``csplab.x``'s package)."""
+    import ast
+
+    out = []
+    for path in sorted((ROOT / "csplab").rglob("*.py")):
+        rel = path.relative_to(ROOT).with_suffix("")
+        parts = list(rel.parts)
+        if parts[-1] == "__init__":
+            parts = parts[:-1]
+        pkg = ".".join(parts if path.name == "__init__.py" else parts[:-1])
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(node, ast.ImportFrom) or not (node.module or "").startswith("csplab"):
+                continue
+            mod = node.module or ""
+            for alias in node.names:
+                full = f"{mod}.{alias.name}"
+                private = [
+                    p for p in full.split(".") if p.startswith("_") and not p.startswith("__")
+                ]
+                if not private:
+                    continue
+                owner = full.split("." + private[0])[0]  # the package that holds the private part
+                if pkg != owner and not pkg.startswith(owner + "."):
+                    out.append(f"{rel}.py:{node.lineno}: {full}")
+    return out
+
+
+def test_no_module_imports_another_packages_private_names():
+    assert _private_imports() == []

@@ -208,7 +208,7 @@ def scan_axes(ndim: int, order: str) -> tuple[int, ...]:
     )
 
 
-def _parse_region(region: Sequence[int] | str | int, ndim: int) -> tuple[int, ...]:
+def parse_region(region: Sequence[int] | str | int, ndim: int) -> tuple[int, ...]:
     if isinstance(region, int):
         r = (region,) * ndim
     elif isinstance(region, str):
@@ -264,7 +264,7 @@ def region_catalog(
     from csplab.catalog import Propagator
 
     G = np.asarray(grid)
-    r = _parse_region(region, G.ndim)
+    r = parse_region(region, G.ndim)
     lo, hi = region_box(p, G.shape, r)
     sl = tuple(slice(a, b + 1) for a, b in zip(lo, hi, strict=True))
     sub = G[sl]
@@ -442,7 +442,7 @@ def prove_infallible(
     rules = Rules.of(example)
     ndim = rules.ndim
     axes = scan_axes(ndim, order)
-    r = _parse_region(region, ndim)
+    r = parse_region(region, ndim)
     hist = (int(history),) * ndim if isinstance(history, int) else tuple(int(h) for h in history)
     if len(hist) != ndim or any(h < 0 for h in hist):
         raise InputError(f"history needs {ndim} non-negative values, got {history!r}")
@@ -608,7 +608,7 @@ def alg36_failure(
     if len(shp) < rules.ndim:
         shp = shp + (1,) * (rules.ndim - len(shp))
     axes = scan_axes(len(shp), order)
-    r = _parse_region(region, len(shp))
+    r = parse_region(region, len(shp))
     t0 = time.perf_counter()
     try:
         run, states = _alg36_search(rules, shp, r, axes, {}, None, max_states)

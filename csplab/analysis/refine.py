@@ -39,7 +39,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.analysis.infallible import _parse_region, prove_infallible
+from csplab.analysis.infallible import parse_region, prove_infallible
 from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.problem import AXIS_NAMES, Problem
@@ -249,7 +249,7 @@ def to_infallible(
         ``holds=False`` is never returned: not finding a refinement proves nothing.
     """
     t0 = time.perf_counter()
-    regs = [_parse_region(r, example.ndim) for r in regions]
+    regs = [parse_region(r, example.ndim) for r in regions]
     stats: dict[str, Any] = {"candidates": 0, "proofs": 0, "lift_checks": 0}
     if check_sizes is None:
         check_sizes = [(3, 3), (4, 3), (3, 4), (4, 2), (5, 3)] if example.ndim == 2 else []

@@ -52,14 +52,14 @@ _SAMPLERS: OrderedDict[tuple[Any, ...], StripSampler] = OrderedDict()
 
 
 def _sampler(trial: Trial, problem: Problem) -> StripSampler:
-    from csplab.experiments.trial import _LOCK
+    from csplab.experiments.trial import TRIAL_LOCK
 
     key = (trial.example_hash, trial.size, trial.boundary, trial.periodic)
-    with _LOCK:
+    with TRIAL_LOCK:
         S = _SAMPLERS.get(key)
     if S is None:
         S = StripSampler(problem)
-        with _LOCK:
+        with TRIAL_LOCK:
             _SAMPLERS[key] = S
             while len(_SAMPLERS) > 4:
                 _SAMPLERS.popitem(last=False)

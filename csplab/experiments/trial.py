@@ -119,7 +119,7 @@ class Trial:
 # ------------------------------------------------------------------------------ worker side
 
 _PROBLEMS: OrderedDict[tuple[Any, ...], Problem] = OrderedDict()
-_LOCK = threading.Lock()  # Dask workers may run several trials in threads
+TRIAL_LOCK = threading.Lock()  # Dask workers may run several trials in threads
 _WARM = False
 
 
@@ -133,7 +133,7 @@ def parse_boundary(text: str) -> Any:
 def problem_for(trial: Trial, example: ExampleModel) -> Problem:
     """The trial's problem, built once per process and kept in a small cache."""
     key = (trial.example_hash, trial.size, trial.boundary, trial.periodic)
-    with _LOCK:
+    with TRIAL_LOCK:
         P = _PROBLEMS.get(key)
         if P is not None:
             _PROBLEMS.move_to_end(key)
@@ -141,7 +141,7 @@ def problem_for(trial: Trial, example: ExampleModel) -> Problem:
     P = Problem.from_example(
         example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
     )
-    with _LOCK:
+    with TRIAL_LOCK:
         _PROBLEMS[key] = P
         while len(_PROBLEMS) > 6:
             _PROBLEMS.popitem(last=False)
@@ -150,7 +150,7 @@ def problem_for(trial: Trial, example: ExampleModel) -> Problem:
 
 def _warmup() -> None:
     global _WARM
-    with _LOCK:
+    with TRIAL_LOCK:
         if not _WARM:
             from csplab.engine.alg31 import jit_warmup
 
