@@ -117,8 +117,20 @@ def test_propagator_save_load_copy():
     eng.load(st_)
     assert eng.sizes().tolist() == [2] * 9
     other = eng.copy()
-    assert not other.assign(0, 0) or True
+    assert other.sizes().tolist() == [2] * 9  # the copy starts in the same state
+    # the checkerboard (0 and 1 alternate on both axes) has exactly two 3x3 models, so
+    # fixing one cell forces all nine: label (x + y) % 2 for a 0 at the origin
+    assert other.assign(0, 0) and other.ok
+    want = [[False, True] if (x + y) % 2 else [True, False] for x in range(3) for y in range(3)]
+    assert other.catalog().tolist() == want
+    assert eng.sizes().tolist() == [2] * 9  # ... and the original did not move
+    third = eng.copy()
+    assert eng.assign(0, 1) and eng.sizes().tolist() == [1] * 9
+    assert third.sizes().tolist() == [2] * 9 and other.catalog().tolist() == want
+    fourth = eng.copy()  # a copy of an engine with assignments keeps them
+    eng.load(st_)
     assert eng.sizes().tolist() == [2] * 9
+    assert fourth.catalog().tolist() == [w[::-1] for w in want]
     assert eng.restrict(4, [False, True])
     assert eng.catalog()[0].tolist() == [False, True]
     assert not eng.assign(0, 0) and not eng.ok

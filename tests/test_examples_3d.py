@@ -37,8 +37,46 @@ def test_registered_and_loadable(name):
     assert np.all(E.counts() > 0)  # every label occurs
 
 
+def _grid_file(name):
+    return Path(build3d.__file__).parent / build3d.EXAMPLES3D[name].file
+
+
+def _read_by_hand(path):
+    """A ``.grid`` file read with plain Python and numpy, not csplab.io: the ``key: value``
+    header fields and every label number of the body (layers separated by blank lines)."""
+    head, nums = {}, []
+    for line in path.read_text(encoding="utf-8").splitlines():
+        if line.startswith("#") or not line.strip():
+            continue
+        key, sep, val = line.partition(":")
+        if sep and key.strip().isidentifier():
+            head[key.strip()] = val.strip()
+        else:
+            nums += [int(v) for v in line.split()]
+    return head, np.array(nums)
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_labels_counted_from_the_file_and_from_the_voxel_scene(name):
+    head, data = _read_by_hand(_grid_file(name))
+    shape = tuple(int(v) for v in head["shape"].split("x"))
+    names = head["labels"].split()
+    K = len(names)
+    assert data.size == np.prod(shape)
+    assert np.array_equal(np.unique(data), np.arange(K))  # labels 0..K-1, each one used
+    # a label is the pattern of the four voxels a cell holds: one per distinct pattern
+    V = build3d.build_scene(name).V
+    quarters = np.stack([V[:-1, :-1], V[1:, :-1], V[:-1, 1:], V[1:, 1:]], axis=-1)
+    assert len(np.unique(quarters.reshape(-1, 4), axis=0)) == K
+    # what csplab reads and builds agrees with the hand count
+    E = load_example(name)
+    assert E.K == K and build3d.build(name).K == K and list(E.names) == names
+    assert E.shape == shape
+    assert np.array_equal(E.counts(), np.bincount(data, minlength=K))
+
+
 def test_label_counts():
-    K = {n: build3d.build(n).K for n in NAMES}
+    K = {n: len(_read_by_hand(_grid_file(n))[0]["labels"].split()) for n in NAMES}
     assert len(K) >= 3
     assert all(40 <= k <= 120 for k in K.values()), K
     assert any(55 <= k <= 65 for k in K.values()), K  # the "about 60" benchmark example

@@ -78,9 +78,45 @@ def test_blocks_from_given_init_and_bad_init():
 
 
 def test_block_stats_and_timeout():
+    # 6x6 blocks on 20 cells start every 3 cells, the last flush with the end:
+    # 0, 3, 6, 9, 12, 14 -> 6 x 6 = 36 blocks
     P = Problem.from_example(load_example("line"), (20, 20))
     r = solve(P, "blocks", rng=0, block=(6, 6))
-    assert r.stats["blocks_tried"] == len(block_starts(20, 6)) ** 2
-    assert r.stats["blocks_accepted"] + 0 <= r.stats["blocks_tried"]
+    assert r.stats["blocks_tried"] == 36
+    assert r.stats["acceptance_rate"] == r.stats["blocks_accepted"] / 36
+    # every pair of labels is adjacent on both axes in this example, so Alg. 3.1 cannot fail
+    # in any block: all 36 are accepted at the first attempt
+    E = ExampleModel([[0, 0, 1, 1], [0, 0, 1, 1], [1, 1, 0, 0], [1, 1, 0, 0]])
+    assert E.transitions().all()
+    r = solve(Problem.from_example(E, (20, 20)), "blocks", rng=0, block=(6, 6), retries=5)
+    stats = {k: r.stats[k] for k in ("blocks_tried", "blocks_accepted", "retries")}
+    assert stats == {"blocks_tried": 36, "blocks_accepted": 36, "retries": 0}
     t = solve(P, "blocks", rng=0, block=4, time_limit=0.0)
     assert t.status == "timeout" and P.is_solution(t.grid)
+
+
+@pytest.mark.parametrize("shape", [(4, 4), (5, 5)])
+def test_acceptance_and_retries_replay_alg31_attempts(shape):
+    """One block covering the model: Alg. 3.4 runs Alg. 3.1 on it up to ``retries + 1``
+    times from one generator, so the attempts can be replayed with the catalog solver
+    (same generator, same order): the block is accepted iff one attempt solves it, the
+    retries are the failed attempts before that one, and the output is that attempt's grid
+    (or the untouched trivial solution). This example makes Alg. 3.1 fail often."""
+    R = 3
+    P = Problem.from_example(ExampleModel(np.array([[0, 0, 0], [1, 2, 2], [0, 1, 2]])), shape)
+    start = trivial_solution(P)
+    seen = set()
+    for seed in range(25):
+        gen = np.random.default_rng(seed)
+        runs = [solve(P, "catalog", rng=gen) for _ in range(R + 1)]
+        first = next((i for i, a in enumerate(runs) if a.status == "solved"), None)
+        r = solve(P, "blocks", rng=seed, block=max(shape), retries=R)
+        assert r.stats["blocks_tried"] == 1
+        if first is None:
+            assert (r.stats["blocks_accepted"], r.stats["retries"]) == (0, R)
+            assert np.array_equal(r.grid, start)
+        else:
+            assert (r.stats["blocks_accepted"], r.stats["retries"]) == (1, first)
+            assert np.array_equal(r.grid, runs[first].grid)
+        seen.add(first)
+    assert None in seen and len(seen) >= 3  # rejections and several retry counts occurred

@@ -1,3 +1,5 @@
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -78,16 +80,45 @@ def test_unsat_and_failure_statuses():
     assert r2.status in ("solved", "failed")
 
 
+# chi-square with 2 degrees of freedom: P(X > x) = exp(-x / 2), so 1e-6 at 2 ln(1e6) = 27.6
+CHI2_2DOF_P1E6 = 2 * math.log(1e6)
+
+
+def _chi2(counts, probs):
+    expected = counts.sum() * np.asarray(probs, dtype=float)
+    return float(((counts - expected) ** 2 / expected).sum())
+
+
+def _label_counts(P, choice, seeds=40):
+    counts = np.zeros(P.K)
+    for s in range(seeds):
+        r = solve(P, "catalog", rng=s, choice=choice)
+        assert r.ok
+        counts += np.bincount(r.grid.ravel(), minlength=P.K)
+    return counts
+
+
 def test_weighted_choice_follows_weights():
-    E = ExampleModel([0, 0, 1], weights=[1.0, 99.0])
-    E2 = ExampleModel([[0, 1], [1, 1]])
-    P = Problem.from_example(E2, (20, 20))
-    r = solve(P, "catalog", rng=0, choice="weighted")
-    assert r.ok
-    P1 = Problem.from_example(ExampleModel([[0, 0], [0, 1]], weights=[1.0, 50.0]), (30, 1))
-    # 1 may follow 0 and vice versa (x axis), so weighted choice picks mostly 1s
-    r1 = solve(P1, "catalog", rng=1, choice="weighted")
-    assert E.K == 2 and r1.ok
+    """The example is a de Bruijn sequence (every ordered pair of the 3 labels occurs), so
+    every label may follow every label: the catalog of each cell is always all 3 labels and
+    Alg. 3.1 draws the cells independently, with probability w / sum(w) under weighted
+    choice and 1/3 under uniform choice. 40 seeds x 60 cells = 2400 draws per setting."""
+    seq = [0, 0, 1, 0, 2, 1, 1, 2, 2, 0]
+    uniform = [1 / 3] * 3
+    for w in ([1.0, 2.0, 5.0], [6.0, 1.0, 1.0]):
+        P = Problem.from_example(ExampleModel(seq, weights=w), (60,))
+        assert P.domains.all() and P.K == 3
+        p = np.array(w) / sum(w)
+        weighted = _label_counts(P, "weighted")
+        assert _chi2(weighted, p) < CHI2_2DOF_P1E6, (w, weighted)
+        assert _chi2(weighted, uniform) > CHI2_2DOF_P1E6, (w, weighted)
+        flat = _label_counts(P, "uniform")  # the weights only matter to weighted choice
+        assert _chi2(flat, uniform) < CHI2_2DOF_P1E6, (w, flat)
+        assert _chi2(flat, p) > CHI2_2DOF_P1E6, (w, flat)
+    # a label of weight 0 is never chosen while another label is possible
+    P0 = Problem.from_example(ExampleModel(seq, weights=[1.0, 1.0, 0.0]), (60,))
+    zero = _label_counts(P0, "weighted", seeds=10)
+    assert zero[2] == 0 and zero[0] > 0 and zero[1] > 0
 
 
 def test_time_limit_and_bad_options():
