@@ -48,24 +48,26 @@ import numpy as np
 
 from csplab.errors import FormatError
 from csplab.io._json import load_json
-from csplab.io.ruleset import DomainOp, RuleSet, _Warnings
+from csplab.io.common import KIND, NO, LoaderWarnings, json_like, read_bytes
+from csplab.io.ruleset import DomainOp, RuleSet
 from csplab.io.symmetry import Group, square_group
 
-__all__ = ["parse_debroglie", "read_debroglie"]
+__all__ = ["parse_debroglie", "read_debroglie", "sniff"]
 
 _SIDES = {  # DeBroglie side name -> csplab face (DeBroglie y points down)
     "xmin": "x-", "xmax": "x+", "ymin": "y+", "ymax": "y-", "zmin": "z-", "zmax": "z+",
 }  # fmt: skip
 
 
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.KIND` for JSON (a POMS ``"rule"`` list scores higher)."""
+    return KIND if json_like(head) else NO
+
+
 def read_debroglie(path: str | Path, *, strict: bool = False) -> RuleSet:
     """Read a DeBroglie JSON config (see the module docstring)."""
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_debroglie(data, path=p, strict=strict)
+    return parse_debroglie(read_bytes(p), path=p, strict=strict)
 
 
 def _key(v: Any, what: str, path: object) -> Any:
@@ -87,7 +89,7 @@ def parse_debroglie(
     d = load_json(text, path=path, comments=True)
     if not isinstance(d, dict):
         raise FormatError("a DeBroglie config is a JSON object", path=path)
-    warn = _Warnings(path)
+    warn = LoaderWarnings(path)
 
     def unsupported(msg: str) -> None:
         if strict:

@@ -51,23 +51,24 @@ from numpy.typing import NDArray
 
 from csplab.errors import FormatError, InputError
 from csplab.io._xml import Node, parse_xml
-from csplab.io.ruleset import RuleSet, _Warnings
+from csplab.io.common import NO, SURE, LoaderWarnings, read_bytes, xml_bool, xml_float, xml_root
+from csplab.io.ruleset import RuleSet
 from csplab.io.symmetry import Group, Orientations, cube_group, expand_rules, square_group
-from csplab.io.wfc import _bool, _float
 
-__all__ = ["parse_markovjunior", "read_markovjunior", "transform_voxels"]
+__all__ = ["parse_markovjunior", "read_markovjunior", "sniff", "transform_voxels"]
 
 _DIRS = [(a, s) for a in range(3) for s in (1, -1)]
+
+
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for XML whose root element is ``<tileset>``."""
+    return SURE if xml_root(head) == "tileset" else NO
 
 
 def read_markovjunior(path: str | Path) -> RuleSet:
     """Read a MarkovJunior tileset XML file (see the module docstring)."""
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_markovjunior(data, path=p)
+    return parse_markovjunior(read_bytes(p), path=p)
 
 
 def transform_voxels(vox: NDArray[Any], m: NDArray[np.int64]) -> NDArray[Any]:
@@ -86,8 +87,8 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
     """Parse MarkovJunior tileset XML into a :class:`RuleSet` (tile ``.vox`` files are
     looked up next to ``path``)."""
     root = parse_xml(text, path=path)
-    warn = _Warnings(path)
-    full = _bool(root, "fullSymmetry", False, path)
+    warn = LoaderWarnings(path)
+    full = xml_bool(root, "fullSymmetry", False, path)
     G: Group = cube_group() if full else square_group(3)
     xtiles = root.find("tiles")
     if xtiles is None:
@@ -101,7 +102,7 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
         if nm in seen:
             raise FormatError(f"tile {nm!r} is defined twice", path=path, line=xt.line)
         seen[nm] = len(tiles)
-        tiles.append((nm, _float(xt, "weight", 1.0, path), xt.line))
+        tiles.append((nm, xml_float(xt, "weight", 1.0, path), xt.line))
     if not tiles:
         raise FormatError("the tileset has no tiles", path=path, line=xtiles.line)
 
@@ -309,7 +310,7 @@ def _infer_stabilizers(
     return stabs, arms
 
 
-def _voxels(path: object, names: list[str], warn: _Warnings) -> list[NDArray[np.uint8]] | None:
+def _voxels(path: object, names: list[str], warn: LoaderWarnings) -> list[NDArray[np.uint8]] | None:
     p = Path(str(path))
     folder = p.parent / p.stem
     if not folder.is_dir():

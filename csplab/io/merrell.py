@@ -32,8 +32,31 @@ import numpy as np
 
 from csplab.errors import FormatError
 from csplab.example import ExampleModel
+from csplab.io.common import NO, PLAUSIBLE, Output, read_text, text_lines
 
-__all__ = ["format_merrell", "parse_merrell", "read_merrell", "write_merrell"]
+__all__ = [
+    "format_merrell",
+    "parse_merrell",
+    "read_merrell",
+    "sniff",
+    "write_merrell",
+    "write_output",
+]
+
+
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.PLAUSIBLE` when the fourth line starts with three positive
+    integers (the size line).
+
+    Examples
+    --------
+    >>> sniff(b"house\\n\\n\\n3 3 2\\n1 1 1\\n"), sniff(b"0 1\\n1 0\\n")
+    (1, 0)
+    """
+    lines = text_lines(head, 4)
+    toks = lines[3].split()[:3] if len(lines) == 4 else []
+    ok = len(toks) == 3 and all(t.isdigit() and int(t) > 0 for t in toks)
+    return PLAUSIBLE if ok else NO
 
 
 def parse_merrell(text: str, *, path: object = "<string>", name: str = "") -> ExampleModel:
@@ -104,11 +127,7 @@ def parse_merrell(text: str, *, path: object = "<string>", name: str = "") -> Ex
 def read_merrell(path: str | Path) -> ExampleModel:
     """Read a Merrell-format file."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8", errors="replace")
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_merrell(text, path=p, name=p.stem)
+    return parse_merrell(read_text(p), path=p, name=p.stem)
 
 
 def format_merrell(example: ExampleModel) -> str:
@@ -143,3 +162,8 @@ def format_merrell(example: ExampleModel) -> str:
 
 def write_merrell(example: ExampleModel, path: str | Path) -> None:
     Path(path).write_text(format_merrell(example), encoding="utf-8")
+
+
+def write_output(out: Output, path: Path) -> None:
+    """The grid (at most 3D, no unassigned cells) in Merrell's format."""
+    write_merrell(out.to_example(), path)

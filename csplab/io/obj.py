@@ -38,8 +38,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import FormatError, InputError
+from csplab.io.common import Output, read_text
 
-__all__ = ["Mesh", "parse_obj", "read_obj", "write_obj"]
+__all__ = ["Mesh", "parse_obj", "read_obj", "write_obj", "write_output"]
 
 # cube faces: (axis, side) -> 4 corners (dx, dy, dz), counter-clockwise seen from outside
 _FACES: dict[tuple[int, int], list[tuple[int, int, int]]] = {
@@ -200,15 +201,19 @@ def write_obj(
     }
 
 
+def write_output(out: Output, path: Path) -> None:
+    """The grid as a mesh (a rule set's voxel tiles composited, or its pieces placed)."""
+    out = out.tile_voxels()
+    write_obj(
+        out.grid, path, empty=out.empty, colors=out.colors, names=out.names, pieces=out.pieces
+    )
+
+
 def read_obj(path: str | Path) -> Mesh:
     """Read an OBJ file (``v``, ``vn``, ``f``, ``usemtl``, ``mtllib``; other statements are
     skipped) and the colours of its material libraries when present."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8", errors="replace")
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    mesh = parse_obj(text, path=p)
+    mesh = parse_obj(read_text(p), path=p)
     for lib in mesh.mtllibs:
         f = p.parent / lib
         if f.is_file():

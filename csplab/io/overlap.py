@@ -35,9 +35,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import FormatError, InputError
+from csplab.io.common import NO, SURE, load_image
 from csplab.io.ruleset import DomainOp, RuleSet
 
-__all__ = ["OverlapModel"]
+__all__ = ["OverlapModel", "sniff"]
+
+_MAGIC = (b"\x89PNG", b"GIF87a", b"GIF89a")
+
+
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for a PNG or GIF picture (a sample)."""
+    return SURE if head.startswith(_MAGIC) else NO
+
 
 MAX_PATTERNS = 4000
 
@@ -191,8 +200,6 @@ class OverlapModel(RuleSet):
     ) -> OverlapModel:
         """The overlapping model of a picture; colours are numbered in order of first
         appearance (rows from the top), the picture's ``y`` axis is turned to point up."""
-        from csplab.io.wfc import load_image
-
         p = Path(path)
         img = load_image(p)
         if img.shape[0] * img.shape[1] > 256 * 256:

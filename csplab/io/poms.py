@@ -44,6 +44,7 @@ Examples
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any, Literal
 
@@ -52,10 +53,11 @@ from numpy.typing import NDArray
 
 from csplab.errors import FormatError
 from csplab.io._json import load_json
-from csplab.io.ruleset import DomainOp, RuleSet, _Warnings
+from csplab.io.common import NO, SURE, LoaderWarnings, json_like, load_image, read_bytes
+from csplab.io.ruleset import DomainOp, RuleSet
 from csplab.problem import AXIS_NAMES
 
-__all__ = ["parse_poms", "read_poms"]
+__all__ = ["parse_poms", "read_poms", "sniff"]
 
 MAX_TILES = 100_000
 _DIRS = [(0, 1), (0, -1), (1, 1), (1, -1), (2, 1), (2, -1)]  # POMS dir -> (axis, sign)
@@ -71,14 +73,15 @@ _OPS = {
 }
 
 
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for JSON with a ``"rule"`` key."""
+    return SURE if json_like(head) and re.search(rb'"rule"\s*:', head) else NO
+
+
 def read_poms(path: str | Path, *, up: Literal["auto", "y", "z"] = "auto") -> RuleSet:
     """Read a POMS JSON config (see the module docstring)."""
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_poms(data, path=p, up=up)
+    return parse_poms(read_bytes(p), path=p, up=up)
 
 
 def _int(v: Any, what: str, path: object) -> int:
@@ -104,7 +107,7 @@ def parse_poms(
     d = load_json(text, path=path)
     if not isinstance(d, dict):
         raise FormatError("a POMS config is a JSON object", path=path)
-    warn = _Warnings(path)
+    warn = LoaderWarnings(path)
     rules = d.get("rule")
     if not isinstance(rules, list) or not rules:
         raise FormatError("'rule' must be a non-empty list of [src, dst, dir, val]", path=path)
@@ -290,7 +293,7 @@ def parse_poms(
     )
 
 
-def _pieces(objmap: Any, path: object, K: int, warn: _Warnings) -> dict[int, str]:
+def _pieces(objmap: Any, path: object, K: int, warn: LoaderWarnings) -> dict[int, str]:
     if objmap is None:
         return {}
     if not isinstance(objmap, list) or len(objmap) != K:
@@ -310,7 +313,7 @@ def _pieces(objmap: Any, path: object, K: int, warn: _Warnings) -> dict[int, str
     return out
 
 
-def _tile_images(ts: Any, path: object, K: int, warn: _Warnings) -> NDArray[np.uint8] | None:
+def _tile_images(ts: Any, path: object, K: int, warn: LoaderWarnings) -> NDArray[np.uint8] | None:
     """Tiled-style tileset image: tile ``t >= 1`` is image tile ``t - 1`` (row major)."""
     if not isinstance(ts, dict) or not isinstance(ts.get("image"), str):
         return None
@@ -318,8 +321,6 @@ def _tile_images(ts: Any, path: object, K: int, warn: _Warnings) -> NDArray[np.u
     f = next((r / ts["image"] for r in (base, base.parent) if (r / ts["image"]).is_file()), None)
     if f is None:
         return None
-    from csplab.io.wfc import load_image
-
     img = load_image(f)
     try:
         tw, th = int(ts["tilewidth"]), int(ts["tileheight"])

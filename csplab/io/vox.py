@@ -32,8 +32,18 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import FormatError, InputError
+from csplab.io.common import NO, SURE, Output, read_bytes
 
-__all__ = ["VoxModel", "parse_vox", "read_vox", "read_vox_example", "vox_bytes", "write_vox"]
+__all__ = [
+    "VoxModel",
+    "parse_vox",
+    "read_vox",
+    "read_vox_example",
+    "sniff",
+    "vox_bytes",
+    "write_output",
+    "write_vox",
+]
 
 MAX_SIDE = 256
 
@@ -179,20 +189,20 @@ def parse_vox(data: bytes, *, path: object = "<bytes>") -> VoxModel:
     return VoxModel(grid, pal, models=len(sizes))
 
 
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for the ``"VOX "`` magic number."""
+    return SURE if head.startswith(b"VOX ") else NO
+
+
 def read_vox(path: str | Path) -> VoxModel:
     """Read the first model of a ``.vox`` file."""
-    p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_vox(data, path=p)
+    return parse_vox(read_bytes(path), path=Path(path))
 
 
 def read_vox_example(path: str | Path) -> Any:
     """A voxel model as an :class:`~csplab.example.ExampleModel`: label 0 is empty space,
     labels ``1, 2, ...`` the colour indices in use (their palette colours are kept in
-    ``metadata["colors"]`` and the names are ``"c<index>"``)."""
+    ``metadata["colors"]``, ``metadata["empty"]`` is 0 and the names are ``"c<index>"``)."""
     from csplab.example import ExampleModel
 
     vox = read_vox(path)
@@ -203,5 +213,28 @@ def read_vox_example(path: str | Path) -> Any:
     labels = lut[vox.grid]
     names = ["empty", *(f"c{int(c)}" for c in used)]
     colors = np.concatenate([[[225, 225, 225]], vox.palette[used, :3]]).astype(int).tolist()
-    meta = {"format": "vox", "source": str(path), "colors": colors, "models": vox.models}
+    meta = {
+        "format": "vox",
+        "source": str(path),
+        "colors": colors,
+        "empty": 0,
+        "models": vox.models,
+    }
     return ExampleModel(labels, names=names, name=Path(path).stem, metadata=meta)
+
+
+def write_output(out: Output, path: Path) -> None:
+    """The grid as a voxel model (a rule set's voxel tiles composited when they fit)."""
+    vox = out.tile_voxels()
+    if vox is not out and max(vox.grid.shape) > MAX_SIDE:
+        import warnings
+
+        warnings.warn(
+            f"{path}: the tile voxels make a {'x'.join(map(str, vox.grid.shape))} model, more "
+            f"than .vox holds ({MAX_SIDE} per axis); writing one voxel per cell",
+            UserWarning,
+            stacklevel=3,
+        )
+    else:
+        out = vox
+    write_vox(out.grid, path, empty=out.empty, colors=out.colors)

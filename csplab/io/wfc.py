@@ -48,10 +48,20 @@ from numpy.typing import NDArray
 
 from csplab.errors import FormatError
 from csplab.io._xml import Node, parse_xml
-from csplab.io.ruleset import RuleSet, _Warnings
+from csplab.io.common import (
+    KIND,
+    NO,
+    LoaderWarnings,
+    load_image,
+    read_bytes,
+    xml_bool,
+    xml_float,
+    xml_root,
+)
+from csplab.io.ruleset import RuleSet
 from csplab.io.symmetry import Group, Orientations, expand_rules, square_group
 
-__all__ = ["CARDINALITY", "parse_wfc", "read_wfc", "stabilizer_words"]
+__all__ = ["CARDINALITY", "parse_wfc", "read_wfc", "sniff", "stabilizer_words"]
 
 CARDINALITY = {"X": 1, "L": 4, "T": 4, "I": 2, "\\": 2, "F": 8}
 # words generating the symmetry group of orientation 0 (a: quarter turn +x -> +y, b: x-mirror)
@@ -71,34 +81,6 @@ def stabilizer_words(symmetry: str) -> list[str]:
     return list(_STAB[symmetry])
 
 
-def _bool(node: Node, key: str, default: bool, path: object) -> bool:
-    v = node.get(key)
-    if v is None:
-        return default
-    if v.strip().lower() in ("true", "1", "yes"):
-        return True
-    if v.strip().lower() in ("false", "0", "no"):
-        return False
-    raise FormatError(f"<{node.tag}> {key}={v!r} is not True or False", path=path, line=node.line)
-
-
-def _float(node: Node, key: str, default: float, path: object) -> float:
-    v = node.get(key)
-    if v is None:
-        return default
-    try:
-        f = float(v)
-    except ValueError:
-        raise FormatError(
-            f"<{node.tag}> {key}={v!r} is not a number", path=path, line=node.line
-        ) from None
-    if not np.isfinite(f) or f < 0:
-        raise FormatError(
-            f"<{node.tag}> {key}={v!r} must be a non-negative number", path=path, line=node.line
-        )
-    return f
-
-
 def _transform(img: NDArray[np.uint8], word: str) -> NDArray[np.uint8]:
     """Apply a word in ``a`` (counter-clockwise quarter turn) and ``b`` (left-right mirror) to
     an image array (rows top to bottom), right to left."""
@@ -108,33 +90,15 @@ def _transform(img: NDArray[np.uint8], word: str) -> NDArray[np.uint8]:
     return np.ascontiguousarray(out)
 
 
-def load_image(path: Path, *, where: object = None) -> NDArray[np.uint8]:
-    """An RGBA uint8 array (rows top to bottom) from an image file, as a FormatError on
-    anything unreadable."""
-    from PIL import Image
-
-    try:
-        with Image.open(path) as im:
-            if im.width * im.height > 4_000_000:
-                raise FormatError(f"image {im.width}x{im.height} is too large", path=path)
-            arr = np.asarray(im.convert("RGBA"), dtype=np.uint8)
-    except FormatError:
-        raise
-    except Exception as e:  # PIL raises many kinds of errors on bad files
-        raise FormatError(
-            f"cannot read image ({type(e).__name__}: {e})", path=where or path
-        ) from None
-    return arr
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.KIND` for XML (a MarkovJunior ``<tileset>`` scores higher)."""
+    return NO if xml_root(head) is None else KIND
 
 
 def read_wfc(path: str | Path, *, subset: str | None = None, images: bool = True) -> RuleSet:
     """Read a WaveFunctionCollapse simple-tiled XML tileset (see the module docstring)."""
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as e:
-        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
-    return parse_wfc(data, path=p, subset=subset, images=images)
+    return parse_wfc(read_bytes(p), path=p, subset=subset, images=images)
 
 
 def parse_wfc(
@@ -150,11 +114,11 @@ def parse_wfc(
 
 
 def _build(root: Node, *, path: object, subset: str | None, images: bool) -> RuleSet:
-    warn = _Warnings(path)
+    warn = LoaderWarnings(path)
     xtiles = root.find("tiles")
     if xtiles is None:
         raise FormatError(f"<{root.tag}> has no <tiles> element", path=path, line=root.line)
-    unique = _bool(root, "unique", False, path)
+    unique = xml_bool(root, "unique", False, path)
     wanted: set[str] | None = None
     if subset is not None:
         xsubsets = root.find("subsets")
@@ -193,7 +157,7 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
                 path=path,
                 line=xt.line,
             )
-        w = _float(xt, "weight", 1.0, path)
+        w = xml_float(xt, "weight", 1.0, path)
         if wanted is not None and nm not in wanted:
             continue
         seen[nm] = len(tiles)
@@ -284,7 +248,11 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
 
 
 def _images(
-    path: object, tiles: list[tuple[str, str, float, int]], unique: bool, G: Group, warn: _Warnings
+    path: object,
+    tiles: list[tuple[str, str, float, int]],
+    unique: bool,
+    G: Group,
+    warn: LoaderWarnings,
 ) -> NDArray[np.uint8] | None:
     p = Path(str(path))
     if not p.parent.exists():

@@ -1,0 +1,265 @@
+"""Helpers the format modules share: reading files, loader warnings, XML attributes,
+images, content sniffing and :class:`Output` (a label grid on its way to a file).
+
+Every name here is public within :mod:`csplab.io`; a format module never imports another
+format module's private names.
+
+Examples
+--------
+>>> xml_root(b'<?xml version="1.0"?>\\n<tileset size="3">'), xml_root(b"3 3 1")
+('tileset', None)
+>>> json_like(b"// a comment\\n{}"), json_like(b"0 1 2")
+(True, False)
+>>> out = Output.of([[0, 1], [1, 0]], names=["sea", "land"])
+>>> out.grid.dtype, out.names, out.to_example().K
+(dtype('int32'), ('sea', 'land'), 2)
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from csplab.errors import FormatError
+
+if TYPE_CHECKING:
+    from csplab.example import ExampleModel
+    from csplab.io._xml import Node
+    from csplab.io.ruleset import RuleSet
+
+__all__ = [
+    "KIND",
+    "NO",
+    "PLAUSIBLE",
+    "SURE",
+    "LoaderWarnings",
+    "Output",
+    "json_like",
+    "load_image",
+    "read_bytes",
+    "read_text",
+    "text_lines",
+    "xml_bool",
+    "xml_float",
+    "xml_root",
+]
+
+# sniffing scores (the highest wins, see csplab.io.registry): not this format; text that
+# could be it; the right kind of file (XML, JSON, a numeric grid); certain (a magic number,
+# a distinguishing root element or key)
+NO, PLAUSIBLE, KIND, SURE = 0, 1, 2, 3
+
+_LEAD = b"\xef\xbb\xbf \t\r\n"  # a UTF-8 byte order mark and white space
+
+
+# ---------------------------------------------------------------------------- files
+def read_bytes(path: str | Path, limit: int | None = None) -> bytes:
+    """The file's bytes (the first ``limit`` only, if given); a :class:`FormatError` naming
+    the file when it cannot be read."""
+    p = Path(path)
+    try:
+        with open(p, "rb") as fh:
+            return fh.read() if limit is None else fh.read(limit)
+    except OSError as e:
+        raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
+
+
+def read_text(path: str | Path) -> str:
+    """The file as UTF-8 text (undecodable bytes replaced), as :func:`read_bytes`."""
+    return read_bytes(path).decode("utf-8", errors="replace")
+
+
+# ---------------------------------------------------------------------------- sniffing
+def xml_root(head: bytes) -> str | None:
+    """The lower-case root tag of XML bytes (``""`` when none is visible), or ``None``
+    when the bytes do not start like XML."""
+    if not head.lstrip(_LEAD).startswith(b"<"):
+        return None
+    m = re.search(rb"<\s*([A-Za-z_][\w.-]*)", re.sub(rb"<[?!][^>]*>", b"", head))
+    return m.group(1).decode().lower() if m else ""
+
+
+def json_like(head: bytes) -> bool:
+    """Whether the bytes start like JSON (an object or array, or a ``//``/``/*`` comment)."""
+    return head.lstrip(_LEAD).startswith((b"{", b"[", b"//", b"/*"))
+
+
+def text_lines(head: bytes, n: int) -> list[str]:
+    """The first ``n`` lines of the bytes as text."""
+    return head.decode("utf-8", errors="replace").splitlines()[:n]
+
+
+# ---------------------------------------------------------------------------- loaders
+@dataclass
+class LoaderWarnings:
+    """Collects a loader's warnings (each also emitted as a :class:`UserWarning` naming the
+    file); ``items`` goes into the model's ``meta["warnings"]``."""
+
+    path: object
+    items: list[str] = field(default_factory=list)
+
+    def add(self, message: str) -> None:
+        self.items.append(message)
+        warnings.warn(f"{self.path}: {message}", UserWarning, stacklevel=3)
+
+
+def xml_bool(node: Node, key: str, default: bool, path: object) -> bool:
+    """A ``True``/``False`` attribute of an XML element."""
+    v = node.get(key)
+    if v is None:
+        return default
+    if v.strip().lower() in ("true", "1", "yes"):
+        return True
+    if v.strip().lower() in ("false", "0", "no"):
+        return False
+    raise FormatError(f"<{node.tag}> {key}={v!r} is not True or False", path=path, line=node.line)
+
+
+def xml_float(node: Node, key: str, default: float, path: object) -> float:
+    """A non-negative number attribute of an XML element."""
+    v = node.get(key)
+    if v is None:
+        return default
+    try:
+        f = float(v)
+    except ValueError:
+        raise FormatError(
+            f"<{node.tag}> {key}={v!r} is not a number", path=path, line=node.line
+        ) from None
+    if not np.isfinite(f) or f < 0:
+        raise FormatError(
+            f"<{node.tag}> {key}={v!r} must be a non-negative number", path=path, line=node.line
+        )
+    return f
+
+
+def load_image(path: Path, *, where: object = None) -> NDArray[np.uint8]:
+    """An RGBA uint8 array (rows top to bottom) from an image file, as a FormatError on
+    anything unreadable."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as im:
+            if im.width * im.height > 4_000_000:
+                raise FormatError(f"image {im.width}x{im.height} is too large", path=path)
+            arr = np.asarray(im.convert("RGBA"), dtype=np.uint8)
+    except FormatError:
+        raise
+    except Exception as e:  # PIL raises many kinds of errors on bad files
+        raise FormatError(
+            f"cannot read image ({type(e).__name__}: {e})", path=where or path
+        ) from None
+    return arr
+
+
+# ---------------------------------------------------------------------------- writers
+@dataclass(frozen=True, eq=False)
+class Output:
+    """A label grid to write, with what its model says about the labels.
+
+    Build it with :meth:`of`; every writer of :mod:`csplab.io.registry` takes one.
+
+    Attributes
+    ----------
+    grid : int32 array
+        Labels, ``-1`` for unassigned cells.
+    names, name, metadata :
+        Label names, the model's name and metadata (kept by the text formats).
+    model : ExampleModel or RuleSet, optional
+        Supplies tile pictures, voxels and pieces.
+    periodic : bool, optional
+        Whether the grid wraps around (pictures of the overlapping model depend on it).
+    colors, empty, pieces :
+        One RGB colour per label, the empty-space label and label -> mesh file.
+    example : ExampleModel, optional
+        Written as it is by the example formats (set by :func:`csplab.io.write_example`).
+    """
+
+    grid: NDArray[np.int32]
+    names: tuple[str, ...] | None = None
+    name: str = ""
+    metadata: Mapping[str, Any] = field(default_factory=dict)
+    model: ExampleModel | RuleSet | None = None
+    periodic: bool | None = None
+    colors: NDArray[np.uint8] | None = None
+    empty: int | None = None
+    pieces: Mapping[int, str] = field(default_factory=dict)
+    example: ExampleModel | None = None
+
+    @classmethod
+    def of(
+        cls,
+        grid: ArrayLike,
+        *,
+        model: ExampleModel | RuleSet | None = None,
+        names: Sequence[str] | None = None,
+        name: str = "",
+        metadata: Mapping[str, Any] | None = None,
+        periodic: bool | None = None,
+        example: ExampleModel | None = None,
+    ) -> Output:
+        """The output of ``grid``; names, colours, the empty label and pieces come from
+        ``model`` unless given."""
+        from csplab.example import ExampleModel
+        from csplab.io.ruleset import RuleSet
+
+        g = np.asarray(grid, dtype=np.int32)
+        if names is None and model is not None:
+            names = model.names
+        colors = empty = None
+        pieces: dict[int, str] = {}
+        if isinstance(model, RuleSet):
+            colors = model.label_colors()
+            empty = model.empty
+            pieces = dict(model.meta.get("pieces", {}))
+        elif isinstance(model, ExampleModel) and model.metadata.get("colors") is not None:
+            colors = np.asarray(model.metadata["colors"], dtype=np.uint8)
+            empty = model.metadata.get("empty")
+        return cls(
+            g,
+            names=None if names is None else tuple(str(n) for n in names),
+            name=name,
+            metadata=dict(metadata or {}),
+            model=model,
+            periodic=periodic,
+            colors=colors,
+            empty=empty,
+            pieces=pieces,
+            example=example,
+        )
+
+    def to_example(self) -> ExampleModel:
+        """The grid as an :class:`ExampleModel` (``example`` when set)."""
+        from csplab.example import ExampleModel
+
+        if self.example is not None:
+            return self.example
+        return ExampleModel(self.grid, names=self.names, name=self.name, metadata=self.metadata)
+
+    def tile_voxels(self) -> Output:
+        """The grid with every cell replaced by its tile's voxels (a rule set with voxel
+        tiles, as MarkovJunior writes them): colour ``c`` becomes label ``c - 1``, empty
+        voxels ``-1``; ``self`` when the model has no voxel tiles."""
+        from csplab.io.ruleset import RuleSet
+
+        m = self.model
+        if not isinstance(m, RuleSet) or m.voxels is None:
+            return self
+        vox = m.expand_voxels(self.grid)
+        assert m.voxel_palette is not None
+        return Output(
+            vox.astype(np.int32) - 1,
+            name=self.name,
+            metadata=self.metadata,
+            model=m,
+            periodic=self.periodic,
+            colors=m.voxel_palette[1:],
+            empty=-1,
+        )

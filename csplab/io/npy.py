@@ -1,0 +1,52 @@
+"""NumPy ``.npy`` label grids: an int array indexed ``[x, y, z]`` (``-1`` = unassigned in
+results).
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> from csplab.io.common import Output
+>>> with tempfile.TemporaryDirectory() as d:
+...     p = pathlib.Path(d) / "g.npy"
+...     write_output(Output.of([[0, 1], [1, 0]]), p)
+...     read_npy(p).labels.tolist()
+[[0, 1], [1, 0]]
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from csplab.errors import FormatError, InputError
+from csplab.example import ExampleModel
+from csplab.io.common import NO, SURE, Output
+
+__all__ = ["read_npy", "sniff", "write_output"]
+
+MAGIC = b"\x93NUMPY"
+
+
+def sniff(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for the ``.npy`` magic number."""
+    return SURE if head.startswith(MAGIC) else NO
+
+
+def read_npy(path: str | Path) -> ExampleModel:
+    """An example model from an ``.npy`` int array (no pickles)."""
+    p = Path(path)
+    try:
+        arr = np.load(p, allow_pickle=False)
+    except Exception as e:  # numpy raises many kinds of errors on damaged files
+        raise FormatError(f"not a readable .npy array ({e})", path=p) from None
+    if not np.issubdtype(arr.dtype, np.integer):
+        raise FormatError(f".npy array must hold integers, got {arr.dtype}", path=p)
+    try:
+        return ExampleModel(arr, name=p.stem, metadata={"format": "npy", "source": str(p)})
+    except InputError as e:
+        raise FormatError(str(e), path=p) from None
+
+
+def write_output(out: Output, path: Path) -> None:
+    """The grid as an int32 array."""
+    np.save(path, out.grid)

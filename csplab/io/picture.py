@@ -1,0 +1,39 @@
+"""PNG pictures of label grids (written, never read as grids: a ``.png`` read as a model is
+an overlapping-model sample, :mod:`csplab.io.overlap`).
+
+2D grids are drawn as one coloured square per cell, or with a rule set's tile pictures;
+3D grids as an isometric view of the non-empty cells (:func:`csplab.render.render`).
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> from PIL import Image
+>>> from csplab.io.common import Output
+>>> with tempfile.TemporaryDirectory() as d:
+...     p = pathlib.Path(d) / "g.png"
+...     write_output(Output.of([[0, 1], [1, 0]]), p)
+...     Image.open(p).format
+'PNG'
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from csplab.io.common import Output
+
+__all__ = ["write_output"]
+
+
+def write_output(out: Output, path: Path) -> None:
+    """A picture of the grid: the rule set's own (tile pictures, voxels, the overlapping
+    model's colours) or one colour per label."""
+    from csplab.io.ruleset import RuleSet
+
+    if isinstance(out.model, RuleSet):
+        out.model.render(out.grid, periodic=out.periodic).save(path, format="PNG")
+        return
+    from csplab.render import render
+
+    K = len(out.names) if out.names is not None else None
+    render(out.grid, K=K, colors=out.colors).save(path, format="PNG")
