@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.grids import parse_boundary, parse_shape
+from csplab.io.registry import input_help, option_help
 from csplab.io.ruleset import RuleSet
 from csplab.problem import Problem
 
@@ -49,39 +50,29 @@ def model_options(items: list[str] | None) -> dict[str, Any]:
 
 
 def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
-    """A built-in example name or a model file path (any format of :func:`read_model`)."""
-    from csplab.examples import ALIASES, EXAMPLES, load_example
+    """:func:`csplab.io.load_model`, printing the loader's warnings to stderr, one line
+    each."""
+    import sys
+    import warnings
 
-    p = Path(spec)
-    if p.exists():
-        import sys
-        import warnings
+    from csplab.io import load_model as load
 
-        from csplab.io import read_model
-
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
-            model = read_model(p, **(options or {}))
-        for w in caught:  # one line each, no source location
-            print(f"csplab: warning: {w.message}", file=sys.stderr)
-        return model
-    if options:
-        raise InputError("--model-option applies to model files only")
-    if spec in EXAMPLES or spec in ALIASES:
-        return load_example(spec)
-    if p.suffix or "/" in spec or "\\" in spec:
-        raise FormatError("no such file", path=spec)
-    raise InputError(
-        f"{spec!r} is neither a model file nor a built-in example "
-        f"({', '.join(EXAMPLES)}); see `csplab info`"
-    )
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model = load(spec, options)
+    for w in caught:  # one line each, no source location
+        print(f"csplab: warning: {w.message}", file=sys.stderr)
+    return model
 
 
 def load_grid(path: str, ndim: int) -> NDArray[np.int32]:
-    """Read a label grid from ``.npy``, Merrell ``.txt`` or ``.grid`` with ``ndim`` axes."""
+    """Read a label grid with ``ndim`` axes from a file that keeps label ids (``.npy``,
+    ``.txt``, ``.grid``: the registry's ``exact`` formats)."""
     from csplab.io import read_example
+    from csplab.io.registry import detect
 
-    g = np.asarray(read_example(path).labels)
+    fmt = detect(path, gives="ExampleModel", exact=True).name if Path(path).is_file() else None
+    g = np.asarray(read_example(path, format=fmt).labels)
     while g.ndim > ndim and g.shape[-1] == 1:
         g = g[..., 0]
     if g.ndim != ndim:
@@ -93,8 +84,7 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
     p.add_argument(
         "model",
         metavar="MODEL",
-        help="built-in example name or model file (example grid .txt/.grid/.npy/.vox, or "
-        "tileset: WFC/MarkovJunior .xml, POMS/DeBroglie .json, overlapping-model .png)",
+        help=f"built-in example name or model file ({input_help()}; see `csplab info`)",
     )
     p.add_argument(
         "--size",
@@ -119,9 +109,7 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help="option for the model file's loader (repeatable): subset=NAME (WFC), "
-        "N=3, symmetry=8, periodic_input=true, ground=true (PNG sample), up=y|z (POMS), "
-        "strict=true (DeBroglie)",
+        help=f"option for the model file's loader (repeatable): {option_help()}",
     )
     p.set_defaults(_size_required=size_required)
 

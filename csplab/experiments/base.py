@@ -83,7 +83,7 @@ def size_for(example: ExampleModel, s: int, nz: int) -> tuple[int, ...]:
 
 def load_examples(specs: Sequence[str]) -> list[tuple[str, ExampleModel]]:
     """Built-in names or model files -> ``(spec, ExampleModel)``; bad input raises one line."""
-    from csplab.cli.common import load_model
+    from csplab.io import load_model
 
     if not specs:
         raise InputError("no example model given")
