@@ -13,6 +13,8 @@ consistency) is a polynomial over-approximation: ``C* <= C`` (Theorem 3.3.2), an
   chosen label was in C* (one SAT call only when the label differs from the last witness
   solution), where the model first became inconsistent, and how many steps later the
   catalog emptied.
+* :func:`is_consistent` asks the same completability oracle
+  (:class:`~csplab.engine.completability.SatCompletability`) once.
 * :func:`explain_unsat` finds a minimal set of the problem's unary restrictions (fixed
   cells, boundary faces, masks; :attr:`Problem.unary`) that is already unsatisfiable, from
   assumption cores and deletion-based minimisation.
@@ -42,6 +44,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.catalog import propagate
+from csplab.engine.completability import PrefixTimeout, SatCompletability, catalog_at
 from csplab.engine.sat import SatOracle, preferred_labels
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -106,9 +109,9 @@ def is_consistent(problem: Problem, partial: ArrayLike | None = None,
     False
     """
     flat = _partial_array(problem, partial)
-    with SatOracle(problem, backend=backend) as o:
-        _fix(o, flat)
-        return o.solve() == "sat"
+    idx = np.flatnonzero(flat >= 0)
+    with SatCompletability(problem, backend=backend) as o:
+        return o.completable(idx, flat[idx]) is True
 
 
 def exact_catalog(
@@ -244,15 +247,17 @@ def catalog_gap(
     first_bad: dict[str, Any] | None = None
     consistent = True
     calls = 0
-    with SatOracle(problem, backend=backend, deadline=deadline) as o:
-        status = o.solve(deadline=deadline)
+    # one oracle for the whole replay: each good step is fixed in it for good, so a query
+    # only assumes the one label asked about
+    with SatCompletability(problem, backend=backend, deadline=deadline) as o:
+        status = o.completable([], [])
         calls += 1
-        if status == "timeout":
+        if status is None:
             return Verdict(None, None, {**stats, "calls": calls}, "time limit")
-        if status == "unsat":
+        if not status:
             consistent = False
             stats["unsat"] = True
-        witness = None if o.grid is None else o.grid.reshape(-1).copy()
+        witness = o.solution
         for t, (p, b) in enumerate(trace.tolist()):
             entry: list[Any] = [list(problem.coords(p)), int(b)]
             if not consistent:
@@ -260,26 +265,28 @@ def catalog_gap(
                 steps.append([*entry, False, *([None, 0] if sizes else [])])
                 continue
             assert witness is not None
-            lit = o.literal(p, b)
-            inside = bool(witness[p] == b)
+            inside: bool | None = bool(witness[p] == b)
             if not inside:
-                st = o.solve([lit], deadline=deadline)
+                inside = o.completable([p], [b])
                 calls += 1
-                if st == "timeout":
+                if inside is None:
                     stats.update(calls=calls, steps=steps)
                     return Verdict(None, None, stats, "time limit")
-                inside = st == "sat"
                 if inside:
-                    assert o.grid is not None
-                    witness = o.grid.reshape(-1).copy()
+                    witness = o.solution
             extra: list[Any] = []
             if sizes:
-                csize, starsize = _sizes_at(o, problem, trace, t, p, witness)
-                calls += csize
-                extra = [csize, starsize]
+                assert witness is not None
+                try:
+                    C, star = catalog_at(o, problem, trace[:t, 0], trace[:t, 1], p, witness[p])
+                except PrefixTimeout:
+                    stats.update(calls=calls, steps=steps)
+                    return Verdict(None, None, stats, "time limit")
+                calls += len(C)  # one query per label of C(p) (the witness's label is free)
+                extra = [len(C), len(star)]
             steps.append([*entry, inside, *extra])
             if inside:
-                o.add_clause([lit])  # M_{t+1} is consistent: fix the step for good
+                o.fix([p], [b])  # M_{t+1} is consistent: fix the step for good
             else:
                 consistent = False
                 first_bad = {"step": t, "cell": list(problem.coords(p)), "label": int(b),
@@ -300,24 +307,6 @@ def catalog_gap(
         + (f" {first_bad['steps_until_failure']} steps later" if run.status == "failed" else "")
     )
     return Verdict(False, first_bad, stats, msg)
-
-
-def _sizes_at(o: SatOracle, problem: Problem, trace: NDArray[np.int64], t: int, p: int,
-              witness: NDArray[np.int32] | None) -> tuple[int, int]:  # fmt: skip
-    """``|C(p)|`` and ``|C*(p)|`` just before step ``t`` (whose prefix is fixed in ``o``)."""
-    dom = problem.domains.copy()
-    for q, lab in trace[:t].tolist():
-        dom[q] = False
-        dom[q, lab] = True
-    C, ok = propagate(problem, dom)
-    labels = np.flatnonzero(C[p]) if ok else np.zeros(0, dtype=np.int64)
-    star = 0
-    for lab in labels.tolist():
-        if witness is not None and witness[p] == lab:
-            star += 1
-            continue
-        star += o.solve([o.literal(p, lab)]) == "sat"
-    return int(labels.size), star
 
 
 # ----------------------------------------------------------------------------- explanations

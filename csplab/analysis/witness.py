@@ -13,8 +13,11 @@ exhaustively (every label of C at every step, breadth first over distinct catalo
 first failure found has the fewest choices) on outputs of up to ``exhaustive_cells``
 cells, then by random runs on a ladder of larger sizes up to ``max_size``, shrinking the
 size again when a run fails. For the witness it finds the first step whose label was
-outside the exact catalog C* (the model became inconsistent there) and how many
-assignments later Alg. 3.1 noticed (Fig. 3.6: the delay can be positive).
+outside the exact catalog C* (the model became inconsistent there;
+:func:`~csplab.engine.completability.first_inconsistent_prefix` with the exact search
+:class:`~csplab.engine.completability.SearchCompletability`) and how many assignments later
+Alg. 3.1 noticed (Fig. 3.6: the delay can be positive). Choices are counted from 1 in the
+witness (``first_outside_cstar``: choice 3 is the third).
 
 Examples
 --------
@@ -32,6 +35,7 @@ True
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import time
@@ -39,18 +43,23 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
 from csplab.engine.alg31 import run_alg31, scan_order
+from csplab.engine.completability import (
+    PrefixTimeout,
+    SearchCompletability,
+    first_inconsistent_prefix,
+)
 from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.grids import parse_shape
 from csplab.problem import Problem
 from csplab.result import Verdict
 from csplab.rng import make_rng
-from csplab.testing.brute import satisfiable
 
-__all__ = ["alg31_exhaustive", "find_failure", "first_outside_exact", "replay"]
+__all__ = ["alg31_exhaustive", "find_failure", "replay"]
 
 
 class _Budget(Exception):
@@ -96,7 +105,8 @@ def alg31_exhaustive(
         stats["time_s"] = time.perf_counter() - t0
         return Verdict(False, [], stats, "no consistent model: C is empty before any choice")
     level: dict[bytes, tuple[Propagator, list[list[Any]]]] = {eng.bits.tobytes(): (eng, [])}
-    if late and satisfiable(problem, None, max_nodes=max_nodes) is not True:
+    oracle = SearchCompletability(problem, max_nodes=max_nodes)  # exact, node budget
+    if late and oracle.completable([], []) is not True:
         return Verdict(None, None, stats, "undecided: no consistent model found at this size")
     order_list = cells.tolist()
     for t, cell in enumerate(order_list):
@@ -114,7 +124,7 @@ def alg31_exhaustive(
                 key = e2.bits.tobytes()
                 if key in nxt:
                     continue
-                if late and _inconsistent(problem, p2, max_nodes):
+                if late and _inconsistent(oracle, problem, p2):
                     run = _continue_to_failure(problem, e2, p2, order_list[t + 1 :])
                     stats["first_outside_cstar"] = len(p2)
                     stats["time_s"] = time.perf_counter() - t0
@@ -132,11 +142,16 @@ def alg31_exhaustive(
     return Verdict(True, None, stats, f"no run fails ({stats['states']} catalogs)")
 
 
-def _inconsistent(problem: Problem, path: list[list[Any]], max_nodes: int) -> bool:
-    g = np.full(problem.shape, -1, dtype=np.int64)
-    for c, b in path:
-        g[tuple(c)] = b
-    return satisfiable(problem, g, max_nodes=max_nodes) is False
+def _cell_choices(problem: Problem, path: Sequence[Sequence[Any]]) -> NDArray[np.int64]:
+    """``[[coords, label], ...]`` as ``(cell, label)`` rows."""
+    out = [[problem.cell(tuple(int(t) for t in c)), int(b)] for c, b in path]
+    return np.asarray(out, dtype=np.int64).reshape(-1, 2)
+
+
+def _inconsistent(oracle: SearchCompletability, problem: Problem, path: list[list[Any]]) -> bool:
+    """Proven to have no completion (``False`` also when the node budget ran out)."""
+    ch = _cell_choices(problem, path)
+    return oracle.completable(ch[:, 0], ch[:, 1]) is False
 
 
 def _continue_to_failure(
@@ -270,7 +285,14 @@ def find_failure(
     found["fail_step"] = len(found["choices"])
     if exact and found["kind"] == "failed":
         P = Problem.from_example(example, tuple(found["shape"]))
-        t = first_outside_exact(P, found["choices"], max_nodes=max_nodes)
+        oracle = SearchCompletability(P, max_nodes=max_nodes)
+        t = None
+        if oracle.completable([], []) is True:  # else undecided (the run failed anyway)
+            with contextlib.suppress(PrefixTimeout):  # undecided within max_nodes
+                k = first_inconsistent_prefix(
+                    oracle, _cell_choices(P, found["choices"]), full_inconsistent=True
+                )
+                t = None if k is None else k + 1  # choices count from 1 in the witness
         found["first_outside_cstar"] = t
         if t is not None:
             found["detection_delay"] = found["fail_step"] - t
@@ -336,40 +358,6 @@ def _random_search(
                     hit, shp, improved = h2, s2, True
                     break
     return hit
-
-
-def first_outside_exact(
-    problem: Problem, choices: Sequence[Sequence[Any]], max_nodes: int = 200_000
-) -> int | None:
-    """1-based index of the first choice after which the partial model has no consistent
-    completion (its label was outside C*), or ``None`` if undecided within ``max_nodes``.
-
-    Consistency of a prefix is monotone (an inconsistent prefix stays inconsistent), so
-    a binary search needs about log2(len(choices)) exact checks.
-    """
-    grid = np.full(problem.shape, -1, dtype=np.int64)
-    cells = [tuple(int(t) for t in c) for c, _ in choices]
-    labels = [int(b) for _, b in choices]
-
-    def sat(t: int) -> bool | None:
-        g = grid.copy()
-        for c, b in zip(cells[:t], labels[:t], strict=True):
-            g[c] = b
-        return satisfiable(problem, g, max_nodes=max_nodes)
-
-    lo, hi = 0, len(choices)  # sat(lo) is True, sat(hi) is False (a wipe-out)
-    if sat(0) is not True:
-        return None
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        s = sat(mid)
-        if s is None:
-            return None
-        if s:
-            lo = mid
-        else:
-            hi = mid
-    return hi
 
 
 def replay(example: ExampleModel, witness: dict[str, Any]) -> Verdict:

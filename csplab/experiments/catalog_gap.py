@@ -5,10 +5,15 @@ Alg. 3.1 picks labels from the arc-consistent catalog C, which may hold labels t
 solution has (C ≠ C*, Sec. 3.3.4, Fig. 3.5). A choice outside C* makes the partial model
 impossible to complete; the algorithm notices only when a domain empties, possibly many
 steps later (Fig. 3.6). For each run this experiment replays Alg. 3.1's trace against a
-completability oracle (SAT when available, else brute force):
+completability oracle (:mod:`csplab.engine.completability`): ``"sat"`` (incremental SAT,
+through :func:`csplab.exact.catalog_gap`) when python-sat is installed, else ``"brute"``
+(the exact depth-first search :class:`~csplab.engine.completability.SearchCompletability`;
+the experiment keeps its published name):
 
 * the **first bad step**: the first assignment after which the partial model cannot be
-  completed (binary search over prefixes: completability only ever turns false);
+  completed (:func:`~csplab.engine.completability.first_inconsistent_prefix`, a binary
+  search over prefixes: completability only ever turns false). Reported **1-based** (the
+  step count of Alg. 3.1, like the failure step), as stored results always were;
 * the **failure step**: the assignment at which Alg. 3.1 found an empty domain;
 * with ``per_step``: at every step taken from a completable state, C and C* at the chosen
   cell, giving the probability that a uniform choice there is bad (|C \\ C*| / |C|).
@@ -33,6 +38,12 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from csplab.deps import available
+from csplab.engine.completability import (
+    SearchCompletability,
+    catalog_at,
+    first_inconsistent_prefix,
+)
 from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.experiments.base import (
@@ -44,27 +55,17 @@ from csplab.experiments.base import (
     size_for,
 )
 from csplab.experiments.fig3_8 import check_boundary
-from csplab.experiments.oracle import make_oracle, oracle_methods
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 from csplab.problem import Problem
 
-__all__ = ["CatalogGap", "first_bad_step", "measure"]
+__all__ = ["CatalogGap", "measure", "oracle_methods"]
 
 
-def first_bad_step(oracle: Any, trace: np.ndarray, steps: int) -> int:
-    """The 1-based step whose assignment first made the prefix uncompletable.
-
-    Assumes the empty prefix is completable and the ``steps``-long prefix is not.
-    """
-    lo, hi = 0, steps  # prefix lo completable, prefix hi not
-    while hi - lo > 1:
-        mid = (lo + hi) // 2
-        if oracle.completable(trace[:mid, 0], trace[:mid, 1]):
-            lo = mid
-        else:
-            hi = mid
-    return hi
+def oracle_methods() -> list[str]:
+    """The experiment's oracles usable here, best first: ``"sat"`` (needs python-sat) and
+    ``"brute"`` (:class:`~csplab.engine.completability.SearchCompletability`)."""
+    return ["sat", "brute"] if available("pysat") else ["brute"]
 
 
 def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
@@ -117,7 +118,6 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     if trial.params.get("oracle") == "sat":
         return measure_exact(trial, example, problem)
 
-    from csplab.catalog import Propagator
     from csplab.solvers import solve
 
     r = solve(problem, "catalog", rng=trial.seed, **trial.options)
@@ -127,41 +127,39 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     if r.status == "unsat":
         return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
     t0 = time.perf_counter()
-    oracle = make_oracle(problem)
+    oracle = SearchCompletability(problem)
     first_bad: int | None = None
     if r.status == "failed":
         stats["fail_step"] = T
         if not oracle.completable([], []):
             stats["unsat_undetected"] = True  # unsatisfiable, yet C was not empty
         else:
-            first_bad = first_bad_step(oracle, trace, T)
+            k = first_inconsistent_prefix(oracle, trace, full_inconsistent=True)
+            assert k is not None
+            first_bad = k + 1  # 1-based in the stored rows: step k + 1 of Alg. 3.1
             stats["first_bad"] = first_bad
             stats["delay"] = T - first_bad
     good_steps = T if r.status == "solved" else (first_bad - 1 if first_bad else 0)
     stats["good_steps"] = good_steps
     stats["bad_choice"] = int(first_bad is not None)
     if trial.params.get("per_step") and (r.status == "solved" or first_bad is not None):
-        eng = Propagator(problem)
         upto = T if first_bad is None else first_bad
         gaps: list[list[int]] = []
         total_gap = 0.0
         for t in range(upto):
             x, b = int(trace[t, 0]), int(trace[t, 1])
-            cand = eng.domain(x)
-            cells = [*trace[:t, 0].tolist(), x]
-            labels = trace[:t, 1].tolist()
-            star = [int(c) for c in cand if oracle.completable(cells, [*labels, int(c)])]
+            cand, star = catalog_at(oracle, problem, trace[:t, 0], trace[:t, 1], x)
             if len(star) < cand.size:
                 gaps.append([t + 1, int(cand.size), len(star)])
                 total_gap += 1 - len(star) / cand.size
             if b not in star and first_bad is not None and t + 1 != first_bad:
                 raise InputError(f"per-step C* disagrees with the binary search at step {t + 1}")
-            eng.assign(x, b)
+            oracle.fix([x], [b])
         stats["gap_steps"] = len(gaps)
         stats["expected_bad"] = total_gap
         stats["checked_steps"] = upto
         stats["_gaps"] = gaps
-    stats["oracle"] = oracle.name
+    stats["oracle"] = "brute"  # the experiment's name for the search oracle, as stored
     stats["oracle_calls"] = oracle.calls
     stats["oracle_s"] = time.perf_counter() - t0
     return {"status": r.status, "time_s": float(r.time_s), "stats": stats}

@@ -10,8 +10,11 @@ compatibility (transfer) matrices, and runs the forward/backward recursions. Tha
 * :meth:`~StripSampler.label_frequencies`, :meth:`~StripSampler.pattern_frequencies`: the
   exact expected counts of every label and of every 2×2 (or other) window pattern over the
   uniform distribution on solutions;
-* :attr:`~StripSampler.log_count`: the natural log of the number of solutions (exact
-  integer counting is :func:`count` for small strips).
+* :attr:`~StripSampler.log_count`: the natural log of the number of solutions (the exact
+  integer is :meth:`~StripSampler.count`, by :func:`csplab.count.count_solutions`).
+
+Slice states are enumerated by the engine's exact search
+(:func:`csplab.engine.completability.search_solutions`).
 
 It is practical when slices are narrow (a few cells across and a few labels): the number of
 states grows exponentially with the slice size. Probabilities use scaled floating point.
@@ -38,6 +41,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab.engine.completability import search_solutions
 from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.rng import RngLike, make_rng
@@ -56,8 +60,6 @@ class StripSampler:
     """
 
     def __init__(self, problem: Problem, *, max_states: int = 20_000) -> None:
-        from csplab.testing.brute import solutions
-
         self.problem = problem
         shp = problem.shape
         self.L = shp[0]
@@ -81,7 +83,7 @@ class StripSampler:
             if st is None:
                 sub = Problem(self.slice_shape, dom, problem.relations, local)
                 found = []
-                for g in solutions(sub, limit=max_states + 1):
+                for g in search_solutions(sub, limit=max_states + 1):
                     found.append(g.reshape(-1))
                 if len(found) > max_states:
                     raise InputError(
@@ -137,12 +139,11 @@ class StripSampler:
         return [int(s.shape[0]) for s in self.states]
 
     def count(self) -> int:
-        """The exact number of solutions (Python integers; for small strips)."""
-        v = [1] * self.states[0].shape[0]
-        for i in range(self.L - 1):
-            M = self.T[i]
-            v = [sum(v[a] for a in np.flatnonzero(M[:, j])) for j in range(M.shape[1])]
-        return int(sum(v))
+        """The exact number of solutions: :func:`csplab.count.count_solutions` (its
+        transfer method, the frontier form of these matrices)."""
+        from csplab.count import count_solutions
+
+        return int(count_solutions(self.problem, "transfer"))
 
     def _marginal(self, i: int) -> NDArray[np.float64]:
         p = self._fwd[i] * self._bwd[i]

@@ -44,7 +44,13 @@ from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
 from csplab.engine.alg31 import run_alg31
-from csplab.engine.completability import WitnessPool, choose_from_exact
+from csplab.engine.completability import (
+    PrefixTimeout,
+    SatCompletability,
+    WitnessPool,
+    choose_from_exact,
+    first_inconsistent_prefix,
+)
 from csplab.engine.sat import SAT_STAT_KEYS, SatOracle
 from csplab.engine.sat import backends as sat_backends
 from csplab.errors import CsplabError
@@ -127,7 +133,7 @@ class HybridSolver(Solver):
                 trace = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
                 if r.status != "failed" or trace.shape[0] == 0:
                     raise CsplabError("hybrid: Alg. 3.1 failed on a consistent prefix (a bug)")
-                k = self._first_bad(oracle, trace, fixed, stats, deadline)
+                k = self._first_bad(oracle, trace, stats, deadline)
                 if k is None:
                     return self.result("timeout", fixed, problem, stats, t0)
                 # fix the consistent prefix, then redraw step k from C*
@@ -159,19 +165,15 @@ class HybridSolver(Solver):
                 oracle.close()
 
     @staticmethod
-    def _first_bad(oracle: SatOracle, trace: NDArray[np.int64], fixed: NDArray[np.int64],
-                   stats: dict[str, Any], deadline: float | None) -> int | None:  # fmt: skip
-        """Index of the first step whose prefix (with it) is inconsistent (binary search)."""
-        lits = [oracle.literal(int(p), int(b)) for p, b in trace.tolist()]
-        lo, hi = 0, len(lits)  # prefix lo is consistent, prefix hi is not
-        while hi - lo > 1:
-            mid = (lo + hi) // 2
-            st = oracle.solve(lits[:mid], deadline=deadline)
-            stats["sat_calls"] += 1
-            if st == "timeout":
-                return None
-            if st == "sat":
-                lo = mid
-            else:
-                hi = mid
-        return hi - 1
+    def _first_bad(oracle: SatOracle, trace: NDArray[np.int64], stats: dict[str, Any],
+                   deadline: float | None) -> int | None:  # fmt: skip
+        """0-based index of the first step of the failed run whose prefix (with it) is
+        inconsistent, on top of the oracle's clauses (the fixed cells); ``None`` on
+        timeout."""
+        comp = SatCompletability(oracle.problem, deadline=deadline, oracle=oracle)
+        try:
+            return first_inconsistent_prefix(comp, trace, full_inconsistent=True)
+        except PrefixTimeout:
+            return None
+        finally:
+            stats["sat_calls"] += comp.calls

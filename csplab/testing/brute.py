@@ -3,6 +3,10 @@
 These enumerate solutions by depth-first search with arc consistency (so they are exact
 and complete) and are meant for problems with at most a few thousand solutions.
 
+They are the tests' independent reference: the library's own exact search is
+:mod:`csplab.engine.completability` (``SearchCompletability``, ``search_solutions``), which
+the tests check against this module; nothing in the library imports it.
+
 Examples
 --------
 >>> from csplab import ExampleModel, Problem

@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from csplab import Problem, solve
 from csplab.analysis import alg31_exhaustive, find_failure, replay
-from csplab.analysis.witness import first_outside_exact
 from csplab.catalog import Propagator
+from csplab.engine.completability import SearchCompletability, first_inconsistent_prefix
 from csplab.errors import InputError
 from csplab.examples import load_example
 from csplab.testing.brute import exact_catalog, satisfiable
@@ -73,7 +73,9 @@ def test_fig3_6a_late_detection():  # I7
     assert satisfiable(P, prefix_grid(P.shape, v.witness, t)) is False
     eng = Propagator(P.with_fixed(prefix_grid(P.shape, v.witness, t)))
     assert eng.ok
-    assert first_outside_exact(P, v.witness) == t
+    choices = [[P.cell(tuple(c)), b] for c, b in v.witness]
+    # 0-based index of the bad choice; the witness counts choices from 1
+    assert first_inconsistent_prefix(SearchCompletability(P), choices) == t - 1
     # the bottom row holds three 2s that cannot be paired (Fig. 3.6(b))
     row = [b for c, b in v.witness if c[1] == 0]
     assert row.count(2) % 2 == 1

@@ -59,7 +59,7 @@ def test_quick_default_runs(tmp_path):
 def test_sat_oracle_agrees_with_brute_force(tmp_path, fallible_npy):
     import pytest
 
-    from csplab.experiments.oracle import oracle_methods
+    from csplab.experiments.catalog_gap import oracle_methods
 
     if "sat" not in oracle_methods():
         pytest.skip("needs csplab's sat solver (issue 3) and python-sat")
@@ -83,9 +83,8 @@ def test_fig3_6_inconsistency_can_show_late():
     catalog, figure scan order) leaves three 2s that cannot be paired: the model is
     inconsistent after step 9, but the catalog empties only at step 12."""
     from csplab.catalog import Propagator
+    from csplab.engine.completability import SearchCompletability, first_inconsistent_prefix
     from csplab.examples import load_example
-    from csplab.experiments.catalog_gap import first_bad_step
-    from csplab.experiments.oracle import make_oracle
 
     P = Problem.from_example(load_example("fig3_6a"), (9, 3))
     eng = Propagator(P)
@@ -101,5 +100,8 @@ def test_fig3_6_inconsistency_can_show_late():
         if not eng.assign(c, b):
             break
     tr = np.array(trace)
-    assert first_bad_step(make_oracle(P, "brute"), tr, len(tr)) == 9
+    # 0-based: the ninth choice (index 8) made the model inconsistent
+    assert first_inconsistent_prefix(SearchCompletability(P), tr, full_inconsistent=True) == 8
+    assert first_inconsistent_prefix(SearchCompletability(P), tr) == 8
+    assert first_inconsistent_prefix(SearchCompletability(P), tr[:8]) is None
     assert len(tr) == 12
