@@ -1,7 +1,9 @@
 """The ``csplab`` command line.
 
-Each subcommand lives in its own module with ``add_parser(subparsers)`` and
-``run(args) -> int``; :data:`COMMANDS` maps names to modules. Exit codes: 0 success,
+Each subcommand lives in its own module, which declares ``HELP`` (one line), optionally
+``DESCRIPTION`` (or a ``description()`` function; ``RAW_DESCRIPTION = True`` keeps its
+layout), ``add_arguments(parser)`` and ``run(args) -> int``; :data:`COMMANDS` maps names to
+modules, and :func:`build_parser` builds every subparser the same way. Exit codes: 0 success,
 1 the algorithm failed / the problem is unsatisfiable / a check found problems,
 2 bad input (one line on stderr, no traceback).
 """
@@ -51,9 +53,19 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"csplab {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
-    for modname in COMMANDS.values():
+    for name, modname in COMMANDS.items():
         mod = importlib.import_module(modname)
-        p = mod.add_parser(sub)
+        desc = getattr(mod, "DESCRIPTION", None)
+        if hasattr(mod, "description"):
+            desc = mod.description()
+        raw = getattr(mod, "RAW_DESCRIPTION", False)
+        p = sub.add_parser(
+            name,
+            help=mod.HELP,
+            description=desc or mod.HELP,
+            formatter_class=argparse.RawDescriptionHelpFormatter if raw else argparse.HelpFormatter,
+        )
+        mod.add_arguments(p)
         p.set_defaults(_run=mod.run)
     return parser
 

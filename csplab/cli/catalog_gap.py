@@ -12,33 +12,30 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import Any
 
 from csplab.cli.common import add_problem_args
 from csplab.cli.explain import add_fixed_args, problem_with_fixed
+from csplab.engine.alg31 import CHOICES, ORDERS
 from csplab.errors import InputError
 
+HELP = "run Alg. 3.1 and report at each step whether the chosen label was in C*"
+DESCRIPTION = __doc__
+RAW_DESCRIPTION = True  # keep the docstring's layout in --help
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "catalog-gap",
-        help="run Alg. 3.1 and report at each step whether the chosen label was in C*",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p, size_required=True)
     add_fixed_args(p)
     p.add_argument("--seed", type=int, help="random seed of Alg. 3.1 (default: fresh, printed)")
-    p.add_argument("--order", default="scanline", help="cell order of Alg. 3.1: scanline, "
-                   "random, min-entropy or scan:AXES (e.g. scan:yx)")  # fmt: skip
-    p.add_argument("--choice", choices=["uniform", "weighted"], default="uniform")
+    p.add_argument("--order", default="scanline",
+                   help=f"cell order of Alg. 3.1: {', '.join(ORDERS)} (e.g. scan:yx)")
+    p.add_argument("--choice", choices=CHOICES, default="uniform")
     p.add_argument("--backend", help="pysat backend (default cadical195)")
     p.add_argument("--sizes", action="store_true", help="also count |C(p)| and |C*(p)|")
     p.add_argument("--steps", choices=["all", "summary"], default="all",
                    help="print every step (default) or only the summary")  # fmt: skip
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument("--json", action="store_true")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import Any
 
 from csplab.cli.common import (
     add_problem_args,
@@ -14,19 +13,18 @@ from csplab.cli.common import (
     problem_from_args,
 )
 
+HELP = "count the violations of a grid file against an example"
+DESCRIPTION = (
+    "Check a grid (.npy, Merrell .txt or .grid) against an example model or "
+    "a tileset's rules. Exit 0 when it is consistent, 1 when it violates something."
+)
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "check",
-        help="count the violations of a grid file against an example",
-        description="Check a grid (.npy, Merrell .txt or .grid) against an example model or "
-        "a tileset's rules. Exit 0 when it is consistent, 1 when it violates something.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p, size_required=False)
     p.add_argument("grid", metavar="GRID", help="grid file to check")
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

@@ -10,17 +10,17 @@ from typing import Any
 from csplab.cli.common import add_problem_args, load_model, problem_from_args
 from csplab.errors import InputError
 
+HELP = "count the models consistent with an example: D_E(n) (Sec. 3.2)"
+DESCRIPTION = (
+    "Count exactly (Python integers) the models of a given size consistent "
+    "with an example: transfer matrix over slices for models narrow in one or two "
+    "axes, Ganak (#SAT) or SAT enumeration otherwise; --method approxmc gives an "
+    "(epsilon, delta) approximation. Exit 0 when there is at least one model, 1 when "
+    "there is none, 2 on bad input."
+)
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "count",
-        help="count the models consistent with an example: D_E(n) (Sec. 3.2)",
-        description="Count exactly (Python integers) the models of a given size consistent "
-        "with an example: transfer matrix over slices for models narrow in one or two "
-        "axes, Ganak (#SAT) or SAT enumeration otherwise; --method approxmc gives an "
-        "(epsilon, delta) approximation. Exit 0 when there is at least one model, 1 when "
-        "there is none, 2 on bad input.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p)
     p.add_argument(
         "--method",
@@ -43,7 +43,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         "L1 < L2 along the last axis",
     )
     p.add_argument("--json", action="store_true")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

@@ -52,21 +52,23 @@ _COMMON: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {
 }  # fmt: skip
 
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
+HELP = "run a thesis experiment (`csplab experiment list` lists them)"
+
+
+def description() -> str:
     from csplab.experiments import EXPERIMENTS
 
-    p: argparse.ArgumentParser = sub.add_parser(
-        "experiment",
-        help="run a thesis experiment (fig3_8, blocksize, table3_1, catalog_gap, sampling_bias)",
-        description="Run an experiment's missing trials into a SQLite results store and "
-        "write its report (markdown, CSV, PNG, SVG). Experiments: "
-        + ", ".join(EXPERIMENTS)
-        + ". `csplab experiment NAME --help` lists an experiment's options; "
-        "`csplab experiment list` describes them.",
+    return (
+        "Run an experiment's missing trials into a SQLite results store and write its report "
+        f"(markdown, CSV, PNG, SVG). Experiments: {', '.join(EXPERIMENTS)}. `csplab "
+        "experiment NAME --help` lists an experiment's options; `csplab experiment list` "
+        "describes them."
     )
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("name", metavar="NAME", help="experiment name, or 'list'")
     p.add_argument("rest", nargs=argparse.REMAINDER, help=argparse.SUPPRESS)
-    return p
 
 
 def _experiment_parser(exp: Any) -> argparse.ArgumentParser:

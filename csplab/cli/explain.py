@@ -23,21 +23,18 @@ from csplab.cli.common import add_problem_args, load_model, model_options, probl
 from csplab.errors import FormatError, InputError
 from csplab.problem import Problem
 
+HELP = "explain why a problem is unsatisfiable (minimal conflicting constraints)"
+DESCRIPTION = __doc__
+RAW_DESCRIPTION = True  # keep the docstring's layout in --help
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "explain",
-        help="explain why a problem is unsatisfiable (minimal conflicting constraints)",
-        description=__doc__,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p, size_required=True)
     add_fixed_args(p)
     p.add_argument("--backend", help="pysat backend (default cadical195)")
     p.add_argument("--no-minimize", action="store_true", help="report the first core as is")
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument("--json", action="store_true")
-    return p
 
 
 def add_fixed_args(p: argparse.ArgumentParser) -> None:

@@ -1,29 +1,37 @@
-"""``csplab info``: solvers, their dependencies, and the built-in examples."""
+"""``csplab info``: solvers, their dependencies, the built-in examples and the file formats."""
 
 from __future__ import annotations
 
 import argparse
 import json
-from typing import Any
+
+HELP = "list solvers (and whether they are installed) and built-in examples"
 
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "info", help="list solvers (and whether they are installed) and built-in examples"
-    )
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:
     from csplab import __version__
     from csplab.examples import example_info
+    from csplab.io.registry import FORMATS
     from csplab.solvers import available_solvers
 
     solvers = available_solvers()
     examples = example_info()
     if args.json:
-        print(json.dumps({"version": __version__, "solvers": solvers, "examples": dict(examples)}))
+        formats = [f.info() for f in FORMATS.values()]
+        print(
+            json.dumps(
+                {
+                    "version": __version__,
+                    "solvers": solvers,
+                    "examples": dict(examples),
+                    "formats": formats,
+                }
+            )
+        )
         return 0
     print(f"csplab {__version__}")
     print("solvers:")
@@ -43,4 +51,10 @@ def run(args: argparse.Namespace) -> int:
     print("built-in examples:")
     for name, desc in examples:
         print(f"  {name:<14} {desc}")
+    print("file formats (--model-option KEY=VALUE for the loader's options):")
+    for f in FORMATS.values():
+        rw = "read+write" if f.readable and f.writable else ("read" if f.readable else "write")
+        print(f"  {f.name:<13} {rw:<10} {' '.join(f.extensions):<15} {f.description}")
+        for o in f.options:
+            print(f"  {'':<13} {o.usage}: {o.help}")
     return 0

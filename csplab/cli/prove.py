@@ -8,7 +8,6 @@ ran out; the state count is printed), 2 bad input.
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
 from csplab.analysis import corner_condition, prove_infallible
 from csplab.cli._analysis import (
@@ -20,16 +19,16 @@ from csplab.cli._analysis import (
 )
 from csplab.errors import InputError
 
+HELP = "prove an example infallible (Alg. 3.1 never fails) by region enumeration"
+DESCRIPTION = (
+    "Enumerate every window state Alg. 3.6 can reach with the given region "
+    "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
+    "fails on the example, at any output size (Theorem 3.3.6). Exit 0 proven, "
+    "1 refuted (fallible), 3 undecided, 2 bad input."
+)
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "prove",
-        help="prove an example infallible (Alg. 3.1 never fails) by region enumeration",
-        description="Enumerate every window state Alg. 3.6 can reach with the given region "
-        "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
-        "fails on the example, at any output size (Theorem 3.3.6). Exit 0 proven, "
-        "1 refuted (fallible), 3 undecided, 2 bad input.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
     p.add_argument("--region", default="2", help="region size per axis, e.g. 3x2 (default 2)")
     p.add_argument("--order", default="scanline", help=ORDER_HELP)
@@ -40,7 +39,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
     p.add_argument("--out", help="save the failing run as a .png picture or .json")
     p.add_argument("--json", action="store_true", help="print the verdict as JSON")
     p.add_argument("--model-option", action="append", default=[], metavar="KEY=VALUE")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

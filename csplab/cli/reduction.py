@@ -14,13 +14,11 @@ from typing import Any
 
 from csplab.errors import InputError
 
+HELP = "Theorem 3.3.4 (planar 3-SAT) and 5.2.4 (LBA) reductions to model consistency"
+DESCRIPTION = "Generate and check the thesis' reductions to model consistency."
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "reduction",
-        help="Theorem 3.3.4 (planar 3-SAT) and 5.2.4 (LBA) reductions to model consistency",
-        description="Generate and check the thesis' reductions to model consistency.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     rs = p.add_subparsers(dest="which", metavar="REDUCTION", parser_class=type(p))
     rs.required = True
     q = rs.add_parser(
@@ -65,7 +63,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
     l.add_argument("--png", help="picture of the completed model")
     l.add_argument("--json", action="store_true")
     l.set_defaults(_sub=_run_lba)
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

@@ -7,21 +7,20 @@ within the search bounds, 2 bad input.
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
 from csplab.analysis import to_infallible
 from csplab.cli._analysis import ORDER_HELP, load_example_model, print_verdict
 
+HELP = "split labels of a fallible example into an infallible one (Sec. 3.3.8)"
+DESCRIPTION = (
+    "Search label splits (rename the occurrences of a label whose neighbour "
+    "in one direction lies in a set) for an example E_I with f(E_I) = E_F that the "
+    "region prover shows infallible and whose models map onto the example's (Eq. 3.13, "
+    "checked by enumeration). Exit 0 found, 3 not found."
+)
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "refine",
-        help="split labels of a fallible example into an infallible one (Sec. 3.3.8)",
-        description="Search label splits (rename the occurrences of a label whose neighbour "
-        "in one direction lies in a set) for an example E_I with f(E_I) = E_F that the "
-        "region prover shows infallible and whose models map onto the example's (Eq. 3.13, "
-        "checked by enumeration). Exit 0 found, 3 not found.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
     p.add_argument("--order", default="scanline", help=ORDER_HELP)
     p.add_argument("--regions", default="2x2,3x2,4x2",
@@ -31,7 +30,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
     p.add_argument("--out", help="write E_I to this .grid (or any example format) file")
     p.add_argument("--json", action="store_true")
     p.add_argument("--model-option", action="append", default=[], metavar="KEY=VALUE")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:

@@ -1,8 +1,9 @@
 """``csplab show``: write a PNG picture of any model file.
 
-Example grids (``.txt``, ``.grid``, ``.npy``, ``.vox``) are drawn as coloured cells in 2D
-and as an isometric view of the non-empty cells in 3D; tilesets and samples (``.xml``,
-``.json``, ``.png``) as a sheet of their labels (tile pictures or colours, with names).
+Example grids (the formats of :mod:`csplab.io.registry` that give an ``ExampleModel``) are
+drawn as coloured cells in 2D and as an isometric view of the non-empty cells in 3D; rule
+sets (tilesets and samples) as a sheet of their labels (tile pictures or colours, with
+names).
 ``--tiles TILESET`` draws a result grid with a tileset's pictures.
 """
 
@@ -10,22 +11,21 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
 from csplab.cli.common import load_model, model_options
 from csplab.errors import InputError
 
+HELP = "write a PNG picture of a model file (grid, tileset or sample)"
+DESCRIPTION = (
+    "Write a PNG of any model file: 2D grids as cells, 3D grids as an "
+    "isometric rendering, tilesets as a sheet of their labels. Exit 0 on success, 2 on "
+    "bad input."
+)
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "show",
-        help="write a PNG picture of a model file (grid, tileset or sample)",
-        description="Write a PNG of any model file: 2D grids as cells, 3D grids as an "
-        "isometric rendering, tilesets as a sheet of their labels. Exit 0 on success, 2 on "
-        "bad input.",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", metavar="FILE", help="model file or built-in example name")
     p.add_argument(
         "--out", help="PNG to write (default: FILE's name with .png, in the current directory)"
@@ -39,7 +39,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         "--model-option", action="append", default=[], metavar="KEY=VALUE",
         help="option for the loader of FILE (or of --tiles), as in synthesize",
     )  # fmt: skip
-    return p
 
 
 def run(args: argparse.Namespace) -> int:
@@ -77,9 +76,7 @@ def run(args: argparse.Namespace) -> int:
             what = f"{model.K} labels of {model.meta.get('format')} tileset {model.name}"
         else:
             colors = model.metadata.get("colors")
-            empty = args.empty
-            if empty is None and model.metadata.get("format") == "vox":
-                empty = 0
+            empty = args.empty if args.empty is not None else model.metadata.get("empty")
             img = render(model.labels, K=model.K, scale=args.scale, empty=empty, colors=colors)
             what = f"{'x'.join(map(str, model.shape))} grid {model.name}"
     img.save(out, format="PNG")

@@ -15,14 +15,15 @@ from csplab.grids import parse_shape
 OUT_EXT = (".npy", ".txt", ".grid", ".png", ".vox", ".obj")
 
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "synthesize",
-        help="synthesize a model from an example",
-        description="Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 "
-        "or any registered solver). Exit 0 when solved, 1 when the algorithm failed or the "
-        "problem is unsatisfiable, 2 on bad input.",
-    )
+HELP = "synthesize a model from an example"
+DESCRIPTION = (
+    "Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 "
+    "or any registered solver). Exit 0 when solved, 1 when the algorithm failed or the "
+    "problem is unsatisfiable, 2 on bad input."
+)
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p)
     from csplab.solvers import option_values, solver_names, solvers_taking
 
@@ -64,7 +65,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
         "tilesets), .vox (MagicaVoxel) or .obj (+ .mtl)",
     )
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
-    return p
 
 
 def _options(args: argparse.Namespace) -> dict[str, Any]:

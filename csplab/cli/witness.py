@@ -8,7 +8,6 @@ found (printed; ``--out`` saves it), 3 nothing found but the search was not exha
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
 from csplab.analysis import find_failure
 from csplab.cli._analysis import (
@@ -19,16 +18,16 @@ from csplab.cli._analysis import (
     save_witness,
 )
 
+HELP = "find a failing run of Alg. 3.1 (or show none exists up to a size)"
+DESCRIPTION = (
+    "Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, "
+    "memoised), then random runs on larger ones; print the smallest failing run, its "
+    "seed and the first choice outside the exact catalog C*. Exit 0 no failure up to "
+    "--max-size (exhaustive), 1 failure found, 3 none found (not exhaustive)."
+)
 
-def add_parser(sub: Any) -> argparse.ArgumentParser:
-    p: argparse.ArgumentParser = sub.add_parser(
-        "witness",
-        help="find a failing run of Alg. 3.1 (or show none exists up to a size)",
-        description="Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, "
-        "memoised), then random runs on larger ones; print the smallest failing run, its "
-        "seed and the first choice outside the exact catalog C*. Exit 0 no failure up to "
-        "--max-size (exhaustive), 1 failure found, 3 none found (not exhaustive).",
-    )
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
     p.add_argument("--max-size", default="4x4", help="largest output searched (default 4x4)")
     p.add_argument("--order", default="scanline", help=ORDER_HELP + "; or random, min-entropy")
@@ -41,7 +40,6 @@ def add_parser(sub: Any) -> argparse.ArgumentParser:
     p.add_argument("--out", help="save the failing run as a .png picture or .json")
     p.add_argument("--json", action="store_true")
     p.add_argument("--model-option", action="append", default=[], metavar="KEY=VALUE")
-    return p
 
 
 def run(args: argparse.Namespace) -> int:
