@@ -9,7 +9,8 @@ module                                 what
 :mod:`csplab.engine.sat`               the incremental SAT oracle (:class:`SatOracle`)
 :mod:`csplab.engine.completability`    one :class:`Completability` protocol (SAT or
                                        search), :func:`first_inconsistent_prefix`,
-                                       drawing labels from C*
+                                       :func:`catalog_at` (C(p), C*(p)),
+                                       :func:`search_solutions`, drawing labels from C*
 =====================================  ==============================================
 
 The arc-consistency engine (:mod:`csplab.catalog`, compiled kernels in

@@ -12,19 +12,8 @@ any decision) proves unsatisfiability.
 With ``order="scanline"`` and no restarts this is exactly Alg. 3.1 plus chronological
 backtracking: the same cell order and uniform label choice from the catalog.
 
-Options
--------
-order : {"min-domain", "scanline"}
-    ``min-domain`` (default): a cell with the fewest labels left, random tie-breaking.
-    ``scanline``: the first unassigned cell in the thesis' scan order.
-choice : {"uniform", "weighted"}
-    Label order: uniformly random, or random by label weight.
-restart : int
-    Failures before the first restart (0: never restart). Default 100.
-node_limit : int, optional
-    Status ``timeout`` (``stats["limit"] = "nodes"``) after this many decisions.
-time_limit : float, optional
-    Seconds; status ``timeout``.
+The options are declared once, on :class:`BacktrackSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------

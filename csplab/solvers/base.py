@@ -98,8 +98,8 @@ class Option:
         if self.convert is not None:
             try:
                 return self.convert(value)
-            except InputError as e:
-                raise InputError(f"{where}: {e}") from None
+            except InputError as e:  # converters say "must be ...": the name goes first
+                raise InputError(f"{where} {e}") from None
         if self.kind is bool:
             if isinstance(value, bool | np.bool_):
                 return bool(value)

@@ -8,20 +8,8 @@ is retried with fresh random choices up to ``retries`` times, then the block is 
 The grid is consistent after every block, so the result is always a solution. With ``m``
 equal to the model size and ``retries=0`` this is exactly Alg. 3.1 for the same seed.
 
-Options
--------
-block : int or tuple of int
-    Block size ``m`` per axis (default 10, capped at the model size).
-retries : int
-    Extra attempts per block after a failure (default 20).
-init : int array, optional
-    A consistent starting grid.
-sweeps : int
-    How many times to sweep all blocks (default 1, as Alg. 3.4).
-order, choice : str
-    Passed to Alg. 3.1 inside each block.
-time_limit : float, optional
-    Seconds; the current (consistent) grid is returned with status ``timeout``.
+The options are declared once, on :class:`BlocksSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------

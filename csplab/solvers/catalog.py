@@ -5,20 +5,8 @@ after each assignment. When a domain empties the run stops with status ``failed`
 algorithm gave up, which says nothing about satisfiability. A wipe-out before any choice is
 a proof of unsatisfiability (Theorem 3.3.2) and gives ``unsat``.
 
-Options
--------
-order : {"scanline", "random", "min-entropy", "scan:AXES"}
-    ``scanline`` is the thesis' loop order (x outermost, z innermost; default);
-    ``scan:AXES`` scans with the named axes from outermost to innermost, e.g. ``scan:yx``,
-    the order of the thesis' 2D figures (left to right, then bottom to top);
-    ``random`` a random permutation; ``min-entropy`` picks the unassigned cell of least
-    Shannon entropy (weighted when ``choice="weighted"``) with tiny random tie-breaking, as
-    WaveFunctionCollapse does.
-choice : {"uniform", "weighted"}
-    ``uniform`` over the catalog (thesis, default) or ``weighted`` by the problem's label
-    weights (example frequencies).
-time_limit : float, optional
-    Seconds; status ``timeout`` when exceeded.
+The options are declared once, on :class:`CatalogSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------

@@ -24,14 +24,8 @@ from the catalog with the rng (CP-SAT then repairs the hint, which is also fast:
 hint); ``"none"`` keeps CP-SAT's defaults. The seed is passed as ``random_seed``; with
 ``num_workers=1`` (default) runs are reproducible.
 
-Options
--------
-model : {"onehot", "table"}
-diversity : {"hint", "polarity", "none"}
-num_workers : int
-presolve : bool
-time_limit : float, optional
-    Seconds for the whole call (model building and search); status ``timeout``.
+The options are declared once, on :class:`CpsatSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------

@@ -17,12 +17,8 @@ redrawn uniformly from C*(p); later steps use fresh randomness. (A chi-square te
 the exact distribution checks this: ``tests/solvers/test_perfect_hybrid.py``.) So
 ``hybrid`` is a cheap sampler of the thesis' ideal algorithm.
 
-Options
--------
-order : {"scanline", "random", "min-entropy"}
-choice : {"uniform", "weighted"}
-backend : pysat backend (``hybrid:glucose4``), default ``cadical195``
-time_limit : float, optional
+The options are declared once, on :class:`HybridSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------

@@ -13,14 +13,8 @@ with the partial model and has it (a pool of witnesses); otherwise one increment
 under an assumption decides it. Accepted labels become unit clauses, rejected ones
 negative units (C* only shrinks as the model grows), so every call has one assumption.
 
-Options
--------
-order : {"scanline", "random"}
-choice : {"uniform", "weighted"}
-backend : pysat backend (``perfect:glucose4``), default ``cadical195``
-pool : int
-    Witness solutions kept (default 16).
-time_limit : float, optional
+The options are declared once, on :class:`PerfectSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------

@@ -15,16 +15,8 @@ mostly empty space and much less variety; ``choice="none"`` keeps the solver's o
 Status ``unsat`` comes only with a proof: the SAT solver's refutation, or an arc-consistency
 wipe-out before any choice (what unit propagation on the support encoding also derives).
 
-Options
--------
-encoding : {"support", "direct"}
-supports : {"both", "forward"}
-amo : str
-    ``"lazy"`` (default) or a :mod:`pysat.card` encoding (see :mod:`csplab.cnf`).
-phase : {"uniform", "weighted", "none"}
-time_limit : float, optional
-    Seconds for the whole call (encoding, loading and search); status ``timeout``.
-loader : {"auto", "api"}
+The options are declared once, on :class:`SatSolver` (``csplab info`` and the
+README solver table list them with defaults and allowed values).
 
 Examples
 --------
