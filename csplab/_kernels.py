@@ -13,7 +13,7 @@ All randomness is drawn by the caller from a numpy Generator and passed in as ar
 the MAC search, as a splitmix64 seed in its state), so the kernels are deterministic.
 
 Arguments travel in bundles (:class:`typing.NamedTuple` s of arrays, which numba compiles as
-structs; fields are read once at the top of each kernel): :class:`Arcs`, the static arrays
+structs): :class:`Arcs`, the static arrays
 of a compiled problem; :class:`AcState`, the mutable arc-consistency state of one
 :class:`csplab.catalog.Propagator`; :class:`Heap`, the min-entropy heap; :class:`Run`, one
 Alg. 3.1 run; :class:`Search`, one MAC search. Kernels return a :class:`Code` (as an int:
@@ -24,18 +24,20 @@ one method per kernel (``propagate``, ``alg31``, ``mac_search``, ``mac_restart``
 Kernel cache rule
 -----------------
 **Every ``@njit`` function that calls another csplab ``@njit`` function lives in this file.**
-numba's on-disk cache (``cache=True``) keys a compiled function on its own source file only
-(path and modification time): a caller in another file that inlined or linked a helper from
-this one would keep its stale machine code after the helper changed. With every caller and
-every helper in one file, editing any of them invalidates all of them together.
-``tests/test_catalog.py::test_njit_callers_of_csplab_kernels_live_in_kernels`` enforces the
+numba's on-disk cache (``cache=True``) checks a compiled function against its own source
+file only (modification time and size): a caller in another file that inlined or linked a
+helper from this one would keep its stale machine code after the helper changed. With every
+caller and every helper in one file, editing any of them invalidates all of them together.
+``tests/test_kernels.py::test_njit_callers_of_csplab_kernels_live_in_kernels`` enforces the
 rule (``@njit`` functions elsewhere, such as the ctypes feeders of
 :mod:`csplab.engine.sat`, may call only non-csplab functions).
 
-The two arc revisions (:func:`propagate`, :func:`propagate_trail`) are copies on purpose:
-moving the loop into a shared ``@njit`` helper (inlined or not) made Alg. 3.1 30-40% slower
-at 40x40x10 (castle, city; A/B of both kernels in one process, 16 shuffled rounds, identical
-copies within 5-9%).
+Bundles are unpacked once per kernel call; the hot per-step calls inside the kernels
+(:func:`_propagate` from :func:`alg31`, :func:`_propagate_trail` from :func:`mac_search`)
+keep flat array arguments, so the compiled loops are those of the flat-argument kernels.
+The two arc revisions are copies on purpose: moving the loop into a shared ``@njit`` helper
+(inlined or not) made Alg. 3.1 30-40% slower at 40x40x10 (castle, city; A/B of both kernels
+in one process, 16 shuffled rounds, identical copies within 5-9%).
 """
 
 from __future__ import annotations
@@ -351,6 +353,47 @@ def propagate(
 ) -> int:
     """Arc consistency from the cells ``start[:nstart]``; returns the wiped-out cell or -1.
 
+    ``ac.prev[u]`` is ``D(u)`` when ``u`` was last processed (all zero: unknown). When ``u``
+    lost only a few of many labels since then, only the neighbour labels those supported
+    are re-checked (``D(u) & sup[s ^ 1, c]``); otherwise ``D(v)`` is intersected with the
+    union of the supports of ``D(u)``. ``ac.stats[0]`` counts queue pops (propagation steps),
+    ``ac.stats[1]`` label removals. When ``hsize > 0`` the keys of changed cells in the
+    min-entropy heap ``hp`` are updated (weighted entropy with ``weighted``). The queue is
+    left empty on return (also after a wipe-out).
+    """
+    return _propagate(
+        ac.dom, ac.prev, arcs.full, arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup, arcs.supall,
+        ac.queue, ac.inq, start, nstart, ac.stats, hp.heap, hp.pos, hp.key, hsize, hp.noise,
+        arcs.weights, arcs.wlogw, weighted,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _propagate(
+    dom: np.ndarray,
+    prev: np.ndarray,
+    full: np.ndarray,
+    ptr: np.ndarray,
+    nbr: np.ndarray,
+    sidx: np.ndarray,
+    sup: np.ndarray,
+    supall: np.ndarray,
+    queue: np.ndarray,
+    inq: np.ndarray,
+    start: np.ndarray,
+    nstart: int,
+    stats: np.ndarray,
+    heap: np.ndarray,
+    hpos: np.ndarray,
+    hkey: np.ndarray,
+    hsize: int,
+    noise: np.ndarray,
+    weights: np.ndarray,
+    wlogw: np.ndarray,
+    weighted: bool,
+) -> int:
+    """:func:`propagate` with flat arguments (Alg. 3.1 calls it per step with its own arrays).
+
     ``prev[u]`` is ``D(u)`` when ``u`` was last processed (all zero: unknown). When ``u``
     lost only a few of many labels since then, only the neighbour labels those supported
     are re-checked (``D(u) & sup[s ^ 1, c]``); otherwise ``D(v)`` is intersected with the
@@ -358,11 +401,6 @@ def propagate(
     ``stats[1]`` label removals. When ``hsize > 0`` the min-entropy heap keys of changed cells
     are updated. The queue is left empty on return (also after a wipe-out).
     """
-    dom, prev, queue, inq, stats = ac.dom, ac.prev, ac.queue, ac.inq, ac.stats
-    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
-    sup, supall = arcs.sup, arcs.supall
-    weights, wlogw = arcs.weights, arcs.wlogw
-    heap, hpos, hkey, noise = hp.heap, hp.pos, hp.key, hp.noise
     n = dom.shape[0]
     W = dom.shape[1]
     head = 0
@@ -550,12 +588,13 @@ def alg31(
     with ``use_heap``, from the entropy heap ``hp``. The catalog must already be arc
     consistent when the run starts.
     """
-    dom = ac.dom
-    stats = ac.stats
+    # unpacked once: the per-step call of the arc-consistency loop takes flat arrays
+    dom, prev, queue, inq, stats = ac.dom, ac.prev, ac.queue, ac.inq, ac.stats
+    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
+    sup, supall, weights, wlogw = arcs.sup, arcs.supall, arcs.weights, arcs.wlogw
     order, ustream, grid, state = run.order, run.ustream, run.grid, run.state
     trace_cell, trace_label = run.trace_cell, run.trace_label
-    heap, hpos, hkey = hp.heap, hp.pos, hp.key
-    weights = arcs.weights
+    heap, hpos, hkey, noise = hp.heap, hp.pos, hp.key, hp.noise
     n = dom.shape[0]
     start = np.empty(1, dtype=np.int64)
     steps_here = 0
@@ -588,7 +627,10 @@ def alg31(
                 changed = True
         if changed:
             start[0] = p
-            wiped = propagate(arcs, ac, start, 1, hp, state[1] if use_heap else 0, weighted)
+            wiped = _propagate(
+                dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
+                heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw, weighted,
+            )  # fmt: skip
             if wiped >= 0:
                 state[2] = wiped
                 return _FAILED
@@ -634,16 +676,17 @@ def _undo(dom: np.ndarray, to: int, state: np.ndarray, tcell: np.ndarray,
 
 
 @njit(cache=True)
-def propagate_trail(arcs: Arcs, ac: AcState, start: int, se: Search) -> int:
+def _propagate_trail(
+    dom: np.ndarray, full: np.ndarray, ptr: np.ndarray, nbr: np.ndarray, sidx: np.ndarray,
+    sup: np.ndarray, supall: np.ndarray, queue: np.ndarray, inq: np.ndarray, start: int,
+    stamp: np.ndarray, state: np.ndarray, tcell: np.ndarray, tbits: np.ndarray,
+    counters: np.ndarray,
+) -> int:  # fmt: skip
     """Arc consistency from cell ``start`` saving old domains on the trail; wiped cell or -1.
 
-    The revision of :func:`propagate` without its delta step (``ac.prev`` is not used);
-    ``se.counters`` counts queue pops and label removals.
+    The revision of :func:`_propagate` without its delta step (``prev`` is not kept);
+    ``counters`` counts queue pops and label removals.
     """
-    dom, queue, inq = ac.dom, ac.queue, ac.inq
-    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
-    sup, supall = arcs.sup, arcs.supall
-    stamp, state, tcell, tbits, counters = se.stamp, se.state, se.tcell, se.tbits, se.counters
     n = dom.shape[0]
     W = dom.shape[1]
     head = 0
@@ -814,18 +857,20 @@ def mac_search(
 
     Each decision assigns a label (uniform, or by weight) to a cell (the first unassigned one
     of ``se.order`` with ``scan``, else one of fewest labels) and runs
-    :func:`propagate_trail`; a wipe-out tries the cell's next label; a cell without labels
+    :func:`_propagate_trail`; a wipe-out tries the cell's next label; a cell without labels
     left backtracks chronologically. Returns :attr:`Code.SOLVED` (``ac.dom`` holds one label
     per cell), :attr:`Code.EXHAUSTED` (no solution; the domains are back at the root),
     :attr:`Code.RESTART` after ``restart_fails`` failures in this run (0: never; call
     :func:`mac_restart`), :attr:`Code.PAUSED` after ``max_nodes`` decisions in this call,
     :attr:`Code.GROW` when the trail is nearly full (resume with ``se.grown()``).
     """
-    dom = ac.dom
-    state, tcell, tbits, lv_cell = se.state, se.tcell, se.tbits, se.lv_cell
-    lv_cand, lv_trail, lv_scan = se.lv_cand, se.lv_trail, se.lv_scan
-    stamp, order = se.stamp, se.order
-    weights = arcs.weights
+    # unpacked once: the per-decision call of the arc-consistency loop takes flat arrays
+    dom, queue, inq = ac.dom, ac.queue, ac.inq
+    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
+    sup, supall, weights = arcs.sup, arcs.supall, arcs.weights
+    state, tcell, tbits, stamp, order = se.state, se.tcell, se.tbits, se.stamp, se.order
+    lv_cell, lv_cand, lv_trail, lv_scan = se.lv_cell, se.lv_cand, se.lv_trail, se.lv_scan
+    counters = se.counters
     n, W = dom.shape
     nodes_here = 0
     while True:
@@ -874,7 +919,8 @@ def mac_search(
         _save(dom, v, stamp, state, tcell, tbits)
         for w in range(W):
             dom[v, w] = bit if w == wb else np.uint64(0)
-        wiped = propagate_trail(arcs, ac, v, se)
+        wiped = _propagate_trail(dom, full, ptr, nbr, sidx, sup, supall, queue, inq, v, stamp,
+                                 state, tcell, tbits, counters)  # fmt: skip
         if wiped >= 0:
             state[FAILS] += 1
             state[FAILS_RUN] += 1
