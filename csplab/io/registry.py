@@ -34,7 +34,6 @@ overlapping, poms, debroglie, markovjunior, png, vox or obj
 
 from __future__ import annotations
 
-import argparse
 import importlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -60,6 +59,7 @@ __all__ = [
     "option_help",
     "output_extensions",
     "output_format",
+    "resolve",
     "update_readme",
 ]
 
@@ -74,7 +74,8 @@ def _or(items: Sequence[str]) -> str:
     return items[0] if len(items) == 1 else f"{', '.join(items[:-1])} or {items[-1]}"
 
 
-def _resolve(target: str) -> Any:
+def resolve(target: str) -> Any:
+    """The object a ``"module:attr.attr"`` target names (the module is imported)."""
     modname, _, attr = target.partition(":")
     obj: Any = importlib.import_module(modname)
     for part in attr.split("."):
@@ -232,7 +233,7 @@ class Format:
         """How sure the sniffer is that ``head`` starts a file of this format (0 to 3)."""
         if self.sniffer is None:
             return NO
-        return int(_resolve(self.sniffer)(head))
+        return int(resolve(self.sniffer)(head))
 
     def check_options(self, options: Mapping[str, Any]) -> dict[str, Any]:
         """``options`` checked against :attr:`options` and converted to their types."""
@@ -250,7 +251,7 @@ class Format:
         if self.reader is None:
             raise InputError(f"csplab writes {self.name} files but does not read them")
         opts = self.check_options(options)
-        reader = cast("Callable[..., ExampleModel | RuleSet]", _resolve(self.reader))
+        reader = cast("Callable[..., ExampleModel | RuleSet]", resolve(self.reader))
         return reader(Path(path), **opts)
 
     def write(self, out: Output, path: str | Path) -> None:
@@ -261,7 +262,7 @@ class Format:
         if not self.partial and out.grid.size and int(out.grid.min()) < 0:
             exts = output_extensions(partial=True)
             raise InputError(f"{p}: the grid has unassigned cells; write it as {_or(exts)}")
-        writer = cast("Callable[[Output, Path], None]", _resolve(self.writer))
+        writer = cast("Callable[[Output, Path], None]", resolve(self.writer))
         writer(out, p)
 
     def info(self) -> dict[str, Any]:
@@ -365,8 +366,7 @@ FORMATS: dict[str, Format] = {
                     "symmetry",
                     int,
                     8,
-                    "how many of a pattern's 8 images under the "
-                    "square's symmetries are added (1..8)",
+                    "1..8: how many of a pattern's 8 images (turns, mirrors) are added",
                 ),
                 Option("periodic_input", bool, True, "the sample wraps around"),
                 Option(
@@ -394,8 +394,8 @@ FORMATS: dict[str, Format] = {
                     "up",
                     str,
                     "auto",
-                    "axes of 3D configs: `y` reads them `y`-up, `z` "
-                    "keeps them, `auto` is `y` with an `objMap`",
+                    "3D configs: `y` reads them `y`-up, `z` keeps the axes, `auto` is `y` "
+                    "when there is an `objMap`",
                     choices=("auto", "y", "z"),
                 ),
             ),
@@ -637,7 +637,8 @@ def markdown_table() -> str:
 
 def update_readme(path: str | Path = README, *, check: bool = False) -> bool:
     """Put :func:`markdown_table` between the ``<!-- formats:begin/end -->`` markers of
-    the README; ``True`` when it was (``check``: would be) changed."""
+    the README (``python -m csplab.io --write-readme``); ``True`` when it was
+    (``check``: would be) changed."""
     p = Path(path)
     text = p.read_text(encoding="utf-8")
     try:
@@ -651,24 +652,3 @@ def update_readme(path: str | Path = README, *, check: bool = False) -> bool:
     if not check:
         p.write_text(new, encoding="utf-8")
     return True
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m csplab.io.registry [--write-readme | --check-readme] [README]``."""
-    ap = argparse.ArgumentParser(prog="python -m csplab.io.registry", description=__doc__)
-    ap.add_argument("readme", nargs="?", default=str(README))
-    g = ap.add_mutually_exclusive_group()
-    g.add_argument("--write-readme", action="store_true", help="update the README table")
-    g.add_argument("--check-readme", action="store_true", help="exit 1 if it is outdated")
-    args = ap.parse_args(argv)
-    if args.write_readme or args.check_readme:
-        changed = update_readme(args.readme, check=args.check_readme)
-        state = "outdated" if args.check_readme and changed else ("updated" if changed else "")
-        print(f"{args.readme}: formats table {state or 'up to date'}")
-        return 1 if args.check_readme and changed else 0
-    print(markdown_table(), end="")
-    return 0
-
-
-if __name__ == "__main__":
-    raise SystemExit(main())
