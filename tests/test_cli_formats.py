@@ -94,6 +94,11 @@ def test_show_every_format(tmp_path, capsys, monkeypatch):
         (["synthesize", DATA / "pipes.xml", "--size", "4x4", "--out", "x.stl"], "use .npy"),
         (["show", DATA / "pipes.xml", "--out", "x.jpg"], ".png"),
         (["synthesize", "line", "--size", "4x4", "--model-option", "a=1"], "model files only"),
+        (
+            ["synthesize", DATA / "sample.png", "--size", "4x4", "--model-option", "N=x"],
+            "N='x' of overlapping files must be an integer",
+        ),
+        (["check", "line", DATA / "pipes.xml"], "not as label grids (use .txt, .grid or .npy)"),
     ],
 )
 def test_bad_input_one_line(capsys, argv, what):
@@ -158,3 +163,21 @@ def test_text_outputs_of_tilesets_check_back(tmp_path, capsys):
             assert code == 0, err
             code, o, _ = run(capsys, "check", model, out)
             assert code == 0 and o.startswith("0 violations"), (model, ext, o)
+
+
+def test_info_lists_the_formats_of_the_registry(capsys):
+    from csplab.io.registry import FORMATS
+
+    code, o, _ = run(capsys, "info")
+    assert code == 0
+    listing = o[o.index("file formats") :]
+    for f in FORMATS.values():
+        assert f"  {f.name} " in listing
+    assert "N=INT: pattern width (default 3)" in listing
+    assert "obj           write      .obj" in listing
+    code, o, _ = run(capsys, "info", "--json")
+    d = {f["name"]: f for f in json.loads(o)["formats"]}
+    assert list(d) == list(FORMATS)
+    assert d["vox"]["read"] and d["vox"]["write"] and d["wfc"]["gives"] == "RuleSet"
+    assert [o["name"] for o in d["poms"]["options"]] == ["up"]
+    assert d["poms"]["options"][0]["choices"] == ["auto", "y", "z"]

@@ -1,27 +1,29 @@
-"""Loaders only ever raise CsplabError on damaged files, and never hang."""
+"""Loaders only ever raise CsplabError on damaged files, and never hang.
+
+Every readable format of the registry is fuzzed: its sample is the smallest file of
+``tests/io/data`` detected as that format, else a small grid written by its own writer; a
+new format without either fails here until it gets a sample.
+"""
 
 import warnings
 
 import pytest
 from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from csplab.errors import CsplabError
-from csplab.io import read_model
+from csplab.io import model_format, read_model
+from csplab.io.registry import formats
 from csplab.testing.strategies import corrupted, tile_rule_sets
 
-from ._helpers import ANCHORS, DATA
+from ._helpers import ANCHORS, format_sample
 
-SMALL = {
-    "wfc.xml": (DATA / "pipes.xml").read_bytes(),
-    "mj.xml": (DATA / "pipes3d.xml").read_bytes(),
-    "poms.json": (DATA / "tiny_poms.json").read_bytes(),
-    "debroglie.json": (DATA / "tiny_debroglie.json").read_bytes(),
-    "sample.png": (DATA / "sample.png").read_bytes(),
-    "model.vox": (DATA / "pipes3d" / "Turn.vox").read_bytes(),
+READABLE = [f.name for f in formats(readable=True)]
+EXTRA = {  # larger real files, when the shared test data is there
+    "knots.xml": ANCHORS / "MarkovJunior" / "Knots3D.xml",
+    "edged.json": ANCHORS / "DeBroglie" / "edged_path_constraint.json",
 }
-if (ANCHORS / "MarkovJunior" / "Knots3D.xml").is_file():
-    SMALL["knots.xml"] = (ANCHORS / "MarkovJunior" / "Knots3D.xml").read_bytes()
-    SMALL["edged.json"] = (ANCHORS / "DeBroglie" / "edged_path_constraint.json").read_bytes()
+EXTRA = {k: v for k, v in EXTRA.items() if v.is_file()}
 
 
 def load(tmp_path, name, data):
@@ -42,12 +44,27 @@ def load(tmp_path, name, data):
     return m
 
 
-@pytest.mark.parametrize("name", sorted(SMALL))
+@pytest.mark.parametrize("fmt", READABLE)
+def test_every_readable_format_has_a_sample_that_loads(tmp_path, fmt):
+    name, data = format_sample(fmt)
+    (tmp_path / name).write_bytes(data)
+    assert model_format(tmp_path / name) == fmt
+    assert load(tmp_path, name, data) is not None
+
+
+@pytest.mark.parametrize("fmt", READABLE)
 @settings(deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(data=__import__("hypothesis").strategies.data())
-def test_corrupted_files_raise_only_csplab_errors(tmp_path, name, data):
-    bad = data.draw(corrupted(SMALL[name]))
-    load(tmp_path, name, bad)
+@given(data=st.data())
+def test_corrupted_files_raise_only_csplab_errors(tmp_path, fmt, data):
+    name, good = format_sample(fmt)
+    load(tmp_path, name, data.draw(corrupted(good)))
+
+
+@pytest.mark.parametrize("name", sorted(EXTRA))
+@settings(deadline=5000, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_corrupted_shared_files_raise_only_csplab_errors(tmp_path, name, data):
+    load(tmp_path, name, data.draw(corrupted(EXTRA[name].read_bytes())))
 
 
 @settings(
