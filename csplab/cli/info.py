@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-HELP = "list solvers (and whether they are installed) and built-in examples"
+HELP = "list solvers (and whether they are installed), built-in examples and file formats"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
