@@ -14,7 +14,9 @@ several do (``.xml``, ``.json``, ``.txt``), or none (an unknown extension: then 
 readable format), the one whose sniffer scores the first bytes highest
 (:mod:`csplab.io.common`: 0 no, 1 plausible, 2 the right kind of file, 3 certain); on a tie
 the one declared first; when nothing scores, the first format of the extension or, for an
-unknown extension, :data:`FALLBACK`. Writing (:func:`output_format`) takes the first
+unknown extension, :data:`FALLBACK`. An extension that only formats of another kind claim
+(``.obj``, never read; ``.xml`` when an example grid is wanted) is a one-line
+:class:`~csplab.errors.FormatError`. Writing (:func:`output_format`) takes the first
 writable format that claims the extension.
 
 Examples
