@@ -313,6 +313,17 @@ def setting_of(row: dict[str, Any]) -> str:
     return str(row["params"].get("label", row["solver"]))
 
 
+def check_boundary(example: ExampleModel, boundary: str, spec: str) -> None:
+    """Fail early (one line) when ``boundary="auto"`` cannot label this example."""
+    if boundary == "auto":
+        from csplab.grids import auto_boundary
+
+        try:
+            auto_boundary(example)
+        except InputError as e:
+            raise InputError(f"example {spec}: {e}; use --boundary none") from None
+
+
 class Experiment:
     """Base class: subclasses set the class attributes and implement :meth:`build` and
     :meth:`report`.
@@ -369,6 +380,16 @@ class Experiment:
         raise NotImplementedError
 
     # helpers ------------------------------------------------------------------------
+    def load_examples(
+        self, config: dict[str, Any]
+    ) -> tuple[list[tuple[str, ExampleModel]], dict[str, ExampleModel]]:
+        """The configured examples as ``(spec, model)`` pairs, each checked against the
+        boundary, and the same models by content hash (what :meth:`build` returns)."""
+        loaded = load_examples(config["examples"])
+        for spec, E in loaded:
+            check_boundary(E, config["boundary"], spec)
+        return loaded, {E.hash(): E for _, E in loaded}
+
     def seeds(self, config: dict[str, Any]) -> range:
         s0 = int(config.get("seed0", 0))
         return range(s0, s0 + int(config["seeds"]))

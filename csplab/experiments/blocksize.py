@@ -43,7 +43,6 @@ from csplab.experiments.base import (
     new_figure,
     save_figure,
 )
-from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.measures import (
     objects,
     pack_grid,
@@ -141,10 +140,8 @@ class BlockSize(Experiment):
 
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         trials: list[Trial] = []
-        examples: dict[str, ExampleModel] = {}
-        for spec, E in load_examples(config["examples"]):
-            check_boundary(E, config["boundary"], spec)
-            examples[E.hash()] = E
+        loaded, examples = self.load_examples(config)
+        for spec, E in loaded:
             size = parse_shape(config["size"]) if config["size"] else default_size(E)
             common = {"background": background_labels(E), "window": int(config["window"])}
             shapes: dict[tuple[int, ...], None] = {}
@@ -254,7 +251,6 @@ class BlockSize(Experiment):
 
     def _montage(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> list[Path]:
         """Outputs of the first seed at a few block sizes (re-run from their seeds)."""
-        from csplab.experiments.base import load_examples
         from csplab.experiments.trial import Trial, problem_for
         from csplab.render import render
         from csplab.solvers import solve

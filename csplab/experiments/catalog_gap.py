@@ -49,12 +49,10 @@ from csplab.example import ExampleModel
 from csplab.experiments.base import (
     Experiment,
     Report,
-    load_examples,
     new_figure,
     save_figure,
     size_for,
 )
-from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 from csplab.problem import Problem
@@ -208,12 +206,10 @@ class CatalogGap(Experiment):
 
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         trials: list[Trial] = []
-        examples: dict[str, ExampleModel] = {}
         opts = self.solver_options(config, "catalog")
         params = {"options": opts, "oracle": config["oracle"], "per_step": bool(config["per_step"])}
-        for spec, E in load_examples(config["examples"]):
-            check_boundary(E, config["boundary"], spec)
-            examples[E.hash()] = E
+        loaded, examples = self.load_examples(config)
+        for spec, E in loaded:
             for s in config["sizes"]:
                 size = size_for(E, int(s), int(config["nz"]))
                 for seed in self.seeds(config):

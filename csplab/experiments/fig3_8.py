@@ -27,7 +27,6 @@ from csplab.example import ExampleModel
 from csplab.experiments.base import (
     Experiment,
     Report,
-    load_examples,
     new_figure,
     save_figure,
     setting_of,
@@ -37,17 +36,6 @@ from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 
 __all__ = ["Fig38"]
-
-
-def check_boundary(example: ExampleModel, boundary: str, spec: str) -> None:
-    """Fail early (one line) when ``boundary="auto"`` cannot label this example."""
-    if boundary == "auto":
-        from csplab.grids import auto_boundary
-
-        try:
-            auto_boundary(example)
-        except InputError as e:
-            raise InputError(f"example {spec}: {e}; use --boundary none") from None
 
 
 class Fig38(Experiment):
@@ -88,10 +76,8 @@ class Fig38(Experiment):
 
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         trials: list[Trial] = []
-        examples: dict[str, ExampleModel] = {}
-        for spec, E in load_examples(config["examples"]):
-            check_boundary(E, config["boundary"], spec)
-            examples[E.hash()] = E
+        loaded, examples = self.load_examples(config)
+        for spec, E in loaded:
             for s in config["sizes"]:
                 size = size_for(E, int(s), int(config["nz"]))
                 trials += self.solver_trials(config, spec, E, size)

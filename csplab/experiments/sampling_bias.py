@@ -38,7 +38,6 @@ from csplab.experiments.base import (
     setting_of,
     split_solver,
 )
-from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
 from csplab.experiments.trial import Trial
@@ -168,12 +167,10 @@ class SamplingBias(Experiment):
 
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         trials: list[Trial] = []
-        examples: dict[str, ExampleModel] = {}
         size = parse_shape(config["size"])
         m = "csplab.experiments.sampling_bias:measure"
-        for spec, E in load_examples(config["examples"]):
-            check_boundary(E, config["boundary"], spec)
-            examples[E.hash()] = E
+        loaded, examples = self.load_examples(config)
+        for spec, E in loaded:
             common = (config["boundary"], False, m)
             trials.append(Trial(self.name, spec, E.hash(), size, "exact", {}, 0, *common))
             for seed in self.seeds(config):

@@ -33,7 +33,6 @@ from csplab.experiments.base import (
     save_figure,
     setting_of,
 )
-from csplab.experiments.fig3_8 import check_boundary
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
 from csplab.grids import parse_shape
@@ -132,10 +131,8 @@ class Table31(Experiment):
 
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         trials: list[Trial] = []
-        examples: dict[str, ExampleModel] = {}
-        for spec, E in load_examples(config["examples"]):
-            check_boundary(E, config["boundary"], spec)
-            examples[E.hash()] = E
+        loaded, examples = self.load_examples(config)
+        for spec, E in loaded:
             sizes = dict.fromkeys(
                 [self.displayed_size(config, spec, E), _shape_2d_or_3d(E, config["compare"])]
             )
