@@ -12,9 +12,6 @@ any decision) proves unsatisfiability.
 With ``order="scanline"`` and no restarts this is exactly Alg. 3.1 plus chronological
 backtracking: the same cell order and uniform label choice from the catalog.
 
-The options are declared once, on :class:`BacktrackSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -38,7 +35,7 @@ import numpy as np
 from csplab.catalog import Code, Propagator, Search
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Option, Solver, order_option
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Option, Solver, order_option
 
 __all__ = ["BacktrackSolver", "luby"]
 
@@ -86,19 +83,11 @@ class BacktrackSolver(Solver):
         TIME_LIMIT,
     )  # fmt: skip
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        order: str,
-        choice: str,
-        restart: int,
-        node_limit: int | None,
-        time_limit: float | None,
-    ) -> Result:
+    def run(self, problem: Problem, call: Call) -> Result:
+        rng = call.rng
+        order, choice, restart, node_limit, time_limit = call.get(
+            "order", "choice", "restart", "node_limit", "time_limit"
+        )
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n

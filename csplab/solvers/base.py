@@ -45,7 +45,7 @@ from __future__ import annotations
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -60,6 +60,7 @@ __all__ = [
     "CHOICE",
     "STATS",
     "TIME_LIMIT",
+    "Call",
     "Option",
     "Solver",
     "order_option",
@@ -208,8 +209,10 @@ STATS: dict[str, str] = {
     "literals": "literals of the encoding",
     "x_vars": "cell-label variables of the encoding",
     "aux_vars": "auxiliary variables of the encoding (at-most-one)",
-    "support_clauses": "support (or conflict) clauses of the encoding",
+    "support_clauses": "support clauses of the encoding",
     "alo_clauses": "at-least-one clauses of the encoding",
+    "amo_clauses": "at-most-one clauses of the encoding",
+    "conflict_clauses": "conflict clauses of the direct encoding",
     "empty_clause": "arc consistency wiped out before encoding (the CNF is the empty clause)",
     "ac_s": "seconds spent on arc consistency before encoding",
     "refinements": "lazy at-most-one refinements",
@@ -228,6 +231,32 @@ STATS: dict[str, str] = {
     "solver_status": "the backend's own status name",
     "solver_stats": "the backend's own statistics (a dict, backend names)",
 }
+
+
+@dataclass(frozen=True)
+class Call:
+    """What :meth:`Solver.run` gets: the randomness (``rng``, and the ``seed`` it was made
+    from, recorded in the result), the backend, every declared option validated, and the
+    start time."""
+
+    rng: np.random.Generator
+    seed: int | None
+    backend: str | None
+    options: Mapping[str, Any]
+    t0: float = field(default_factory=time.perf_counter)
+
+    def __getitem__(self, name: str) -> Any:
+        return self.options[name]
+
+    def get(self, *names: str) -> tuple[Any, ...]:
+        """The values of several options, in the order named."""
+        return tuple(self.options[n] for n in names)
+
+    @property
+    def deadline(self) -> float | None:
+        """``time.perf_counter()`` value of the time limit (``None``: no limit)."""
+        limit = self.options.get("time_limit")
+        return None if limit is None else self.t0 + float(limit)
 
 
 class Solver(ABC):
@@ -281,13 +310,13 @@ class Solver(ABC):
         **options: Any,
     ) -> Result:
         """Validate ``options`` against the declaration, then :meth:`run`."""
-        opts = self.validate(options, backend)
-        return self.run(problem, rng=rng, seed=seed, backend=backend, **opts)
+        call = Call(rng, seed, backend, self.validate(options, backend))
+        return self.run(problem, call)
 
     @abstractmethod
-    def run(self, *args: Any, **kwargs: Any) -> Result:
-        """Solve: called as ``run(problem, *, rng, seed, backend, **options)`` with every
-        declared option validated (each solver spells out its own keywords)."""
+    def run(self, problem: Problem, call: Call) -> Result:
+        """Solve ``problem``; ``call`` holds the randomness, the backend and every declared
+        option, validated."""
 
     @classmethod
     def result(

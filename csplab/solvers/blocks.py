@@ -8,9 +8,6 @@ is retried with fresh random choices up to ``retries`` times, then the block is 
 The grid is consistent after every block, so the result is always a solution. With ``m``
 equal to the model size and ``retries=0`` this is exactly Alg. 3.1 for the same seed.
 
-The options are declared once, on :class:`BlocksSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import Problem, solve
@@ -35,7 +32,7 @@ from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Option, Solver, order_option
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Option, Solver, order_option
 
 __all__ = ["BlocksSolver", "block_starts", "trivial_solution"]
 
@@ -277,13 +274,5 @@ class BlocksSolver(Solver):
         TIME_LIMIT,
     )  # fmt: skip
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        **options: Any,
-    ) -> Result:
-        return run_blocks(problem, rng, **options)
+    def run(self, problem: Problem, call: Call) -> Result:
+        return run_blocks(problem, call.rng, **call.options)

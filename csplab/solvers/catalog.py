@@ -5,9 +5,6 @@ after each assignment. When a domain empties the run stops with status ``failed`
 algorithm gave up, which says nothing about satisfiability. A wipe-out before any choice is
 a proof of unsatisfiability (Theorem 3.3.2) and gives ``unsat``.
 
-The options are declared once, on :class:`CatalogSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -20,12 +17,10 @@ Examples
 
 from __future__ import annotations
 
-import numpy as np
-
 from csplab.engine.alg31 import run_alg31
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Solver, order_option
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Solver, order_option
 
 __all__ = ["CatalogSolver"]
 
@@ -44,15 +39,5 @@ class CatalogSolver(Solver):
     )
     options = (order_option(), CHOICE, TIME_LIMIT)
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        order: str,
-        choice: str,
-        time_limit: float | None,
-    ) -> Result:
-        return run_alg31(problem, rng, order=order, choice=choice, time_limit=time_limit)
+    def run(self, problem: Problem, call: Call) -> Result:
+        return run_alg31(problem, call.rng, **call.options)

@@ -24,9 +24,6 @@ from the catalog with the rng (CP-SAT then repairs the hint, which is also fast:
 hint); ``"none"`` keeps CP-SAT's defaults. The seed is passed as ``random_seed``; with
 ``num_workers=1`` (default) runs are reproducible.
 
-The options are declared once, on :class:`CpsatSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -50,7 +47,7 @@ from csplab.deps import require
 from csplab.engine.sat import preferred_labels
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.base import TIME_LIMIT, Option, Solver
+from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
 
 __all__ = ["CpsatSolver"]
 
@@ -90,19 +87,11 @@ class CpsatSolver(Solver):
     )  # fmt: skip
     bench = ({}, {"model": "table"})
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        model: str,
-        diversity: str,
-        num_workers: int,
-        presolve: bool,
-        time_limit: float | None,
-    ) -> Result:
+    def run(self, problem: Problem, call: Call) -> Result:
+        rng = call.rng
+        model, diversity, num_workers, presolve, time_limit = call.get(
+            "model", "diversity", "num_workers", "presolve", "time_limit"
+        )
         cp_model = require("ortools.sat.python.cp_model", "cpsat", "solver 'cpsat'")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)

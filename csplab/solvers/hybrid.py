@@ -17,9 +17,6 @@ redrawn uniformly from C*(p); later steps use fresh randomness. (A chi-square te
 the exact distribution checks this: ``tests/solvers/test_perfect_hybrid.py``.) So
 ``hybrid`` is a cheap sampler of the thesis' ideal algorithm.
 
-The options are declared once, on :class:`HybridSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -52,7 +49,7 @@ from csplab.engine.sat import backends as sat_backends
 from csplab.errors import CsplabError
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Solver, order_option
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Solver, order_option
 
 __all__ = ["HybridSolver"]
 
@@ -76,17 +73,9 @@ class HybridSolver(Solver):
     options = (order_option(), CHOICE, TIME_LIMIT)
     backends = staticmethod(sat_backends)
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        order: str,
-        choice: str,
-        time_limit: float | None,
-    ) -> Result:
+    def run(self, problem: Problem, call: Call) -> Result:
+        rng, backend = call.rng, call.backend
+        order, choice, time_limit = call.get("order", "choice", "time_limit")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n

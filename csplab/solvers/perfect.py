@@ -13,9 +13,6 @@ with the partial model and has it (a pool of witnesses); otherwise one increment
 under an assumption decides it. Accepted labels become unit clauses, rejected ones
 negative units (C* only shrinks as the model grows), so every call has one assumption.
 
-The options are declared once, on :class:`PerfectSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -41,7 +38,7 @@ from csplab.engine.sat import backends as sat_backends
 from csplab.errors import CsplabError
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Option, Solver, order_option
+from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Option, Solver, order_option
 
 __all__ = ["PerfectSolver"]
 
@@ -64,18 +61,9 @@ class PerfectSolver(Solver):
     )  # fmt: skip
     backends = staticmethod(sat_backends)
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        order: str,
-        choice: str,
-        pool: int,
-        time_limit: float | None,
-    ) -> Result:
+    def run(self, problem: Problem, call: Call) -> Result:
+        rng, backend = call.rng, call.backend
+        order, choice, pool, time_limit = call.get("order", "choice", "pool", "time_limit")
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n

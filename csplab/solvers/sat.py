@@ -15,9 +15,6 @@ mostly empty space and much less variety; ``choice="none"`` keeps the solver's o
 Status ``unsat`` comes only with a proof: the SAT solver's refutation, or an arc-consistency
 wipe-out before any choice (what unit propagation on the support encoding also derives).
 
-The options are declared once, on :class:`SatSolver` (``csplab info`` and the
-README solver table list them with defaults and allowed values).
-
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -42,7 +39,7 @@ from csplab.cnf import AMO_ENCODINGS
 from csplab.engine.sat import SatOracle, backends, preferred_labels
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.solvers.base import TIME_LIMIT, Option, Solver
+from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
 
 __all__ = ["SatSolver"]
 
@@ -86,20 +83,11 @@ class SatSolver(Solver):
     backends = staticmethod(backends)
     bench = ({}, {"supports": "forward"}, {"loader": "api"}, {"backend": "glucose4"})
 
-    def run(
-        self,
-        problem: Problem,
-        *,
-        rng: np.random.Generator,
-        seed: int | None,
-        backend: str | None,
-        encoding: str,
-        supports: str,
-        amo: str,
-        choice: str,
-        loader: str,
-        time_limit: float | None,
-    ) -> Result:
+    def run(self, problem: Problem, call: Call) -> Result:
+        rng, backend = call.rng, call.backend
+        encoding, supports, amo, choice, loader, time_limit = call.get(
+            "encoding", "supports", "amo", "choice", "loader", "time_limit"
+        )
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         cseed = int(rng.integers(2**31 - 1))

@@ -37,7 +37,7 @@ TOY = textwrap.dedent(
         options = (Option("flavour", str, "plain", "a toy option", values=("plain", "salty")),
                    TIME_LIMIT)
 
-        def run(self, problem, *, rng, seed, backend, flavour, time_limit):
+        def run(self, problem, call):
             t0 = time.perf_counter()
             eng = Propagator(problem)
             g = search_solution(eng) if eng.ok else None
