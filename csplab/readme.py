@@ -24,6 +24,7 @@ __all__ = ["SECTIONS", "render", "stale_sections", "update"]
 # section name -> "module:function" returning the markdown
 SECTIONS: dict[str, str] = {
     "solvers": "csplab.solvers:markdown_table",
+    "formats": "csplab.io.registry:markdown_table",
 }
 
 

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
 from collections.abc import Sequence
 
 from csplab.errors import CsplabError
@@ -70,12 +71,19 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _show_warning(message: Warning | str, category: type[Warning], *args: object,
+                  **kwargs: object) -> None:  # fmt: skip
+    print(f"csplab: warning: {str(message).strip().splitlines()[0]}", file=sys.stderr)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``csplab`` console script."""
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
-        code: int = args._run(args)
+        with warnings.catch_warnings():  # library warnings: one line each, no source line
+            warnings.showwarning = _show_warning
+            code: int = args._run(args)
         return code
     except CsplabError as e:
         msg = str(e).strip().splitlines()

@@ -15,14 +15,17 @@ from csplab.cli.common import (
 
 HELP = "count the violations of a grid file against an example"
 DESCRIPTION = (
-    "Check a grid (.npy, Merrell .txt or .grid) against an example model or "
-    "a tileset's rules. Exit 0 when it is consistent, 1 when it violates something."
+    "Check a grid against an example model or a tileset's rules. Exit 0 when it is "
+    "consistent, 1 when it violates something."
 )
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    from csplab.io.registry import formats
+
+    exts = ", ".join(e for f in formats(gives="ExampleModel", exact=True) for e in f.extensions)
     add_problem_args(p, size_required=False)
-    p.add_argument("grid", metavar="GRID", help="grid file to check")
+    p.add_argument("grid", metavar="GRID", help=f"grid file to check ({exts}: label ids kept)")
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 

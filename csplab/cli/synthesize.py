@@ -5,15 +5,11 @@ from __future__ import annotations
 import argparse
 import json
 import sys
-from pathlib import Path
 from typing import Any
 
 from csplab.cli.common import add_problem_args, load_model, model_options, problem_from_args
 from csplab.errors import InputError
 from csplab.grids import parse_shape
-
-OUT_EXT = (".npy", ".txt", ".grid", ".png", ".vox", ".obj")
-
 
 HELP = "synthesize a model from an example"
 DESCRIPTION = (
@@ -59,10 +55,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="KEY=VALUE",
         help="extra solver option (repeatable; VALUE parsed as JSON when possible)",
     )
+    from csplab.io.registry import formats, output_extensions
+
+    kinds = ", ".join(f"{f.extensions[0]} ({f.name})" for f in formats(writable=True))
     p.add_argument(
         "--out",
-        help="output file: .npy, .txt (Merrell format), .grid, .png (tile pictures for "
-        "tilesets), .vox (MagicaVoxel) or .obj (+ .mtl)",
+        help=f"output file, format by extension: {kinds}; a failed run's partial grid is "
+        f"written only to {', '.join(output_extensions(partial=True))}",
     )
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
 
@@ -103,6 +102,7 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
 
 def run(args: argparse.Namespace) -> int:
     from csplab.io import write_labels
+    from csplab.io.registry import output_format
     from csplab.solvers import solve
 
     example = load_model(args.model, model_options(args.model_option))
@@ -110,13 +110,10 @@ def run(args: argparse.Namespace) -> int:
     opts = _options(args)
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
-    if args.out:
-        out = Path(args.out)
-        if out.suffix.lower() not in OUT_EXT:
-            raise InputError(f"--out {args.out}: use {', '.join(OUT_EXT)}")
+    out_format = output_format(args.out) if args.out else None  # bad extension: fail early
     result = solve(problem, args.solver, rng=args.seed, **opts)
     wrote = None
-    if args.out and (result.ok or Path(args.out).suffix.lower() in (".npy", ".png")):
+    if out_format is not None and (result.ok or out_format.partial):
         per = problem.meta.get("periodic", False)
         write_labels(
             result.grid, args.out, name=example.name, model=example, periodic=bool(all(per))
@@ -141,7 +138,8 @@ def run(args: argparse.Namespace) -> int:
         if keys:
             print("  " + ", ".join(f"{k}={result.stats[k]}" for k in keys))
         if wrote:
-            print(f"  wrote {wrote}")
+            unset = int((result.grid < 0).sum())
+            print(f"  wrote {wrote}" + (f" (partial: {unset} cells unassigned)" if unset else ""))
         elif args.out:
             print(f"  not written: {args.out} (no solution)", file=sys.stderr)
     return 0 if result.ok else 1

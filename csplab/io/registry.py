@@ -62,13 +62,11 @@ __all__ = [
     "output_extensions",
     "output_format",
     "resolve",
-    "update_readme",
 ]
 
 Gives = Literal["ExampleModel", "RuleSet"]
 HEAD_SIZE = 1 << 20  # bytes a sniffer sees
 FALLBACK = "grid"  # text that no sniffer recognises (its parser then says what is wrong)
-README = Path(__file__).resolve().parents[2] / "README.md"
 BEGIN, END = "<!-- formats:begin -->", "<!-- formats:end -->"
 
 
@@ -622,7 +620,8 @@ def _cell(text: str) -> str:
 
 
 def markdown_table() -> str:
-    """The README formats table, from the declarations (see :func:`update_readme`)."""
+    """The README formats table, from the declarations (``python -m csplab.readme --write``
+    puts it between the README's ``<!-- formats:begin/end -->`` markers)."""
     rows = [
         "| format | file | what csplab reads or writes | `--model-option` | try it |",
         "|---|---|---|---|---|",
@@ -635,22 +634,3 @@ def markdown_table() -> str:
         cells = [f"{f.description} (`{f.name}`)", file, f.details, opts, f"`{f.example}`"]
         rows.append("| " + " | ".join(_cell(c) for c in cells) + " |")
     return "\n".join(rows) + "\n"
-
-
-def update_readme(path: str | Path = README, *, check: bool = False) -> bool:
-    """Put :func:`markdown_table` between the ``<!-- formats:begin/end -->`` markers of
-    the README (``python -m csplab.io --write-readme``); ``True`` when it was
-    (``check``: would be) changed."""
-    p = Path(path)
-    text = p.read_text(encoding="utf-8")
-    try:
-        a = text.index(BEGIN) + len(BEGIN)
-        b = text.index(END, a)
-    except ValueError:
-        raise InputError(f"{p} has no {BEGIN} ... {END} markers") from None
-    new = text[:a] + "\n" + markdown_table() + text[b:]
-    if new == text:
-        return False
-    if not check:
-        p.write_text(new, encoding="utf-8")
-    return True

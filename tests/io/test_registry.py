@@ -23,7 +23,6 @@ from csplab.io.registry import (
     output_extensions,
     output_format,
     resolve,
-    update_readme,
 )
 
 from ._helpers import DATA, format_sample
@@ -32,26 +31,26 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_readme_formats_table_is_generated_from_the_registry():
+    from csplab.readme import render
+
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert BEGIN in text and END in text, "README.md lost its formats table markers"
     table = text[text.index(BEGIN) + len(BEGIN) : text.index(END)]
-    assert table.strip() == markdown_table().strip(), (
+    assert table.strip() == render("formats") == markdown_table().strip(), (
         "README.md's formats table differs from csplab/io/registry.py; "
-        "run: python -m csplab.io --write-readme"
+        "run: python -m csplab.readme --write"
     )
 
 
-def test_update_readme_replaces_only_the_table(tmp_path):
-    p = tmp_path / "README.md"
-    p.write_text(f"# x\n\n{BEGIN}\nold\n{END}\n\nafter\n")
-    assert update_readme(p, check=True) and "old" in p.read_text()
-    assert update_readme(p) and not update_readme(p)
-    text = p.read_text()
-    assert text.startswith("# x\n\n") and text.endswith(f"{END}\n\nafter\n")
-    assert markdown_table() in text
-    p.write_text("no markers")
-    with pytest.raises(InputError, match="markers"):
-        update_readme(p)
+def test_readme_update_replaces_only_the_table():
+    from csplab.readme import stale_sections, update
+
+    text = f"# x\n\n{BEGIN}\nold\n{END}\n\nafter\n"
+    assert "formats" in stale_sections(text)
+    new = update(text)
+    assert new.startswith("# x\n\n") and new.endswith(f"{END}\n\nafter\n")
+    assert markdown_table().strip() in new and "formats" not in stale_sections(new)
+    assert update(new) == new
 
 
 @pytest.mark.parametrize("fmt", list(FORMATS.values()), ids=list(FORMATS))
