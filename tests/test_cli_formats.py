@@ -91,7 +91,10 @@ def test_show_every_format(tmp_path, capsys, monkeypatch):
         ),
         (["synthesize", DATA / "pipes.xml", "--size", "4x4x4"], "is 2-D"),
         (["synthesize", "line"], "--size is required"),
-        (["synthesize", DATA / "pipes.xml", "--size", "4x4", "--out", "x.stl"], "unknown output format '.stl'"),
+        (
+            ["synthesize", DATA / "pipes.xml", "--size", "4x4", "--out", "x.stl"],
+            "unknown output format '.stl'",
+        ),
         (["show", DATA / "pipes.xml", "--out", "x.jpg"], ".png"),
         (["synthesize", "line", "--size", "4x4", "--model-option", "a=1"], "model files only"),
         (
