@@ -32,12 +32,14 @@ caller and every helper in one file, editing any of them invalidates all of them
 rule (``@njit`` functions elsewhere, such as the ctypes feeders of
 :mod:`csplab.engine.sat`, may call only non-csplab functions).
 
-Bundles are unpacked once per kernel call; the hot per-step calls inside the kernels
-(:func:`_propagate` from :func:`alg31`, :func:`_propagate_trail` from :func:`mac_search`)
-keep flat array arguments, so the compiled loops are those of the flat-argument kernels.
-The two arc revisions are copies on purpose: moving the loop into a shared ``@njit`` helper
-(inlined or not) made Alg. 3.1 30-40% slower at 40x40x10 (castle, city; A/B of both kernels
-in one process, 16 shuffled rounds, identical copies within 5-9%).
+Bundles are unpacked once per kernel call: the loops behind the entry points
+(:func:`_propagate`, called per step by :func:`alg31`; :func:`_mac_search` and its
+per-decision :func:`_propagate_trail`) keep flat array arguments and are the code of the
+earlier flat-argument kernels, unchanged (with the loops reading bundle fields, the MAC
+search measured 4-5% slower). The two arc revisions are copies on purpose: moving the loop
+into a shared ``@njit`` helper (inlined or not) made Alg. 3.1 30-40% slower at 40x40x10
+(castle, city; A/B of both kernels in one process, 16 shuffled rounds, identical copies
+within 5-9%).
 """
 
 from __future__ import annotations
@@ -864,13 +866,24 @@ def mac_search(
     :func:`mac_restart`), :attr:`Code.PAUSED` after ``max_nodes`` decisions in this call,
     :attr:`Code.GROW` when the trail is nearly full (resume with ``se.grown()``).
     """
-    # unpacked once: the per-decision call of the arc-consistency loop takes flat arrays
-    dom, queue, inq = ac.dom, ac.queue, ac.inq
-    full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
-    sup, supall, weights = arcs.sup, arcs.supall, arcs.weights
-    state, tcell, tbits, stamp, order = se.state, se.tcell, se.tbits, se.stamp, se.order
-    lv_cell, lv_cand, lv_trail, lv_scan = se.lv_cell, se.lv_cand, se.lv_trail, se.lv_scan
-    counters = se.counters
+    return _mac_search(
+        ac.dom, arcs.full, arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup, arcs.supall, ac.queue,
+        ac.inq, se.stamp, se.state, se.tcell, se.tbits, se.lv_cell, se.lv_cand, se.lv_trail,
+        se.lv_scan, scan, se.order, arcs.weights, weighted, max_nodes, restart_fails,
+        se.counters,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _mac_search(
+    dom: np.ndarray, full: np.ndarray, ptr: np.ndarray, nbr: np.ndarray, sidx: np.ndarray,
+    sup: np.ndarray, supall: np.ndarray, queue: np.ndarray, inq: np.ndarray,
+    stamp: np.ndarray, state: np.ndarray, tcell: np.ndarray, tbits: np.ndarray,
+    lv_cell: np.ndarray, lv_cand: np.ndarray, lv_trail: np.ndarray, lv_scan: np.ndarray,
+    scan: bool, order: np.ndarray, weights: np.ndarray, weighted: bool,
+    max_nodes: int, restart_fails: int, counters: np.ndarray,
+) -> int:  # fmt: skip
+    """:func:`mac_search` with flat arguments."""
     n, W = dom.shape
     nodes_here = 0
     while True:
