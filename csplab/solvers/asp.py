@@ -1,0 +1,618 @@
+"""Solver ``asp``: answer-set programming with clingo (Karth & Smith, FDG 2017).
+
+The program (first-order; the default grounding writes its ground instances itself)::
+
+    1 { a(C,L) : d(C,L) } 1 :- cell(C).                       % one label per cell
+    :- a(U,A), arc(U,V,R), not a(V,B) : ok(R,A,B), d(V,B).   % A has a successor
+    :- a(V,B), arc(U,V,R), not a(U,A) : ok(R,A,B), d(U,A).   % B has a predecessor
+
+``d(C,L)`` is the arc-consistent catalog of the :class:`~csplab.problem.Problem` (its
+domains -- fixed cells, masks, boundary labels -- pruned by arc consistency, Alg. 3.2, as
+:func:`csplab.cnf.encode` does for ``sat`` and ``cpsat``; a cell left with one label is a
+constant), ``arc(U,V,R)`` its arcs and ``ok(R,A,B)`` its relations, so every grid variant
+(periodic axes, extra arcs from ``add_arcs``, fixed cells, masks, boundaries) is covered.
+The integrity constraints are *supports*: one per (arc direction, label), "this label has
+a compatible label next to it". Answer sets and solutions correspond one to one (tested
+against brute-force counts). ``supports="forward"`` keeps only the first (exact with
+exactly-one, weaker propagation); ``encoding="direct"`` states one integrity constraint
+per forbidden pair instead, ``:- a(U,A), a(V,B), arc(U,V,R), not ok(R,A,B).``
+
+Grounding
+---------
+The ground program has one atom per (cell, label) of the catalog, a choice rule and an
+at-most-one cardinality constraint per cell and one integrity constraint per support:
+at 40×40×10 on the built-in examples 0.2--1.1 million atoms and 1.3--6.1 million rules
+(3.6--17 million literals). ``grounding="csplab"`` (default) takes the rules from
+:func:`csplab.cnf.encode` (the clauses of solver ``sat``) and streams them to clingo in
+its intermediate format aspif (:func:`ground_program`); ``grounding="gringo"`` passes the
+catalog, arcs and relations as facts with the program above (:func:`facts`) and lets
+gringo ground it. Measured on castle 12×12×6 (864 cells, 281,000 support rules; a shared
+2-core machine, ±30%):
+
+=======================================================  =========  ====================
+program                                                  grounding  clingo's solve call
+=======================================================  =========  ====================
+aspif written by csplab (writing + clingo parsing it)    0.3 s      0.3 s
+clingo's Python backend, one ``add_rule`` per rule       0.85 s     0.5 s
+gringo, support atoms ``s(V,R,A) :- a(V,B), ok(R,A,B)``  1.9 s      1.3 s (2× the rules)
+gringo, conditional literals (the program above)         4.9 s      0.9 s
+gringo, one constraint per forbidden pair                23 s       21 s (8.3M rules)
+=======================================================  =========  ====================
+
+At 40×40×10 forbidden pairs are out of reach (each relation allows about 200 of
+K² = 4,000--14,000 pairs: 100--200 million rules; :func:`~csplab.cnf.encode` refuses them
+with an :class:`~csplab.errors.InputError`), and gringo's grounding of the support program
+costs 16 s for canal (auto; whole call 22 s) and 88 s for castle (none; 116 s). Time to a
+40×40×10 model with the default (``benchmarks/bench_solvers.py --solvers asp --seeds 3
+--time-limit 60 [--boundary auto]``, median of 3 seeds, all solved; total = encode + load +
+solve seconds, where load is csplab writing the aspif and clingo parsing it, overlapped,
+and solve is clasp preparing the program plus the search): none -- city 17.6 = 0.57 +
+8.9 + 7.2, castle 15.4 = 0.50 + 7.3 + 6.8, canal 8.1 = 0.08 + 4.2 + 3.4; auto -- city
+6.4 = 0.06 + 3.2 + 2.7, castle 7.1 = 0.07 + 3.3 + 3.4, canal 3.0 = 0.03 + 1.4 + 1.3. The
+search itself takes under 1.5 s (at most a few dozen conflicts): clingo's per-rule cost of
+parsing and preparing dominates, and none of clasp's preprocessing options changed it
+(``--eq=0``, ``--no-init-moms``, ``--trans-ext=no``: within noise). With
+``supports="forward"`` castle (none) ran 12 minutes without an answer (weak propagation;
+solver ``sat`` saw the same).
+
+Time limit and process
+----------------------
+clingo reads an aspif program in one piece (a second ``load`` fails: "incremental aspif
+programs are not supported") and prepares it inside ``solve`` without looking at
+interrupts: 4 s for the 1.7 million rules of a 30×30×8 box town. So clingo runs in a child
+process (the same Python, importing only clingo, about 0.1 s to start): the program is
+streamed into its standard input while csplab writes it, the child solves with clingo's
+asynchronous ``solve``, ``wait(timeout)`` and ``cancel``, and reports the true atoms.
+``time_limit`` covers the whole call: the child stops its search at the deadline, and is
+killed 0.3 s after it if it is still parsing or preparing.
+
+Diversity
+---------
+The seed comes from ``rng`` (clingo's ``--seed``); the same seed gives the same grid (one
+thread). Mean fraction of cells that differ between two seeds' outputs, with the fraction
+of non-empty cells in brackets, at 16×16×8 (city, canal none; castle auto):
+``diversity="sign"`` (default, ``--sign-def=rnd``: random default signs) 0.28--0.34
+(0.24--0.38); ``"label"`` (one random catalog label per cell preferred through clasp's
+domain heuristic, like the decision phases of ``sat``) 0.40--0.74 (0.45--0.92: a uniform
+label prefers the many non-empty labels); ``"none"`` 0: the seed alone does not change
+clingo's first answer set. ``--rand-freq=0.05`` on top of random signs added nothing
+(0.27--0.38), so it is not offered. For comparison, Alg. 3.1 0.19--0.21 (0.12), ``sat``
+0.49--0.51 (0.44). At 40×40×10 ``"sign"`` gives 0.23--0.50 (0.19--0.37).
+
+Status ``unsat`` comes with a proof: clingo's exhaustive search (no answer set), or an
+arc-consistency wipe-out before encoding (Theorem 3.3.2). When arc consistency leaves one
+label per cell, that is the solution and clingo is not started.
+
+Examples
+--------
+>>> import numpy as np
+>>> from csplab import ExampleModel, Problem
+>>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 5))
+>>> r = AspSolver().solve(P, rng=np.random.default_rng(0), seed=0)
+>>> r.status, P.is_solution(r.grid), r.stats["solver_status"]
+('solved', True, 'SAT')
+>>> Q = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (5, 4), periodic=True)
+>>> AspSolver().solve(Q, rng=np.random.default_rng(0), seed=0).stats["proof"]
+'clingo ...: no answer set (exhaustive search)'
+>>> R = P.with_fixed({(0, 0): 0, (0, 1): 0})
+>>> AspSolver().solve(R, rng=np.random.default_rng(0), seed=0).stats["proof"]
+'arc-consistency wipe-out before encoding (Theorem 3.3.2)'
+"""
+
+from __future__ import annotations
+
+import inspect
+import json
+import subprocess
+import sys
+import tempfile
+import textwrap
+import threading
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import numpy as np
+from numba import njit
+from numpy.typing import NDArray
+
+from csplab.cnf import DeadlineExceeded, Encoding, encode
+from csplab.deps import require
+from csplab.engine.sat import preferred_labels
+from csplab.errors import CsplabError
+from csplab.problem import Problem
+from csplab.result import Result, Status
+from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
+
+__all__ = ["PROGRAM", "AspSolver", "facts", "ground_program"]
+
+PROGRAM = {
+    "choice": "1 { a(C,L) : d(C,L) } 1 :- cell(C).",
+    "forward": ":- a(U,A), arc(U,V,R), not a(V,B) : ok(R,A,B), d(V,B).",
+    "backward": ":- a(V,B), arc(U,V,R), not a(U,A) : ok(R,A,B), d(U,A).",
+    "direct": ":- a(U,A), a(V,B), arc(U,V,R), not ok(R,A,B).",
+    "show": "#show a/2.",
+}
+"""The first-order program of ``grounding="gringo"`` (see the module docstring)."""
+
+_GRACE = 0.3  # seconds the child may run past the deadline before it is killed
+_CLAUSE_CHUNK = 100_000  # integrity constraints per streamed piece
+_CELL_CHUNK = 4_096  # cells per streamed piece of choice rules
+
+
+# ----------------------------------------------------------------------------- aspif
+
+
+@njit(cache=True, nogil=True)
+def _format_lines(
+    tokens: NDArray[np.int64], line_len: NDArray[np.int64], out: NDArray[np.uint8]
+) -> int:
+    """Write ``tokens`` as decimal text, ``line_len[i]`` tokens per line, into ``out``.
+
+    Returns the number of bytes written (``out`` must be large enough).
+    """
+    pos = 0
+    t = 0
+    for i in range(line_len.size):
+        for j in range(line_len[i]):
+            x = tokens[t]
+            t += 1
+            if j > 0:
+                out[pos] = 32
+                pos += 1
+            if x < 0:
+                out[pos] = 45
+                pos += 1
+                x = -x
+            nd = 1
+            y = x // 10
+            while y > 0:
+                nd += 1
+                y //= 10
+            for d in range(nd - 1, -1, -1):
+                out[pos + d] = 48 + x % 10
+                x //= 10
+            pos += nd
+        out[pos] = 10
+        pos += 1
+    return pos
+
+
+def _text(tokens: NDArray[np.int64], line_len: NDArray[np.int64]) -> bytes:
+    if tokens.size == 0:
+        return b""
+    width = len(str(int(np.abs(tokens).max()))) + 2
+    out = np.empty(tokens.size * width + line_len.size, dtype=np.uint8)
+    n = _format_lines(tokens, line_len, out)
+    return out[:n].tobytes()
+
+
+def _cell_rules(first: NDArray[np.int64], k: NDArray[np.int64]) -> bytes:
+    """Per cell with atoms ``first .. first+k-1``: the choice rule ``{a; ...}.`` and the
+    at-most-one constraint ``:- 2 {a; ...}.`` (aspif lines ``1 1 k a.. 0 0`` and
+    ``1 0 0 1 2 k a 1 ..``)."""
+    m = k.size
+    line = np.empty(2 * m, dtype=np.int64)
+    line[0::2] = k + 5
+    line[1::2] = 2 * k + 6
+    off = np.zeros(2 * m, dtype=np.int64)
+    np.cumsum(line[:-1], out=off[1:])
+    tok = np.empty(int(line.sum()), dtype=np.int64)
+    o1, o2 = off[0::2], off[1::2]
+    cid = np.repeat(np.arange(m), k)
+    j = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+    atoms = first[cid] + j
+    tok[o1], tok[o1 + 1], tok[o1 + 2] = 1, 1, k
+    tok[o1[cid] + 3 + j] = atoms
+    tok[o1 + 3 + k] = 0
+    tok[o1 + 4 + k] = 0
+    tok[o2], tok[o2 + 1], tok[o2 + 2], tok[o2 + 3], tok[o2 + 4], tok[o2 + 5] = 1, 0, 0, 1, 2, k
+    tok[o2[cid] + 6 + 2 * j] = atoms
+    tok[o2[cid] + 7 + 2 * j] = 1
+    return _text(tok, line)
+
+
+def _constraints(lits: NDArray[np.int32], starts: NDArray[np.int64], a: int, b: int) -> bytes:
+    """Clauses ``a..b-1`` as integrity constraints ``:- not c1, ...`` (aspif
+    ``1 0 0 0 n -c1 ...``): a clause is violated exactly when its negation holds."""
+    lens = np.diff(starts[a : b + 1]).astype(np.int64)
+    m = b - a
+    line = lens + 5
+    off = np.zeros(m, dtype=np.int64)
+    np.cumsum(line[:-1], out=off[1:])
+    tok = np.empty(int(line.sum()), dtype=np.int64)
+    head = off[:, None] + np.arange(5)
+    tok[head[:, 0]] = 1
+    tok[head[:, 1:4]] = 0
+    tok[head[:, 4]] = lens
+    body = np.ones(tok.size, dtype=bool)
+    body[head.ravel()] = False
+    tok[body] = -lits[starts[a] : starts[b]].astype(np.int64)
+    return _text(tok, line)
+
+
+def _heuristics(atoms: NDArray[np.int64]) -> bytes:
+    """``#heuristic a. [1, sign]`` for each atom (aspif ``7 1 a 1 0 0``)."""
+    m = atoms.size
+    tok = np.zeros((m, 6), dtype=np.int64)
+    tok[:, 0], tok[:, 1], tok[:, 2], tok[:, 3] = 7, 1, atoms, 1
+    return _text(tok.ravel(), np.full(m, 6, dtype=np.int64))
+
+
+def ground_program(enc: Encoding, prefer: NDArray[np.int64] | None = None) -> Iterator[bytes]:
+    """The ground ASP program of an encoding, in aspif, as a stream of pieces.
+
+    Atom ``i`` is CNF variable ``i`` of ``enc`` (``(cell, label)`` of the catalog, numbered
+    cell by cell); constant cells have no atoms. ``prefer`` (one label per cell, -1 for
+    none) adds domain-heuristic sign preferences.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, Problem
+    >>> from csplab.cnf import encode
+    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (1, 2))
+    >>> print(b"".join(ground_program(encode(P))).decode(), end="")
+    asp 1 0 0
+    1 1 2 1 2 0 0
+    1 0 0 1 2 2 1 1 2 1
+    1 1 2 3 4 0 0
+    1 0 0 1 2 2 3 1 4 1
+    1 0 0 0 2 1 -4
+    1 0 0 0 2 2 -3
+    1 0 0 0 2 3 -2
+    1 0 0 0 2 4 -1
+    1 0 0 0 2 -1 -2
+    1 0 0 0 2 -3 -4
+    0
+    """
+    yield b"asp 1 0 0\n"
+    has = enc.var > 0
+    k_all = has.sum(axis=1).astype(np.int64)
+    cells = np.flatnonzero(k_all > 0)
+    k = k_all[cells]
+    first = np.cumsum(k) - k + 1
+    for a in range(0, cells.size, _CELL_CHUNK):
+        yield _cell_rules(first[a : a + _CELL_CHUNK], k[a : a + _CELL_CHUNK])
+    for a in range(0, enc.nclauses, _CLAUSE_CHUNK):
+        yield _constraints(enc.lits, enc.starts, a, min(a + _CLAUSE_CHUNK, enc.nclauses))
+    if prefer is not None:
+        c = cells[prefer[cells] >= 0]
+        atoms = enc.var[c, prefer[c]].astype(np.int64)
+        yield _heuristics(atoms[atoms > 0])
+    yield b"0\n"
+
+
+def facts(problem: Problem, catalog: NDArray[np.bool_], supports: str, encoding: str) -> str:
+    """The facts and first-order program of ``grounding="gringo"``.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, Problem
+    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (1, 2))
+    >>> print(facts(P, P.domains, "forward", "support"))
+    cell(0..1).
+    d(0,(0;1)).
+    d(1,(0;1)).
+    arc(0,1,1).
+    ok(0,0,1). ok(0,1,0). ok(1,0,1). ok(1,1,0).
+    1 { a(C,L) : d(C,L) } 1 :- cell(C).
+    :- a(U,A), arc(U,V,R), not a(V,B) : ok(R,A,B), d(V,B).
+    #show a/2.
+    """
+    lines = [f"cell(0..{problem.n - 1})."]
+    for c, row in enumerate(catalog):
+        lab = np.flatnonzero(row)
+        if lab.size:
+            lines.append(f"d({c},({';'.join(map(str, lab.tolist()))})).")
+    arcs = problem.arcs[problem.arcs[:, 0] != problem.arcs[:, 1]]
+    lines += [f"arc({u},{v},{r})." for u, v, r in arcs.tolist()]
+    lines.append(
+        " ".join(f"ok({r},{x},{y})." for r, x, y in np.argwhere(problem.relations).tolist())
+    )
+    lines.append(PROGRAM["choice"])
+    if encoding == "direct":
+        lines.append(PROGRAM["direct"])
+    else:
+        lines.append(PROGRAM["forward"])
+        if supports == "both":
+            lines.append(PROGRAM["backward"])
+    lines.append(PROGRAM["show"])
+    return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- the child
+
+
+def _clingo_child() -> None:  # pragma: no cover - runs in the child process
+    """Entry point of the child: load the program from stdin, solve, print JSON.
+
+    ``sys.argv[1]`` is the configuration: clingo ``args``, the wall-clock ``deadline``
+    (or null), how to ``read`` the model (``atoms`` 1..``nx`` or the ``shown`` symbols).
+    Self-contained (its source is what the child runs): stdlib and clingo only.
+    """
+    import json
+    import sys
+    import time
+
+    out: dict[str, Any] = {"status": "UNKNOWN", "messages": []}
+    try:
+        import clingo
+
+        cfg = json.loads(sys.argv[1])
+
+        def log(code: Any, msg: str) -> None:
+            if len(out["messages"]) < 10:
+                out["messages"].append(msg.strip()[:500])
+
+        ctl = clingo.Control(cfg["args"], logger=log, message_limit=10)
+        ctl.load("-")
+        ctl.ground([("base", [])])
+        out["loaded"] = time.time()
+        deadline = cfg["deadline"]
+        model: dict[str, Any] = {}
+
+        def on_model(m: Any) -> None:
+            t = time.time()
+            if cfg["read"] == "atoms":
+                model["atoms"] = [i for i in range(1, cfg["nx"] + 1) if m.is_true(i)]
+            else:
+                model["pairs"] = [
+                    [s.arguments[0].number, s.arguments[1].number] for s in m.symbols(shown=True)
+                ]
+            out["read_s"] = time.time() - t
+
+        if deadline is None or time.time() < deadline:
+            t = time.time()
+            with ctl.solve(on_model=on_model, async_=True) as h:
+                out["prepare_s"] = time.time() - t
+                left = None if deadline is None else max(0.0, deadline - time.time())
+                if not h.wait(left):
+                    h.cancel()
+                res = h.get()
+            out["search_s"] = time.time() - t - out["prepare_s"]
+            if res.satisfiable and model:
+                out["status"] = "SAT"
+                out.update(model)
+            elif res.unsatisfiable:
+                out["status"] = "UNSAT"
+        st = ctl.statistics
+        lp = st.get("problem", {}).get("lp", {})
+        sv = st.get("solving", {}).get("solvers", {})
+        out["stats"] = {
+            "atoms": int(lp.get("atoms", 0)),
+            "rules": int(lp.get("rules", 0)),
+            "choices": int(sv.get("choices", 0)),
+            "conflicts": int(sv.get("conflicts", 0)),
+            "restarts": int(sv.get("restarts", 0)),
+        }
+    except Exception as e:
+        out["status"] = "ERROR"
+        out["error"] = f"{type(e).__name__}: {e}"
+    sys.stdout.write(json.dumps(out))
+    sys.stdout.flush()
+
+
+_CHILD_SOURCE: str | None = None
+
+
+def _child_source() -> str:
+    global _CHILD_SOURCE
+    if _CHILD_SOURCE is None:
+        src = textwrap.dedent(inspect.getsource(_clingo_child))
+        _CHILD_SOURCE = (
+            f"# csplab solver asp: clingo child\nfrom typing import Any\n{src}\n_clingo_child()\n"
+        )
+    return _CHILD_SOURCE
+
+
+def _run_child(
+    args: list[str],
+    pieces: Iterator[bytes],
+    *,
+    read: str,
+    nx: int,
+    deadline: float | None,
+) -> tuple[dict[str, Any] | None, float]:
+    """Run clingo in a child process on the streamed program.
+
+    Returns the child's report (``None`` when it was killed at the deadline) and the
+    wall-clock time at which csplab finished writing the program.
+    """
+    wall_deadline = None if deadline is None else time.time() + (deadline - time.perf_counter())
+    cfg = json.dumps({"args": args, "deadline": wall_deadline, "read": read, "nx": nx})
+    with tempfile.TemporaryFile() as err:
+        proc = subprocess.Popen(
+            [sys.executable, "-c", _child_source(), cfg],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            stderr=err,
+        )
+        written = [0.0]
+        failure: list[BaseException] = []
+        output: list[bytes] = []
+
+        def writer() -> None:
+            stdin = proc.stdin
+            assert stdin is not None
+            try:
+                for piece in pieces:
+                    try:
+                        stdin.write(piece)
+                    except (OSError, ValueError):  # the child died or was killed
+                        return
+                stdin.close()
+                written[0] = time.time()
+            except (OSError, ValueError):
+                return
+            except BaseException as e:  # building the program failed: re-raised below
+                failure.append(e)
+                proc.kill()
+
+        def reader() -> None:
+            assert proc.stdout is not None
+            output.append(proc.stdout.read())
+
+        threads = [threading.Thread(target=f, daemon=True) for f in (writer, reader)]
+        for th in threads:
+            th.start()
+        killed = False
+        try:
+            try:
+                left = None if deadline is None else deadline - time.perf_counter()
+                proc.wait(None if left is None else max(0.0, left) + _GRACE)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                killed = True
+                proc.wait()
+            for th in threads:
+                th.join()
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+        if failure:
+            raise failure[0]
+        if killed:
+            return None, written[0]
+        try:
+            report: dict[str, Any] = json.loads((output[0] if output else b"").decode())
+        except ValueError:
+            err.seek(0)
+            tail = err.read().decode(errors="replace").strip().splitlines()[-3:]
+            raise CsplabError(
+                f"the clingo child process exited with code {proc.returncode} without a "
+                "result" + (": " + " | ".join(tail) if tail else "")
+            ) from None
+    return report, written[0]
+
+
+# ----------------------------------------------------------------------------- solver
+
+
+class AspSolver(Solver):
+    """Complete: answer-set programming with clingo (choice rule + support constraints)."""
+
+    name = "asp"
+    complete = True
+    requires = ("clingo",)
+    extra = "asp"
+    description = "answer-set programming with clingo (Karth & Smith 2017)"
+    notes = (
+        "one label per cell by a choice rule, one integrity constraint per (arc, label) "
+        'support (`encoding="direct"`: per forbidden pair) on the arc-consistent catalog; '
+        'ground by csplab and streamed as aspif (`grounding="gringo"` grounds the '
+        "first-order program); clingo runs in a child process, so `time_limit` also stops "
+        "parsing; diverse outputs from `--seed` and random signs"
+    )
+    options = (
+        Option("encoding", str, "support", "integrity constraints per (arc, label) support "
+               "or per forbidden pair", values=("support", "direct")),
+        Option("supports", str, "both", "support constraints in both arc directions or "
+               "forward only", values=("both", "forward")),
+        Option("grounding", str, "csplab", "ground program written by csplab (aspif) or "
+               "grounded by gringo from facts", values=("csplab", "gringo")),
+        Option("diversity", str, "sign", "how seeds vary the output: random default signs, "
+               "a random preferred label per cell, or the seed alone",
+               values=("sign", "label", "none")),
+        TIME_LIMIT,
+    )  # fmt: skip
+
+    def run(self, problem: Problem, call: Call) -> Result:
+        encoding, supports, grounding, diversity = call.get(
+            "encoding", "supports", "grounding", "diversity"
+        )
+        clingo = require("clingo", "asp", "solver 'asp'")
+        t0, deadline, rng = call.t0, call.deadline, call.rng
+        cseed = int(rng.integers(2**31 - 1))
+        empty = np.full(problem.shape, -1, dtype=np.int32)
+        stats: dict[str, Any] = {
+            "encoding": encoding,
+            "supports": supports,
+            "grounding": grounding,
+            "diversity": diversity,
+        }
+
+        def done(status: Status, grid: NDArray[np.int32] = empty) -> Result:
+            return self.result(status, grid, problem, stats, t0)
+
+        try:
+            enc = encode(problem, encoding=encoding, supports=supports, deadline=deadline)
+        except DeadlineExceeded:
+            return done("timeout")
+        t_enc = time.perf_counter()
+        stats["encode_s"] = t_enc - t0
+        if not enc.ok:
+            stats["proof"] = "arc-consistency wipe-out before encoding (Theorem 3.3.2)"
+            stats["fail_cell"] = list(problem.coords(enc.wiped))
+            return done("unsat")
+        stats["x_vars"] = enc.nx
+        if enc.nx == 0:  # arc consistency left one label per cell: that is the solution
+            stats["ground_s"] = stats["encode_s"]
+            stats["solve_s"] = 0.0
+            return done("solved", enc.const.reshape(problem.shape))
+        if deadline is not None and time.perf_counter() > deadline:
+            return done("timeout")
+
+        args = ["--models=1", f"--seed={cseed}"]
+        if diversity == "sign":
+            args.append("--sign-def=rnd")
+        prefer = None
+        if diversity == "label":
+            prefer = preferred_labels(enc.catalog, None, rng)
+            args.append("--heuristic=Domain")
+        pieces: Iterator[bytes]
+        if grounding == "csplab":
+            pieces = ground_program(enc, prefer)
+            read = "atoms"
+        else:
+            text = facts(problem, enc.catalog, supports, encoding)
+            if prefer is not None:
+                text += "\n" + " ".join(
+                    f"#heuristic a({c},{b}). [1,sign]"
+                    for c, b in enumerate(prefer.tolist())
+                    if b >= 0 and enc.var[c, b] > 0
+                )
+            pieces = iter([text.encode()])
+            read = "shown"
+        t_write = time.time()
+        report, written = _run_child(args, pieces, read=read, nx=enc.nx, deadline=deadline)
+        stats["solver_stats"] = sub = {
+            "clingo": str(clingo.__version__),
+            "seed": cseed,
+            "args": args,
+            "write_s": round(max(0.0, written - t_write), 6) if written else None,
+        }
+        if report is None:
+            sub["killed"] = "at the deadline, while clingo parsed or prepared the program"
+            return done("timeout")
+        if report.get("status") == "ERROR":
+            raise CsplabError(f"clingo failed: {report.get('error')}")
+        stats["solver_status"] = report["status"]
+        stats.update(report.get("stats", {}))
+        if "loaded" in report:
+            stats["load_s"] = max(0.0, report["loaded"] - t_write)
+            stats["ground_s"] = stats["encode_s"] + stats["load_s"]
+        for key in ("prepare_s", "search_s", "read_s"):
+            if key in report:
+                sub[key] = report[key]
+        if "prepare_s" in report:
+            stats["solve_s"] = report["prepare_s"] + report["search_s"]
+        if report.get("messages"):
+            sub["messages"] = report["messages"]
+        if report["status"] == "SAT":
+            grid = enc.const.copy()
+            if read == "atoms":
+                cells, labels = np.nonzero(enc.var > 0)  # atom i+1 <-> (cells[i], labels[i])
+                idx = np.asarray(report["atoms"], dtype=np.int64) - 1
+                if idx.size != np.count_nonzero(enc.const < 0):
+                    raise CsplabError(f"clingo's model has {idx.size} labels for the "
+                                      f"{np.count_nonzero(enc.const < 0)} open cells")  # fmt: skip
+                grid[cells[idx]] = labels[idx]
+            else:
+                pairs = np.asarray(report["pairs"], dtype=np.int64).reshape(-1, 2)
+                grid[pairs[:, 0]] = pairs[:, 1]
+            return done("solved", grid.reshape(problem.shape))
+        if report["status"] == "UNSAT":
+            stats["proof"] = f"clingo {clingo.__version__}: no answer set (exhaustive search)"
+            return done("unsat")
+        return done("timeout")

@@ -1,0 +1,321 @@
+"""Solver ``asp`` (clingo): brute-force agreement, the ground program's answer sets, every
+grid variant, unsat proofs, time limits and seeds."""
+
+import os
+import sys
+import tempfile
+import time
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+pytest.importorskip("clingo")
+
+from csplab import ExampleModel, Problem, solve
+from csplab.cnf import encode
+from csplab.errors import CsplabError, DependencyError, InputError
+from csplab.solvers import REGISTRY, STATS
+from csplab.solvers.asp import AspSolver, _run_child, facts, ground_program
+from csplab.testing.brute import count, solutions
+from csplab.testing.strategies import csp_problems
+from csplab.testing.synthetic import box_town
+
+CHECKER = ExampleModel([[0, 1], [1, 0]])
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _asp_registered():
+    """Register the solver for this module (a no-op once it is in the registry)."""
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(REGISTRY, "asp", "csplab.solvers.asp:AspSolver")
+        yield
+
+
+def _searched(P: Problem) -> bool:
+    """Arc consistency neither wipes out nor decides every cell: clingo has to search."""
+    enc = encode(P)
+    return enc.ok and enc.nx > 0
+
+
+SEARCHED = csp_problems().filter(_searched)
+
+
+def _check(P, seed, **opts):
+    """The conformance rules for one run; returns the result."""
+    r = solve(P, "asp", rng=seed, **opts)
+    satisfiable = next(solutions(P, limit=1), None) is not None
+    assert r.status == ("solved" if satisfiable else "unsat"), (r.status, r.stats)
+    assert r.grid.dtype == np.int32 and r.grid.shape == P.shape
+    if r.ok:
+        assert len(P.violations(r.grid)) == 0
+    else:
+        assert r.stats["proof"]
+        assert (r.grid == -1).all()
+    unknown = set(r.stats) - set(STATS) - {o.name for o in AspSolver.options}
+    assert not unknown, unknown
+    return r
+
+
+# ----------------------------------------------------------------------------- brute force
+
+
+@given(P=csp_problems(), seed=st.integers(0, 2**31))
+def test_agrees_with_brute_force(P, seed):
+    _check(P, seed)
+
+
+@given(P=SEARCHED, seed=st.integers(0, 2**31))
+def test_agrees_with_brute_force_where_clingo_searches(P, seed):
+    r = _check(P, seed)
+    assert r.stats["solver_status"] in ("SAT", "UNSAT")
+
+
+VARIANTS = [
+    {"grounding": "gringo"},
+    {"encoding": "direct"},
+    {"supports": "forward"},
+    {"diversity": "label"},
+    {"grounding": "gringo", "encoding": "direct", "diversity": "label"},
+]
+
+
+@pytest.mark.parametrize("opts", VARIANTS, ids=lambda o: ",".join(f"{k}={v}" for k, v in o.items()))
+@settings(max_examples=20)
+@given(P=SEARCHED, seed=st.integers(0, 2**31))
+def test_variants_agree_with_brute_force(opts, P, seed):
+    _check(P, seed, **opts)
+
+
+def test_passes_the_conformance_suite_checks():
+    from tests.solvers.test_conformance import check_solver_on
+
+    rng = np.random.default_rng(1)
+    for _ in range(8):
+        E = ExampleModel(rng.integers(0, 3, size=(3, 3)))
+        P = Problem.from_example(E, (4, 3), fixed={(0, 0): int(rng.integers(0, 3))})
+        check_solver_on("asp", {}, P, int(rng.integers(1000)))
+
+
+def _answer_sets(program: bytes | str) -> int:
+    import clingo
+
+    ctl = clingo.Control(["--models=0"], logger=lambda *_: None)
+    if isinstance(program, str):
+        ctl.add("base", [], program)
+    else:
+        with tempfile.NamedTemporaryFile(suffix=".aspif", delete=False) as f:
+            f.write(program)
+        try:
+            ctl.load(f.name)
+        finally:
+            os.unlink(f.name)
+    ctl.ground([("base", [])])
+    n = 0
+
+    def on_model(m):
+        nonlocal n
+        n += 1
+
+    ctl.solve(on_model=on_model)
+    return n
+
+
+@pytest.mark.parametrize("grounding", ["csplab", "gringo"])
+@pytest.mark.parametrize(("encoding", "supports"), [("support", "both"), ("support", "forward"),
+                                                    ("direct", "both")])  # fmt: skip
+@settings(max_examples=25)
+@given(P=csp_problems(max_cells=9).filter(_searched))
+def test_answer_sets_are_exactly_the_solutions(grounding, encoding, supports, P):
+    """One answer set per solution: the ground program (csplab's aspif, or gringo's
+    grounding of the first-order program) is exact, not just satisfiable together."""
+    enc = encode(P, encoding=encoding, supports=supports)
+    if grounding == "csplab":
+        n = _answer_sets(b"".join(ground_program(enc)))
+    else:
+        n = _answer_sets(facts(P, enc.catalog, supports, encoding))
+    assert n == count(P)
+
+
+# ----------------------------------------------------------------------------- grid variants
+
+
+def _variants():
+    E = ExampleModel([[0, 0, 1, 2], [0, 1, 2, 2], [1, 2, 2, 0], [0, 0, 0, 0]])
+    yield "plain", Problem.from_example(E, (9, 7))
+    yield "periodic", Problem.from_example(E, (8, 8), periodic=True)
+    yield "periodic x only", Problem.from_example(E, (8, 6), periodic=(True, False))
+    yield "fixed", Problem.from_example(E, (9, 7), fixed={(0, 0): 1, (4, 3): 2, (8, 6): 0})
+    mask = np.ones((9, 7, E.K), dtype=bool)
+    mask[3:6, 2:5, 0] = False
+    yield "mask", Problem.from_example(E, (9, 7), mask=mask)
+    P = Problem.from_example(E, (7, 7))
+    idx = np.arange(49).reshape(7, 7)
+    differ = ~np.eye(E.K, dtype=bool)
+    yield "diagonal arcs", P.add_arcs(differ, idx[:-1, :-1].ravel(), idx[1:, 1:].ravel(), "diag")
+    T = box_town(2, rng=0)
+    yield "3D boundary auto", Problem.from_example(T, (8, 8, 5), boundary="auto")
+    yield "3D periodic fixed", Problem.from_example(T, (6, 6, 4), periodic=(True, True, False),
+                                                    fixed={(2, 2, 0): 1})  # fmt: skip
+
+
+@pytest.mark.parametrize(("what", "P"), list(_variants()), ids=[w for w, _ in _variants()])
+def test_grid_variants_agree_with_backtracking(what, P):
+    ref = solve(P, "backtrack", rng=0)
+    for opts in ({}, {"grounding": "gringo"}):
+        r = solve(P, "asp", rng=3, **opts)
+        assert r.status == ref.status, (what, opts)
+        if r.ok:
+            assert len(P.violations(r.grid)) == 0
+            fixed = P.fixed_grid >= 0
+            assert (r.grid[fixed] == P.fixed_grid[fixed]).all()
+
+
+# ----------------------------------------------------------------------------- unsat
+
+
+def test_fixed_cell_conflict_wiped_out_by_arc_consistency():
+    P = Problem.from_example(CHECKER, (3, 3), fixed={(0, 0): 0, (0, 1): 0})
+    r = solve(P, "asp", rng=0)
+    assert r.status == "unsat"
+    assert "arc-consistency wipe-out" in r.stats["proof"]
+    assert len(r.stats["fail_cell"]) == 2
+    assert "solver_stats" not in r.stats  # decided before clingo
+
+
+def _clique_colouring(n, colours, fixed=None):
+    """Colouring of the complete graph K_n (unsatisfiable for fewer than n colours; arc
+    consistency prunes nothing while two or more colours are left per cell)."""
+    arcs = [(u, v, 0) for u in range(n) for v in range(u + 1, n)]
+    eq = np.eye(colours, dtype=bool)
+    P = Problem((n,), np.ones((n, colours), dtype=bool), [~eq], arcs)
+    return P if fixed is None else P.with_fixed(fixed)
+
+
+@pytest.mark.parametrize(
+    "P",
+    [
+        _clique_colouring(4, 3, {(0,): 0}),
+        _clique_colouring(5, 4, {(2,): 3}),
+        Problem.from_example(CHECKER, (5, 4), periodic=True),  # odd cycle
+    ],
+    ids=["K4 3 colours fixed", "K5 4 colours fixed", "odd periodic checkerboard"],
+)
+def test_unsat_proven_by_clingos_search(P):
+    assert encode(P).ok  # arc consistency does not see it
+    for opts in ({}, {"grounding": "gringo"}, {"encoding": "direct"}):
+        r = solve(P, "asp", rng=0, **opts)
+        assert r.status == "unsat"
+        assert r.stats["proof"].startswith("clingo")
+        assert r.stats["solver_status"] == "UNSAT"
+
+
+def test_satisfiable_clique_with_enough_colours():
+    r = solve(_clique_colouring(5, 5, {(2,): 3}), "asp", rng=0, time_limit=30)
+    assert r.ok and sorted(r.grid.tolist()) == [0, 1, 2, 3, 4] and r.grid[2] == 3
+
+
+# ----------------------------------------------------------------------------- time limits
+
+
+def test_time_limit_cancels_the_search():
+    P = _clique_colouring(14, 13)  # the pigeonhole principle: exponential for clause learning
+    t0 = time.perf_counter()
+    r = solve(P, "asp", rng=0, time_limit=1.5)
+    wall = time.perf_counter() - t0
+    assert r.status == "timeout"
+    assert wall < 1.5 + 1.0
+    assert r.stats["solver_status"] == "UNKNOWN"  # the child stopped its own search
+    assert r.stats["conflicts"] > 0 and "search_s" in r.stats["solver_stats"]
+
+
+@pytest.mark.parametrize("limit", [0.3, 1.5])
+def test_time_limit_while_grounding_a_large_problem(limit):
+    big = Problem.from_example(box_town(2, rng=0), (30, 30, 8))  # 1.7 million rules
+    solve(Problem.from_example(box_town(1, rng=0), (3, 3, 3)), "asp", rng=0)  # load kernels
+    t0 = time.perf_counter()
+    r = solve(big, "asp", rng=0, time_limit=limit)
+    wall = time.perf_counter() - t0
+    assert r.status == "timeout"
+    assert wall < limit + 1.0
+    assert (r.grid == -1).all()
+
+
+# ----------------------------------------------------------------------------- seeds
+
+
+def test_same_seed_same_grid_different_seeds_differ():
+    P = Problem.from_example(box_town(2, rng=0), (12, 12, 6), boundary="auto")
+    a, b, c = (solve(P, "asp", rng=s) for s in (7, 7, 8))
+    assert a.ok and b.ok and c.ok
+    assert np.array_equal(a.grid, b.grid)
+    assert np.mean(a.grid != c.grid) > 0.05
+    # the seed alone does not vary clingo's answer (hence the random signs)
+    d, e = (solve(P, "asp", rng=s, diversity="none") for s in (7, 8))
+    assert np.array_equal(d.grid, e.grid)
+    f, g = (solve(P, "asp", rng=s, diversity="label") for s in (7, 8))
+    assert np.mean(f.grid != g.grid) > 0.05
+
+
+def test_seed_is_drawn_from_rng_only():
+    P = Problem.from_example(CHECKER, (4, 4))
+    np.random.seed(1)  # noqa: NPY002 - the global RNG must not matter
+    a = solve(P, "asp", rng=5).stats["solver_stats"]["seed"]
+    np.random.seed(2)  # noqa: NPY002
+    b = solve(P, "asp", rng=5).stats["solver_stats"]["seed"]
+    assert a == b == int(np.random.default_rng(5).integers(2**31 - 1))
+
+
+# ----------------------------------------------------------------------------- the rest
+
+
+def test_arc_consistency_alone_solves_it_without_clingo():
+    P = Problem.from_example(ExampleModel([0, 1, 2]), (3,))
+    r = solve(P, "asp", rng=0)
+    assert r.ok and r.grid.tolist() == [0, 1, 2]
+    assert r.stats["solve_s"] == 0.0 and "solver_stats" not in r.stats
+
+
+def test_stats():
+    P = Problem.from_example(box_town(2, rng=0), (6, 6, 4))
+    s = solve(P, "asp", rng=0).stats
+    assert s["rules"] > s["x_vars"] > 0 and s["atoms"] == s["x_vars"]
+    assert s["ground_s"] >= s["encode_s"] and s["solve_s"] > 0
+    assert s["solver_stats"]["clingo"].count(".") == 2
+    assert {"choices", "conflicts"} <= set(s)
+
+
+def test_options_are_checked():
+    P = Problem.from_example(CHECKER, (3, 3))
+    with pytest.raises(InputError, match="unknown option"):
+        solve(P, "asp", rng=0, order="scanline")
+    with pytest.raises(InputError, match="no backends"):
+        solve(P, "asp:gringo", rng=0)
+    with pytest.raises(InputError, match="grounding must be one of"):
+        solve(P, "asp", rng=0, grounding="lparse")
+
+
+def test_missing_clingo_is_one_dependency_error(monkeypatch):
+    monkeypatch.setitem(sys.modules, "clingo", None)
+    P = Problem.from_example(CHECKER, (3, 3))
+    with pytest.raises(DependencyError, match=r"csplab\[asp\]"):
+        AspSolver().solve(P, rng=np.random.default_rng(0), seed=0)
+
+
+def test_a_failing_child_is_reported():
+    report, _ = _run_child(["--no-such-option"], iter([b"asp 1 0 0\n0\n"]), read="atoms", nx=0,
+                           deadline=None)  # fmt: skip
+    assert report is not None and report["status"] == "ERROR"
+    report, _ = _run_child([], iter([b"asp 1 0 0\nnonsense\n"]), read="atoms", nx=0,
+                           deadline=None)  # fmt: skip
+    assert report is not None and report["status"] == "ERROR"
+
+
+def test_a_child_crash_is_an_error(monkeypatch):
+    import csplab.solvers.asp as asp
+
+    monkeypatch.setattr(asp, "_child_source", lambda: "import sys; sys.exit(3)")
+    P = Problem.from_example(box_town(2, rng=0), (5, 5, 3))
+    with pytest.raises(CsplabError, match="exited with code 3"):
+        solve(P, "asp", rng=0)
