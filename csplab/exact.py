@@ -149,7 +149,7 @@ def exact_catalog(
     C, ok = propagate(problem, dom)
     if not (ok and ok_pre):
         C = np.zeros((n, K), dtype=bool) if not ok_pre else C
-    stats: dict[str, Any] = {"calls": 0, "models": 0}
+    stats: dict[str, Any] = {"sat_calls": 0, "models": 0}
     exact = np.zeros((n, K), dtype=bool)
     if not (ok and ok_pre):
         stats["time_s"] = time.perf_counter() - t0
@@ -161,7 +161,7 @@ def exact_catalog(
         idx = np.arange(n)
 
         def sweep(status: str) -> bool:
-            stats["calls"] += 1
+            stats["sat_calls"] += 1
             if status == "timeout":
                 return False
             if status == "sat":
@@ -185,7 +185,7 @@ def exact_catalog(
             if not todo[v, b]:
                 continue
             todo[v, b] = False
-            if stats["calls"] % 8 == 0:
+            if stats["sat_calls"] % 8 == 0:
                 o.set_phases(preferred_labels(todo, None, gen))
             st = o.solve([o.literal(int(v), int(b))], deadline=deadline)
             if not sweep(st):
@@ -220,7 +220,7 @@ def catalog_gap(
     ``holds`` is ``True`` when every chosen label was in C* (the run stayed completable),
     ``False`` when some label was in C but not in C* (the phenomenon of Fig. 3.5; the
     witness describes the first such step), ``None`` if the time limit stopped the check.
-    ``stats["steps"]`` lists, per step, ``[cell coords, label, in C*]`` (and with
+    ``stats["per_step"]`` lists, per step, ``[cell coords, label, in C*]`` (and with
     ``sizes=True`` also ``|C(p)|`` and ``|C*(p)|``, one SAT call per label of C(p)).
 
     Examples
@@ -253,7 +253,7 @@ def catalog_gap(
         status = o.completable([], [])
         calls += 1
         if status is None:
-            return Verdict(None, None, {**stats, "calls": calls}, "time limit")
+            return Verdict(None, None, {**stats, "sat_calls": calls}, "time limit")
         if not status:
             consistent = False
             stats["unsat"] = True
@@ -270,7 +270,7 @@ def catalog_gap(
                 inside = o.completable([p], [b])
                 calls += 1
                 if inside is None:
-                    stats.update(calls=calls, steps=steps)
+                    stats.update(sat_calls=calls, per_step=steps)
                     return Verdict(None, None, stats, "time limit")
                 if inside:
                     witness = o.solution
@@ -280,7 +280,7 @@ def catalog_gap(
                 try:
                     C, star = catalog_at(o, problem, trace[:t, 0], trace[:t, 1], p, witness[p])
                 except PrefixTimeout:
-                    stats.update(calls=calls, steps=steps)
+                    stats.update(sat_calls=calls, per_step=steps)
                     return Verdict(None, None, stats, "time limit")
                 calls += len(C)  # one query per label of C(p) (the witness's label is free)
                 extra = [len(C), len(star)]
@@ -291,7 +291,7 @@ def catalog_gap(
                 consistent = False
                 first_bad = {"step": t, "cell": list(problem.coords(p)), "label": int(b),
                              "label_name": problem.label_name(int(b))}  # fmt: skip
-    stats.update(calls=calls, steps=steps, time_s=time.perf_counter() - t0)
+    stats.update(sat_calls=calls, per_step=steps, time_s=time.perf_counter() - t0)
     if run.status == "failed":
         stats["fail_step"] = len(trace)
         stats["fail_cell"] = run.stats.get("fail_cell")
@@ -342,7 +342,7 @@ def explain_unsat(
     t0 = time.perf_counter()
     deadline = None if time_limit is None else t0 + float(time_limit)
     U = problem.unary
-    stats: dict[str, Any] = {"unary": len(U), "calls": 0}
+    stats: dict[str, Any] = {"unary": len(U), "sat_calls": 0}
     with SatOracle(problem, backend=backend, domains=problem.base_domains,
                    deadline=deadline) as o:  # fmt: skip
         sel: list[int] = []
@@ -363,7 +363,7 @@ def explain_unsat(
         pos = {s: i for i, s in enumerate(sel)}
 
         def run(active: list[int]) -> str:
-            stats["calls"] += 1
+            stats["sat_calls"] += 1
             return o.solve([sel[i] for i in active], deadline=deadline)
 
         st = run(list(range(len(U))))

@@ -72,7 +72,7 @@ class ExampleModel:
         One non-negative weight per label (default: the label frequencies in ``labels``).
     name : str
         A short name used in reports.
-    metadata : mapping
+    meta : mapping
         Free-form data carried along (for example the header and trailing table of a
         Merrell-format file, so it can be written back).
     num_labels : int, optional
@@ -83,7 +83,7 @@ class ExampleModel:
     names: tuple[str, ...] | None = None
     weights: NDArray[np.float64] | None = None
     name: str = ""
-    metadata: Mapping[str, Any] = field(default_factory=dict)
+    meta: Mapping[str, Any] = field(default_factory=dict)
     num_labels: int | None = None
 
     def __init__(
@@ -92,7 +92,7 @@ class ExampleModel:
         names: Sequence[str] | None = None,
         weights: ArrayLike | None = None,
         name: str = "",
-        metadata: Mapping[str, Any] | None = None,
+        meta: Mapping[str, Any] | None = None,
         num_labels: int | None = None,
     ) -> None:
         raw = np.asarray(labels)
@@ -134,7 +134,7 @@ class ExampleModel:
         object.__setattr__(self, "names", names)
         object.__setattr__(self, "weights", w)
         object.__setattr__(self, "name", name)
-        object.__setattr__(self, "metadata", dict(metadata or {}))
+        object.__setattr__(self, "meta", dict(meta or {}))
         object.__setattr__(self, "num_labels", K)
 
     # ------------------------------------------------------------------ basic properties

@@ -36,7 +36,7 @@ def _first_gap(P, seeds=range(40), order="scanline"):
         if v.holds is False and v.witness is not None:
             t = v.witness["step"]
             partial = np.full(P.n, -1)
-            for cell, lab, _inside in v.stats["steps"][:t]:
+            for cell, lab, _inside in v.stats["per_step"][:t]:
                 partial[P.cell(cell)] = lab
             X = exact_catalog(P, partial)
             c, b = P.cell(v.witness["cell"]), v.witness["label"]
@@ -87,8 +87,8 @@ def test_fig3_5_reproduction():
 def test_catalog_gap_on_infallible_and_unsat_problems():
     P = Problem.from_example(load_example("line"), (6, 6))
     v = catalog_gap(P, rng=3, sizes=True)
-    assert v.holds is True and len(v.stats["steps"]) == P.n
-    assert all(row[3] == row[4] for row in v.stats["steps"])  # C = C* (infallible)
+    assert v.holds is True and len(v.stats["per_step"]) == P.n
+    assert all(row[3] == row[4] for row in v.stats["per_step"])  # C = C* (infallible)
     odd = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)
     w = catalog_gap(odd, rng=0)
     assert w.holds is False and "unsatisfiable" in w.message

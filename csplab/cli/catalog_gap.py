@@ -56,13 +56,13 @@ def run(args: argparse.Namespace) -> int:
           f"{args.choice}, seed {st.get('seed')}: {st.get('alg31_status')} after "
           f"{st.get('steps_taken', 0)} steps")  # fmt: skip
     if args.steps == "all":
-        for t, row in enumerate(st.get("steps", [])):
+        for t, row in enumerate(st.get("per_step", [])):
             cell, lab, inside = row[0], row[1], row[2]
             extra = f"  |C|={row[3]} |C*|={row[4]}" if len(row) > 3 and row[3] is not None else ""
             mark = "in C*" if inside else "NOT in C*"
             print(f"  step {t:>5}  cell {tuple(cell)}  label {problem.label_name(lab)}: "
                   f"{mark}{extra}")  # fmt: skip
     print(("ok: " if v.holds else "gap: " if v.holds is False else "undecided: ") + v.message)
-    if "calls" in st:
-        print(f"  ({st['calls']} SAT calls, {st.get('time_s', 0.0):.3f} s)")
+    if "sat_calls" in st:
+        print(f"  ({st['sat_calls']} SAT calls, {st.get('time_s', 0.0):.3f} s)")
     return code

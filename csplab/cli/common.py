@@ -124,7 +124,8 @@ def problem_from_args(
     if isinstance(model, RuleSet):
         if shape is None and model.shape is None:
             raise InputError(f"{model.name or args.model} gives no output size: use --size")
-        return model.problem(shape, periodic=args.periodic, boundary=boundary)
+        # no --boundary: a tileset keeps the file's own boundary conditions
+        return model.problem(shape, periodic=args.periodic, boundary=boundary or "auto")
     if shape is None:
         if getattr(args, "_size_required", False):
             raise InputError("--size is required for an example model (e.g. --size 40x40x10)")

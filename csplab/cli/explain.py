@@ -135,5 +135,5 @@ def run(args: argparse.Namespace) -> int:
             print(f"unsat: {head}: {v.message}")
             for line in v.witness["unary"]:
                 print(f"  {line}")
-            print(f"  ({v.stats['calls']} SAT calls, {v.stats['time_s']:.3f} s)")
+            print(f"  ({v.stats['sat_calls']} SAT calls, {v.stats['time_s']:.3f} s)")
     return 3 if v.holds is None else (0 if v.holds else 1)

@@ -75,8 +75,8 @@ def run(args: argparse.Namespace) -> int:
             img = model.sheet()
             what = f"{model.K} labels of {model.meta.get('format')} tileset {model.name}"
         else:
-            colors = model.metadata.get("colors")
-            empty = args.empty if args.empty is not None else model.metadata.get("empty")
+            colors = model.meta.get("colors")
+            empty = args.empty if args.empty is not None else model.meta.get("empty")
             img = render(model.labels, K=model.K, scale=args.scale, empty=empty, colors=colors)
             what = f"{'x'.join(map(str, model.shape))} grid {model.name}"
     img.save(out, format="PNG")

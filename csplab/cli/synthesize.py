@@ -123,9 +123,7 @@ def run(args: argparse.Namespace) -> int:
         d = result.to_dict()
         d["example"] = example.name
         d["out"] = wrote
-        d["format"] = (getattr(example, "meta", None) or getattr(example, "metadata", {})).get(
-            "format"
-        )
+        d["format"] = example.meta.get("format")
         print(json.dumps(d))
     else:
         size = "x".join(map(str, problem.shape))

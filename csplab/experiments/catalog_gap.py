@@ -81,7 +81,7 @@ def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict
     status = st.get("alg31_status", "solved")
     T = int(st.get("steps_taken", 0))
     stats: dict[str, Any] = {"steps": T, "cells": problem.n, "oracle": "sat (csplab.exact)",
-                             "oracle_calls": int(st.get("calls", 0))}  # fmt: skip
+                             "oracle_calls": int(st.get("sat_calls", 0))}  # fmt: skip
     if status == "unsat":
         return {"status": status, "time_s": float(st.get("time_s", 0.0)), "stats": stats}
     first_bad: int | None = None
@@ -99,7 +99,7 @@ def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict
         upto = T if first_bad is None else first_bad
         gaps = []
         total = 0.0
-        for t, e in enumerate(st["steps"][:upto]):
+        for t, e in enumerate(st["per_step"][:upto]):
             c, cs = int(e[3]), int(e[4])
             if cs < c:
                 gaps.append([t + 1, c, cs])

@@ -161,7 +161,7 @@ def write_example(example: ExampleModel, path: str | Path, format: str | None = 
         example.labels,
         model=example,
         name=example.name,
-        metadata=example.metadata,
+        meta=example.meta,
         example=example,
     )
     fmt.write(out, p)
@@ -173,7 +173,7 @@ def write_labels(
     *,
     names: Any = None,
     name: str = "",
-    metadata: dict[str, Any] | None = None,
+    meta: dict[str, Any] | None = None,
     model: Any = None,
     periodic: bool | None = None,
 ) -> None:
@@ -188,5 +188,5 @@ def write_labels(
     """
     p = Path(path)
     fmt = output_format(p)
-    out = Output.of(grid, model=model, names=names, name=name, metadata=metadata, periodic=periodic)
+    out = Output.of(grid, model=model, names=names, name=name, meta=meta, periodic=periodic)
     fmt.write(out, p)

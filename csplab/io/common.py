@@ -170,8 +170,8 @@ class Output:
     ----------
     grid : int32 array
         Labels, ``-1`` for unassigned cells.
-    names, name, metadata :
-        Label names, the model's name and metadata (kept by the text formats).
+    names, name, meta :
+        Label names, the model's name and meta (kept by the text formats).
     model : ExampleModel or RuleSet, optional
         Supplies tile pictures, voxels and pieces.
     periodic : bool, optional
@@ -185,7 +185,7 @@ class Output:
     grid: NDArray[np.int32]
     names: tuple[str, ...] | None = None
     name: str = ""
-    metadata: Mapping[str, Any] = field(default_factory=dict)
+    meta: Mapping[str, Any] = field(default_factory=dict)
     model: ExampleModel | RuleSet | None = None
     periodic: bool | None = None
     colors: NDArray[np.uint8] | None = None
@@ -201,7 +201,7 @@ class Output:
         model: ExampleModel | RuleSet | None = None,
         names: Sequence[str] | None = None,
         name: str = "",
-        metadata: Mapping[str, Any] | None = None,
+        meta: Mapping[str, Any] | None = None,
         periodic: bool | None = None,
         example: ExampleModel | None = None,
     ) -> Output:
@@ -219,14 +219,14 @@ class Output:
             colors = model.label_colors()
             empty = model.empty
             pieces = dict(model.meta.get("pieces", {}))
-        elif isinstance(model, ExampleModel) and model.metadata.get("colors") is not None:
-            colors = np.asarray(model.metadata["colors"], dtype=np.uint8)
-            empty = model.metadata.get("empty")
+        elif isinstance(model, ExampleModel) and model.meta.get("colors") is not None:
+            colors = np.asarray(model.meta["colors"], dtype=np.uint8)
+            empty = model.meta.get("empty")
         return cls(
             g,
             names=None if names is None else tuple(str(n) for n in names),
             name=name,
-            metadata=dict(metadata or {}),
+            meta=dict(meta or {}),
             model=model,
             periodic=periodic,
             colors=colors,
@@ -241,7 +241,7 @@ class Output:
 
         if self.example is not None:
             return self.example
-        return ExampleModel(self.grid, names=self.names, name=self.name, metadata=self.metadata)
+        return ExampleModel(self.grid, names=self.names, name=self.name, meta=self.meta)
 
     def tile_voxels(self) -> Output:
         """The grid with every cell replaced by its tile's voxels (a rule set with voxel
@@ -257,7 +257,7 @@ class Output:
         return Output(
             vox.astype(np.int32) - 1,
             name=self.name,
-            metadata=self.metadata,
+            meta=self.meta,
             model=m,
             periodic=self.periodic,
             colors=m.voxel_palette[1:],

@@ -202,7 +202,7 @@ def parse_grid(text: str, *, path: object = "<string>", name: str = "") -> Examp
             names=names,
             weights=weights,
             name=nm,
-            metadata={"format": "grid", "source": str(path)},
+            meta={"format": "grid", "source": str(path)},
         )
     except ValueError as e:
         raise FormatError(str(e), path=path) from None
@@ -295,6 +295,6 @@ def write_output(out: Output, path: Path) -> None:
         safe = grid_safe_names(ex.names)
         if safe != list(ex.names):
             ex = ExampleModel(
-                ex.labels, names=safe, weights=ex.weights, name=ex.name, metadata=ex.metadata
+                ex.labels, names=safe, weights=ex.weights, name=ex.name, meta=ex.meta
             )
     write_grid(ex, path)

@@ -2,7 +2,7 @@
 
 Layout::
 
-    <header line 1>            free text, kept as metadata
+    <header line 1>            free text, kept as meta
     <header line 2>
     <header line 3>
     nx ny nz [anything]        the size line starts with three positive integers
@@ -18,7 +18,7 @@ Examples
 >>> E = parse_merrell(text, path="toy.txt")
 >>> E.shape, E.labels[:, :, 0].tolist()
 ((2, 3, 1), [[0, 1, 0], [1, 2, 1]])
->>> E.metadata["merrell_trailer"]
+>>> E.meta["merrell_trailer"]
 '0 ground.obj\\n'
 >>> format_merrell(E) == text
 True
@@ -121,7 +121,7 @@ def parse_merrell(text: str, *, path: object = "<string>", name: str = "") -> Ex
         "merrell_trailer": "".join(lines[i:]),
         "source": str(path),
     }
-    return ExampleModel(labels, name=name, metadata=meta)
+    return ExampleModel(labels, name=name, meta=meta)
 
 
 def read_merrell(path: str | Path) -> ExampleModel:
@@ -140,7 +140,7 @@ def format_merrell(example: ExampleModel) -> str:
     shp3: tuple[int, ...] = (*lab.shape, *(1,) * (3 - lab.ndim))
     lab3 = lab.reshape(shp3)
     nx, ny, nz = shp3[0], shp3[1], shp3[2]
-    md = example.metadata
+    md = example.meta
     header = list(md.get("merrell_header", []))[:3]
     if len(header) < 3:
         header = [

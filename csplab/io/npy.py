@@ -42,7 +42,7 @@ def read_npy(path: str | Path) -> ExampleModel:
     if not np.issubdtype(arr.dtype, np.integer):
         raise FormatError(f".npy array must hold integers, got {arr.dtype}", path=p)
     try:
-        return ExampleModel(arr, name=p.stem, metadata={"format": "npy", "source": str(p)})
+        return ExampleModel(arr, name=p.stem, meta={"format": "npy", "source": str(p)})
     except InputError as e:
         raise FormatError(str(e), path=p) from None
 

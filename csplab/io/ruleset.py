@@ -267,7 +267,7 @@ class RuleSet:
         shape: Sequence[int] | str | None = None,
         *,
         periodic: bool | Sequence[bool] | None = None,
-        boundary: Mapping[str, int] | Literal["auto", "none"] | None = None,
+        boundary: Mapping[str, int] | Literal["auto", "none"] | None = "auto",
         fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
         mask: ArrayLike | None = None,
     ) -> Problem:
@@ -279,10 +279,10 @@ class RuleSet:
         periodic : bool or sequence of bool, optional
             Default: the file's setting. Boundary conditions of the file are not applied
             on periodic axes (there is no outside).
-        boundary : None, "auto", "none" or mapping face -> label
-            ``None``/``"auto"``: the file's boundary conditions; ``"none"``: none; a mapping
-            puts one label on each named face (as in :meth:`Problem.from_example`). The
-            file's other restrictions are always applied.
+        boundary : "auto" (default), "none", None or mapping face -> label
+            ``"auto"``: the file's boundary conditions; ``"none"`` or ``None``: none (as in
+            :meth:`Problem.from_example`, where ``None`` also means none); a mapping puts
+            one label on each named face. The file's other restrictions are always applied.
         fixed, mask :
             As in :meth:`Problem.grid`.
         """
@@ -309,13 +309,13 @@ class RuleSet:
         if isinstance(boundary, Mapping):
             mapping = dict(boundary)
             ops = list(self.constraint_ops)
-        elif boundary in (None, "auto"):
+        elif boundary == "auto":
             ops = [
                 op
                 for op in self.boundary_ops
                 if op.face is None or not per_t[AXIS_NAMES.index(op.face[0])]
             ] + list(self.constraint_ops)
-        elif boundary == "none":
+        elif boundary in (None, "none"):
             ops = list(self.constraint_ops)
         else:
             raise InputError(

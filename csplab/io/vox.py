@@ -202,7 +202,7 @@ def read_vox(path: str | Path) -> VoxModel:
 def read_vox_example(path: str | Path) -> Any:
     """A voxel model as an :class:`~csplab.example.ExampleModel`: label 0 is empty space,
     labels ``1, 2, ...`` the colour indices in use (their palette colours are kept in
-    ``metadata["colors"]``, ``metadata["empty"]`` is 0 and the names are ``"c<index>"``)."""
+    ``meta["colors"]``, ``meta["empty"]`` is 0 and the names are ``"c<index>"``)."""
     from csplab.example import ExampleModel
 
     vox = read_vox(path)
@@ -220,7 +220,7 @@ def read_vox_example(path: str | Path) -> Any:
         "empty": 0,
         "models": vox.models,
     }
-    return ExampleModel(labels, names=names, name=Path(path).stem, metadata=meta)
+    return ExampleModel(labels, names=names, name=Path(path).stem, meta=meta)
 
 
 def write_output(out: Output, path: Path) -> None:

@@ -64,6 +64,7 @@ REGISTRY: dict[str, str] = {
     "backtrack": "csplab.solvers.backtrack:BacktrackSolver",
     "perfect": "csplab.solvers.perfect:PerfectSolver",
     "hybrid": "csplab.solvers.hybrid:HybridSolver",
+    "asp": "csplab.solvers.asp:AspSolver",
 }
 _PLUGINS_LOADED = False
 

@@ -13,11 +13,11 @@ from csplab.testing.strategies import label_grids
 @given(label_grids(ndim=3, max_side=5, max_labels=12), st.text(max_size=40))
 def test_roundtrip_preserves_labels_and_trailer(lab, trailer_word):
     trailer = "".join(ch for ch in trailer_word if ch.isprintable()) + "\n"
-    E = ExampleModel(lab, metadata={"merrell_trailer": "objects:\n" + trailer})
+    E = ExampleModel(lab, meta={"merrell_trailer": "objects:\n" + trailer})
     text = format_merrell(E)
     E2 = parse_merrell(text)
     assert np.array_equal(E2.labels, E.labels)
-    assert E2.metadata["merrell_trailer"] == "objects:\n" + trailer
+    assert E2.meta["merrell_trailer"] == "objects:\n" + trailer
     assert format_merrell(E2) == text
 
 
@@ -38,8 +38,8 @@ def test_tolerates_whitespace_and_keeps_header(tmp_path):
     p.write_text(text)
     E = read_example(p)
     assert E.labels[:, :, 0].tolist() == [[0, 1], [1, 0]]
-    assert E.metadata["merrell_header"][0] == "Castle wall  "
-    assert E.metadata["merrell_trailer"] == "\n0 empty\n1 wall.obj\n"
+    assert E.meta["merrell_header"][0] == "Castle wall  "
+    assert E.meta["merrell_trailer"] == "\n0 empty\n1 wall.obj\n"
     out = tmp_path / "again.txt"
     write_example(E, out)
     assert read_example(out) == E

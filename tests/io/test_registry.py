@@ -184,7 +184,7 @@ def read(path, *, scale=1):
         grid = np.array([int(w) for w in words[2 + ndim :]]).reshape(shape) * scale
     except (IndexError, ValueError) as e:
         raise FormatError(f"not a toy grid ({e})", path=path) from None
-    return ExampleModel(grid, name=Path(path).stem, metadata={"format": "toy"})
+    return ExampleModel(grid, name=Path(path).stem, meta={"format": "toy"})
 
 
 def write(out, path):
