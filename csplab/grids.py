@@ -177,6 +177,7 @@ def grid(
         meta=m,
     )
 
+
 def from_example(
     example: ExampleModel,
     shape: Sequence[int] | str,

@@ -451,5 +451,3 @@ class Problem:
             name=self.name,
             meta={**self.meta, "subproblem_of": self.shape},
         )
-
-

@@ -27,8 +27,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p, size_required=True)
     add_fixed_args(p)
     p.add_argument("--seed", type=int, help="random seed of Alg. 3.1 (default: fresh, printed)")
-    p.add_argument("--order", default="scanline",
-                   help=f"cell order of Alg. 3.1: {', '.join(ORDERS)} (e.g. scan:yx)")
+    p.add_argument(
+        "--order",
+        default="scanline",
+        help=f"cell order of Alg. 3.1: {', '.join(ORDERS)} (e.g. scan:yx)",
+    )
     p.add_argument("--choice", choices=CHOICES, default="uniform")
     p.add_argument("--backend", help="pysat backend (default cadical195)")
     p.add_argument("--sizes", action="store_true", help="also count |C(p)| and |C*(p)|")

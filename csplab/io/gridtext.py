@@ -294,7 +294,5 @@ def write_output(out: Output, path: Path) -> None:
     if ex.names is not None:
         safe = grid_safe_names(ex.names)
         if safe != list(ex.names):
-            ex = ExampleModel(
-                ex.labels, names=safe, weights=ex.weights, name=ex.name, meta=ex.meta
-            )
+            ex = ExampleModel(ex.labels, names=safe, weights=ex.weights, name=ex.name, meta=ex.meta)
     write_grid(ex, path)
