@@ -24,6 +24,11 @@ from the catalog with the rng (CP-SAT then repairs the hint, which is also fast:
 hint); ``"none"`` keeps CP-SAT's defaults. The seed is passed as ``random_seed``; with
 ``num_workers=1`` (default) runs are reproducible.
 
+Time limit: the model is built in chunks that check the deadline, and CP-SAT gets the time
+that is left; but CP-SAT loads a table model without looking at its limit (nor at
+``StopSearch``): on a 30×30×8 box town (4 labels) the call ended 1.7–2.1 s after a 0.3 s
+limit. The one-hot model stays within the limit.
+
 Examples
 --------
 >>> from csplab import ExampleModel, Problem, solve
@@ -74,7 +79,8 @@ class CpsatSolver(Solver):
     notes = (
         '`model="onehot"` (Booleans + the support clauses, default) or `"table"` '
         "(`AddAllowedAssignments` per arc); presolve off by default (it expands the tables); "
-        "diverse outputs from random solution hints; `num_workers`, `time_limit`"
+        "diverse outputs from random solution hints; `num_workers`, `time_limit` (CP-SAT "
+        "loads a table model without looking at the limit: 1.7-2.1 s over it on 30x30x8)"
     )
     options = (
         Option("model", str, "onehot", "one Boolean per label and the support clauses, or "
