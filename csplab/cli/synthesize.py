@@ -46,6 +46,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--retries", type=int, help=f"retries; for {', '.join(solvers_taking('retries'))}"
     )
+    p.add_argument(
+        "--restarts",
+        type=int,
+        default=10,
+        help="run an incomplete solver again, with a fresh derived seed, up to N times while "
+        "it fails (default 10, as WaveFunctionCollapse per output; Merrell's code retries "
+        "20 times per block; 0: one run, as the thesis' experiments)",
+    )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument(
@@ -60,8 +68,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     kinds = ", ".join(f"{f.extensions[0]} ({f.name})" for f in formats(writable=True))
     p.add_argument(
         "--out",
-        help=f"output file, format by extension: {kinds}; a failed run's partial grid is "
-        f"written only to {', '.join(output_extensions(partial=True))}",
+        help=f"output file, format by extension: {kinds}",
+    )
+    p.add_argument(
+        "--out-partial",
+        action="store_true",
+        help="also write a failed or timed-out run's partial grid (unassigned cells -1; "
+        f"{', '.join(output_extensions(partial=True))})",
     )
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
 
@@ -100,20 +113,51 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
     return opts
 
 
+def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> dict[str, Any]:
+    """Fill the order and choice the model's format suits (when the user named none and
+    the solver takes them); return the effective settings and where they came from."""
+    from csplab.io.registry import synthesis_defaults
+    from csplab.solvers import solver_class
+
+    cls = solver_class(args.solver.partition(":")[0])
+    suggested, source = synthesis_defaults(example)
+    settings: dict[str, Any] = {}
+    for key in ("order", "choice"):
+        o = cls.option(key)
+        if o is None:
+            continue
+        if key in opts:
+            settings[key] = f"{opts[key]} (given)"
+            continue
+        value = suggested.get(key)
+        if value is not None and (o.values is None or value in o.values):
+            opts[key] = value
+            settings[key] = f"{value} ({source})"
+        else:
+            settings[key] = f"{o.default} ({'solver default' if suggested else source})"
+    settings["restarts"] = 0 if cls.complete else args.restarts
+    return settings
+
+
 def run(args: argparse.Namespace) -> int:
     from csplab.io import write_labels
     from csplab.io.registry import output_format
     from csplab.solvers import solve
 
+    if args.restarts < 0:
+        raise InputError("--restarts must be >= 0")
+    if args.seed is not None and args.seed < 0:
+        raise InputError("--seed must be non-negative")
     example = load_model(args.model, model_options(args.model_option))
     problem = problem_from_args(args, example)
     opts = _options(args)
-    if args.seed is not None and args.seed < 0:
-        raise InputError("--seed must be non-negative")
+    settings = _settings(args, example, opts)
     out_format = output_format(args.out) if args.out else None  # bad extension: fail early
-    result = solve(problem, args.solver, rng=args.seed, **opts)
+    if out_format is not None and args.out_partial and not out_format.partial:
+        raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
+    result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"], **opts)
     wrote = None
-    if out_format is not None and (result.ok or out_format.partial):
+    if out_format is not None and (result.ok or args.out_partial):
         per = problem.meta.get("periodic", False)
         write_labels(
             result.grid, args.out, name=example.name, model=example, periodic=bool(all(per))
@@ -124,6 +168,7 @@ def run(args: argparse.Namespace) -> int:
         d["example"] = example.name
         d["out"] = wrote
         d["format"] = example.meta.get("format")
+        d["settings"] = settings
         print(json.dumps(d))
     else:
         size = "x".join(map(str, problem.shape))
@@ -132,6 +177,7 @@ def run(args: argparse.Namespace) -> int:
             f"{result.solver} in {result.time_s:.3f} s, seed {result.seed}"
         )
         print(msg)
+        print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
         keys = [k for k in result.stats if k not in ("order", "choice")]
         if keys:
             print("  " + ", ".join(f"{k}={result.stats[k]}" for k in keys))
@@ -139,5 +185,8 @@ def run(args: argparse.Namespace) -> int:
             unset = int((result.grid < 0).sum())
             print(f"  wrote {wrote}" + (f" (partial: {unset} cells unassigned)" if unset else ""))
         elif args.out:
-            print(f"  not written: {args.out} (no solution)", file=sys.stderr)
+            print(
+                f"  not written: {args.out} (no solution; --out-partial writes the partial grid)",
+                file=sys.stderr,
+            )
     return 0 if result.ok else 1

@@ -62,6 +62,7 @@ __all__ = [
     "output_extensions",
     "output_format",
     "resolve",
+    "synthesis_defaults",
 ]
 
 Gives = Literal["ExampleModel", "RuleSet"]
@@ -195,6 +196,11 @@ class Format:
     files, details, example : str
         README: what else tells the files apart, what csplab reads or writes (Markdown),
         and a command to try.
+    synthesis : tuple of (option, value)
+        The synthesis settings that suit models of this format when the user names none
+        (:func:`synthesis_defaults`): WaveFunctionCollapse-style inputs are built for
+        minimum-entropy order with weighted choice, Merrell's models for the thesis'
+        scanline with uniform choice (the solvers' own defaults).
     """
 
     name: str
@@ -210,6 +216,7 @@ class Format:
     files: str = ""
     details: str = ""
     example: str = ""
+    synthesis: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         if (self.gives is None) != (self.reader is None):
@@ -285,6 +292,11 @@ class Format:
 _SHARED = "`../shared/anchors-data/`"
 _EMPTY6 = "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0"
 
+# WaveFunctionCollapse's own settings (minimum entropy, weights), for its kind of inputs
+_WFC_LIKE = (("order", "min-entropy"), ("choice", "weighted"))
+# a file's own heuristic (WFC's samples list names one per entry) -> csplab's order
+_HEURISTICS = {"entropy": "min-entropy", "mrv": "min-entropy", "scanline": "scanline"}
+
 #: Every format, in the order of the README table; the first format declared for an
 #: extension is its default.
 FORMATS: dict[str, Format] = {
@@ -337,6 +349,7 @@ FORMATS: dict[str, Format] = {
         ),
         Format(
             name="wfc",
+            synthesis=_WFC_LIKE,
             extensions=(".xml",),
             gives="RuleSet",
             description="WaveFunctionCollapse simple tiled",
@@ -355,6 +368,7 @@ FORMATS: dict[str, Format] = {
         ),
         Format(
             name="overlapping",
+            synthesis=_WFC_LIKE,
             extensions=(".png", ".bmp", ".gif"),
             gives="RuleSet",
             description="overlapping model of a sample picture",
@@ -384,6 +398,7 @@ FORMATS: dict[str, Format] = {
         ),
         Format(
             name="poms",
+            synthesis=_WFC_LIKE,
             extensions=(".json",),
             gives="RuleSet",
             description="PunchOutModelSynthesis (POMS) config",
@@ -409,6 +424,7 @@ FORMATS: dict[str, Format] = {
         ),
         Format(
             name="debroglie",
+            synthesis=_WFC_LIKE,
             extensions=(".json",),
             gives="RuleSet",
             description="DeBroglie config",
@@ -426,6 +442,7 @@ FORMATS: dict[str, Format] = {
         ),
         Format(
             name="markovjunior",
+            synthesis=_WFC_LIKE,
             extensions=(".xml",),
             gives="RuleSet",
             description="MarkovJunior 3D tileset",
@@ -591,6 +608,30 @@ def output_extensions(*, gives: Gives | None = None, partial: bool | None = None
 
 
 # ---------------------------------------------------------------------------- derived texts
+def synthesis_defaults(model: Any) -> tuple[dict[str, str], str]:
+    """The synthesis settings that suit ``model`` and where they come from.
+
+    A model read from a file records its format (``meta["format"]``); the format declares
+    its settings (:attr:`Format.synthesis`), and a file that names its own heuristic
+    (``meta["heuristic"]``: WFC's ``Entropy``, ``MRV``, ``Scanline``) wins for the order.
+
+    Examples
+    --------
+    >>> import csplab
+    >>> synthesis_defaults(csplab.load_example("line"))
+    ({}, 'the thesis defaults')
+    """
+    meta = getattr(model, "meta", {}) or {}
+    fmt = FORMATS.get(str(meta.get("format")))
+    out = dict(fmt.synthesis) if fmt is not None else {}
+    source = f"{fmt.name} defaults" if out and fmt is not None else "the thesis defaults"
+    heuristic = str(meta.get("heuristic") or "").lower()
+    if heuristic in _HEURISTICS:
+        out["order"] = _HEURISTICS[heuristic]
+        source = f"the file's heuristic {meta['heuristic']}"
+    return out, source
+
+
 def option_help() -> str:
     """The ``--model-option`` keys of every format, for the CLI's help.
 

@@ -32,6 +32,8 @@ import time
 from importlib.metadata import entry_points
 from typing import Any
 
+import numpy as np
+
 from csplab.deps import available
 from csplab.errors import CsplabError, DependencyError, InputError, UnknownSolverError
 from csplab.problem import Problem
@@ -220,7 +222,14 @@ def markdown_table() -> str:
     return "\n".join(rows)
 
 
-def solve(problem: Problem, solver: str = "catalog", rng: RngLike = None, **options: Any) -> Result:
+def solve(
+    problem: Problem,
+    solver: str = "catalog",
+    rng: RngLike = None,
+    *,
+    restarts: int = 0,
+    **options: Any,
+) -> Result:
     """Solve ``problem`` with the named solver.
 
     Parameters
@@ -230,6 +239,14 @@ def solve(problem: Problem, solver: str = "catalog", rng: RngLike = None, **opti
         ``"catalog"``, ``"blocks"``, ... or ``"name:backend"``.
     rng : int, numpy.random.Generator or None
         Randomness; the seed is recorded in the result.
+    restarts : int
+        For an incomplete solver, run again up to this many times while it reports
+        ``failed`` (each attempt with a fresh seed derived from ``rng``; the first attempt is
+        the run without restarts). WaveFunctionCollapse retries a contradiction up to 10
+        times per output, Merrell's code up to 20 times per block; the thesis' experiments
+        measure single runs (0, the default here). The result's stats say ``attempts`` and,
+        after a restart, the ``attempt_seed`` that reproduces the returned run alone.
+        ``time_limit`` covers all attempts.
     **options
         Solver options (``order=``, ``time_limit=``, ``block=`` ...).
 
@@ -237,20 +254,52 @@ def solve(problem: Problem, solver: str = "catalog", rng: RngLike = None, **opti
     -------
     Result
         A ``solved`` grid is always checked with :meth:`Problem.violations`.
+
+    Examples
+    --------
+    >>> from csplab import Problem, load_example
+    >>> P = Problem.from_example(load_example("fig3_5a"), (8, 8))   # Fig. 3.5: fallible
+    >>> solve(P, "catalog", rng=3, order="scan:yx").status          # fails on this seed
+    'failed'
+    >>> r = solve(P, "catalog", rng=3, order="scan:yx", restarts=10)
+    >>> r.status, r.stats["attempts"] > 1, r.seed
+    ('solved', True, 3)
+    >>> solve(P, "catalog", rng=r.stats["attempt_seed"], order="scan:yx").status  # alone
+    'solved'
     """
     if not isinstance(problem, Problem):
         raise InputError(f"solve() needs a Problem, got {type(problem).__name__}")
+    if isinstance(restarts, bool) or not isinstance(restarts, int) or restarts < 0:
+        raise InputError(f"restarts must be a non-negative integer, not {restarts!r}")
     cls, backend = get_solver(solver)
     gen, seed = make_rng(rng)
     t0 = time.perf_counter()
-    res = cls().solve(problem, rng=gen, seed=seed, backend=backend, **options)
+    limit = options.get("time_limit")
+    attempt_seed: int | None = None
+    attempt = 0
+    while True:
+        res = cls().solve(problem, rng=gen, seed=seed, backend=backend, **options)
+        attempt += 1
+        if res.status not in STATUSES:
+            raise CsplabError(f"solver {solver!r} returned unknown status {res.status!r}")
+        if res.status != "failed" or cls.complete or attempt > restarts:
+            break
+        if limit is not None:
+            left = float(limit) - (time.perf_counter() - t0)
+            if left <= 0:
+                break
+            options = {**options, "time_limit": left}
+        attempt_seed = _derived_seed(seed, attempt, gen)
+        gen = make_rng(attempt_seed)[0]
     elapsed = time.perf_counter() - t0
-    if res.status not in STATUSES:
-        raise CsplabError(f"solver {solver!r} returned unknown status {res.status!r}")
     res.solver = solver
     res.seed = seed
-    res.time_s = res.time_s or elapsed
+    res.time_s = elapsed if attempt > 1 else (res.time_s or elapsed)
     res.problem = problem
+    if restarts:
+        res.stats["attempts"] = attempt
+        if attempt_seed is not None:
+            res.stats["attempt_seed"] = attempt_seed
     if res.status == "solved":
         v = problem.violations(res.grid)
         if len(v):
@@ -260,3 +309,12 @@ def solve(problem: Problem, solver: str = "catalog", rng: RngLike = None, **opti
             )
         res.stats.setdefault("violations", 0)
     return res
+
+
+def _derived_seed(seed: int | None, attempt: int, gen: Any) -> int:
+    """The seed of restart ``attempt``: a function of the user's seed (so the whole call
+    repeats), or drawn from the generator when it has no recorded seed."""
+    if seed is None:
+        return int(gen.integers(2**62))
+    state = np.random.SeedSequence([seed, attempt]).generate_state(1, np.uint64)[0]
+    return int(state >> np.uint64(2))

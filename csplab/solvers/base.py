@@ -42,6 +42,7 @@ csplab.errors.InputError: solver 'catalog': order must be one of scanline, rando
 
 from __future__ import annotations
 
+import math
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
@@ -64,6 +65,7 @@ __all__ = [
     "Option",
     "Solver",
     "order_option",
+    "positive_seconds",
 ]
 
 _MISSING = object()
@@ -166,9 +168,23 @@ CHOICE = Option(
     "label choice: uniform over the candidates (thesis) or weighted by label frequencies",
     values=CHOICES,
 )  # fmt: skip
+
+
+def positive_seconds(value: Any) -> float:
+    """``value`` as a time limit: a positive finite number of seconds (0, negative numbers
+    and ``nan`` are an :class:`InputError`)."""
+    try:
+        num = float(value)
+    except (TypeError, ValueError):
+        num = math.nan
+    if isinstance(value, bool) or not math.isfinite(num) or num <= 0:
+        raise InputError(f"must be a positive number of seconds, not {value!r}")
+    return num
+
+
 TIME_LIMIT = Option(
     "time_limit", float, None, "seconds for the whole call; status timeout when exceeded",
-    minimum=0.0, nullable=True,
+    nullable=True, convert=positive_seconds,
 )  # fmt: skip
 
 # One name per concept for Result.stats (the conformance suite checks every solver's keys).
@@ -186,6 +202,8 @@ STATS: dict[str, str] = {
     "blocks_accepted": "blocks whose new labels were kept (Alg. 3.4)",
     "acceptance_rate": "blocks_accepted / blocks_tried",
     "retries": "extra Alg. 3.1 runs after a failure",
+    "attempts": "runs of the solver with restarts (solve(..., restarts=N))",
+    "attempt_seed": "the seed that reproduces the returned attempt alone",
     "sweeps": "passes over the blocks",
     "init": "how the starting model of modify-in-blocks was built",
     "block": "block size used",
