@@ -38,6 +38,7 @@ __all__ = [
     "build_unary",
     "from_example",
     "grid",
+    "merrell_boundary",
     "parse_boundary",
     "parse_shape",
 ]
@@ -209,6 +210,12 @@ def from_example(
         axis and is most frequent on the example's outer layer (bottom excluded); for an
         example whose empty space is one layer thin, a top-layer label that tiles itself
         along the horizontal axes.
+        On a 3D example whose output has no solution under that rule (decided on a small
+        probe of the output's height: arc consistency, then a search with a node budget),
+        ``"auto"`` uses Merrell's rule instead: the bottom layer gets the example's label
+        at ``(0, 0, 0)``, the top layer the label at the top of the example's column
+        ``(0, 0)``, and the sides stay free. ``problem.meta["boundary_rule"]`` says which
+        rule was used.
     mask : bool array ``(*shape, K)`` (or broadcastable)
         Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
 
@@ -217,9 +224,10 @@ def from_example(
     """
     shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
     shp = _match_ndim(shp, example.shape)
+    rule: str | None = None
     if isinstance(boundary, str):
         if boundary == "auto":
-            boundary = auto_boundary(example, len(shp))
+            boundary, rule = _auto_or_merrell(example, shp, periodic)
         elif boundary == "none":
             boundary = None
         else:
@@ -228,7 +236,9 @@ def from_example(
     if T.shape[0] < len(shp):
         pad = np.zeros((len(shp) - T.shape[0], example.K, example.K), dtype=bool)
         T = np.concatenate([T, pad])
-    meta = {"example": example.name, "example_hash": example.hash()}
+    meta: dict[str, Any] = {"example": example.name, "example_hash": example.hash()}
+    if rule is not None:
+        meta["boundary_rule"] = rule
     return grid(
         shp,
         T,
@@ -241,6 +251,91 @@ def from_example(
         name=example.name,
         meta=meta,
         labels=example.counts() > 0,
+    )
+
+
+_PROBE_SIDE = 6
+_PROBE_NODES = 20_000
+
+
+def merrell_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, int]:
+    """Merrell's boundary rule: the bottom face gets the example's label at the origin and
+    the top face the label at the top of the example's first column; the sides stay free.
+
+    Examples
+    --------
+    >>> from csplab.example import ExampleModel
+    >>> E = ExampleModel([[[2, 1, 0]], [[2, 1, 0]]])   # 2x1x3: 2 at the bottom, 0 on top
+    >>> merrell_boundary(E)
+    {'z-': 2, 'z+': 0}
+    """
+    ndim = example.ndim if ndim is None else ndim
+    lab = example.labels
+    axis = AXIS_NAMES[ndim - 1]
+    column = lab[(0,) * (example.ndim - 1)]
+    return {f"{axis}-": int(column[0]), f"{axis}+": int(column[-1])}
+
+
+def _probe(
+    example: ExampleModel,
+    shape: tuple[int, ...],
+    periodic: bool | Sequence[bool],
+    boundary: Mapping[str, int],
+) -> bool | None:
+    """Whether the problem on a small probe of ``shape`` (sides at most 6 cells, the full
+    height) has a solution: ``False`` when arc consistency wipes out or the search is
+    exhausted, ``None`` when the node budget runs out."""
+    from csplab._kernels import Code, Search
+    from csplab.catalog import Propagator
+
+    small = (*(min(s, _PROBE_SIDE) for s in shape[:-1]), shape[-1])
+    P = from_example(example, small, periodic=periodic, boundary=boundary)
+    eng = Propagator(P)
+    if not eng.ok:
+        return False
+    search = Search.new(P.n, eng.c.W, seed=0)
+    while search.nodes < _PROBE_NODES:
+        code = eng.mac_search(
+            search, scan=True, weighted=False, max_nodes=_PROBE_NODES - search.nodes
+        )
+        if code is Code.SOLVED:
+            return True
+        if code is Code.EXHAUSTED:
+            return False
+        if code is Code.GROW:
+            search = search.grown()
+        elif code is Code.RESTART:  # pragma: no cover - no restarts were asked for
+            eng.mac_restart(search)
+    return None
+
+
+def _auto_or_merrell(
+    example: ExampleModel, shape: tuple[int, ...], periodic: bool | Sequence[bool]
+) -> tuple[dict[str, int], str]:
+    """The ``boundary="auto"`` labelling for ``shape`` and a line naming the rule used."""
+    ndim = len(shape)
+    bottom, top = f"{AXIS_NAMES[ndim - 1]}-", f"{AXIS_NAMES[ndim - 1]}+"
+    try:
+        auto: dict[str, int] | None = auto_boundary(example, ndim)
+    except InputError:
+        if ndim != 3 or example.ndim != 3:
+            raise
+        auto = None
+    if auto is not None:
+        others = sorted({b for f, b in auto.items() if f != bottom})
+        rule = (
+            f"auto: ground {bottom}={auto[bottom]}, empty space "
+            f"{'/'.join(map(str, others))} on every other face"
+            if bottom in auto
+            else f"auto: empty space {'/'.join(map(str, others))} on every face"
+        )
+        if ndim != 3 or example.ndim != 3 or _probe(example, shape, periodic, auto):
+            return auto, rule
+    merrell = merrell_boundary(example, ndim)
+    why = "no solution" if auto is not None else "no empty-space label"
+    return merrell, (
+        f"merrell: {bottom}={merrell[bottom]}, {top}={merrell[top]}, sides free "
+        f"(the auto rule has {why})"
     )
 
 

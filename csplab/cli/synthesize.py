@@ -178,6 +178,8 @@ def run(args: argparse.Namespace) -> int:
         )
         print(msg)
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
+        if problem.meta.get("boundary_rule"):
+            print(f"  boundary {problem.meta['boundary_rule']}")
         keys = [k for k in result.stats if k not in ("order", "choice")]
         if keys:
             print("  " + ", ".join(f"{k}={result.stats[k]}" for k in keys))
