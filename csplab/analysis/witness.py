@@ -8,16 +8,22 @@ no consistent model at all and arc consistency empties C before any choice
 :func:`csplab.engine.alg31.run_alg31` that produced them. :func:`replay` re-checks a
 witness.
 
-:func:`find_failure` looks for the smallest output and the shortest prefix that fail:
-exhaustively (every label of C at every step, breadth first over distinct catalogs, so the
-first failure found has the fewest choices) on outputs of up to ``exhaustive_cells``
-cells, then by random runs on a ladder of larger sizes up to ``max_size``, shrinking the
-size again when a run fails. For the witness it finds the first step whose label was
-outside the exact catalog C* (the model became inconsistent there;
-:func:`~csplab.engine.completability.first_inconsistent_prefix` with the exact search
-:class:`~csplab.engine.completability.SearchCompletability`) and how many assignments later
-Alg. 3.1 noticed (Fig. 3.6: the delay can be positive). Choices are counted from 1 in the
-witness (``first_outside_cstar``: choice 3 is the third).
+:func:`find_failure` looks for the smallest output and the shortest prefix that fail,
+within a time budget (``time_limit``, 60 s by default): exhaustively (every label of C at
+every step, breadth first over distinct catalogs, so the first failure found has the
+fewest choices) on outputs of up to ``exhaustive_cells`` cells, within a budget of
+catalogs; then by seeded random runs on a ladder of larger sizes: up to ``max_size``, or
+by default for 3D examples growing outputs round after round until the budget is spent.
+A failing random run is shrunk: output size first (windows of the failing run's labels
+at smaller sizes, fresh seeds), then choices (the run at the final size that fails
+soonest; after the first choice outside C*, the shortest continuation found that wipes C
+out). For the witness it finds the first step whose label was outside the exact catalog
+C* (the model became inconsistent there;
+:func:`~csplab.engine.completability.first_inconsistent_prefix`, exact by SAT or by
+:class:`~csplab.engine.completability.SearchCompletability`) and how many assignments
+later Alg. 3.1 noticed (Fig. 3.6: the delay can be positive). Choices are counted from 1
+in the witness (``first_outside_cstar``: choice 3 is the third). ``stats`` say what was
+searched (:func:`searched` as one line).
 
 Examples
 --------
@@ -39,7 +45,7 @@ import contextlib
 import itertools
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -54,12 +60,12 @@ from csplab.engine.completability import (
 )
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.grids import parse_shape
+from csplab.grids import parse_boundary, parse_shape
 from csplab.problem import Problem
 from csplab.result import Verdict
 from csplab.rng import make_rng
 
-__all__ = ["alg31_exhaustive", "find_failure", "replay"]
+__all__ = ["alg31_exhaustive", "find_failure", "replay", "searched"]
 
 
 class _Budget(Exception):
@@ -73,13 +79,15 @@ def alg31_exhaustive(
     *,
     late: bool = False,
     max_nodes: int = 100_000,
+    deadline: float | None = None,
 ) -> Verdict:
     """Every run of Alg. 3.1 on one problem: does some choice sequence fail?
 
     Breadth first over the distinct catalogs after each step (equal catalogs have equal
     futures), so a failure found has the fewest choices. ``holds=True``: no run fails;
     ``False``: ``witness`` is a failing choice list ``[[coords, label], ...]``;
-    ``None``: more than ``max_states`` catalogs.
+    ``None``: more than ``max_states`` catalogs, or ``time.perf_counter()`` passed
+    ``deadline``.
 
     With ``late=True`` it looks instead for a run that makes the model inconsistent while
     C stays non-empty (Fig. 3.6): every non-wiped catalog is checked for a consistent
@@ -124,6 +132,9 @@ def alg31_exhaustive(
                 key = e2.bits.tobytes()
                 if key in nxt:
                     continue
+                if deadline is not None and time.perf_counter() > deadline:
+                    stats["time_s"] = time.perf_counter() - t0
+                    return Verdict(None, None, stats, "undecided: out of time")
                 if late and _inconsistent(oracle, problem, p2):
                     run = _continue_to_failure(problem, e2, p2, order_list[t + 1 :])
                     stats["first_outside_cstar"] = len(p2)
@@ -169,8 +180,14 @@ def _continue_to_failure(
     raise AssertionError("an inconsistent partial model was completed")  # pragma: no cover
 
 
-def _shapes_upto(limit: tuple[int, ...]) -> list[tuple[int, ...]]:
-    out = list(itertools.product(*[range(1, m + 1) for m in limit]))
+def _shapes_upto(limit: tuple[int, ...], max_cells: int | None = None) -> list[tuple[int, ...]]:
+    if max_cells is not None:  # prune the product: every axis <= max_cells
+        limit = tuple(min(m, max_cells) for m in limit)
+    out = [
+        s
+        for s in itertools.product(*[range(1, m + 1) for m in limit])
+        if max_cells is None or math.prod(s) <= max_cells
+    ]
     out.sort(key=lambda s: (math.prod(s), s))
     return out
 
@@ -184,11 +201,210 @@ def _ladder(limit: tuple[int, ...], steps: int = 6) -> list[tuple[int, ...]]:
     return out
 
 
+_SIDES = (2, 3, 4, 5, 6, 8, 10, 12, 16, 20, 24, 32, 40, 48, 64, 80, 96, 128)
+_AUTO_CELLS = 2_000_000
+
+
+def _auto_ladder(example_shape: tuple[int, ...]) -> list[tuple[int, ...]]:
+    """Growing outputs for ``max_size=None``: a cube of side ``n`` whose axes stop growing at
+    the example's size, then the example's proportions scaled up (at most ``_AUTO_CELLS``)."""
+    big = max(example_shape)
+    out: list[tuple[int, ...]] = []
+    for n in _SIDES:
+        if n <= big:
+            s = tuple(max(2, min(n, m)) for m in example_shape)
+        else:
+            s = tuple(max(2, math.ceil(m * n / big)) for m in example_shape)
+        if math.prod(s) > _AUTO_CELLS:
+            break
+        if s not in out:
+            out.append(s)
+    return out
+
+
+def _fmt(shape: Sequence[int]) -> str:
+    return "x".join(map(str, shape))
+
+
+class _Search:
+    """The state of one :func:`find_failure` call: problems per size, seeds, budget, stats."""
+
+    def __init__(
+        self,
+        example: ExampleModel,
+        order: str,
+        gen: np.random.Generator,
+        stats: dict[str, Any],
+        deadline: float,
+        boundary: Any,
+    ) -> None:
+        self.example, self.order, self.gen, self.stats = example, order, gen, stats
+        self.deadline, self.boundary = deadline, boundary
+        self.is_scan = scan_order((1,) * example.ndim, order) is not None
+        self._problems: dict[tuple[int, ...], Problem] = {}
+
+    def left(self) -> float:
+        return self.deadline - time.perf_counter()
+
+    def problem(self, shape: tuple[int, ...]) -> Problem:
+        P = self._problems.get(shape)
+        if P is None:
+            kw = {} if self.boundary is None else {"boundary": self.boundary}
+            P = Problem.from_example(self.example, shape, **kw)
+            if P.n <= 200_000:
+                self._problems[shape] = P
+        return P
+
+    def witness(self, shape: tuple[int, ...], choices: list[list[Any]], kind: str,
+                search: str, seed: int | None = None) -> dict[str, Any]:  # fmt: skip
+        w: dict[str, Any] = {"shape": list(shape), "order": self.order}
+        if self.boundary is not None:
+            w["boundary"] = self.boundary
+        if seed is not None:
+            w["seed"] = seed
+        w.update(choices=choices, kind=kind, search=search)
+        return w
+
+    def seeded(self, shape: tuple[int, ...], runs: int, key: str = "random_runs"
+               ) -> dict[str, Any] | None:  # fmt: skip
+        """Up to ``runs`` seeded Alg. 3.1 runs at ``shape``; the first failing one."""
+        P = self.problem(shape)
+        per = self.stats["runs_per_size"]
+        for _ in range(runs):
+            if self.left() <= 0:
+                return None
+            seed = int(self.gen.integers(2**31))
+            limit = max(self.left(), 0.01) if P.n > 50_000 else None  # big: stop in time
+            r = run_alg31(P, np.random.default_rng(seed), order=self.order, time_limit=limit)
+            self.stats[key] += 1
+            if key == "random_runs":
+                per[_fmt(shape)] = per.get(_fmt(shape), 0) + 1
+            if r.status in ("failed", "unsat"):
+                tr = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
+                ch = [[list(P.coords(int(c))), int(b)] for c, b in tr.tolist()]
+                return self.witness(shape, ch, r.status, "random runs", seed)
+        return None
+
+    def guided(self, shape: tuple[int, ...], want: NDArray[np.int64]) -> dict[str, Any] | None:
+        """One scan-order run at ``shape`` that takes the label of ``want`` wherever it is in
+        C and a uniform label of C elsewhere; the run if it fails."""
+        P = self.problem(shape)
+        eng = Propagator(P)
+        self.stats["shrink_runs"] += 1
+        if not eng.ok:
+            return None  # no consistent model at this size: not a failing run
+        scan = scan_order(shape, self.order)
+        assert scan is not None
+        flat = want.reshape(-1)
+        out: list[list[Any]] = []
+        for cell in scan.tolist():
+            dom = eng.domain(cell)
+            b = int(flat[cell])
+            if b < 0 or b not in dom:
+                b = int(dom[int(self.gen.integers(dom.size))])
+            out.append([list(P.coords(cell)), b])
+            if not eng.assign(cell, b):
+                return self.witness(shape, out, "failed", "random runs, shrunk")
+        return None
+
+
+def _grid(shape: Sequence[int], choices: list[list[Any]]) -> NDArray[np.int64]:
+    g = np.full(tuple(shape), -1, dtype=np.int64)
+    for c, b in choices:
+        g[tuple(c)] = b
+    return g
+
+
+def _shrink_size(s: _Search, hit: dict[str, Any], runs: int) -> dict[str, Any]:
+    """Smaller outputs that still fail, one axis at a time (smallest length first): the
+    failing run's labels in a window at the origin or ending at the failing cell
+    (scan orders), then fresh seeds."""
+    improved = True
+    while improved and s.left() > 0:
+        improved = False
+        shp = tuple(hit["shape"])
+        grid = _grid(shp, hit["choices"])
+        fail = hit["choices"][-1][0] if hit["choices"] else [0] * len(shp)
+        for d in range(len(shp)):
+            few = (1, 2, 3, 4, 6, 8, shp[d] // 2, shp[d] - 1)
+            cands = range(1, shp[d]) if shp[d] <= 16 else sorted({c for c in few if c >= 1})
+            for L in cands:
+                if s.left() <= 0:
+                    return hit
+                s2 = (*shp[:d], L, *shp[d + 1 :])
+                h2 = None
+                if s.is_scan and hit["kind"] == "failed":
+                    offs = sorted({0, min(max(int(fail[d]) - L + 1, 0), shp[d] - L)})
+                    for off in offs:
+                        sl = [slice(None)] * len(shp)
+                        sl[d] = slice(off, off + L)
+                        for _ in range(3):
+                            h2 = s.guided(s2, grid[tuple(sl)])
+                            if h2 is not None:
+                                break
+                        if h2 is not None:
+                            break
+                if h2 is None:
+                    h2 = s.seeded(s2, runs, key="shrink_runs")
+                if h2 is not None and (h2["kind"] == "failed" or hit["kind"] == "unsat"):
+                    hit, improved = h2, True
+                    break
+            if improved:
+                break
+    return hit
+
+
+def _shrink_choices(s: _Search, hit: dict[str, Any], runs: int) -> dict[str, Any]:
+    """At the final size, more runs; keep the one that fails after the fewest choices."""
+    shp = tuple(hit["shape"])
+    if not hit["choices"]:
+        return hit
+    for _ in range(2):
+        h2 = s.seeded(shp, runs, key="shrink_runs")
+        if h2 is not None and len(h2["choices"]) < len(hit["choices"]):
+            hit = h2
+        if s.is_scan and s.left() > 0:
+            h3 = s.guided(shp, _grid(shp, hit["choices"][:-1]))
+            if h3 is not None and len(h3["choices"]) < len(hit["choices"]):
+                hit = h3
+    return hit
+
+
+def _shortest_continuation(
+    s: _Search, P: Problem, choices: list[list[Any]], t: int, tries: int = 8
+) -> list[list[Any]]:
+    """Keep the first ``t`` choices (an inconsistent partial model, so every continuation
+    fails) and continue them as briefly as a few tries find (scan orders only)."""
+    scan = scan_order(P.shape, s.order)
+    assert scan is not None
+    eng = Propagator(P)
+    for c, b in choices[:t]:
+        eng.assign(P.cell(tuple(c)), int(b))
+    best = choices
+    if not eng.ok:
+        return best
+    rest = scan.tolist()[t:]
+    for k in range(tries):
+        if s.left() <= 0:
+            break
+        e = eng.copy()
+        out = [list(x) for x in choices[:t]]
+        for cell in rest:
+            dom = e.domain(cell)
+            b = int(dom[0]) if k == 0 else int(dom[int(s.gen.integers(dom.size))])
+            out.append([list(P.coords(cell)), b])
+            if len(out) >= len(best) or not e.assign(cell, b):
+                break
+        if not e.ok and len(out) < len(best):
+            best = out
+    return best
+
+
 def find_failure(
     example: ExampleModel,
     *,
     order: str = "scanline",
-    max_size: Sequence[int] | str = (4, 4),
+    max_size: Sequence[int] | str | None = None,
     exhaustive_cells: int = 20,
     random_runs: int = 30,
     rng: int | np.random.Generator | None = 0,
@@ -196,8 +412,19 @@ def find_failure(
     exact: bool = True,
     max_nodes: int = 200_000,
     late: bool = False,
+    time_limit: float | None = 60.0,
+    boundary: Mapping[str, int] | str | None = None,
 ) -> Verdict:
     """Find a failing run of Alg. 3.1 on ``example`` (smallest size, shortest prefix).
+
+    The search escalates: every run on outputs of at most ``exhaustive_cells`` cells
+    (exhaustive, at most ``max_states`` catalogs per size and half of the time; with the
+    growing default sizes ``max_states`` catalogs in all, a tenth of them per size, and a
+    tenth of the time), then
+    seeded random runs on growing outputs; a failing random run is shrunk, output size
+    first (smaller windows of the failing run, then fresh seeds), then choices (the run
+    at the final size that fails soonest, and after its first choice outside C* the
+    shortest continuation that wipes C out).
 
     Parameters
     ----------
@@ -205,20 +432,29 @@ def find_failure(
     order : str
         Alg. 3.1's cell order: a scan order (exhaustive and random search) or ``random`` /
         ``min-entropy`` (random search only).
-    max_size : shape or str
-        Largest output searched (each axis); missing trailing axes are 1.
+    max_size : shape or str, optional
+        Largest output searched (each axis; missing trailing axes are 1): its sizes are
+        searched once. Default: ``4x4`` for 1D and 2D examples; for 3D and higher, growing
+        outputs (cubes up to the example's size, then its proportions scaled up) searched
+        round after round until the time budget is spent.
     exhaustive_cells : int
         Outputs with at most this many cells are searched exhaustively (scan orders).
     random_runs : int
-        Seeds tried per size on the ladder of larger sizes (0: exhaustive only).
+        Seeds tried per size and round on the larger sizes (0: exhaustive only).
     rng : seed or Generator
         Seeds of the random runs are drawn from it and recorded in the witness.
     exact : bool
-        Also find the first step outside C* (exact satisfiability by MAC backtracking,
-        at most ``max_nodes`` nodes per check).
+        Also find the first step outside C* (exact: SAT when python-sat is installed,
+        else MAC backtracking with at most ``max_nodes`` nodes per check).
     late : bool
         Look for a *late* failure instead (Fig. 3.6): a run whose model becomes
         inconsistent while the catalog is still non-empty (exhaustive sizes only).
+    time_limit : float, optional
+        Seconds for the whole call (``None``: no limit); the random search stops at 70 %
+        of it, shrinking and the exact check use the rest.
+    boundary : optional
+        Boundary of the outputs, as in :meth:`Problem.from_example` (``"auto"``, a
+        mapping face -> label); recorded in the witness.
 
     Returns
     -------
@@ -227,137 +463,196 @@ def find_failure(
         ``holds=False``: ``witness`` is a failing run (see the module docstring);
         ``holds=True``: every output up to ``max_size`` was searched exhaustively and no
         run fails (a bounded proof); ``holds=None``: nothing found, search not exhaustive.
+        ``stats``: ``exhaustive_sizes``, ``states``, ``random_runs``, ``runs_per_size``
+        (size -> seeded runs), ``found_on`` (size of the first failing random run),
+        ``shrink_runs``, ``search_s``, ``shrink_s``, ``time_s``.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> v = find_failure(load_example("castle"), boundary="auto", time_limit=20, rng=1)
+    >>> v.holds, replay(load_example("castle"), v.witness).holds
+    (False, True)
     """
     t0 = time.perf_counter()
+    ok_limit = isinstance(time_limit, (int, float)) and math.isfinite(time_limit)
+    if time_limit is not None and not (ok_limit and time_limit > 0):
+        raise InputError(f"time_limit must be a positive number of seconds, not {time_limit!r}")
+    deadline = math.inf if time_limit is None else t0 + float(time_limit)
     ndim = example.ndim
-    lim = parse_shape(max_size) if isinstance(max_size, str) else tuple(int(m) for m in max_size)
-    if len(lim) < ndim:
-        lim = lim + (1,) * (ndim - len(lim))
-    if len(lim) != ndim:
-        raise InputError(f"max_size {max_size!r} has more axes than the example ({ndim})")
+    auto = max_size is None and ndim >= 3
+    if max_size is None and not auto:
+        max_size = (4, 4)[:ndim] if ndim <= 2 else (4,) * ndim
+    if auto:
+        lim = tuple(max(s) for s in zip(*_auto_ladder(example.shape), strict=True))
+    else:
+        assert max_size is not None
+        lim = (
+            parse_shape(max_size) if isinstance(max_size, str) else tuple(int(m) for m in max_size)
+        )
+        if len(lim) < ndim:
+            lim = lim + (1,) * (ndim - len(lim))
+        if len(lim) != ndim:
+            raise InputError(f"max_size {max_size!r} has more axes than the example ({ndim})")
     is_scan = order == "scanline" or order.startswith("scan:")
     scan_order(lim, order)  # validates the order
+    bnd = boundary
+    if isinstance(boundary, str):
+        bnd = parse_boundary(boundary)
+    if boundary is not None:
+        Problem.from_example(example, (2,) * ndim, boundary=bnd)  # validates the boundary
     gen, seed0 = make_rng(rng)
-    stats_seed = seed0
     stats: dict[str, Any] = {
         "states": 0,
         "exhaustive_sizes": 0,
         "random_runs": 0,
-        "seed": stats_seed,
+        "runs_per_size": {},
+        "shrink_runs": 0,
+        "seed": seed0,
+        "time_limit": time_limit,
     }
+    s = _Search(example, order, gen, stats, deadline, bnd)
     complete = is_scan
     found: dict[str, Any] | None = None
-    for shp in _shapes_upto(lim) if is_scan else []:
-        if math.prod(shp) > exhaustive_cells:
+    share = 1.0 if late else 0.1 if auto else 0.5  # of the time, for the exhaustive phase
+    ex_deadline = t0 + share * (deadline - t0)
+    for shp in _shapes_upto(lim, exhaustive_cells) if is_scan else []:
+        budget = min(max_states // 10, max_states - stats["states"]) if auto else max_states
+        if budget <= 0 or time.perf_counter() > ex_deadline:
             complete = False
-            continue
-        P = Problem.from_example(example, shp)
-        v = alg31_exhaustive(P, order, max_states, late=late, max_nodes=max_nodes)
+            break
+        v = alg31_exhaustive(s.problem(shp), order, budget, late=late, max_nodes=max_nodes,
+                             deadline=ex_deadline)  # fmt: skip
         stats["states"] += v.stats["states"]
         stats["exhaustive_sizes"] += 1
         if v.holds is None:
             complete = False
             continue
         if v.holds is False:
-            found = {
-                "shape": list(shp),
-                "order": order,
-                "choices": v.witness,
-                "kind": "failed" if v.witness else "unsat",
-                "search": "exhaustive (fewest choices at this size)",
-            }
+            found = s.witness(shp, v.witness, "failed" if v.witness else "unsat",
+                              "exhaustive (fewest choices at this size)")  # fmt: skip
             break
+    if math.prod(lim) > exhaustive_cells:
+        complete = False
+    search_deadline = t0 + 0.7 * (deadline - t0)
     if found is None and random_runs > 0 and not late:
-        found = _random_search(example, order, lim, random_runs, gen, stats, exhaustive_cells)
+        s.deadline = search_deadline
+        if auto:
+            found = _climb(s, _auto_ladder(example.shape), random_runs, exhaustive_cells)
+        else:
+            for shp in _ladder(lim):
+                if math.prod(shp) <= exhaustive_cells and is_scan:
+                    continue
+                found = s.seeded(shp, random_runs)
+                if found is not None:
+                    break
+        stats["search_s"] = time.perf_counter() - t0
+        s.deadline = deadline
+        if found is not None:
+            stats["found_on"] = list(found["shape"])
+            found = _shrink_size(s, found, random_runs)
+            if found["kind"] == "failed":
+                found = _shrink_choices(s, found, random_runs)
+        stats["shrink_s"] = time.perf_counter() - t0 - stats["search_s"]
     stats["time_s"] = time.perf_counter() - t0
+    searched = _searched(stats)
     if found is None:
         if complete:
             return Verdict(
                 True, None, stats,
                 f"no failure of Alg. 3.1 ({order}) on any output up to "
-                f"{'x'.join(map(str, lim))} ({stats['states']} catalogs, exhaustive)",
+                f"{_fmt(lim)} ({stats['states']} catalogs, exhaustive)",
             )  # fmt: skip
-        return Verdict(
-            None, None, stats,
-            f"no failure found ({stats['random_runs']} random runs, "
-            f"{stats['exhaustive_sizes']} sizes exhaustive); not a proof",
-        )  # fmt: skip
+        return Verdict(None, None, stats, f"no failure found ({searched}); not a proof")
     found["fail_step"] = len(found["choices"])
     if exact and found["kind"] == "failed":
-        P = Problem.from_example(example, tuple(found["shape"]))
-        oracle = SearchCompletability(P, max_nodes=max_nodes)
-        t = None
-        if oracle.completable([], []) is True:  # else undecided (the run failed anyway)
-            with contextlib.suppress(PrefixTimeout):  # undecided within max_nodes
-                k = first_inconsistent_prefix(
-                    oracle, _cell_choices(P, found["choices"]), full_inconsistent=True
-                )
-                t = None if k is None else k + 1  # choices count from 1 in the witness
-        found["first_outside_cstar"] = t
-        if t is not None:
-            found["detection_delay"] = found["fail_step"] - t
+        _first_outside(s, found, max_nodes)
     stats["time_s"] = time.perf_counter() - t0
-    msg = (
-        f"Alg. 3.1 ({order}) fails on {'x'.join(map(str, found['shape']))} after "
-        f"{found['fail_step']} choices"
-    )
+    msg = f"Alg. 3.1 ({order}) fails on {_fmt(found['shape'])} after {found['fail_step']} choices"
     if found.get("first_outside_cstar") is not None:
         msg += f"; inconsistent from choice {found['first_outside_cstar']}"
     return Verdict(False, found, stats, msg)
 
 
-def _random_search(
-    example: ExampleModel,
-    order: str,
-    lim: tuple[int, ...],
-    runs: int,
-    gen: np.random.Generator,
-    stats: dict[str, Any],
-    exhaustive_cells: int,
+def _climb(
+    s: _Search, ladder: list[tuple[int, ...]], runs: int, exhaustive_cells: int
 ) -> dict[str, Any] | None:
-    def attempt(shp: tuple[int, ...]) -> dict[str, Any] | None:
-        P = Problem.from_example(example, shp)
-        for _ in range(runs):
-            seed = int(gen.integers(2**31))
-            r = run_alg31(P, np.random.default_rng(seed), order=order)
-            stats["random_runs"] += 1
-            if r.status in ("failed", "unsat"):
-                tr = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
-                ch = [[list(P.coords(int(c))), int(b)] for c, b in tr.tolist()]
-                return {
-                    "shape": list(shp),
-                    "order": order,
-                    "seed": seed,
-                    "choices": ch,
-                    "kind": r.status,
-                    "search": "random runs",
-                }
-        return None
+    """Rounds of ``runs`` seeded runs per size up the ladder until the budget is spent; a
+    round climbs no higher than the size whose runs would take a quarter of what is left."""
+    ladder = [x for x in ladder if not (s.is_scan and math.prod(x) <= exhaustive_cells)]
+    top = len(ladder)
+    while s.left() > 0 and ladder:
+        for i, shp in enumerate(ladder[:top]):
+            t1 = time.perf_counter()
+            hit = s.seeded(shp, runs)
+            if hit is not None:
+                return hit
+            if (time.perf_counter() - t1) > s.left() / 4:
+                top = i + 1
+                break
+    return None
 
-    hit: dict[str, Any] | None = None
-    for shp in _ladder(lim):
-        if math.prod(shp) <= exhaustive_cells and (order == "scanline" or order[:5] == "scan:"):
-            continue
-        hit = attempt(shp)
-        if hit is not None:
-            break
-    if hit is None:
-        return None
-    # shrink: one axis at a time, halve while a failure is still found
-    shp = tuple(hit["shape"])
-    improved = True
-    while improved:
-        improved = False
-        for d in range(len(shp)):
-            for cand in (shp[d] // 2, shp[d] - 1):
-                if cand < 1 or cand == shp[d]:
-                    continue
-                s2 = (*shp[:d], cand, *shp[d + 1 :])
-                h2 = attempt(s2)
-                if h2 is not None:
-                    hit, shp, improved = h2, s2, True
-                    break
-    return hit
+
+def _first_outside(s: _Search, found: dict[str, Any], max_nodes: int) -> None:
+    """``first_outside_cstar`` and ``detection_delay`` of a failing run, shortening the run
+    after the first choice outside C* (scan orders)."""
+    from csplab.deps import available
+
+    P = s.problem(tuple(found["shape"]))
+    oracle: Any
+    if available("pysat") and (P.n > 64 or P.ndim >= 3):
+        from csplab.engine.completability import SatCompletability
+
+        oracle = SatCompletability(P, deadline=None if math.isinf(s.deadline) else s.deadline)
+    else:
+        oracle = SearchCompletability(P, max_nodes=max_nodes)
+    t = None
+    try:
+        if oracle.completable([], []) is True:  # else undecided (the run failed anyway)
+            with contextlib.suppress(PrefixTimeout):  # undecided within the budget
+                k = first_inconsistent_prefix(
+                    oracle, _cell_choices(P, found["choices"]), full_inconsistent=True
+                )
+                t = None if k is None else k + 1  # choices count from 1 in the witness
+    finally:
+        close = getattr(oracle, "close", None)
+        if close is not None:
+            close()
+    found["first_outside_cstar"] = t
+    if t is not None:
+        if s.is_scan and found["search"].startswith("random"):
+            short = _shortest_continuation(s, P, found["choices"], t)
+            if len(short) < len(found["choices"]):
+                found.pop("seed", None)  # scan order: the choices replay without it
+                found["choices"], found["fail_step"] = short, len(short)
+                found["search"] += ", shortest continuation after C*"
+        found["detection_delay"] = found["fail_step"] - t
+
+
+def _searched(stats: dict[str, Any]) -> str:
+    per = stats["runs_per_size"]
+    sizes = ", ".join(f"{k}: {n}" for k, n in per.items())
+    out = f"{stats['exhaustive_sizes']} sizes exhaustive ({stats['states']} catalogs), "
+    out += f"{stats['random_runs']} random runs"
+    if sizes:
+        out += f" ({sizes})"
+    return out + f", {stats['time_s']:.1f} s"
+
+
+def searched(stats: dict[str, Any]) -> str:
+    """What a :func:`find_failure` call searched, from its ``stats``, as one line.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> v = find_failure(load_example("line"), max_size=(3, 3), random_runs=0)
+    >>> searched(v.stats).split(", ")[:2]
+    ['9 sizes exhaustive (501 catalogs)', '0 random runs']
+    """
+    line = _searched(stats)
+    if stats.get("shrink_runs"):
+        line += f"; shrunk with {stats['shrink_runs']} runs in {stats.get('shrink_s', 0):.1f} s"
+    return line
 
 
 def replay(example: ExampleModel, witness: dict[str, Any]) -> Verdict:
@@ -365,11 +660,16 @@ def replay(example: ExampleModel, witness: dict[str, Any]) -> Verdict:
 
     Every label must be in the catalog when it is chosen, cells must come in the scan
     order (random orders: the recorded seed must reproduce the run), and the catalog must
-    be wiped out by the last choice (or before any choice for ``kind="unsat"``).
+    be wiped out by the last choice (or before any choice for ``kind="unsat"``). The
+    output has the witness' ``boundary`` when it records one.
     """
     shape = tuple(int(s) for s in witness["shape"])
     order = str(witness.get("order", "scanline"))
-    P = Problem.from_example(example, shape)
+    bnd = witness.get("boundary")
+    if isinstance(bnd, str):
+        bnd = parse_boundary(bnd)
+    P = Problem.from_example(example, shape) if bnd is None else Problem.from_example(
+        example, shape, boundary=bnd)  # fmt: skip
     eng = Propagator(P)
     choices = witness.get("choices", [])
     if not eng.ok:

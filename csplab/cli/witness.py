@@ -8,8 +8,10 @@ found (printed; ``--out`` saves it), 3 nothing found but the search was not exha
 from __future__ import annotations
 
 import argparse
+import math
 
 from csplab.analysis import find_failure
+from csplab.analysis.witness import searched
 from csplab.cli._analysis import (
     ORDER_HELP,
     describe_run,
@@ -17,19 +19,30 @@ from csplab.cli._analysis import (
     print_verdict,
     save_witness,
 )
+from csplab.errors import InputError
 
 HELP = "find a failing run of Alg. 3.1 (or show none exists up to a size)"
 DESCRIPTION = (
     "Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, "
-    "memoised), then random runs on larger ones; print the smallest failing run, its "
-    "seed and the first choice outside the exact catalog C*. Exit 0 no failure up to "
+    "memoised), then random runs on growing outputs within --time-limit; shrink a failing "
+    "run (output size first, then choices) and print it, its seed, the first choice "
+    "outside the exact catalog C* and what was searched. Exit 0 no failure up to "
     "--max-size (exhaustive), 1 failure found, 3 none found (not exhaustive)."
 )
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
-    p.add_argument("--max-size", default="4x4", help="largest output searched (default 4x4)")
+    p.add_argument("--max-size", default=None,
+                   help="largest output searched (default: 4x4 for 2D examples; 3D: growing "
+                   "sizes until the time limit)")  # fmt: skip
+    p.add_argument("--time-limit", type=float, default=60.0,
+                   help="seconds for the whole search and shrinking (default 60)")  # fmt: skip
+    p.add_argument(
+        "--boundary",
+        default=None,
+        help="boundary of the outputs: auto, none or face=label,... (default none)",
+    )
     p.add_argument("--order", default="scanline", help=ORDER_HELP + "; or random, min-entropy")
     p.add_argument("--exhaustive-cells", type=int, default=20,
                    help="outputs up to this many cells are searched exhaustively")  # fmt: skip
@@ -43,6 +56,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not (math.isfinite(args.time_limit) and args.time_limit > 0):
+        raise InputError(f"--time-limit {args.time_limit}: give a positive number of seconds")
     E = load_example_model(args.model, args.model_option)
     v = find_failure(
         E,
@@ -52,8 +67,12 @@ def run(args: argparse.Namespace) -> int:
         random_runs=args.runs,
         rng=args.seed,
         late=args.late,
+        time_limit=args.time_limit,
+        boundary=args.boundary,
     )
     print_verdict(v, args.json)
+    if not args.json:
+        print(f"  searched: {searched(v.stats)}")
     if v.holds is False:
         if not args.json:
             print(describe_run(v.witness, E))

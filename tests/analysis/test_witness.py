@@ -121,3 +121,79 @@ def test_find_failure_witnesses_replay_and_bounds_hold(E, order):
             P = Problem.from_example(E, shape)
             for seed in range(5):
                 assert solve(P, "catalog", rng=seed, order=order).status == "solved"
+
+
+# ------------------------------------------------------- 3D: escalate, shrink, time budget
+
+
+def test_3d_witness_with_defaults_in_a_few_seconds():
+    E = load_example("castle")  # fails often with boundary auto at 12x12x8
+    v = find_failure(E, boundary="auto", time_limit=5, rng=1)
+    assert v.holds is False and v.stats["time_s"] < 5 + 2
+    w = v.witness
+    assert replay(E, w).holds and w["boundary"] == "auto" and w["kind"] == "failed"
+    st = v.stats
+    assert st["random_runs"] > 0 and sum(st["runs_per_size"].values()) == st["random_runs"]
+    assert int(np.prod(w["shape"])) <= int(np.prod(st["found_on"]))  # shrunk (or kept)
+    t = w["first_outside_cstar"]
+    assert t is not None and w["detection_delay"] == w["fail_step"] - t
+    P = Problem.from_example(E, tuple(w["shape"]), boundary="auto")
+    ch = w["choices"]
+    assert satisfiable(P, prefix_grid(P.shape, ch, t - 1)) is True
+    assert satisfiable(P, prefix_grid(P.shape, ch, t)) is False
+
+
+def test_3d_shrinks_a_large_failure():
+    E = load_example("castle")
+    # no exhaustive phase (no catalogs allowed): the failure comes from a random run
+    v = find_failure(E, boundary="auto", time_limit=10, rng=0, max_states=0)
+    assert v.holds is False and v.stats["exhaustive_sizes"] == 0
+    assert int(np.prod(v.witness["shape"])) < int(np.prod(v.stats["found_on"]))
+    assert v.stats["shrink_runs"] > 0 and "shrunk" in v.witness["search"]
+    assert replay(E, v.witness).holds
+    # the boundary matters: without it the witness does not replay as a failure
+    assert not replay(E, {**v.witness, "boundary": None}).holds
+
+
+def test_time_limit_is_kept_on_an_infallible_3d_model():
+    E = load_example("pillar")
+    v = find_failure(E, time_limit=2)
+    assert v.holds is None and "not a proof" in v.message
+    assert v.stats["time_s"] < 2 + 1.5 and v.stats["random_runs"] > 0
+
+
+def test_random_order_3d_witness_replays_by_seed():
+    E = load_example("castle")
+    for order in ("random", "min-entropy"):
+        v = find_failure(E, boundary="auto", order=order, time_limit=5, rng=2)
+        assert v.holds is False and v.stats["exhaustive_sizes"] == 0  # no exhaustive phase
+        assert "seed" in v.witness and replay(E, v.witness).holds
+        bad = {**v.witness, "seed": v.witness["seed"] + 1}
+        assert not replay(E, bad).holds
+
+
+@pytest.mark.parametrize("bad", [0, -1.0, float("nan"), float("inf")])
+def test_bad_time_limit(bad):
+    with pytest.raises(InputError, match="time_limit"):
+        find_failure(load_example("line"), time_limit=bad)
+
+
+def _merrell_3d_models():
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[3] / "shared" / "anchors-data"
+    return sorted(p for p in root.glob("**/*.txt") if "errell" in str(p)) if root.is_dir() else []
+
+
+@pytest.mark.parametrize("path", _merrell_3d_models() or [None])
+def test_merrell_3d_model_witness(path):
+    if path is None:
+        pytest.skip("no Merrell 3D model in ../shared/anchors-data")
+    from csplab.io import read_model
+
+    E = read_model(path)
+    if E.ndim < 3:
+        pytest.skip(f"{path.name} is not 3D")
+    v = find_failure(E, time_limit=10)
+    if v.holds is False:
+        assert replay(E, v.witness).holds

@@ -53,6 +53,9 @@ def test_prove_budget_and_corner(capsys):
         (["prove", "line", "--order", "random"], "region proof"),
         (["prove", "nosuchmodel"], "neither a model file"),
         (["witness", "line", "--order", "sideways"], "order"),
+        (["witness", "line", "--time-limit", "0"], "--time-limit"),
+        (["witness", "line", "--time-limit", "nan"], "--time-limit"),
+        (["witness", "castle", "--boundary", "q"], "--boundary"),
     ],
 )
 def test_bad_input_is_one_line(capsys, args, msg):
@@ -74,6 +77,24 @@ def test_witness_outputs(tmp_path, capsys):
     code, out, _ = run(capsys, "witness", "line", "--max-size", "5x5", "--exhaustive-cells",
                        "4", "--runs", "2")  # fmt: skip
     assert code == 3 and "not a proof" in out
+
+
+def test_witness_3d_defaults_escalate_and_shrink(tmp_path, capsys):
+    js = tmp_path / "w.json"
+    code, out, _ = run(capsys, "witness", "castle", "--boundary", "auto", "--time-limit", "5",
+                       "--out", str(js))  # fmt: skip
+    assert code == 1 and "fails on" in out
+    line = next(x for x in out.splitlines() if x.startswith("  searched: "))
+    assert "sizes exhaustive" in line and "random runs (" in line and "shrunk with" in line
+    w = json.loads(js.read_text())
+    assert w["boundary"] == "auto" and w["choices"]
+    from csplab.analysis import replay
+
+    assert replay(load_example("castle"), w).holds
+    code, out, _ = run(capsys, "witness", "castle", "--boundary", "auto", "--time-limit", "5",
+                       "--json")  # fmt: skip
+    d = json.loads(out)
+    assert code == 1 and d["stats"]["random_runs"] > 0 and d["stats"]["runs_per_size"]
 
 
 def test_refine_writes_an_infallible_example(tmp_path, capsys):
