@@ -196,6 +196,11 @@ def parse_debroglie(
     meta["closure_violations"] = bad
     for msg in bad[:5]:
         warn.add(f"rule set not closed under the symmetry group: {msg}")
+    # csplab reads no tile pictures of adjacent models (Tiled .tsx tilesets, tile 'src'):
+    # say so, or a picture in one colour per tile looks like a bug
+    where = f" (csplab does not read {src!r})" if isinstance(src, str) and src else ""
+    if where or Path(str(path)).is_file():
+        warn.add(f"no tile pictures{where}: pictures show one colour per tile")
     return rs
 
 

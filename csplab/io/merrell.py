@@ -165,5 +165,38 @@ def write_merrell(example: ExampleModel, path: str | Path) -> None:
 
 
 def write_output(out: Output, path: Path) -> None:
-    """The grid (at most 3D, no unassigned cells) in Merrell's format."""
-    write_merrell(out.to_example(), path)
+    """The grid (at most 3D, no unassigned cells) in Merrell's format.
+
+    A result of an example read from Merrell's format (``out.model``) gets that example's
+    trailing label -> object table verbatim, as Merrell's program writes it: his 3DS Max
+    and Blender loaders read the labels up to it.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> E = parse_merrell("m\\n\\n\\n2 1 1\\n0\\n1\\n<Objects>\\n1 wall\\n")
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = pathlib.Path(d) / "out.txt"
+    ...     write_output(Output.of([[1], [0]], model=E), p)
+    ...     print(p.read_text())
+    csplab model
+    written by csplab: labels for z: for x: for y
+    <BLANKLINE>
+    2 1 1
+    1
+    0
+    <Objects>
+    1 wall
+    <BLANKLINE>
+    """
+    example = out.to_example()
+    model = out.model
+    if (
+        out.example is None
+        and isinstance(model, ExampleModel)
+        and model.meta.get("merrell_trailer")
+        and not example.meta.get("merrell_trailer")
+    ):
+        meta = {**example.meta, "merrell_trailer": model.meta["merrell_trailer"]}
+        example = ExampleModel(example.labels, names=example.names, name=example.name, meta=meta)
+    write_merrell(example, path)

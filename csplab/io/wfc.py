@@ -8,8 +8,8 @@ Layout::
         ...
       </tiles>
       <neighbors>
-        <neighbor left="corner 1" right="line"/>   "name k" = orientation k (default 0):
-        ...                                        right may be the +x neighbour of left
+        <neighbor left="corner 1" right="line"/>   "name k": k = 0..7 (default 0), see
+        ...                                        below; right may be the +x neighbour
       </neighbors>
       <subsets>
         <subset name="small"><tile name="corner"/>...</subset>
@@ -19,7 +19,11 @@ Layout::
 A tile of symmetry class X, L, T, I, \\ or F has 1, 4, 4, 2, 2 or 8 orientations (labels
 ``"corner 0"`` ... ``"corner 3"``): orientation ``k < 4`` is the tile turned ``k`` quarter
 turns counter-clockwise, ``k >= 4`` that turned ``k - 4`` times and mirrored left-right,
-as WaveFunctionCollapse numbers them. Rules are stated for ``+x`` and hold in every frame of
+as WaveFunctionCollapse numbers them. A neighbour ``"name k"`` is resolved as
+WaveFunctionCollapse resolves it, through the tile's 8-element action table
+(:func:`wfc_action`): ``k`` may be 0..7 for every tile, and for ``k`` beyond the tile's
+orientations it names the orientation the table gives (``"line 3"`` of a symmetry-``I``
+tile is ``"line 1"``). Rules are stated for ``+x`` and hold in every frame of
 the square's symmetry group (:mod:`csplab.io.symmetry`); vertical rules follow from the
 rotations. Tile images are read from a folder named after the XML file next to it (or
 from the XML file's own folder): ``corner.png``, or ``corner 0.png``, ``corner 1.png``
@@ -40,6 +44,7 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -61,7 +66,7 @@ from csplab.io.common import (
 from csplab.io.ruleset import RuleSet
 from csplab.io.symmetry import Group, Orientations, expand_rules, square_group
 
-__all__ = ["CARDINALITY", "parse_wfc", "read_wfc", "sniff", "stabilizer_words"]
+__all__ = ["CARDINALITY", "parse_wfc", "read_wfc", "sniff", "stabilizer_words", "wfc_action"]
 
 CARDINALITY = {"X": 1, "L": 4, "T": 4, "I": 2, "\\": 2, "F": 8}
 # words generating the symmetry group of orientation 0 (a: quarter turn +x -> +y, b: x-mirror)
@@ -74,6 +79,43 @@ _STAB: dict[str, list[str]] = {
     "F": [],
 }
 _ORDER = ["", "a", "aa", "aaa", "b", "ba", "baa", "baaa"]  # orientation k = this element
+
+
+# WaveFunctionCollapse's maps a (quarter turn) and b (mirror) on a tile's orientation indices
+_A: dict[str, Callable[[int], int]] = {
+    "L": lambda i: (i + 1) % 4,
+    "T": lambda i: (i + 1) % 4,
+    "I": lambda i: 1 - i,
+    "\\": lambda i: 1 - i,
+    "F": lambda i: (i + 1) % 4 if i < 4 else 4 + (i - 1) % 4,
+    "X": lambda i: i,
+}
+_B: dict[str, Callable[[int], int]] = {
+    "L": lambda i: i + 1 if i % 2 == 0 else i - 1,
+    "T": lambda i: i if i % 2 == 0 else 4 - i,
+    "I": lambda i: i,
+    "\\": lambda i: 1 - i,
+    "F": lambda i: i + 4 if i < 4 else i - 4,
+    "X": lambda i: i,
+}
+
+
+def wfc_action(symmetry: str) -> list[list[int]]:
+    """WaveFunctionCollapse's action table of a symmetry class: row ``t`` (one per
+    orientation) lists the orientations ``t, a(t), a(a(t)), a(a(a(t)))`` and their images
+    under ``b``; a neighbour ``"name k"`` is orientation ``wfc_action(sym)[0][k]``.
+
+    Examples
+    --------
+    >>> wfc_action("I")[0], wfc_action("L")[0]
+    ([0, 1, 0, 1, 0, 1, 0, 1], [0, 1, 2, 3, 1, 0, 3, 2])
+    """
+    a, b = _A[symmetry], _B[symmetry]
+    rows = []
+    for t in range(CARDINALITY[symmetry]):
+        r = [t, a(t), a(a(t)), a(a(a(t)))]
+        rows.append(r + [b(i) for i in r])
+    return rows
 
 
 def stabilizer_words(symmetry: str) -> list[str]:
@@ -198,15 +240,13 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
                 path=path,
                 line=node.line,
             ) from None
-        card = CARDINALITY[tiles[t][1]]
-        if not 0 <= k < card:
+        if not 0 <= k < 8:  # WFC indexes its 8-element action table with k
             raise FormatError(
-                f"<neighbor> {side}={text!r}: tile {nm!r} (symmetry {tiles[t][1]}) has "
-                f"orientations 0..{card - 1}",
+                f"<neighbor> {side}={text!r}: orientation {k} is not 0..7",
                 path=path,
                 line=node.line,
             )
-        return orient.label(t, order[t][k])
+        return orient.label(t, order[t][wfc_action(tiles[t][1])[0][k]])
 
     rules = []
     xn = root.find("neighbors")
@@ -270,6 +310,12 @@ def _images(
         None,
     )
     if folder is None:
+        if p.is_file():  # a tileset read from a file whose pictures are not there
+            first = tiles[0][0] + (" 0" if unique else "")
+            warn.add(
+                f"no tile pictures found (looked for {folders[0].name}/{first}.png and "
+                f"{first}.png next to the file): pictures show one colour per tile"
+            )
         return None
     out: list[NDArray[np.uint8] | None] = []
     missing = []

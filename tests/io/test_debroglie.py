@@ -109,3 +109,21 @@ def test_shared_edged_path_every_solver_30x30(solver):
     r = csplab.solve(P, solver, rng=1)
     assert r.ok and P.is_solution(r.grid)
     assert (r.grid[0] == rs.names.index("1")).all()  # the border constraint
+
+
+def test_missing_tile_pictures_are_reported(tmp_path):
+    with pytest.warns(UserWarning, match=r"no tile pictures \(csplab does not read 'roads.tsx'\)"):
+        rs = load_tiny()
+    assert rs.images is None
+    assert any("one colour per tile" in w for w in rs.warnings)
+    text = '{"tiles": [{"value": 1}], "adjacencies": [{"left": [1], "right": [1]}]}'
+    (tmp_path / "c.json").write_text(text)
+    with pytest.warns(UserWarning, match="c.json: no tile pictures: pictures show one colour"):
+        read_debroglie(tmp_path / "c.json")
+    assert parse_debroglie(text, path="c.json").warnings == []  # text, not a file
+
+
+def test_shared_edged_path_file_says_why_its_pictures_are_colours():
+    p = anchor("DeBroglie/edged_path_constraint.json")
+    with pytest.warns(UserWarning, match="does not read 'grass_biome.tsx'"):
+        read_model(p)

@@ -73,3 +73,49 @@ def test_missing_file_and_too_many_dims(tmp_path):
         read_example(tmp_path / "nope.txt")
     with pytest.raises(FormatError):
         format_merrell(ExampleModel(np.zeros((2, 2, 2, 2), dtype=int)))
+
+
+# a small example of Merrell's layout with an object table after the labels (made for these
+# tests: a wall of labels 1 on the ground 0, air 2 above)
+_WITH_TABLE = (
+    "wall\nmade for csplab's tests\n\n3 3 2\n0 0 0\n0 1 0\n0 0 0\n2 2 2\n2 1 2\n2 2 2\n"
+    "<Objects>\n0 ground.obj 0\n1 wall.obj 0\n2 EMPTY\n</Objects>\n"
+)
+
+
+def test_results_carry_the_object_table(tmp_path):
+    import csplab
+    from csplab.io import write_labels
+
+    src = tmp_path / "wall.txt"
+    src.write_text(_WITH_TABLE)
+    E = read_example(src)
+    trailer = E.meta["merrell_trailer"]
+    assert trailer.startswith("<Objects>\n0 ground.obj")
+    r = csplab.solve(csplab.Problem.from_example(E, (5, 4, 2)), "catalog", rng=1)
+    assert r.ok
+    out = tmp_path / "out.txt"
+    write_labels(r.grid, out, name=E.name, model=E)
+    again = read_example(out)
+    assert np.array_equal(again.labels, r.grid)
+    assert again.meta["merrell_trailer"] == trailer
+    assert out.read_text().endswith(trailer)
+    # a model without a table writes none; meta given by the caller wins
+    write_labels(r.grid, out, model=ExampleModel(E.labels))
+    assert read_example(out).meta["merrell_trailer"] == ""
+    write_labels(r.grid, out, model=E, meta={"merrell_trailer": "<Objects>\nmine\n"})
+    assert read_example(out).meta["merrell_trailer"] == "<Objects>\nmine\n"
+
+
+def test_cli_output_carries_the_object_table(tmp_path, capsys):
+    from csplab.cli import main
+
+    src = tmp_path / "wall.txt"
+    src.write_text(_WITH_TABLE)
+    out = tmp_path / "out.txt"
+    code = main(["synthesize", str(src), "--size", "4x4x2", "--seed", "2", "--out", str(out)])
+    capsys.readouterr()
+    assert code == 0
+    assert out.read_text().endswith(
+        "<Objects>\n0 ground.obj 0\n1 wall.obj 0\n2 EMPTY\n</Objects>\n"
+    )

@@ -6,7 +6,8 @@ import pytest
 import csplab
 from csplab.errors import CsplabError, FormatError
 from csplab.io import model_format, read_model
-from csplab.io.wfc import parse_wfc, read_wfc
+from csplab.io.symmetry import Orientations, square_group
+from csplab.io.wfc import _ORDER, _STAB, CARDINALITY, parse_wfc, read_wfc, wfc_action
 
 from ._helpers import DATA, installed_solvers
 
@@ -95,7 +96,8 @@ def test_unique_tileset_and_symmetry_warning(tmp_path):
 
 def test_without_images_colours_are_used(tmp_path):
     shutil.copy(DATA / "pipes.xml", tmp_path / "p.xml")
-    rs = read_wfc(tmp_path / "p.xml")
+    with pytest.warns(UserWarning, match="no tile pictures"):
+        rs = read_wfc(tmp_path / "p.xml")
     assert rs.images is None
     assert rs.render(np.zeros((3, 3), int)).size[0] > 0
 
@@ -105,8 +107,10 @@ def test_without_images_colours_are_used(tmp_path):
     [
         ('<set><tiles><tile name="a"/>\n<tile name="a"/></tiles><neighbors/></set>', 2, "twice"),
         ('<set><tiles>\n<tile name="a" symmetry="Q"/></tiles><neighbors/></set>', 2, "symmetry"),
-        ('<set><tiles><tile name="a"/></tiles><neighbors>\n<neighbor left="a 1" right="a"/>'
-         "</neighbors></set>", 2, "orientations 0..0"),
+        ('<set><tiles><tile name="a"/></tiles><neighbors>\n<neighbor left="a 8" right="a"/>'
+         "</neighbors></set>", 2, "orientation 8 is not 0..7"),
+        ('<set><tiles><tile name="a"/></tiles><neighbors>\n<neighbor left="a -1" right="a"/>'
+         "</neighbors></set>", 2, "orientation -1 is not 0..7"),
         ('<set><tiles><tile name="a"/></tiles><neighbors>\n\n<neighbor left="b" right="a"/>'
          "</neighbors></set>", 3, "unknown tile"),
         ('<set><tiles><tile name="a" weight="-1"/></tiles><neighbors/></set>', 1, "non-negative"),
@@ -121,3 +125,44 @@ def test_errors_name_the_line(xml, line, what):
         parse_wfc(xml, path="bad.xml")
     assert e.value.line == line and "bad.xml" in str(e.value)
     assert isinstance(e.value, CsplabError)
+
+
+@pytest.mark.parametrize("sym", list(CARDINALITY))
+def test_wfc_action_table_is_the_group_action(sym):
+    """WFC's table (its maps a, b on orientation indices) agrees with csplab's group: entry
+    [t][k] is orientation t transformed by the k-th symmetry."""
+    G = square_group()
+    O = Orientations(
+        G, [G.subgroup(_STAB[sym])], [[G.index(w) for w in _ORDER[: CARDINALITY[sym]]]]
+    )
+    table = wfc_action(sym)
+    assert len(table) == CARDINALITY[sym] and all(len(r) == 8 for r in table)
+    for t, row in enumerate(table):
+        assert row == [int(O.perm[G.index(w), t]) for w in _ORDER]
+
+
+def test_indices_beyond_the_orientations_as_wfc_resolves_them():
+    with pytest.warns(UserWarning, match="no tile pictures found"):
+        beyond = read_wfc(DATA / "wfc_index" / "beyond.xml")
+    within = read_wfc(DATA / "wfc_index" / "within.xml", images=False)
+    assert beyond.names == within.names
+    assert np.array_equal(beyond.relations, within.relations)
+    assert beyond.relations.any() and beyond.closure_violations() == []
+    # "line 3" of a symmetry-I tile (2 orientations) is "line 1", not an error
+    xml = (
+        '<set><tiles><tile name="line" symmetry="I"/><tile name="e"/></tiles><neighbors>'
+        '<neighbor left="line K" right="e"/></neighbors></set>'
+    )
+    one = parse_wfc(xml.replace("K", "3"))
+    assert one.names == ("line 0", "line 1", "e 0")
+    assert np.array_equal(one.relations, parse_wfc(xml.replace("K", "1")).relations)
+    assert one.relations[0, 1, 2] and not one.relations[0, 0, 2]
+
+
+def test_missing_pictures_are_reported(tmp_path):
+    shutil.copy(DATA / "pipes.xml", tmp_path / "p.xml")
+    with pytest.warns(UserWarning, match=r"no tile pictures found \(looked for p/empty.png"):
+        rs = read_wfc(tmp_path / "p.xml")
+    assert rs.images is None and any("one colour per tile" in w for w in rs.warnings)
+    rs = read_wfc(tmp_path / "p.xml", images=False)  # not asked for: nothing to say
+    assert rs.warnings == []
