@@ -2,7 +2,15 @@
 
 2D grids are drawn as in the thesis figures: x to the right, y up. 3D grids are drawn from
 above the ``+x, +y`` corner; cells holding the empty-space label (and unassigned cells) are
-left out. Each label gets a fixed colour (label 0 a light grey).
+left out. Faces are shaded by orientation, as in a lit isometric view: the top face at the
+label's full colour, the ``+x`` face darker, the ``+y`` face darker still.
+
+Each label gets a fixed colour (label 0 a light grey). Labels of one object share the
+colour (:func:`label_objects`, :func:`object_colors`): the labels that Merrell's object
+table (the trailer of his ``.txt`` files, lines ``LABEL FILE.obj``) maps to the same file,
+the orientations of one tile (names ``"corner 1"``, ``"corner 2"``) and, for names such as
+``"shop_cnr_ne"``, the labels of one material (``shop``). ``legend=True`` adds a small
+legend of object name -> colour.
 
 Examples
 --------
@@ -16,7 +24,7 @@ from __future__ import annotations
 
 import colorsys
 import io
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -26,6 +34,9 @@ from PIL import Image, ImageDraw
 
 __all__ = [
     "empty_label_guess",
+    "label_objects",
+    "model_objects",
+    "object_colors",
     "palette",
     "render",
     "render_png_bytes",
@@ -45,6 +56,128 @@ def palette(K: int) -> NDArray[np.uint8]:
         r, g, bl = colorsys.hsv_to_rgb(h, s, v)
         cols[b] = (int(r * 255), int(g * 255), int(bl * 255))
     return cols
+
+
+def _object_of_name(name: str) -> str:
+    n = name.strip()
+    head, sep, tail = n.rpartition(" ")
+    if sep and tail.isdigit() and head.strip():  # a tile's orientation: "corner 1"
+        n = head.strip()
+    core = n.strip("_")
+    if "_" in core:  # material_piece_orientation: "shop_cnr_ne"
+        n = core.split("_", 1)[0]
+    return n
+
+
+def _trailer_objects(trailer: str, K: int) -> dict[int, str]:
+    """Label -> object file stem from Merrell's object table (``LABEL FILE [...]`` lines)."""
+    out: dict[int, str] = {}
+    for line in trailer.splitlines():
+        toks = line.split()
+        if len(toks) < 2:
+            continue
+        try:
+            b = int(toks[0])
+        except ValueError:
+            continue
+        if 0 <= b < K:
+            obj = toks[1].replace("\\", "/").rsplit("/", 1)[-1]
+            out[b] = obj.rsplit(".", 1)[0] if "." in obj.strip(".") else obj
+    return out
+
+
+def label_objects(
+    K: int, *, names: Sequence[str] | None = None, trailer: str | None = None
+) -> list[str]:
+    """The object each of ``K`` labels belongs to.
+
+    From Merrell's object table ``trailer`` (lines ``LABEL FILE.obj``: the file's stem), else
+    from the label's name (a trailing orientation number and, for ``a_b_c`` names,
+    everything after the first ``_`` dropped), else the label id.
+
+    Examples
+    --------
+    >>> label_objects(4, names=["empty 0", "corner 0", "corner 1", "line 0"])
+    ['empty', 'corner', 'corner', 'line']
+    >>> label_objects(3, trailer="<Objects>\\n0 empty\\n1 models/wall.obj 90\\n2 wall.obj\\n")
+    ['empty', 'wall', 'wall']
+    >>> label_objects(3, names=["air", "shop_cnr_ne", "shop_edge_n"])
+    ['air', 'shop', 'shop']
+    """
+    table = _trailer_objects(trailer, K) if trailer else {}
+    out = []
+    for b in range(K):
+        if b in table:
+            out.append(table[b])
+        elif names is not None and b < len(names) and str(names[b]).strip():
+            out.append(_object_of_name(str(names[b])))
+        else:
+            out.append(str(b))
+    return out
+
+
+def model_objects(model: Any) -> list[str] | None:
+    """:func:`label_objects` of an ``ExampleModel`` or ``RuleSet`` (its ``names`` and
+    Merrell's object table ``meta["merrell_trailer"]``), or ``None`` when the model names
+    no label."""
+    K = int(getattr(model, "K", 0))
+    names = getattr(model, "names", None)
+    meta = getattr(model, "meta", None)
+    trailer = meta.get("merrell_trailer") if isinstance(meta, Mapping) else None
+    if K < 1 or (names is None and not trailer):
+        return None
+    return label_objects(K, names=names, trailer=str(trailer) if trailer else None)
+
+
+def object_colors(objects: Sequence[str]) -> NDArray[np.uint8]:
+    """One RGB colour per label: the ``i``-th object (in the order of their first labels)
+    gets colour ``i`` of :func:`palette`, so labels that are all different objects keep
+    :func:`palette`.
+
+    Examples
+    --------
+    >>> c = object_colors(["air", "shop", "shop", "brick"])
+    >>> (c[1] == c[2]).all(), (c[1] == c[3]).all(), (c == palette(4)[[0, 1, 1, 2]]).all()
+    (np.True_, np.False_, np.True_)
+    """
+    K = len(objects)
+    rank: dict[str, int] = {}
+    idx = np.array([rank.setdefault(o, len(rank)) for o in objects], dtype=np.int64)
+    return palette(K)[idx] if K else palette(1)[:0]
+
+
+def _legend(
+    img: Image.Image,
+    g: NDArray[np.int64],
+    objects: Sequence[str],
+    cols: NDArray[np.uint8],
+    skip: int | None,
+    limit: int = 24,
+) -> Image.Image:
+    """``img`` with a legend (object name -> colour) of the labels drawn, on the right."""
+    present = [int(b) for b in np.unique(g) if 0 <= b < len(objects) and b != skip]
+    entries: dict[str, tuple[int, int, int]] = {}
+    for b in present:
+        c = cols[b]
+        entries.setdefault(objects[b], (int(c[0]), int(c[1]), int(c[2])))
+    items = list(entries.items())
+    more = len(items) - limit
+    if more > 0:
+        items = items[:limit]
+    row, sw = 14, 10
+    lines = len(items) + (1 if more > 0 else 0)
+    width = 24 + sw + 7 * max([len(t) for t, _ in items] + [12])
+    out = Image.new("RGB", (img.width + width, max(img.height, lines * row + 8)), (250, 250, 250))
+    out.paste(img, (0, 0))
+    draw = ImageDraw.Draw(out)
+    x0 = img.width + 8
+    for i, (text, c) in enumerate(items):
+        y = 4 + i * row
+        draw.rectangle([x0, y + 1, x0 + sw, y + 1 + sw], fill=c, outline=(90, 90, 90))
+        draw.text((x0 + sw + 5, y), text, fill=(20, 20, 20))
+    if more > 0:
+        draw.text((x0, 4 + len(items) * row), f"... and {more} more", fill=(20, 20, 20))
+    return out
 
 
 def empty_label_guess(grid: NDArray[np.integer[Any]]) -> int:
@@ -160,6 +293,8 @@ def render(
     empty: int | None = None,
     colors: ArrayLike | None = None,
     tiles: ArrayLike | None = None,
+    objects: Sequence[str] | None = None,
+    legend: bool = False,
 ) -> Image.Image:
     """A PIL image of a label grid (1D/2D: cells; 3D: isometric voxels; 4D: the ``w = 0`` slice).
 
@@ -177,6 +312,19 @@ def render(
         One colour per label (default :func:`palette`).
     tiles : uint8 array ``(K, h, w, 3 or 4)``, optional
         2D only: one picture per label, composited by :func:`render_tiles`.
+    objects : sequence of str, optional
+        The object of each label (:func:`label_objects`, :func:`model_objects`): labels of
+        one object share a colour (:func:`object_colors`) unless ``colors`` is given.
+    legend : bool
+        Add a legend (object name, or label id, -> colour) of the labels drawn.
+
+    Examples
+    --------
+    >>> g = np.zeros((2, 2, 2), dtype=int); g[0, 0, 0] = 1; g[1, 1, 0] = 2
+    >>> a = render(g, objects=["air", "wall", "wall"], scale=8, legend=True)
+    >>> b = render(g, objects=["air", "wall", "wall"], scale=8)
+    >>> a.width > b.width
+    True
     """
     g = np.asarray(grid, dtype=np.int64)
     if g.ndim == 4:
@@ -193,15 +341,30 @@ def render(
         K = max(K, len(cols))
         if len(cols) < K:
             cols = np.concatenate([cols, palette(K)[len(cols) :]])
+    objs = None
+    if objects is not None:
+        objs = [str(o) for o in objects]
+        K = max(K, len(objs))
+        objs += [str(b) for b in range(len(objs), K)]
+        if cols is None:
+            cols = object_colors(objs)
     if g.ndim == 2 and tiles is not None:
         t = np.asarray(tiles)
         s = scale or max(1, min(8, 640 // max(max(g.shape) * max(t.shape[1:3]), 1)))
         return render_tiles(g, t, scale=s)
+    skip = None
     if g.ndim == 2:
         s = scale or max(2, min(24, 640 // max(g.shape)))
-        return _render_2d(g, K, s, cols)
-    s = scale or max(3, min(20, 900 // max(g.shape[0] + g.shape[1], 1)))
-    return _render_3d(g, K, s, empty, cols)
+        img = _render_2d(g, K, s, cols)
+    else:
+        s = scale or max(3, min(20, 900 // max(g.shape[0] + g.shape[1], 1)))
+        skip = empty_label_guess(g) if empty is None else empty
+        img = _render_3d(g, K, s, skip, cols)
+    if legend:
+        img = _legend(
+            img, g, objs or [str(b) for b in range(K)], palette(K) if cols is None else cols, skip
+        )
+    return img
 
 
 def save_png(grid: ArrayLike, path: str | Path, *, names: Sequence[str] | None = None,
@@ -225,6 +388,9 @@ def render_png_bytes(
         img = model.render(grid, periodic=periodic)
     else:
         K = len(names) if names is not None else None
-        img = render(grid, K=K)
+        objects = model_objects(model) if model is not None else None
+        if objects is None and names is not None:
+            objects = label_objects(len(names), names=names)
+        img = render(grid, K=K, objects=objects)
     img.save(buf, format="PNG")
     return buf.getvalue()

@@ -33,7 +33,8 @@ def write_output(out: Output, path: Path) -> None:
     if isinstance(out.model, RuleSet):
         out.model.render(out.grid, periodic=out.periodic).save(path, format="PNG")
         return
-    from csplab.render import render
+    from csplab.render import model_objects, render
 
     K = len(out.names) if out.names is not None else None
-    render(out.grid, K=K, colors=out.colors).save(path, format="PNG")
+    objects = model_objects(out.model) if out.model is not None else None
+    render(out.grid, K=K, colors=out.colors, objects=objects).save(path, format="PNG")

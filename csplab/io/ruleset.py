@@ -374,8 +374,8 @@ class RuleSet:
     # ------------------------------------------------------------------ pictures
     def label_colors(self) -> NDArray[np.uint8]:
         """One RGB colour per label (the file's, else the mean tile colour, else csplab's
-        palette)."""
-        from csplab.render import palette
+        palette, one colour per tile: orientations share it)."""
+        from csplab.render import label_objects, object_colors
 
         if self.colors is not None:
             return self.colors
@@ -385,7 +385,7 @@ class RuleSet:
             tot = np.maximum(a.sum(axis=(1, 2)), 1e-9)
             mean = np.clip((im[..., :3] * a).sum(axis=(1, 2)) / tot, 0, 255)
             return np.asarray(mean, dtype=np.uint8)
-        return palette(self.K)
+        return object_colors(label_objects(self.K, names=self.names))
 
     def expand_voxels(self, grid: ArrayLike) -> NDArray[np.uint8]:
         """A 3D label grid with every cell replaced by its tile's voxels (colour indices,
