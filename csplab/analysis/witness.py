@@ -450,8 +450,9 @@ def find_failure(
         Look for a *late* failure instead (Fig. 3.6): a run whose model becomes
         inconsistent while the catalog is still non-empty (exhaustive sizes only).
     time_limit : float, optional
-        Seconds for the whole call (``None``: no limit); the random search stops at 70 %
-        of it, shrinking and the exact check use the rest.
+        Seconds for the whole call (``None``: no limit, and one round of the growing
+        sizes); the random search stops at 70 % of it, shrinking at 90 %, the exact check
+        uses the rest.
     boundary : optional
         Boundary of the outputs, as in :meth:`Problem.from_example` (``"auto"``, a
         mapping face -> label); recorded in the witness.
@@ -547,15 +548,15 @@ def find_failure(
                 if found is not None:
                     break
         stats["search_s"] = time.perf_counter() - t0
-        s.deadline = deadline
+        s.deadline = t0 + 0.9 * (deadline - t0)  # the rest for the exact check
         if found is not None:
             stats["found_on"] = list(found["shape"])
             found = _shrink_size(s, found, random_runs)
             if found["kind"] == "failed":
                 found = _shrink_choices(s, found, random_runs)
         stats["shrink_s"] = time.perf_counter() - t0 - stats["search_s"]
+        s.deadline = deadline
     stats["time_s"] = time.perf_counter() - t0
-    searched = _searched(stats)
     if found is None:
         if complete:
             return Verdict(
@@ -563,7 +564,11 @@ def find_failure(
                 f"no failure of Alg. 3.1 ({order}) on any output up to "
                 f"{_fmt(lim)} ({stats['states']} catalogs, exhaustive)",
             )  # fmt: skip
-        return Verdict(None, None, stats, f"no failure found ({searched}); not a proof")
+        msg = (
+            f"no failure found ({stats['random_runs']} random runs, "
+            f"{stats['exhaustive_sizes']} sizes exhaustive, {stats['time_s']:.1f} s); not a proof"
+        )
+        return Verdict(None, None, stats, msg)
     found["fail_step"] = len(found["choices"])
     if exact and found["kind"] == "failed":
         _first_outside(s, found, max_nodes)
@@ -578,10 +583,13 @@ def _climb(
     s: _Search, ladder: list[tuple[int, ...]], runs: int, exhaustive_cells: int
 ) -> dict[str, Any] | None:
     """Rounds of ``runs`` seeded runs per size up the ladder until the budget is spent; a
-    round climbs no higher than the size whose runs would take a quarter of what is left."""
+    round climbs no higher than the size whose runs would take a quarter of what is left.
+    Without a time limit: one round."""
     ladder = [x for x in ladder if not (s.is_scan and math.prod(x) <= exhaustive_cells)]
     top = len(ladder)
-    while s.left() > 0 and ladder:
+    rounds = 1 if math.isinf(s.deadline) else None
+    while s.left() > 0 and ladder and rounds != 0:
+        rounds = None if rounds is None else rounds - 1
         for i, shp in enumerate(ladder[:top]):
             t1 = time.perf_counter()
             hit = s.seeded(shp, runs)
