@@ -355,10 +355,18 @@ def _shrink_size(s: _Search, hit: dict[str, Any], runs: int) -> dict[str, Any]:
 
 
 def _shrink_choices(s: _Search, hit: dict[str, Any], runs: int) -> dict[str, Any]:
-    """At the final size, more runs; keep the one that fails after the fewest choices."""
+    """At the final size, more runs and (scan orders) a bounded exhaustive search; keep
+    the run that fails after the fewest choices."""
     shp = tuple(hit["shape"])
     if not hit["choices"]:
         return hit
+    if s.is_scan and s.left() > 0:
+        v = alg31_exhaustive(s.problem(shp), s.order, 10_000,
+                             deadline=time.perf_counter() + s.left() / 4)  # fmt: skip
+        s.stats["shrink_states"] = v.stats["states"]
+        if v.holds is False and v.witness and len(v.witness) < len(hit["choices"]):
+            return s.witness(shp, v.witness, "failed",
+                             "random runs, shrunk; exhaustive at this size")  # fmt: skip
     for _ in range(2):
         h2 = s.seeded(shp, runs, key="shrink_runs")
         if h2 is not None and len(h2["choices"]) < len(hit["choices"]):
@@ -419,8 +427,8 @@ def find_failure(
 
     The search escalates: every run on outputs of at most ``exhaustive_cells`` cells
     (exhaustive, at most ``max_states`` catalogs per size and half of the time; with the
-    growing default sizes ``max_states`` catalogs in all, a tenth of them per size, and a
-    tenth of the time), then
+    growing default sizes a third of ``max_states`` catalogs in all, a tenth of that per
+    size, and a tenth of the time), then
     seeded random runs on growing outputs; a failing random run is shrunk, output size
     first (smaller windows of the failing run, then fresh seeds), then choices (the run
     at the final size that fails soonest, and after its first choice outside C* the
@@ -518,7 +526,10 @@ def find_failure(
     share = 1.0 if late else 0.1 if auto else 0.5  # of the time, for the exhaustive phase
     ex_deadline = t0 + share * (deadline - t0)
     for shp in _shapes_upto(lim, exhaustive_cells) if is_scan else []:
-        budget = min(max_states // 10, max_states - stats["states"]) if auto else max_states
+        if auto:  # growing sizes: a third of max_states in all, a tenth of that per size
+            budget = min(max_states // 30, max_states // 3 - stats["states"])
+        else:
+            budget = max_states
         if budget <= 0 or time.perf_counter() > ex_deadline:
             complete = False
             break
