@@ -52,7 +52,7 @@ from numpy.typing import NDArray
 
 from csplab.catalog import Propagator
 from csplab.deps import available, require
-from csplab.errors import InputError
+from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.rng import RngLike, make_rng
 
@@ -64,6 +64,7 @@ _PAIRWISE_MAX = 8  # domain size up to which the counting CNF uses pairwise at-m
 __all__ = [
     "METHODS",
     "Count",
+    "CountTimeoutError",
     "count_solutions",
     "enclosed_sets",
     "entropy_per_cell",
@@ -165,7 +166,9 @@ def frontier_order(problem: Problem, domains: NDArray[np.bool_] | None = None) -
 # ----------------------------------------------------------------------------- transfer
 
 
-def _count_transfer(problem: Problem, max_states: int) -> tuple[int, dict[str, Any]]:
+def _count_transfer(
+    problem: Problem, max_states: int, deadline: float | None = None
+) -> tuple[int, dict[str, Any]]:
     eng = Propagator(problem)
     if not eng.ok:
         return 0, {"decided_by": "arc consistency", "max_states": 0}
@@ -193,6 +196,8 @@ def _count_transfer(problem: Problem, max_states: int) -> tuple[int, dict[str, A
     big = False
     peak = 1
     for step, v in enumerate(order):
+        if deadline is not None and time.perf_counter() > deadline:
+            raise CountTimeoutError("transfer", f"after {step} of {n} cells")
         D = np.flatnonzero(dom[v]).astype(np.int32)
         col = {c: i for i, c in enumerate(frontier)}
         S = labels.shape[0]
@@ -224,6 +229,23 @@ def _count_transfer(problem: Problem, max_states: int) -> tuple[int, dict[str, A
             big = True
     total = int(counts.sum()) if counts.size else 0
     return total, {"max_states": int(peak), "exact_arithmetic": "object" if big else "int64"}
+
+
+class CountTimeoutError(CsplabError, TimeoutError):
+    """:func:`count_solutions` ran out of its ``time_limit`` (the count is undecided).
+
+    Attributes
+    ----------
+    method : str
+        The counting method that was running.
+    progress : str
+        How far it got (cells of the transfer matrix, solutions enumerated).
+    """
+
+    def __init__(self, method: str, progress: str) -> None:
+        super().__init__(f"the time limit ran out while counting by {method} ({progress})")
+        self.method = method
+        self.progress = progress
 
 
 class _TooBig(Exception):
@@ -267,12 +289,16 @@ def _open_cells(enc: Encoding) -> int:
     return int(((enc.var > 0).sum(axis=1) > 0).sum())
 
 
-def _count_enumerate(problem: Problem, limit: int) -> tuple[int, dict[str, Any]]:
+def _count_enumerate(
+    problem: Problem, limit: int, deadline: float | None = None
+) -> tuple[int, dict[str, Any]]:
     from csplab.engine.sat import enumerate_solutions
 
     n = 0
     for _ in enumerate_solutions(problem, limit=limit + 1):
         n += 1
+        if deadline is not None and time.perf_counter() > deadline:
+            raise CountTimeoutError("enumerate", f"{n} solutions so far")
     if n > limit:
         raise InputError(
             f"more than {limit} solutions: enumeration is for tiny problems; use "
@@ -281,8 +307,10 @@ def _count_enumerate(problem: Problem, limit: int) -> tuple[int, dict[str, Any]]
     return n, {"enumerated": n}
 
 
-def _count_ganak(problem: Problem, seed: int) -> tuple[int, dict[str, Any]]:
-    Counter = require("pyganak", "count", "count method 'ganak'").Counter
+def _count_ganak(
+    problem: Problem, seed: int, deadline: float | None = None
+) -> tuple[int, dict[str, Any]]:
+    require("pyganak", "count", "count method 'ganak'")
 
     enc = _counting_cnf(problem)
     stats = {"vars": enc.nvars, "clauses": enc.nclauses, "open_cells": _open_cells(enc)}
@@ -290,12 +318,51 @@ def _count_ganak(problem: Problem, seed: int) -> tuple[int, dict[str, Any]]:
         return 0, stats
     if enc.nx == 0:
         return int(problem.is_solution(enc.const.reshape(problem.shape))), stats
-    c = Counter(seed=seed % (2**31))
-    c.new_vars(enc.nvars)
-    c.add_clauses(enc.clauses())
-    if enc.nvars > enc.nx:
-        c.set_sampling_set(list(range(1, enc.nx + 1)))
-    return int(c.count()), stats
+    job = (enc.nvars, [list(map(int, c)) for c in enc.clauses()], enc.nx, seed % (2**31))
+    if deadline is None:
+        return _ganak_count(*job), stats
+    # pyganak has no time limit: count in a child process, stopped when the time is up
+    import multiprocessing as mp
+
+    ctx: Any = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    recv, send = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_ganak_child, args=(send, job), daemon=True)
+    proc.start()
+    send.close()
+    try:
+        if not recv.poll(max(deadline - time.perf_counter(), 0.0)):
+            raise CountTimeoutError("ganak", "the #SAT count did not finish")
+        try:
+            kind, value = recv.recv()
+        except EOFError:
+            raise InputError("the ganak process ended without a count") from None
+    finally:
+        if proc.is_alive():
+            proc.kill()
+        proc.join()
+        recv.close()
+    if kind != "ok":
+        raise InputError(f"ganak failed: {value}")
+    return int(value), stats
+
+
+def _ganak_count(nvars: int, clauses: list[list[int]], nx: int, seed: int) -> int:
+    Counter = require("pyganak", "count", "count method 'ganak'").Counter
+    c = Counter(seed=seed)
+    c.new_vars(nvars)
+    c.add_clauses(clauses)
+    if nvars > nx:
+        c.set_sampling_set(list(range(1, nx + 1)))
+    return int(c.count())
+
+
+def _ganak_child(send: Any, job: tuple[int, list[list[int]], int, int]) -> None:
+    try:
+        send.send(("ok", str(_ganak_count(*job))))
+    except Exception as e:  # reported to the parent as one line
+        send.send(("error", f"{type(e).__name__}: {e}"))
+    finally:
+        send.close()
 
 
 def _count_approxmc(
@@ -328,6 +395,7 @@ def count_solutions(
     limit: int = 100_000,
     epsilon: float = 0.8,
     delta: float = 0.2,
+    time_limit: float | None = None,
 ) -> Count:
     """The number of solutions of ``problem`` (see the module docstring for methods).
 
@@ -343,11 +411,20 @@ def count_solutions(
         ``enumerate`` refuses problems with more solutions than this.
     epsilon, delta : float
         ApproxMC's tolerance and confidence.
+    time_limit : float, optional
+        Seconds for the whole count: ``transfer`` checks the clock before each cell of its
+        order, ``enumerate`` after each solution, ``ganak`` counts in a child process that
+        is stopped at the limit (``approxmc`` has no limit).
 
     Returns
     -------
     Count
         An ``int`` with ``method``, ``exact``, ``time_s`` and ``stats``.
+
+    Raises
+    ------
+    CountTimeoutError
+        The time limit ran out before the count was known.
     """
     if not isinstance(problem, Problem):
         raise InputError(f"count_solutions() needs a Problem, got {type(problem).__name__}")
@@ -355,12 +432,15 @@ def count_solutions(
         raise InputError(f"method must be one of {', '.join(METHODS)}, not {method!r}")
     if not (epsilon > 0 and 0 < delta < 1):
         raise InputError("epsilon must be > 0 and delta in (0, 1)")
+    if time_limit is not None and not (math.isfinite(time_limit) and time_limit > 0):
+        raise InputError(f"time_limit must be a positive number of seconds, not {time_limit!r}")
     _, seed = make_rng(rng)
     seed = seed or 0
     t0 = time.perf_counter()
+    deadline = None if time_limit is None else t0 + time_limit
     if method in ("auto", "transfer"):
         try:
-            val, st = _count_transfer(problem, max_states)
+            val, st = _count_transfer(problem, max_states, deadline)
             return Count(val, "transfer", True, time.perf_counter() - t0, st)
         except _TooBig as e:
             if method == "transfer":
@@ -371,9 +451,9 @@ def count_solutions(
                 ) from None
         method = "ganak" if available("pyganak") else "enumerate"
     if method == "enumerate":
-        val, st = _count_enumerate(problem, limit)
+        val, st = _count_enumerate(problem, limit, deadline)
     elif method == "ganak":
-        val, st = _count_ganak(problem, seed)
+        val, st = _count_ganak(problem, seed, deadline)
     else:
         val, st = _count_approxmc(problem, seed, epsilon, delta)
         return Count(val, "approxmc", False, time.perf_counter() - t0, st)

@@ -76,10 +76,26 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: object
     print(f"csplab: warning: {str(message).strip().splitlines()[0]}", file=sys.stderr)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``csplab`` console script."""
+# commands that run csplab's numba kernels (the first run compiles them: one line on stderr)
+_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check"}
+
+
+def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> int:
+    """Entry point of the ``csplab`` console script.
+
+    ``announce`` (default: only for the console script itself, ``argv is None``) prints one
+    line on stderr before numba's one-time compilation of the kernels, when its cache is
+    cold.
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
+    if announce is None:
+        announce = argv is None
+    if announce and args.command in _KERNEL_COMMANDS:
+        from csplab.cli.common import COMPILING, kernels_cold
+
+        if kernels_cold():
+            print(f"csplab: {COMPILING}", file=sys.stderr, flush=True)
     try:
         with warnings.catch_warnings():  # library warnings: one line each, no source line
             warnings.showwarning = _show_warning

@@ -12,11 +12,13 @@ from csplab.cli.common import (
     model_options,
     problem_from_args,
 )
+from csplab.errors import InputError
 
 HELP = "count the violations of a grid file against an example"
 DESCRIPTION = (
     "Check a grid against an example model or a tileset's rules. Exit 0 when it is "
-    "consistent, 1 when it violates something."
+    "consistent, 1 when it violates something or has unassigned cells (-1 in the .npy "
+    "of a failed or timed-out run)."
 )
 
 
@@ -25,15 +27,22 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
     exts = ", ".join(e for f in formats(gives="ExampleModel", exact=True) for e in f.extensions)
     add_problem_args(p, size_required=False)
-    p.add_argument("grid", metavar="GRID", help=f"grid file to check ({exts}: label ids kept)")
+    p.add_argument(
+        "grid",
+        metavar="GRID",
+        help=f"grid file to check ({exts}: label ids kept; .vox: colour b + 1 = label b)",
+    )
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.limit < 0:
+        raise InputError("--limit must be >= 0")
     model = load_model(args.model, model_options(args.model_option))
-    grid = load_grid(args.grid, model.ndim)
+    grid = load_grid(args.grid, model.ndim, model)
     problem = problem_from_args(args, model, shape=tuple(grid.shape))
+    unassigned = int((grid < 0).sum())
     v = problem.violations(grid)
     if args.json:
         print(
@@ -42,12 +51,18 @@ def run(args: argparse.Namespace) -> int:
                     "violations": len(v),
                     "arcs": int(v.arcs.size),
                     "cells": int(v.cells.size),
+                    "unassigned": unassigned,
                     "shape": list(problem.shape),
                 }
             )
         )
     else:
         print(f"{len(v)} violations in {args.grid} ({'x'.join(map(str, problem.shape))})")
+        if unassigned:
+            print(
+                f"  {unassigned} of {grid.size} cells are unassigned (-1: the run that wrote "
+                "the grid failed or timed out); they count as violations"
+            )
         if len(v):
             print(v.describe(args.limit))
     return 0 if len(v) == 0 else 1

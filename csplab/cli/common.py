@@ -8,6 +8,8 @@ through :func:`problem_from_args`.
 from __future__ import annotations
 
 import argparse
+import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -22,13 +24,21 @@ from csplab.io.ruleset import RuleSet
 from csplab.problem import Problem
 
 __all__ = [
+    "COMPILING",
     "Model",
     "add_problem_args",
+    "check_output_dir",
+    "check_output_path",
+    "check_time_limit",
+    "kernels_cold",
     "load_grid",
     "load_model",
     "model_options",
     "problem_from_args",
 ]
+
+#: The line the CLI prints on stderr before numba compiles csplab's kernels for the first time.
+COMPILING = "compiling csplab's kernels once (about 5 s; cached afterwards)"
 
 Model = ExampleModel | RuleSet
 
@@ -65,19 +75,187 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     return model
 
 
-def load_grid(path: str, ndim: int) -> NDArray[np.int32]:
-    """Read a label grid with ``ndim`` axes from a file that keeps label ids (``.npy``,
-    ``.txt``, ``.grid``: the registry's ``exact`` formats)."""
+def check_output_path(path: str | Path, what: str, *, force: bool = True) -> Path:
+    """``path`` as a file the command can write, checked before the work: its folder exists
+    and is writable, ``path`` is not a folder, and (``force=False``) no file is there yet.
+
+    Parameters
+    ----------
+    path : str or Path
+        The output file.
+    what : str
+        The argument that named it (``"--out"``), for the message.
+    force : bool
+        Whether an existing file may be overwritten.
+
+    Raises
+    ------
+    InputError
+        One line naming ``what`` and the path.
+
+    Examples
+    --------
+    >>> check_output_path("/no/such/folder/a.png", "--out")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: --out /no/such/folder/a.png: the folder /no/such/folder does \
+not exist
+    """
+    p = Path(path)
+    if str(path) == "" or p.name in ("", ".", ".."):
+        raise InputError(f"{what} {str(path)!r} is not a file name")
+    folder = p.parent
+    if not folder.exists():
+        raise InputError(f"{what} {p}: the folder {folder} does not exist")
+    if not folder.is_dir():
+        raise InputError(f"{what} {p}: {folder} is not a folder")
+    if p.is_dir():
+        raise InputError(f"{what} {p} is a folder, not a file")
+    if p.exists():
+        if not force:
+            raise InputError(f"{what} {p} exists; use --force to overwrite it")
+        if not os.access(p, os.W_OK):
+            raise InputError(f"{what} {p}: the file is not writable")
+    elif not _writable(folder):
+        raise InputError(f"{what} {p}: the folder {folder} is not writable")
+    return p
+
+
+def check_output_dir(path: str | Path, what: str) -> Path:
+    """``path`` as a folder the command can write into (created later with its parents):
+    not a file, and the nearest existing folder on the way is writable; one
+    :class:`InputError` line naming ``what`` otherwise.
+
+    Examples
+    --------
+    >>> check_output_dir("/dev/null/report", "--out")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: --out /dev/null/report: /dev/null is a file, not a folder
+    """
+    p = Path(path)
+    if p.exists() and not p.is_dir():
+        raise InputError(f"{what} {p} is a file, not a folder")
+    base = p
+    while not base.exists():
+        if base.parent == base:
+            break
+        base = base.parent
+    if not base.is_dir():
+        raise InputError(f"{what} {p}: {base} is a file, not a folder")
+    if not _writable(base):
+        raise InputError(f"{what} {p}: the folder {base} is not writable")
+    return p
+
+
+def _writable(folder: Path) -> bool:
+    """Whether a file can be created in ``folder`` (a real probe: permissions alone do not
+    tell for root, read-only mounts or ``/proc``)."""
+    import tempfile
+
+    if not os.access(folder, os.W_OK | os.X_OK):
+        return False
+    try:
+        with tempfile.TemporaryFile(dir=folder, prefix=".csplab-probe-"):
+            return True
+    except OSError:
+        return False
+
+
+def check_time_limit(value: float | None, what: str = "--time-limit") -> float | None:
+    """``value`` when it is ``None`` or a positive finite number of seconds; otherwise one
+    :class:`InputError` line naming ``what``.
+
+    Examples
+    --------
+    >>> check_time_limit(2.5), check_time_limit(None)
+    (2.5, None)
+    >>> check_time_limit(float("nan"))
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: --time-limit must be a positive number of seconds, not nan
+    """
+    if value is None:
+        return None
+    if not math.isfinite(value) or value <= 0:
+        raise InputError(f"{what} must be a positive number of seconds, not {value:g}")
+    return float(value)
+
+
+def kernels_cold() -> bool:
+    """Whether numba has no cached machine code for csplab's kernels yet (the next command
+    that runs Alg. 3.1 compiles them, about 5 s). Reads only numba's small index files of
+    ``csplab/_kernels.py``; ``False`` when that cannot be told."""
+    try:
+        from csplab import _kernels
+
+        for name in ("alg31", "propagate"):
+            cache = getattr(_kernels, name)._cache
+            if not cache._cache_file._load_index():
+                return True
+    except Exception:  # numba internals differ across versions: say nothing then
+        return False
+    return False
+
+
+def load_grid(path: str, ndim: int | None, model: Model | None = None) -> NDArray[np.int32]:
+    """Read a label grid with ``ndim`` axes (``None``: as stored) from a file csplab
+    writes: the formats that keep label ids (``.npy``, ``.txt``, ``.grid``: the registry's
+    ``exact`` formats; ``.npy`` may hold ``-1`` for cells a failed or timed-out run left
+    unassigned) and ``.vox`` (colour ``b + 1`` is label ``b``, colour 0 the ``model``'s
+    empty label, as the writer stores them)."""
     from csplab.io import read_example
+    from csplab.io.common import check_file
     from csplab.io.registry import detect
 
-    fmt = detect(path, gives="ExampleModel", exact=True).name if Path(path).is_file() else None
-    g = np.asarray(read_example(path, format=fmt).labels)
-    while g.ndim > ndim and g.shape[-1] == 1:
+    p = check_file(path)
+    if p.suffix.lower() == ".vox":
+        g = _vox_labels(p, model)
+    else:
+        fmt = detect(p, gives="ExampleModel", exact=True).name
+        if fmt == "npy":
+            g = _npy_labels(p)
+        else:
+            g = np.asarray(read_example(p, format=fmt).labels)
+    while ndim is not None and g.ndim > ndim and g.shape[-1] == 1:
         g = g[..., 0]
-    if g.ndim != ndim:
+    if ndim is not None and g.ndim != ndim:
         raise FormatError(f"grid has shape {g.shape}, expected {ndim} axes", path=path)
     return g.astype(np.int32)
+
+
+def _npy_labels(p: Path) -> NDArray[np.int64]:
+    """An ``.npy`` result grid: labels ``>= 0`` and ``-1`` for unassigned cells."""
+    try:
+        arr = np.load(p, allow_pickle=False)
+    except Exception as e:  # numpy raises many kinds of errors on damaged files
+        raise FormatError(f"not a readable .npy array ({e})", path=p) from None
+    if not np.issubdtype(arr.dtype, np.integer):
+        raise FormatError(f".npy array must hold integers, got {arr.dtype}", path=p)
+    if arr.size and (int(arr.min()) < -1 or int(arr.max()) > np.iinfo(np.int32).max):
+        bad = int(arr.min()) if int(arr.min()) < -1 else int(arr.max())
+        raise FormatError(f"label {bad} is not a label id (0, 1, ... or -1 unassigned)", path=p)
+    return np.asarray(arr, dtype=np.int64)
+
+
+def _vox_labels(p: Path, model: Model | None) -> NDArray[np.int64]:
+    """A ``.vox`` result as labels: colour ``c > 0`` is label ``c - 1``, colour 0 the empty
+    label (the model's, else the guess the writer made on the example)."""
+    from csplab.io.vox import read_vox
+    from csplab.render import empty_label_guess
+
+    vox = read_vox(p)
+    g = vox.grid.astype(np.int64) - 1
+    empty: int | None = None
+    if isinstance(model, RuleSet):
+        empty = model.empty
+    elif model is not None:
+        empty = model.meta.get("empty")
+        if empty is None:
+            empty = int(empty_label_guess(np.asarray(model.labels)))
+    if empty is not None and empty >= 0:
+        g[g < 0] = empty
+    return g
 
 
 def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) -> None:
@@ -94,7 +272,8 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
     p.add_argument(
         "--boundary",
         default=None,
-        help="'auto' (examples: ground below, empty space around; tilesets: the file's "
+        help="'auto' (examples: ground below, empty space around, on 3D examples Merrell's rule "
+        "when that has no solution; tilesets: the file's "
         "boundary conditions), 'none', or face=label pairs such as 'z-=1,x-=0' "
         "(default: none for examples, the file's for tilesets)",
     )

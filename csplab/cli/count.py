@@ -7,7 +7,13 @@ import json
 import math
 from typing import Any
 
-from csplab.cli.common import add_problem_args, load_model, problem_from_args
+from csplab.cli.common import (
+    add_problem_args,
+    check_time_limit,
+    load_model,
+    model_options,
+    problem_from_args,
+)
 from csplab.errors import InputError
 
 HELP = "count the models consistent with an example: D_E(n) (Sec. 3.2)"
@@ -16,7 +22,7 @@ DESCRIPTION = (
     "with an example: transfer matrix over slices for models narrow in one or two "
     "axes, Ganak (#SAT) or SAT enumeration otherwise; --method approxmc gives an "
     "(epsilon, delta) approximation. Exit 0 when there is at least one model, 1 when "
-    "there is none, 2 on bad input."
+    "there is none, 3 when --time-limit ran out first (undecided), 2 on bad input."
 )
 
 
@@ -32,6 +38,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--delta", type=float, default=0.2, help="approxmc failure probability")
     p.add_argument("--seed", type=int, default=0, help="seed of the randomised counters")
     p.add_argument(
+        "--time-limit",
+        type=float,
+        metavar="S",
+        help="stop counting after S seconds: exit 3, undecided (default: no limit; "
+        "approxmc has none)",
+    )
+    p.add_argument(
         "--bounds",
         action="store_true",
         help="also print Theorem 3.2.1's lower and 3.2.2's upper bound",
@@ -46,11 +59,30 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from csplab.count import count_solutions, entropy_per_cell, lower_bound_3_2_1
+    from csplab.count import (
+        CountTimeoutError,
+        count_solutions,
+        entropy_per_cell,
+        lower_bound_3_2_1,
+    )
 
-    example = load_model(args.model)
+    time_limit = check_time_limit(args.time_limit)
+    example = load_model(args.model, model_options(args.model_option))
     problem = problem_from_args(args, example)
-    c = count_solutions(problem, args.method, rng=args.seed, epsilon=args.epsilon, delta=args.delta)
+    try:
+        c = count_solutions(
+            problem, args.method, rng=args.seed, epsilon=args.epsilon, delta=args.delta,
+            time_limit=time_limit,
+        )  # fmt: skip
+    except CountTimeoutError as stop:
+        size = "x".join(map(str, problem.shape))
+        if args.json:
+            print(json.dumps({"example": example.name or args.model, "size": list(problem.shape),
+                              "count": None, "undecided": str(stop)}))  # fmt: skip
+        else:
+            print(f"D_E({size}) undecided for {example.name or args.model}: {stop} "
+                  f"(--time-limit {time_limit:g} s)")  # fmt: skip
+        return 3
     out: dict[str, Any] = {"example": example.name or args.model, "size": list(problem.shape)}
     out.update(c.to_dict())
     if args.bounds:

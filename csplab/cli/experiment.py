@@ -16,9 +16,12 @@ from __future__ import annotations
 import argparse
 import json
 import shlex
+import sqlite3
 import sys
+from pathlib import Path
 from typing import Any
 
+from csplab.cli.common import check_output_dir, check_time_limit
 from csplab.errors import InputError
 
 # common option -> (flags, argparse kwargs)
@@ -161,16 +164,30 @@ def run(args: argparse.Namespace) -> int:
             overrides[extra] = getattr(a, extra)
     if a.jobs is not None and a.jobs < 1:
         raise InputError("--jobs must be >= 1")
+    if "time_limit" in overrides:
+        check_time_limit(overrides["time_limit"])
+    # output paths before the work: the report folder and the store (ResultsStore checks
+    # that an existing store is an intact SQLite database when it opens it)
+    check_output_dir(a.out if a.out else Path("results") / exp.name, "--out")
+    store = Path(a.store) if a.store else Path(ex.DEFAULT_STORE)
+    if store.is_dir():
+        raise InputError(f"--store {store} is a folder, not a file")
+    check_output_dir(store.parent, "--store")
     kwargs: dict[str, Any] = {}
     if a.store:
         kwargs["store"] = a.store
-    summary, report = ex.run(
-        exp.name, quick=a.quick, out=a.out, jobs=a.jobs, scheduler=a.scheduler,
-        progress=not a.no_progress, report_only=a.report_only, rerun=a.rerun,
-        rerun_stale=a.rerun_stale, figures=not a.no_figures,
-        command="csplab experiment " + shlex.join([args.name, *args.rest]), **kwargs,
-        **overrides,
-    )  # fmt: skip
+    try:
+        summary, report = ex.run(
+            exp.name, quick=a.quick, out=a.out, jobs=a.jobs, scheduler=a.scheduler,
+            progress=not a.no_progress, report_only=a.report_only, rerun=a.rerun,
+            rerun_stale=a.rerun_stale, figures=not a.no_figures,
+            command="csplab experiment " + shlex.join([args.name, *args.rest]), **kwargs,
+            **overrides,
+        )  # fmt: skip
+    except sqlite3.DatabaseError as broken:  # the store broke while in use: one line naming it
+        from csplab.experiments.store import store_error
+
+        raise store_error(store, broken) from None
     if a.json:
         print(
             json.dumps(

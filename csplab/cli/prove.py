@@ -8,6 +8,7 @@ ran out; the state count is printed), 2 bad input.
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 from csplab.analysis import corner_condition, prove_infallible
 from csplab.cli._analysis import (
@@ -17,6 +18,7 @@ from csplab.cli._analysis import (
     print_verdict,
     save_witness,
 )
+from csplab.cli.common import check_output_path
 from csplab.errors import InputError
 
 HELP = "prove an example infallible (Alg. 3.1 never fails) by region enumeration"
@@ -42,6 +44,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.out:
+        if Path(args.out).suffix not in (".png", ".json"):
+            raise InputError(f"--out {args.out}: use a .png picture or a .json file")
+        check_output_path(args.out, "--out")
     E = load_example_model(args.model, args.model_option)
     if args.corner:
         v = corner_condition(E, args.order)

@@ -12,6 +12,7 @@ import json
 import sys
 from typing import Any
 
+from csplab.cli.common import check_output_path
 from csplab.errors import InputError
 
 HELP = "Theorem 3.3.4 (planar 3-SAT) and 5.2.4 (LBA) reductions to model consistency"
@@ -79,6 +80,9 @@ def _run_planar(args: argparse.Namespace) -> int:
 
     if args.scale < 1:
         raise InputError("--scale must be positive")
+    for flag in ("png", "solution_png", "labels_png"):
+        if getattr(args, flag):
+            check_output_path(getattr(args, flag), "--" + flag.replace("_", "-"))
     gen, seed = make_rng(args.seed)
     f = random_planar3sat(args.vars, args.clauses, rng=seed, signs=args.signs)
     red = reduce_planar3sat(f)
@@ -137,6 +141,8 @@ def _run_planar(args: argparse.Namespace) -> int:
 def _run_lba(args: argparse.Namespace) -> int:
     from csplab.complexity.lba import lba_consistent, load_lba
 
+    if args.png:
+        check_output_path(args.png, "--png")
     M = load_lba(args.spec)
     sim = M.run(args.input)
     v = lba_consistent(M, args.input, args.rows)

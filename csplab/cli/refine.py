@@ -10,6 +10,7 @@ import argparse
 
 from csplab.analysis import to_infallible
 from csplab.cli._analysis import ORDER_HELP, load_example_model, print_verdict
+from csplab.cli.common import check_output_path
 
 HELP = "split labels of a fallible example into an infallible one (Sec. 3.3.8)"
 DESCRIPTION = (
@@ -33,6 +34,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if args.out:
+        from csplab.io.registry import output_format
+
+        output_format(args.out, gives="ExampleModel")  # a format that reads back as an example
+        check_output_path(args.out, "--out")
     E = load_example_model(args.model, args.model_option)
     regions = [r.strip() for r in args.regions.split(",") if r.strip()]
     if E.ndim == 3 and args.regions == "2x2,3x2,4x2":

@@ -60,12 +60,9 @@ RULESET_FORMATS = tuple(f.name for f in FORMATS.values() if f.gives == "RuleSet"
 
 
 def _existing(path: str | Path) -> Path:
-    p = Path(path)
-    if not p.exists():
-        raise FormatError("no such file", path=p)
-    if p.is_dir():
-        raise FormatError("is a directory, not a model file", path=p)
-    return p
+    from csplab.io.common import check_file
+
+    return check_file(path)  # a regular file within the size cap, one line otherwise
 
 
 def model_format(path: str | Path) -> str:

@@ -17,7 +17,9 @@ Examples
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -36,11 +38,13 @@ if TYPE_CHECKING:
 
 __all__ = [
     "KIND",
+    "MAX_FILE_BYTES",
     "NO",
     "PLAUSIBLE",
     "SURE",
     "LoaderWarnings",
     "Output",
+    "check_file",
     "json_like",
     "load_image",
     "read_bytes",
@@ -60,15 +64,77 @@ _LEAD = b"\xef\xbb\xbf \t\r\n"  # a UTF-8 byte order mark and white space
 
 
 # ---------------------------------------------------------------------------- files
-def read_bytes(path: str | Path, limit: int | None = None) -> bytes:
-    """The file's bytes (the first ``limit`` only, if given); a :class:`FormatError` naming
-    the file when it cannot be read."""
+#: The largest model file csplab reads (bytes): 256 MiB, far beyond any real example or
+#: tileset; a bigger file (or a device such as ``/dev/zero``) is refused before reading.
+MAX_FILE_BYTES = 256 * 2**20
+
+_KINDS = (
+    (stat.S_ISDIR, "a directory"),
+    (stat.S_ISFIFO, "a FIFO (named pipe)"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def check_file(path: str | Path, *, limit: int | None = None) -> Path:
+    """``path`` when it names a regular file csplab may read: a :class:`FormatError` naming
+    the file when it is missing, not a regular file (a directory, FIFO, device: checked with
+    :func:`os.stat` before anything opens it, so a FIFO cannot hang and ``/dev/zero`` is
+    not read forever) or larger than :data:`MAX_FILE_BYTES` (unless only its first
+    ``limit`` bytes are wanted).
+
+    Examples
+    --------
+    >>> check_file("/dev/zero")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.FormatError: /dev/zero: a character device, not a regular file; csplab \
+reads model files only from regular files
+    """
     p = Path(path)
     try:
+        st = os.stat(p)
+    except OSError as e:
+        what = (
+            "no such file"
+            if isinstance(e, FileNotFoundError)
+            else f"cannot read file: {e.strerror}"
+        )
+        raise FormatError(what, path=p) from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = next((k for test, k in _KINDS if test(st.st_mode)), "a special file")
+        raise FormatError(
+            f"{kind}, not a regular file; csplab reads model files only from regular files",
+            path=p,
+        )
+    if (limit is None or limit > MAX_FILE_BYTES) and st.st_size > MAX_FILE_BYTES:
+        raise FormatError(
+            f"the file has {st.st_size / 2**20:.0f} MiB; csplab reads model files of at "
+            f"most {MAX_FILE_BYTES // 2**20} MiB (csplab.io.common.MAX_FILE_BYTES)",
+            path=p,
+        )
+    return p
+
+
+def read_bytes(path: str | Path, limit: int | None = None) -> bytes:
+    """The file's bytes (the first ``limit`` only, if given); a :class:`FormatError` naming
+    the file when it cannot be read, is not a regular file or is larger than
+    :data:`MAX_FILE_BYTES` (see :func:`check_file`)."""
+    p = check_file(path, limit=limit)
+    cap = MAX_FILE_BYTES if limit is None else min(limit, MAX_FILE_BYTES)
+    try:
         with open(p, "rb") as fh:
-            return fh.read() if limit is None else fh.read(limit)
+            data = fh.read(cap + (1 if limit is None else 0))
     except OSError as e:
         raise FormatError(f"cannot read file: {e.strerror}", path=p) from None
+    if len(data) > cap:  # it grew after the check
+        raise FormatError(
+            f"the file has more than {MAX_FILE_BYTES // 2**20} MiB; csplab reads model files "
+            f"of at most {MAX_FILE_BYTES // 2**20} MiB (csplab.io.common.MAX_FILE_BYTES)",
+            path=p,
+        )
+    return data
 
 
 def read_text(path: str | Path) -> str:
@@ -145,6 +211,7 @@ def load_image(path: Path, *, where: object = None) -> NDArray[np.uint8]:
     anything unreadable."""
     from PIL import Image
 
+    check_file(path)
     try:
         with Image.open(path) as im:
             if im.width * im.height > 4_000_000:

@@ -11,7 +11,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from csplab.errors import CsplabError
+from csplab.errors import CsplabError, FormatError
 from csplab.io import model_format, read_model
 from csplab.io.registry import formats
 from csplab.testing.strategies import corrupted, tile_rule_sets
@@ -82,3 +82,35 @@ def test_random_wfc_tilesets_are_closed_and_solvable_or_fail_cleanly(tmp_path, x
     assert rs.closure_violations() == []
     r = csplab.solve(rs.problem((4, 3)), "catalog", rng=0)
     assert r.status in ("solved", "failed", "unsat")
+
+
+@pytest.mark.parametrize("fmt", READABLE)
+def test_special_files_are_refused_before_reading(tmp_path, fmt):
+    """A FIFO (which would block the reader) and a device such as ``/dev/zero`` (endless)
+    are refused with one FormatError line, whatever the format; so is a file beyond the
+    size cap."""
+    import os
+
+    from csplab.io import common
+    from csplab.io.registry import FORMATS
+
+    ext = FORMATS[fmt].extensions[0]
+    if hasattr(os, "mkfifo"):
+        fifo = tmp_path / f"model{ext}"
+        os.mkfifo(fifo)
+        with pytest.raises(FormatError, match="FIFO"):
+            read_model(fifo)
+        with pytest.raises(FormatError, match="FIFO"):
+            read_model(fifo, format=fmt)
+    if os.path.exists("/dev/zero"):
+        with pytest.raises(FormatError, match="regular file"):
+            read_model("/dev/zero", format=fmt)
+    big = tmp_path / f"big{ext}"
+    big.write_bytes(b"0" * 64)
+    old = common.MAX_FILE_BYTES
+    common.MAX_FILE_BYTES = 16
+    try:
+        with pytest.raises(FormatError, match="MAX_FILE_BYTES"):
+            read_model(big)
+    finally:
+        common.MAX_FILE_BYTES = old

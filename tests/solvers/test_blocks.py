@@ -91,7 +91,7 @@ def test_block_stats_and_timeout():
     r = solve(Problem.from_example(E, (20, 20)), "blocks", rng=0, block=(6, 6), retries=5)
     stats = {k: r.stats[k] for k in ("blocks_tried", "blocks_accepted", "retries")}
     assert stats == {"blocks_tried": 36, "blocks_accepted": 36, "retries": 0}
-    t = solve(P, "blocks", rng=0, block=4, time_limit=0.0)
+    t = solve(P, "blocks", rng=0, block=4, time_limit=1e-9)
     assert t.status == "timeout" and P.is_solution(t.grid)
 
 
