@@ -44,6 +44,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from csplab.errors import CsplabError, FormatError, InputError
 from csplab.experiments.trial import Trial
 
 __all__ = [
@@ -53,6 +54,7 @@ __all__ = [
     "git_revision",
     "is_current",
     "same_code",
+    "store_error",
 ]
 
 _SCHEMA = """
@@ -182,6 +184,57 @@ def is_current(git_rev: str, version: str) -> bool:
     return version == ver and same_code(git_rev, rev)
 
 
+def store_error(path: Path, error: sqlite3.DatabaseError) -> CsplabError:
+    """A one-line error naming the results store for an SQLite error."""
+    text = str(error)
+    if "not a database" in text:
+        return FormatError("not an SQLite database (a results store is one)", path=path)
+    if "malformed" in text:
+        return FormatError(f"the SQLite database is damaged or truncated ({text})", path=path)
+    return InputError(f"results store {path}: cannot open or write it ({text})")
+
+
+def _check_store_file(path: Path) -> None:
+    """Before SQLite opens ``path``: the folder can be created and written, the file (if
+    any) is a regular file that starts like an SQLite database and is not shorter than its
+    header says (a truncated copy)."""
+    import stat
+
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(
+            f"results store {path}: cannot create the folder {path.parent} ({e.strerror})"
+        ) from None
+    if not path.exists():
+        if not os.access(path.parent, os.W_OK | os.X_OK):
+            raise InputError(f"results store {path}: the folder {path.parent} is not writable")
+        return
+    st = path.stat()
+    if not stat.S_ISREG(st.st_mode):
+        raise FormatError("not a regular file (a results store is an SQLite file)", path=path)
+    if st.st_size == 0:
+        return  # a new, empty database
+    with open(path, "rb") as fh:
+        head = fh.read(100)
+    if not head.startswith(b"SQLite format 3\x00"):
+        raise FormatError("not an SQLite database (a results store is one)", path=path)
+    if len(head) < 100:
+        raise FormatError("the SQLite database is truncated (no complete header)", path=path)
+    page = int.from_bytes(head[16:18], "big")
+    page = 65536 if page == 1 else page
+    pages = int.from_bytes(head[28:32], "big")
+    header_valid = head[24:28] == head[92:96]  # the in-header size is current
+    if header_valid and pages and st.st_size < page * pages:
+        raise FormatError(
+            f"the SQLite database is truncated ({st.st_size} bytes; its header says "
+            f"{page * pages})",
+            path=path,
+        )
+    if not os.access(path, os.R_OK | os.W_OK):
+        raise InputError(f"results store {path}: the file is not writable")
+
+
 class ResultsStore:
     """A SQLite file holding the trials of any number of experiments.
 
@@ -194,11 +247,14 @@ class ResultsStore:
     def __init__(self, path: str | os.PathLike[str]) -> None:
         self.path = Path(path)
         if str(path) != ":memory:":
-            self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._db = sqlite3.connect(str(path), timeout=60.0, isolation_level=None)
-        self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute("PRAGMA synchronous=NORMAL")
-        self._db.executescript(_SCHEMA)
+            _check_store_file(self.path)
+        try:
+            self._db = sqlite3.connect(str(path), timeout=60.0, isolation_level=None)
+            self._db.execute("PRAGMA journal_mode=WAL")
+            self._db.execute("PRAGMA synchronous=NORMAL")
+            self._db.executescript(_SCHEMA)
+        except sqlite3.DatabaseError as e:  # OperationalError too: one line naming the file
+            raise store_error(self.path, e) from None
 
     # ---------------------------------------------------------------- writing
     def add(
