@@ -375,3 +375,20 @@ def test_kernels_cold_reads_numbas_cache_index(tmp_path):
     assert out.stdout.strip() == "True", out.stderr
     cwd = Path(__file__).resolve().parents[2]
     assert (cwd / "csplab" / "_kernels.py").is_file()
+
+
+def test_show_tiles_draws_unassigned_cells_dark(capsys, tmp_path):
+    from PIL import Image
+
+    g = np.zeros((3, 3), dtype=np.int32)
+    g[1, 1] = -1
+    np.save(tmp_path / "t.npy", g)
+    out = tmp_path / "t.png"
+    xml = Path(__file__).resolve().parents[1] / "io" / "data" / "pipes.xml"
+    code, text, err = run(capsys, "show", str(tmp_path / "t.npy"), "--tiles", str(xml),
+                          "--out", str(out))  # fmt: skip
+    assert code == 0 and err == "" and "1 unassigned cells" in text
+    im = np.asarray(Image.open(out).convert("RGB"), dtype=int)
+    h, w = im.shape[0] // 3, im.shape[1] // 3
+    centre, corner = im[h : 2 * h, w : 2 * w], im[:h, :w]
+    assert centre.mean() < 80 < corner.mean()  # the unassigned cell is dark, tile 0 is not
