@@ -21,7 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
@@ -36,8 +36,10 @@ __all__ = [
     "Experiment",
     "Report",
     "background_labels",
+    "example_names",
     "load_examples",
     "new_figure",
+    "outside_legend",
     "parse_sizes",
     "provenance_note",
     "save_figure",
@@ -97,6 +99,46 @@ def load_examples(specs: Sequence[str]) -> list[tuple[str, ExampleModel]]:
             )
         out.append((s, m))
     return out
+
+
+def example_names(specs: Iterable[str]) -> dict[str, str]:
+    """Short names for example specs in tables, legends and axis labels: a built-in name
+    as it is, a model file by its stem (the full path stays in the report's configuration
+    block); files whose stems collide keep as many parent folders as tell them apart.
+
+    Examples
+    --------
+    >>> example_names(["city", "/home/me/models/Castle.txt", "a/x.txt", "b/x.txt"])
+    {'city': 'city', '/home/me/models/Castle.txt': 'Castle', 'a/x.txt': 'a/x', 'b/x.txt': 'b/x'}
+    """
+    specs = list(dict.fromkeys(specs))
+    parts = {s: Path(s).with_suffix("").parts or (s,) for s in specs}
+    depth = dict.fromkeys(specs, 1)
+    while True:
+        names = {s: "/".join(parts[s][-depth[s] :]) for s in specs}
+        seen: dict[str, list[str]] = {}
+        for s, n in names.items():
+            seen.setdefault(n, []).append(s)
+        grow = [s for group in seen.values() if len(group) > 1 for s in group
+                if depth[s] < len(parts[s])]  # fmt: skip
+        if not grow:
+            break
+        for s in grow:
+            depth[s] += 1
+    # an unchanged collision (the same path written twice, or a file named like a
+    # built-in example) keeps the spec as it was given
+    return {s: (n if len(seen[n]) == 1 else s) for s, n in names.items()}
+
+
+def outside_legend(target: Any, **kwargs: Any) -> Any:
+    """A legend to the right of the axes or figure ``target``, outside the data
+    (``save_figure`` saves with a tight bounding box, so it is kept in the picture)."""
+    kwargs.setdefault("fontsize", 8)
+    kwargs.setdefault("frameon", False)
+    kwargs.setdefault("loc", "upper left")
+    kwargs.setdefault("bbox_to_anchor", (1.02, 1))
+    kwargs.setdefault("borderaxespad", 0)
+    return target.legend(**kwargs)
 
 
 def background_labels(example: ExampleModel) -> list[int]:

@@ -39,8 +39,10 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     background_labels,
+    example_names,
     load_examples,
     new_figure,
+    outside_legend,
     save_figure,
 )
 from csplab.experiments.measures import (
@@ -173,8 +175,10 @@ class BlockSize(Experiment):
         by_ex: dict[str, list[dict[str, Any]]] = defaultdict(list)
         for r in rows:
             by_ex[r["example"]].append(r)
+        names = example_names(by_ex)
         table: list[dict[str, Any]] = []
-        for ex, rs in by_ex.items():
+        for spec, rs in by_ex.items():
+            ex = names[spec]
             ref = [r for r in rs if r["solver"] == "catalog"]
             groups: dict[int, list[dict[str, Any]]] = defaultdict(list)
             for r in rs:
@@ -211,17 +215,21 @@ class BlockSize(Experiment):
         )
         if table and self.draw_figures:
             rep.figures += self._plot(table, out)
-            rep.figures += self._montage(rows, config, out)
+            rep.figures += self._montage(rows, config, out, names)
         return rep
 
     def _plot(self, table: list[dict[str, Any]], out: Path) -> list[Path]:
         exs = list(dict.fromkeys(t["example"] for t in table))
+        from matplotlib.lines import Line2D
+
         fig, axes = new_figure(2, 2, figsize=(9, 6.4))
+        handles: list[Any] = []
         for ex in exs:
             pts = [t for t in table if t["example"] == ex and t["setting"].startswith("blocks")]
             ref = [t for t in table if t["example"] == ex and not t["setting"].startswith("blocks")]
             m = [t["m"] for t in pts]
             (line,) = axes[0, 0].plot(m, [t["accept"] for t in pts], "o-", label=ex)
+            handles.append(Line2D([], [], color=line.get_color(), marker="o", label=ex))
             axes[0, 0].plot(m, [t["per_attempt"] for t in pts], "x:", color=line.get_color())
             axes[0, 1].plot(m, [t["median_s"] for t in pts], "o-", color=line.get_color(), label=ex)
             axes[1, 0].plot(m, [t["largest_rel"] for t in pts], "o-", color=line.get_color(),
@@ -244,12 +252,21 @@ class BlockSize(Experiment):
             ax.set_xscale("log", base=2)
             ax.set_xlabel("block side m")
             ax.grid(alpha=0.3)
-        axes[0, 0].legend(fontsize=7)
-        axes[1, 0].legend(fontsize=7)
+        grey = "0.35"
+        handles += [
+            Line2D([], [], color=grey, marker="o", ls="-", label="acceptance; largest object"),
+            Line2D([], [], color=grey, marker="x", ls=":", label="per-attempt success"),
+            Line2D([], [], color=grey, marker="s", ls="--", label="non-empty cells"),
+            Line2D([], [], color=grey, lw=0.8, ls=":", label="Alg. 3.1 largest object"),
+        ]
         fig.tight_layout()
+        # outside the panels, so no legend covers a curve
+        outside_legend(fig, handles=handles, bbox_to_anchor=(1.0, 0.97))
         return save_figure(fig, out / self.name)
 
-    def _montage(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> list[Path]:
+    def _montage(
+        self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path, names: dict[str, str]
+    ) -> list[Path]:
         """Outputs of the first seed at a few block sizes (re-run from their seeds)."""
         from csplab.experiments.trial import Trial, problem_for
         from csplab.render import render
@@ -278,11 +295,13 @@ class BlockSize(Experiment):
                     grid = solve(P, "blocks", rng=r["seed"], **r["params"]["options"]).grid
                 if grid_digest(grid) != r["stats"].get("grid"):
                     raise InputError(
-                        f"re-running {ex} seed {r['seed']} did not reproduce the stored grid"
+                        f"re-running {names[ex]} seed {r['seed']} did not reproduce the stored grid"
                     )
                 m = r["params"]["options"]["block"][0]
                 bg = r["params"]["background"]
-                panels.append((f"{ex}, m={m}", render(grid, K=E.K, empty=bg[0] if bg else None)))
+                panels.append(
+                    (f"{names[ex]}, m={m}", render(grid, K=E.K, empty=bg[0] if bg else None))
+                )
         if not panels:
             return []
         cols = min(5, len(panels))

@@ -49,7 +49,9 @@ from csplab.example import ExampleModel
 from csplab.experiments.base import (
     Experiment,
     Report,
+    example_names,
     new_figure,
+    outside_legend,
     save_figure,
     size_for,
 )
@@ -225,8 +227,9 @@ class CatalogGap(Experiment):
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
         groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
+        names = example_names(r["example"] for r in rows)
         for r in rows:
-            groups[(r["example"], r["size"])].append(r)
+            groups[(names[r["example"]], r["size"])].append(r)
         table = []
         for (ex, size), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], _cells(kv[0][1]))):
             st = [r["stats"] for r in rs]
@@ -266,7 +269,9 @@ class CatalogGap(Experiment):
             "choice, per run). delay = failure step − first bad step (0: the bad choice "
             "emptied a domain at once); immediate = share of bad choices with delay 0."
         )
-        pts = [(r["example"], r["size"], r["stats"]) for r in rows if "first_bad" in r["stats"]]
+        pts = [
+            (names[r["example"]], r["size"], r["stats"]) for r in rows if "first_bad" in r["stats"]
+        ]
         if pts and self.draw_figures:
             rep.figures += self._plot(pts, out)
         return rep
@@ -285,7 +290,6 @@ class CatalogGap(Experiment):
         axes[0].set_ylabel("failure step (empty catalog)")
         axes[0].set_xscale("log")
         axes[0].set_yscale("log")
-        axes[0].legend(fontsize=6, ncol=2)
         delays = [st["delay"] for _, _, st in pts]
         top = max(delays)
         axes[1].hist(delays, bins=np.arange(-0.5, max(top, 4) + 1.5, max(1, (top + 1) // 40 or 1)),
@@ -295,6 +299,9 @@ class CatalogGap(Experiment):
         for ax in axes:
             ax.grid(alpha=0.3)
         fig.tight_layout()
+        handles, labels = axes[0].get_legend_handles_labels()
+        outside_legend(fig, handles=handles, labels=labels, bbox_to_anchor=(1.0, 0.95),
+                       ncol=1 + len(keys) // 24)  # fmt: skip
         return save_figure(fig, out / self.name)
 
 

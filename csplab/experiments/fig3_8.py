@@ -27,7 +27,9 @@ from csplab.example import ExampleModel
 from csplab.experiments.base import (
     Experiment,
     Report,
+    example_names,
     new_figure,
+    outside_legend,
     save_figure,
     setting_of,
     size_for,
@@ -87,9 +89,10 @@ class Fig38(Experiment):
         rep = Report(self.name, self.title, config)
         groups: dict[tuple[str, str, int], list[dict[str, Any]]] = defaultdict(list)
         sizes: dict[tuple[str, str, int], str] = {}
+        names = example_names(r["example"] for r in rows)
         for r in rows:
             nx = int(r["size"].split("x")[0])
-            key = (r["example"], setting_of(r), nx)
+            key = (names[r["example"]], setting_of(r), nx)
             groups[key].append(r)
             sizes[key] = r["size"]
         table = []
@@ -150,7 +153,7 @@ class Fig38(Experiment):
         ax.set_ylabel("success rate")
         ax.set_ylim(-0.03, 1.03)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        outside_legend(ax)
         n = min(t["trials"] for t in table)
         what = solvers[0] if len(solvers) == 1 else "each solver"
         one = {c[0] for c in curves}

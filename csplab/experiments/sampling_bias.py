@@ -32,6 +32,7 @@ from csplab.example import ExampleModel
 from csplab.experiments.base import (
     Experiment,
     Report,
+    example_names,
     load_examples,
     new_figure,
     save_figure,
@@ -189,7 +190,9 @@ class SamplingBias(Experiment):
             by_ex[r["example"]].append(r)
         table: list[dict[str, Any]] = []
         label_rows: dict[str, dict[str, np.ndarray]] = {}
-        for ex, rs in by_ex.items():
+        names = example_names(by_ex)
+        for spec, rs in by_ex.items():
+            ex = names[spec]
             exact = next((r for r in rs if r["solver"] == "exact"), None)
             if exact is None or exact["status"] != "solved":
                 rep.notes.append(f"{ex}: no exact frequencies (status "
@@ -214,7 +217,7 @@ class SamplingBias(Experiment):
                     res["verdict"] = "no output"
                 else:
                     if sampler is None:
-                        sampler = _report_sampler(settings[s][0], ex)
+                        sampler = _report_sampler(settings[s][0], spec)
                     null = _null_tv(sampler, res["outputs"], ex_lab, ex_pat,
                                     int(config["n_boot"]))  # fmt: skip
                     pv = min(_pvalue(null[w], res[f"tv_{w}"]) for w in ("labels", "patterns"))

@@ -28,8 +28,10 @@ from csplab.example import ExampleModel
 from csplab.experiments.base import (
     Experiment,
     Report,
+    example_names,
     load_examples,
     new_figure,
+    outside_legend,
     save_figure,
     setting_of,
 )
@@ -188,6 +190,11 @@ class Table31(Experiment):
                     row[f"{x['solver']} {cs} (s)"] = x["median_s"] if x["solved"] else float("nan")
                     row[f"{x['solver']} solved {cs}"] = f"{x['solved']}/{x['trials']}"
             wide.append(row)
+        # a model file is named by its stem (its path stays in the configuration block)
+        names = example_names(exs)
+        for x in [*long, *wide]:
+            x["example"] = names.get(str(x["example"]), x["example"])
+        shown = {names[ex]: v for ex, v in shown.items()}
         rep.tables["per solver"] = long
         rep.tables["Table 3.1"] = wide
         rep.notes.append(
@@ -230,8 +237,8 @@ class Table31(Experiment):
             ax.set_ylabel("median time (s), solved runs only")
             ax.set_title("comparison size" if which else "displayed size", fontsize=9)
             ax.grid(alpha=0.3, axis="y")
-        axes[0].legend(fontsize=7)
         fig.tight_layout()
+        outside_legend(axes[1])
         return save_figure(fig, out / self.name)
 
 
