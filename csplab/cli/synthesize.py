@@ -7,7 +7,13 @@ import json
 import sys
 from typing import Any
 
-from csplab.cli.common import add_problem_args, load_model, model_options, problem_from_args
+from csplab.cli.common import (
+    add_problem_args,
+    check_output_path,
+    load_model,
+    model_options,
+    problem_from_args,
+)
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 
@@ -153,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
     opts = _options(args)
     settings = _settings(args, example, opts)
     out_format = output_format(args.out) if args.out else None  # bad extension: fail early
+    if args.out:
+        check_output_path(args.out, "--out")  # an unwritable folder: fail before the work
     if out_format is not None and args.out_partial and not out_format.partial:
         raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
     result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"], **opts)

@@ -76,3 +76,9 @@ def test_failed_runs_write_nothing_unless_asked(capsys, tmp_path):
     assert code == 1 and (g < 0).any() and "partial" in stdout
     code, _, err = _run(capsys, *FALLIBLE, "--out", tmp_path / "g.txt", "--out-partial")
     assert code == 2 and "cannot hold unassigned cells" in err and not (tmp_path / "g.txt").exists()
+
+
+def test_an_unwritable_output_is_refused_before_the_work(capsys, tmp_path):
+    code, out, err = _run(capsys, "synthesize", "line", "--size", "6x4", "--out",
+                          tmp_path / "missing" / "x.npy")  # fmt: skip
+    assert code == 2 and out == "" and "does not exist" in err and len(err.splitlines()) == 1
