@@ -285,9 +285,12 @@ class _Search:
                 return self.witness(shape, ch, r.status, "random runs", seed)
         return None
 
-    def guided(self, shape: tuple[int, ...], want: NDArray[np.int64]) -> dict[str, Any] | None:
+    def guided(
+        self, shape: tuple[int, ...], want: NDArray[np.int64], near: Sequence[int] | None = None
+    ) -> dict[str, Any] | None:
         """One scan-order run at ``shape`` that takes the label of ``want`` wherever it is in
-        C and a uniform label of C elsewhere; the run if it fails."""
+        C and a uniform label of C elsewhere; the run if it fails. With ``near`` (a cell's
+        coordinates) the run gives up a quarter of the output after passing that cell."""
         P = self.problem(shape)
         eng = Propagator(P)
         self.stats["shrink_runs"] += 1
@@ -297,7 +300,11 @@ class _Search:
         assert scan is not None
         flat = want.reshape(-1)
         out: list[list[Any]] = []
-        for cell in scan.tolist():
+        stop = P.n
+        if near is not None:
+            pos = int(np.flatnonzero(scan == P.cell(tuple(int(x) for x in near)))[0])
+            stop = min(P.n, pos + P.n // 4 + 8)
+        for cell in scan.tolist()[:stop]:
             dom = eng.domain(cell)
             b = int(flat[cell])
             if b < 0 or b not in dom:
@@ -317,8 +324,8 @@ def _grid(shape: Sequence[int], choices: list[list[Any]]) -> NDArray[np.int64]:
 
 def _shrink_size(s: _Search, hit: dict[str, Any], runs: int) -> dict[str, Any]:
     """Smaller outputs that still fail, one axis at a time (smallest length first): the
-    failing run's labels in a window at the origin or ending at the failing cell
-    (scan orders), then fresh seeds."""
+    failing run's labels in a window at the origin, or ending at, starting at or centred
+    on the failing cell (scan orders), then fresh seeds."""
     improved = True
     while improved and s.left() > 0:
         improved = False
@@ -334,12 +341,18 @@ def _shrink_size(s: _Search, hit: dict[str, Any], runs: int) -> dict[str, Any]:
                 s2 = (*shp[:d], L, *shp[d + 1 :])
                 h2 = None
                 if s.is_scan and hit["kind"] == "failed":
-                    offs = sorted({0, min(max(int(fail[d]) - L + 1, 0), shp[d] - L)})
+                    f, top = int(fail[d]), shp[d] - L  # from the origin; ending at,
+                    offs = sorted({min(max(o, 0), top)  # starting at, centred on the fail
+                                   for o in (0, f - L + 1, f, f - L // 2)})  # fmt: skip
+                    tries = 3 if math.prod(s2) <= 1000 else 1
                     for off in offs:
                         sl = [slice(None)] * len(shp)
                         sl[d] = slice(off, off + L)
-                        for _ in range(3):
-                            h2 = s.guided(s2, grid[tuple(sl)])
+                        near = None
+                        if off <= f < off + L:
+                            near = [*fail[:d], f - off, *fail[d + 1 :]]
+                        for _ in range(tries):
+                            h2 = s.guided(s2, grid[tuple(sl)], near)
                             if h2 is not None:
                                 break
                         if h2 is not None:
