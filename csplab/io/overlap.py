@@ -9,9 +9,22 @@ neighbour of ``p`` along an axis iff they agree on their overlap (``p`` shifted 
 
 Cell ``[x, y]`` of a result holds the pattern whose corner is pixel ``[x, y]``: the
 picture of a periodic result has the grid's size; a non-periodic result of shape ``S`` shows
-every pattern whole, ``S + N - 1`` pixels. With ``ground`` (2D, symmetry 1 or 2) the bottom
-row of cells may only hold patterns found on the sample's bottom row and the other rows only
-patterns found elsewhere, so the output stands on the sample's ground.
+every pattern whole, ``S + N - 1`` pixels.
+
+``ground`` (2D, symmetry 1 or 2) makes the output stand on the sample's ground:
+
+* ``ground=True`` (or ``"wfc"``) is WaveFunctionCollapse's rule: the ground pattern is the
+  last new pattern of WFC's scan of the sample (picture rows from the top, then columns),
+  which holds the sample's bottom row with the sample's top wrapped below it; it fills the
+  row of cells that puts its ground row on the picture's bottom row and is banned in every
+  other cell, so the picture has exactly one ground band, at the bottom. The pattern wraps
+  around, so the rule needs an output periodic along ``y`` (as in WFC's samples); a
+  non-periodic output gets the ``"bottom"`` rule, with a warning.
+* ``ground="bottom"``: the bottom row of cells may only hold patterns found on the sample's
+  bottom row, and the other rows only patterns found elsewhere.
+
+In csplab's cells (a pattern's corner is its bottom-left pixel) WFC's ground row of cells
+is row ``height - N + 1`` (row 0 when ``N = 1``); the pictures are WFC's.
 
 Examples
 --------
@@ -28,8 +41,11 @@ Examples
 
 from __future__ import annotations
 
+import copy
+import warnings
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -37,6 +53,7 @@ from numpy.typing import ArrayLike, NDArray
 from csplab.errors import FormatError, InputError
 from csplab.io.common import NO, SURE, load_image
 from csplab.io.ruleset import DomainOp, RuleSet
+from csplab.problem import Problem
 
 __all__ = ["OverlapModel", "sniff"]
 
@@ -49,6 +66,56 @@ def sniff(head: bytes) -> int:
 
 
 MAX_PATTERNS = 4000
+
+Ground = Literal["wfc", "bottom"]
+_GROUND = {"true": "wfc", "wfc": "wfc", "yes": "wfc", "1": "wfc", "bottom": "bottom"}
+_NO_GROUND = ("false", "no", "0", "none", "")
+
+
+def ground_rule(value: bool | str | None) -> Ground | None:
+    """The ground rule an option value names: ``"wfc"`` (``True``, ``"true"``), ``"bottom"``
+    or ``None`` (``False``, ``"false"``).
+
+    Examples
+    --------
+    >>> ground_rule(True), ground_rule("bottom"), ground_rule("false")
+    ('wfc', 'bottom', None)
+    """
+    if value is None or value is False:
+        return None
+    if value is True:
+        return "wfc"
+    v = str(value).strip().lower()
+    if v in _NO_GROUND:
+        return None
+    if v not in _GROUND:
+        raise InputError(
+            f"option ground={value!r} of overlapping files must be true (WFC's rule), "
+            "bottom or false"
+        )
+    return "wfc" if _GROUND[v] == "wfc" else "bottom"
+
+
+def _wfc_last_pattern(
+    s: NDArray[np.int64], N: int, symmetry: int, periodic_input: bool, index: dict[bytes, int]
+) -> int:
+    """The pattern WaveFunctionCollapse finds last: it scans the picture's rows from the
+    top (csplab's ``y`` points up) and, in each, the columns, each window ``N`` pixels
+    right and down from its anchor, then its first ``symmetry`` images."""
+    SX, SY = s.shape
+    xmax, ymax = (SX, SY) if periodic_input else (SX - N + 1, SY - N + 1)
+    seen: set[int] = set()
+    last = 0
+    for r in range(ymax):  # picture row r from the top; the window's bottom is r + N - 1
+        c = (SY - N - r) % SY  # its bottom-left corner in y-up coordinates
+        for x in range(xmax):
+            idx = np.ix_([(x + i) % SX for i in range(N)], [(c + j) % SY for j in range(N)])
+            for q in _sym_images(s[idx])[:symmetry]:
+                j = index[np.ascontiguousarray(q).tobytes()]
+                if j not in seen:
+                    seen.add(j)
+                    last = j
+    return last
 
 
 def _sym_images(p: NDArray[np.int64]) -> list[NDArray[np.int64]]:
@@ -83,6 +150,7 @@ class OverlapModel(RuleSet):
     patterns: NDArray[np.int64]
     N: int
     sample_colors: NDArray[np.uint8] | None
+    _bottom_ops: tuple[DomainOp, ...] = ()
 
     @classmethod
     def from_grid(
@@ -92,12 +160,26 @@ class OverlapModel(RuleSet):
         N: int = 3,
         symmetry: int = 8,
         periodic_input: bool = True,
-        ground: bool = False,
+        ground: bool | str = False,
         colors: ArrayLike | None = None,
         name: str = "sample",
         meta: dict[str, Any] | None = None,
     ) -> OverlapModel:
-        """The overlapping model of a 2D or 3D label grid ``sample[x, y, ...]``."""
+        """The overlapping model of a 2D or 3D label grid ``sample[x, y, ...]`` (``ground``:
+        see the module docstring).
+
+        Examples
+        --------
+        >>> sample = np.array([[1, 2, 0, 0], [1, 0, 0, 0], [1, 0, 2, 0]])  # [x, y]: 1 = ground
+        >>> m = OverlapModel.from_grid(sample, N=2, symmetry=1, ground=True)
+        >>> m.patterns[m.meta["ground_pattern"]].tolist()  # [x, y]: the sky wrapped below it
+        [[0, 1], [0, 1]]
+        >>> import csplab
+        >>> r = csplab.solve(m.problem((6, 5), periodic=True), "catalog", rng=0)
+        >>> m.reconstruct(r.grid, periodic=True)[:, 0].tolist()   # the bottom pixel row
+        [1, 1, 1, 1, 1, 1]
+        """
+        rule = ground_rule(ground)
         s = np.asarray(sample)
         if s.ndim not in (2, 3) or s.size == 0:
             raise InputError(f"the sample must be a 2D or 3D grid, got shape {s.shape}")
@@ -108,7 +190,7 @@ class OverlapModel(RuleSet):
             raise InputError(f"N must be 1..8, got {N}")
         if not 1 <= symmetry <= 8:
             raise InputError(f"symmetry must be 1..8, got {symmetry}")
-        if ground and (s.ndim != 2 or symmetry > 2):
+        if rule and (s.ndim != 2 or symmetry > 2):
             raise InputError("ground needs a 2D sample and symmetry 1 or 2 (turns would move it)")
         if not periodic_input and any(n < N for n in s.shape):
             raise InputError(f"a {N}-wide pattern does not fit the sample {s.shape}")
@@ -133,7 +215,7 @@ class OverlapModel(RuleSet):
                     if len(pats) > MAX_PATTERNS:
                         raise InputError(f"the sample has more than {MAX_PATTERNS} patterns")
                 counts[j] += 1
-                if ground:
+                if rule:
                     (bottom if anchor[1] == 0 else above).add(j)
         P = np.stack(pats)  # (K, N, N[, N])
         K = len(pats)
@@ -149,15 +231,28 @@ class OverlapModel(RuleSet):
             keys_b = {r.tobytes(): i for i, r in enumerate(np.unique(a, axis=0))}
             ib = np.array([keys_b.get(r.tobytes(), -1) for r in b])
             T[d] = ia.reshape(-1)[:, None] == ib[None, :]
+        bottom_ops: list[DomainOp] = []
         ops: list[DomainOp] = []
-        if ground:
+        ground_pattern = None
+        if rule:
             g_lab = np.zeros(K, dtype=bool)
             g_lab[sorted(bottom)] = True
             a_lab = np.zeros(K, dtype=bool)
             a_lab[sorted(above)] = True
-            ops = [
+            bottom_ops = [
                 DomainOp("keep", g_lab, face="y-", kind="domain", key="ground (bottom row)"),
                 DomainOp("keep", a_lab, region=[(None, None), (1, None)], key="above ground"),
+            ]
+            ops = bottom_ops
+        if rule == "wfc":
+            ground_pattern = _wfc_last_pattern(s, N, symmetry, periodic_input, index)
+            only = np.zeros(K, dtype=bool)
+            only[ground_pattern] = True
+            lo = 1 - N  # the row of cells whose patterns' top row is the picture's row 0
+            row = (lo, lo + 1 if lo + 1 < 0 else None) if N > 1 else (0, 1)
+            ops = [
+                DomainOp("remove", only, key="ground pattern (WFC): not above the ground"),
+                DomainOp("force", only, region=[(None, None), row], key="ground (WFC)"),
             ]
         cols = None if colors is None else np.asarray(colors, dtype=np.uint8).reshape(-1, 3)
         corner = P.reshape(K, -1)[:, 0]
@@ -178,7 +273,8 @@ class OverlapModel(RuleSet):
                 "N": N,
                 "symmetry": symmetry,
                 "periodic_input": periodic_input,
-                "ground": ground,
+                "ground": rule or False,
+                "ground_pattern": ground_pattern,
                 "sample_shape": list(s.shape),
                 **(meta or {}),
             },
@@ -186,6 +282,7 @@ class OverlapModel(RuleSet):
         m.patterns = P
         m.N = N
         m.sample_colors = cols
+        m._bottom_ops = tuple(bottom_ops)
         return m
 
     @classmethod
@@ -196,11 +293,12 @@ class OverlapModel(RuleSet):
         N: int = 3,
         symmetry: int = 8,
         periodic_input: bool = True,
-        ground: bool = False,
+        ground: bool | str = "false",
     ) -> OverlapModel:
         """The overlapping model of a picture; colours are numbered in order of first
         appearance (rows from the top), the picture's ``y`` axis is turned to point up."""
         p = Path(path)
+        ground_rule(ground)  # a bad value is the option's error, not the file's
         img = load_image(p)
         if img.shape[0] * img.shape[1] > 256 * 256:
             raise FormatError(
@@ -227,6 +325,32 @@ class OverlapModel(RuleSet):
             )
         except InputError as e:
             raise FormatError(str(e), path=p) from None
+
+    def problem(
+        self,
+        shape: Sequence[int] | str | None = None,
+        *,
+        periodic: bool | Sequence[bool] | None = None,
+        **options: Any,
+    ) -> Problem:
+        """As :meth:`RuleSet.problem`; WFC's ground rule on an output that is not periodic
+        along ``y`` becomes the ``"bottom"`` rule, with a warning (WFC's ground pattern
+        wraps around)."""
+        if self.meta.get("ground") == "wfc":
+            per = self.periodic if periodic is None else periodic
+            per_y = bool(per) if isinstance(per, bool | np.bool_) else bool(list(per)[1])
+            if not per_y:
+                warnings.warn(
+                    f"{self.name}: ground=true is WaveFunctionCollapse's rule for outputs "
+                    "periodic along y; this output stands on the sample's bottom row instead "
+                    "(ground=bottom)",
+                    UserWarning,
+                    stacklevel=2,
+                )
+                other = copy.copy(self)
+                other.constraint_ops = self._bottom_ops
+                return RuleSet.problem(other, shape, periodic=periodic, **options)
+        return super().problem(shape, periodic=periodic, **options)
 
     # ------------------------------------------------------------------ results
     def reconstruct(self, grid: ArrayLike, periodic: bool | None = None) -> NDArray[np.int64]:

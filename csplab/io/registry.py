@@ -313,7 +313,8 @@ FORMATS: dict[str, Format] = {
             exact=True,
             details="the thesis' example files: three header lines, `nx ny nz`, the labels "
             "for z: for x: for y, then an optional label table; header and table are kept "
-            "when written back",
+            "when written back, and a result of the model carries its table (as Merrell's "
+            "program writes it)",
             example="csplab synthesize city --size 20x20x10 --boundary auto --seed 1 "
             "--out city.txt && csplab check city city.txt",
         ),
@@ -361,8 +362,10 @@ FORMATS: dict[str, Format] = {
             ),
             files="with root `<set>`",
             details="tiles with symmetry X/L/T/I/\\\\/F (1/4/4/2/2/8 orientations, labels "
-            "`corner 1`), weights, `left`/`right` rules closed under the square's 8 "
-            "symmetries, `<subsets>`, `unique`, tile PNGs in `NAME/` next to the XML",
+            "`corner 1`; a rule's `corner k`, k = 0..7, is resolved through WFC's action "
+            "table), weights, `left`/`right` rules closed under the square's 8 "
+            "symmetries, `<subsets>`, `unique`, tile PNGs in `NAME/` next to the XML (a "
+            "warning when they are missing)",
             example="csplab synthesize tests/io/data/pipes.xml --size 30x30 --seed 1 "
             "--out pipes.png",
         ),
@@ -385,9 +388,11 @@ FORMATS: dict[str, Format] = {
                 Option("periodic_input", bool, True, "the sample wraps around"),
                 Option(
                     "ground",
-                    bool,
-                    False,
-                    "the output stands on the sample's bottom row (2D, symmetry 1 or 2)",
+                    str,
+                    "false",
+                    "2D, symmetry 1 or 2: `true` WaveFunctionCollapse's rule (its ground "
+                    "pattern fills the bottom and nowhere else; periodic outputs), `bottom` "
+                    "the bottom row of cells holds only patterns of the sample's bottom row",
                 ),
             ),
             files="sample",
@@ -436,7 +441,8 @@ FORMATS: dict[str, Format] = {
             "`left/right`, `up/down`, `above/below` adjacencies closed under the group, "
             "`border` and `fixedTile` constraints; every other constraint (`path`, "
             "`edgedPath`, …) is a one-line warning, never dropped silently; `overlapping` "
-            "configs use their PNG sample",
+            "configs use their PNG sample; tile pictures (Tiled `.tsx`) are not read, and a "
+            "warning says so",
             example="csplab synthesize DeBroglie/edged_path_constraint.json --size 30x30 "
             "--seed 1 --out path.png",
         ),

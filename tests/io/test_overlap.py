@@ -48,8 +48,8 @@ def test_outputs_consist_of_sample_patterns(solver, periodic):
     assert pic.size == img.shape
 
 
-def test_ground():
-    m = read_model(DATA / "sample.png", N=3, symmetry=2, ground=True)
+def test_ground_bottom():
+    m = read_model(DATA / "sample.png", N=3, symmetry=2, ground="bottom")
     r = csplab.solve(m.problem((20, 9)), "catalog", rng=0, order="min-entropy")
     assert r.ok
     img = m.reconstruct(r.grid, periodic=False)
@@ -92,3 +92,70 @@ def test_bad_samples(tmp_path):
         read_model(tmp_path / "x.png")
     with pytest.raises(InputError):
         OverlapModel.from_grid(np.zeros((2, 2), int), N=3, periodic_input=False)
+
+
+SKY, BLOCK, EARTH = (120, 180, 250), (200, 50, 50), (90, 60, 30)
+
+
+def skyline(path):
+    """A small sample made for this test: towers on the ground (EARTH only on the bottom row)."""
+    from PIL import Image
+
+    rows = ["ssssssssss", "ssssssssss", "ssbsssssss", "sbbbssssbs", "sbbbssssbs", "sbbbsssbbb"]
+    rows.append("gggggggggg")
+    col = {"s": SKY, "b": BLOCK, "g": EARTH}
+    img = np.array([[col[c] for c in r] for r in rows], dtype=np.uint8)
+    Image.fromarray(img).save(path)
+    return img
+
+
+def wfc_ground_pattern(img, N, symmetry):
+    """WaveFunctionCollapse's ground pattern, computed as WFC does on the picture (rows from
+    the top, periodic input): the last new pattern, turned into csplab's [x, y] with y up."""
+    H, W = img.shape[:2]
+    seen, last = set(), None
+    for y in range(H):
+        for x in range(W):
+            p = img[np.ix_([(y + d) % H for d in range(N)], [(x + d) % W for d in range(N)])]
+            for q in [p, p[:, ::-1]][:symmetry]:
+                key = q.tobytes()
+                if key not in seen:
+                    seen.add(key)
+                    last = q
+    return last.transpose(1, 0, 2)[:, ::-1]  # [row, col] -> [x, y up]
+
+
+@pytest.mark.parametrize("symmetry", [1, 2])
+def test_ground_is_wfcs_rule(tmp_path, symmetry):
+    img = skyline(tmp_path / "skyline.png")
+    m = read_model(tmp_path / "skyline.png", N=3, symmetry=symmetry, ground="true")
+    g = m.meta["ground_pattern"]
+    assert m.meta["ground"] == "wfc"
+    want = wfc_ground_pattern(img, 3, symmetry)
+    assert np.array_equal(m.sample_colors[m.patterns[g]], want)
+    W, H = 16, 11
+    for seed in range(2):
+        r = csplab.solve(m.problem((W, H), periodic=True), "catalog", rng=seed)
+        assert r.ok
+        # the ground pattern fills one row of cells (the one that puts its ground row on
+        # the picture's bottom row) and is nowhere else
+        rows = {int(y) for y in np.nonzero(r.grid == g)[1]}
+        assert rows == {H - 3 + 1} and (r.grid[:, H - 2] == g).all()
+        pic = m.sample_colors[m.reconstruct(r.grid, periodic=True)]  # [x, y up, rgb]
+        earth = (pic == EARTH).all(axis=-1)
+        assert earth[:, 0].all() and not earth[:, 1:].any()  # one band, at the bottom
+
+
+def test_ground_needs_periodic_output_for_wfcs_rule(tmp_path):
+    skyline(tmp_path / "skyline.png")
+    m = read_model(tmp_path / "skyline.png", N=3, symmetry=2, ground=True)
+    with pytest.warns(UserWarning, match="periodic along y.*ground=bottom"):
+        P = m.problem((12, 8))
+    r = csplab.solve(P, "catalog", rng=0)
+    assert r.ok
+    earth = (m.sample_colors[m.reconstruct(r.grid, periodic=False)] == EARTH).all(axis=-1)
+    assert earth[:, 0].all() and not earth[:, 1:].any()
+    assert read_model(tmp_path / "skyline.png", ground="false").meta["ground"] is False
+    with pytest.raises(InputError, match=r"option ground='maybe' of overlapping files") as e:
+        read_model(tmp_path / "skyline.png", ground="maybe")
+    assert "\n" not in str(e.value)

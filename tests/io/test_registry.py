@@ -139,7 +139,8 @@ def test_options_are_checked_and_converted():
     for bad, what in (
         ({"N": "two"}, "N='two' of overlapping files must be an integer"),
         ({"N": 2.5}, "must be an integer"),
-        ({"ground": "maybe"}, "must be true or false"),
+        ({"periodic_input": "maybe"}, "must be true or false"),
+        ({"ground": "maybe"}, "ground='maybe' of overlapping files must be true"),
         ({"n": 3}, r"\['n'\] do not apply to overlapping files \(options: N, ground"),
     ):
         with pytest.raises(InputError, match=what):
