@@ -214,8 +214,9 @@ def from_example(
         probe of the output's height: arc consistency, then a search with a node budget),
         ``"auto"`` uses Merrell's rule instead: the bottom layer gets the example's label
         at ``(0, 0, 0)``, the top layer the label at the top of the example's column
-        ``(0, 0)``, and the sides stay free. ``problem.meta["boundary_rule"]`` says which
-        rule was used.
+        ``(0, 0)``, and the sides stay free (if that has no solution either: the bottom
+        layer alone, else no boundary). ``problem.meta["boundary_rule"]`` says which rule
+        was used.
     mask : bool array ``(*shape, K)`` (or broadcastable)
         Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
 
@@ -332,11 +333,18 @@ def _auto_or_merrell(
         if ndim != 3 or example.ndim != 3 or _probe(example, shape, periodic, auto):
             return auto, rule
     merrell = merrell_boundary(example, ndim)
-    why = "no solution" if auto is not None else "no empty-space label"
-    return merrell, (
-        f"merrell: {bottom}={merrell[bottom]}, {top}={merrell[top]}, sides free "
-        f"(the auto rule has {why})"
-    )
+    why = f"the auto rule has {'no solution' if auto is not None else 'no empty-space label'}"
+    if _probe(example, shape, periodic, merrell) is not False:
+        return merrell, (
+            f"merrell: {bottom}={merrell[bottom]}, {top}={merrell[top]}, sides free ({why})"
+        )
+    # never unsatisfiable because of the default: the ground alone, else no boundary
+    ground = {bottom: merrell[bottom]}
+    if _probe(example, shape, periodic, ground) is not False:
+        return ground, (
+            f"merrell, bottom only: {bottom}={merrell[bottom]} ({why}, Merrell's rule too)"
+        )
+    return {}, f"none ({why}, Merrell's rule and its bottom layer alone too)"
 
 
 def _match_ndim(shape: tuple[int, ...], ex_shape: tuple[int, ...]) -> tuple[int, ...]:

@@ -99,3 +99,16 @@ def test_synthesize_says_which_boundary_rule_it_used(
     out = capsys.readouterr().out
     assert code == 0
     assert "  boundary merrell: z-=1, z+=0, sides free" in out
+
+
+def test_auto_never_makes_the_problem_unsat() -> None:
+    E = _layered()  # ground 1, floor 2, then empty space 0
+    # nz = 2: Merrell's top label 0 cannot sit on the ground; the ground alone can
+    P = Problem.from_example(E, (4, 4, 2), boundary="auto")
+    assert P.meta["boundary"] == {"z-": 1}
+    assert P.meta["boundary_rule"].startswith("merrell, bottom only: z-=1")
+    assert solve(P, "backtrack", rng=0).status == "solved"
+    # nz = 1: the bottom face holds every cell, the ground tiles sideways: auto works
+    P1 = Problem.from_example(E, (3, 3, 1), boundary="auto")
+    assert P1.meta["boundary_rule"].startswith("auto: ground z-=1")
+    assert solve(P1, "backtrack", rng=0).status == "solved"
