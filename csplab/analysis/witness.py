@@ -439,13 +439,13 @@ def find_failure(
     """Find a failing run of Alg. 3.1 on ``example`` (smallest size, shortest prefix).
 
     The search escalates: every run on outputs of at most ``exhaustive_cells`` cells
-    (exhaustive, at most ``max_states`` catalogs per size and half of the time; with the
-    growing default sizes a third of ``max_states`` catalogs in all, a tenth of that per
-    size, and a tenth of the time), then
-    seeded random runs on growing outputs; a failing random run is shrunk, output size
-    first (smaller windows of the failing run, then fresh seeds), then choices (the run
-    at the final size that fails soonest, and after its first choice outside C* the
-    shortest continuation that wipes C out).
+    (exhaustive, at most ``max_states`` catalogs per size and half of the time, all of it
+    without random runs; with the growing default sizes a third of ``max_states``
+    catalogs in all, a tenth of that per size, and a tenth of the time), then seeded
+    random runs on growing outputs; a failing random run is shrunk, output size first
+    (smaller windows of the failing run, then fresh seeds), then choices (the run at the
+    final size that fails soonest, and after its first choice outside C* the shortest
+    continuation that wipes C out).
 
     Parameters
     ----------
@@ -536,7 +536,8 @@ def find_failure(
     s = _Search(example, order, gen, stats, deadline, bnd)
     complete = is_scan
     found: dict[str, Any] | None = None
-    share = 1.0 if late else 0.1 if auto else 0.5  # of the time, for the exhaustive phase
+    # the exhaustive phase's share of the time
+    share = 1.0 if late or random_runs <= 0 else 0.1 if auto else 0.5
     ex_deadline = t0 + share * (deadline - t0)
     for shp in _shapes_upto(lim, exhaustive_cells) if is_scan else []:
         if auto:  # growing sizes: a third of max_states in all, a tenth of that per size
