@@ -223,4 +223,4 @@ class ExampleModel:
     def _repr_png_(self) -> bytes:
         from csplab.render import render_png_bytes
 
-        return render_png_bytes(self.labels, names=self.names)
+        return render_png_bytes(self.labels, names=self.names, model=self)

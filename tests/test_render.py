@@ -105,3 +105,17 @@ def test_tileset_orientations_share_a_colour() -> None:
     c = R.label_colors()
     i, j, k = R.names.index("corner 0"), R.names.index("corner 3"), R.names.index("line 0")
     assert (c[i] == c[j]).all() and not (c[i] == c[k]).all()
+
+
+def test_notebook_picture_of_a_merrell_model_uses_its_object_table() -> None:
+    import io
+
+    trailer = "0 empty\n1 wall.obj\n2 wall.obj\n3 door.obj\n"
+    lab = np.zeros((3, 1, 2), dtype=np.int64)
+    lab[:, 0, 0] = [1, 2, 3]
+    E = ExampleModel(lab, meta={"merrell_trailer": trailer})
+    png = E._repr_png_()
+    with Image.open(io.BytesIO(png)) as img:
+        got = np.asarray(img.convert("RGB"))
+    want = np.asarray(render(lab, objects=label_objects(4, trailer=trailer)))
+    assert got.shape == want.shape and (got == want).all()
