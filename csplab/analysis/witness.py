@@ -440,8 +440,8 @@ def find_failure(
 
     The search escalates: every run on outputs of at most ``exhaustive_cells`` cells
     (exhaustive, at most ``max_states`` catalogs per size and half of the time, all of it
-    without random runs; with the growing default sizes a third of ``max_states``
-    catalogs in all, a tenth of that per size, and a tenth of the time), then seeded
+    without random runs; 3D: a third of ``max_states`` catalogs in all, a tenth of that
+    per size, and a tenth of the time), then seeded
     random runs on growing outputs; a failing random run is shrunk, output size first
     (smaller windows of the failing run, then fresh seeds), then choices (the run at the
     final size that fails soonest, and after its first choice outside C* the shortest
@@ -454,10 +454,10 @@ def find_failure(
         Alg. 3.1's cell order: a scan order (exhaustive and random search) or ``random`` /
         ``min-entropy`` (random search only).
     max_size : shape or str, optional
-        Largest output searched (each axis; missing trailing axes are 1): its sizes are
-        searched once. Default: ``4x4`` for 1D and 2D examples; for 3D and higher, growing
-        outputs (cubes up to the example's size, then its proportions scaled up) searched
-        round after round until the time budget is spent.
+        Largest output searched (each axis; missing trailing axes are 1); 1D and 2D:
+        each size once; 3D and higher: round after round until the time budget is spent.
+        Default: ``4x4`` for 1D and 2D examples; for 3D and higher, growing outputs
+        (cubes up to the example's size, then its proportions scaled up).
     exhaustive_cells : int
         Outputs with at most this many cells are searched exhaustively (scan orders).
     random_runs : int
@@ -503,6 +503,7 @@ def find_failure(
     deadline = math.inf if time_limit is None else t0 + float(time_limit)
     ndim = example.ndim
     auto = max_size is None and ndim >= 3
+    rounds = ndim >= 3  # 3D: exhaustive phase on a budget, rounds of random runs
     if max_size is None and not auto:
         max_size = (4, 4)[:ndim] if ndim <= 2 else (4,) * ndim
     if auto:
@@ -537,10 +538,10 @@ def find_failure(
     complete = is_scan
     found: dict[str, Any] | None = None
     # the exhaustive phase's share of the time
-    share = 1.0 if late or random_runs <= 0 else 0.1 if auto else 0.5
+    share = 1.0 if late or random_runs <= 0 else 0.1 if rounds else 0.5
     ex_deadline = t0 + share * (deadline - t0)
     for shp in _shapes_upto(lim, exhaustive_cells) if is_scan else []:
-        if auto:  # growing sizes: a third of max_states in all, a tenth of that per size
+        if rounds:  # 3D: a third of max_states in all, a tenth of that per size
             budget = min(max_states // 30, max_states // 3 - stats["states"])
         else:
             budget = max_states
@@ -563,8 +564,9 @@ def find_failure(
     search_deadline = t0 + 0.7 * (deadline - t0)
     if found is None and random_runs > 0 and not late:
         s.deadline = search_deadline
-        if auto:
-            found = _climb(s, _auto_ladder(example.shape), random_runs, exhaustive_cells)
+        if rounds:
+            ladder = _auto_ladder(example.shape) if auto else _ladder(lim)
+            found = _climb(s, ladder, random_runs, exhaustive_cells)
         else:
             for shp in _ladder(lim):
                 if math.prod(shp) <= exhaustive_cells and is_scan:
