@@ -111,6 +111,18 @@ def _canonical(backend: str | None) -> str:
 # ----------------------------------------------------------------------------- fast loader
 
 
+def _is_interrupt(e: BaseException) -> bool:
+    """Whether ``e`` is pysat's report of a Ctrl-C inside the native solver
+    (``pysolvers.error: Caught keyboard interrupt``).
+
+    Examples
+    --------
+    >>> _is_interrupt(RuntimeError("Caught keyboard interrupt")), _is_interrupt(ValueError("x"))
+    (True, False)
+    """
+    return "keyboard interrupt" in str(e).lower()
+
+
 @njit(cache=True)
 def _feed_clauses(fn: Any, ptr: int, lits: np.ndarray, starts: np.ndarray, a: int, b: int) -> None:
     """``add(lit) ... add(0)`` for clauses ``a..b-1`` (CaDiCaL's IPASIR-style API)."""
@@ -419,7 +431,12 @@ class SatOracle:
         try:
             while True:
                 self.stats["sat_calls"] += 1
-                r = self._raw(assume, deadline)
+                try:
+                    r = self._raw(assume, deadline)
+                except Exception as e:  # pysat turns Ctrl-C into pysolvers.error
+                    if _is_interrupt(e):
+                        raise KeyboardInterrupt from None
+                    raise
                 if r is None:
                     return "timeout"
                 if not r:

@@ -175,6 +175,8 @@ def run_trials(
     )
     statuses: Counter[str] = Counter()
     t0 = time.perf_counter()
+    interrupted = False
+    restore = _on_sigterm_interrupt()
     client, own = _client(scheduler) if scheduler is not None and todo else (None, False)
     bar = _progress(len(todo), experiment, progress)
     try:
@@ -203,14 +205,77 @@ def run_trials(
                 ", ".join(f"{k} {v}" for k, v in sorted(statuses.items())), refresh=False
             )
             bar.update(1)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the stored rows stay, the run is marked
+        interrupted = True
+        raise
     finally:
+        restore()
         bar.close()
         if own and client is not None:
             client.close()
         summary.statuses = dict(statuses)
         summary.time_s = time.perf_counter() - t0
-        store.finish_run(run_id, ran=summary.ran, errors=len(summary.errors))
+        store.finish_run(
+            run_id, ran=summary.ran, errors=len(summary.errors), interrupted=interrupted
+        )
     return summary
+
+
+def _on_sigterm_interrupt() -> Any:
+    """Handle SIGTERM (what ``timeout`` and batch schedulers send) like Ctrl-C until the
+    returned function is called: it raises :class:`KeyboardInterrupt` in the main thread, so
+    the pool is shut down, its workers killed and the run marked as interrupted."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def handler(signum: int, frame: Any) -> None:
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    try:
+        previous = signal.signal(signal.SIGTERM, handler)
+    except (ValueError, OSError):  # not supported here
+        return lambda: None
+    return lambda: signal.signal(signal.SIGTERM, previous)
+
+
+def _watch_parent(parent: int) -> None:
+    """Pool initializer: the worker exits as soon as its parent process ``parent`` has
+    died (SIGKILL of the main process leaves no chance to shut the pool down)."""
+    import signal
+    import threading
+
+    try:  # Ctrl-C reaches the whole process group: the main process decides what stops
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except (ValueError, OSError):
+        pass
+
+    def poll() -> None:
+        while True:
+            if os.getppid() != parent:
+                os._exit(1)
+            time.sleep(0.5)
+
+    threading.Thread(target=poll, name="csplab-parent-watch", daemon=True).start()
+
+
+def _kill_workers(pool: ProcessPoolExecutor) -> None:
+    """Stop a pool now: cancel what is queued and kill the workers (a running trial
+    cannot be interrupted otherwise)."""
+    procs = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for p in procs:
+        try:
+            p.kill()
+        except (OSError, ValueError, AttributeError):
+            pass
+    for p in procs:
+        try:
+            p.join(timeout=5)
+        except (OSError, ValueError, AssertionError):
+            pass
 
 
 def _check_dependencies(todo: Sequence[Trial]) -> None:
@@ -252,7 +317,10 @@ def _run_pool(todo: Sequence[Trial], examples: dict[str, ExampleModel], n: int) 
     ctx = mp.get_context("spawn")
     pending: dict[Future[dict[str, Any]], Trial] = {}
     it = iter(todo)
-    with ProcessPoolExecutor(max_workers=n, mp_context=ctx) as pool:
+    pool = ProcessPoolExecutor(
+        max_workers=n, mp_context=ctx, initializer=_watch_parent, initargs=(os.getpid(),)
+    )
+    with pool:
         try:
 
             def feed() -> None:
@@ -276,6 +344,7 @@ def _run_pool(todo: Sequence[Trial], examples: dict[str, ExampleModel], n: int) 
         except BaseException:
             for fut in pending:
                 fut.cancel()
+            _kill_workers(pool)
             raise
 
 

@@ -253,6 +253,8 @@ class ResultsStore:
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=NORMAL")
             self._db.executescript(_SCHEMA)
+            if "status" not in {r[1] for r in self._db.execute("PRAGMA table_info(runs)")}:
+                self._db.execute("ALTER TABLE runs ADD COLUMN status TEXT")  # older stores
         except sqlite3.DatabaseError as e:  # OperationalError too: one line naming the file
             raise store_error(self.path, e) from None
 
@@ -310,10 +312,11 @@ class ResultsStore:
         )  # fmt: skip
         return int(cur.lastrowid or 0)
 
-    def finish_run(self, run_id: int, *, ran: int, errors: int) -> None:
+    def finish_run(self, run_id: int, *, ran: int, errors: int, interrupted: bool = False) -> None:
+        """Record the end of a sweep (``status`` ``"finished"`` or ``"interrupted"``)."""
         self._db.execute(
-            "UPDATE runs SET finished_at = ?, ran = ?, errors = ? WHERE id = ?",
-            (time.time(), ran, errors, run_id),
+            "UPDATE runs SET finished_at = ?, ran = ?, errors = ?, status = ? WHERE id = ?",
+            (time.time(), ran, errors, "interrupted" if interrupted else "finished", run_id),
         )
 
     def delete(self, experiment: str, keys: Iterable[str] | None = None) -> int:
