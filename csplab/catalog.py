@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from csplab import _kernels as kern
 from csplab._kernels import Code, Heap, Run, Search
 from csplab.errors import InputError
-from csplab.problem import Problem
+from csplab.problem import Problem, check_memory
 
 __all__ = [
     "Code",
@@ -92,6 +92,8 @@ class _Compiled:
 
     def __init__(self, problem: Problem) -> None:
         n, K, R = problem.n, problem.K, problem.R
+        # the problem exists already: only what the engine adds must still fit
+        check_memory(problem.shape, K, len(problem.arcs), problem=False)
         W = words(K)
         a = problem.arcs
         keep = a[:, 0] != a[:, 1]  # self-arcs are folded into the domains

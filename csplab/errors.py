@@ -58,3 +58,7 @@ class DependencyError(CsplabError, ImportError):
 
 class NoTrivialSolutionError(CsplabError, ValueError):
     """Modify-in-blocks needs a consistent starting model and none could be built."""
+
+
+class MemoryLimitError(CsplabError, MemoryError):
+    """A problem would need more memory than is available (estimated before allocating)."""

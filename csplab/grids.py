@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from csplab.errors import InputError
-from csplab.problem import AXIS_NAMES, Problem, Unary
+from csplab.problem import AXIS_NAMES, Problem, Unary, check_memory
 
 if TYPE_CHECKING:
     from csplab.example import ExampleModel
@@ -139,6 +139,7 @@ def grid(
     K = T.shape[1]
     per = _as_flag_tuple(periodic, ndim, "periodic")
     n = math.prod(shp)
+    check_memory(shp, K)  # one line with the estimate before allocating
     idx = np.arange(n, dtype=np.int64).reshape(shp)
     parts = []
     for d in range(ndim):

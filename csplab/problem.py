@@ -38,12 +38,20 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from csplab.errors import InputError
+from csplab.errors import InputError, MemoryLimitError
 
 if TYPE_CHECKING:
     from csplab.example import ExampleModel
 
-__all__ = ["AXIS_NAMES", "Problem", "Unary", "Violations"]
+__all__ = [
+    "AXIS_NAMES",
+    "Problem",
+    "Unary",
+    "Violations",
+    "available_memory",
+    "check_memory",
+    "memory_estimate",
+]
 
 AXIS_NAMES = "xyzw"
 UnaryKind = Literal["fixed", "boundary", "mask", "domain"]
@@ -451,3 +459,89 @@ class Problem:
             name=self.name,
             meta={**self.meta, "subproblem_of": self.shape},
         )
+
+
+# ----------------------------------------------------------------------------- memory
+
+#: assumed available memory (bytes) where ``/proc/meminfo`` cannot be read
+FALLBACK_MEMORY = 8 * 2**30
+_SMALL = 256 * 2**20
+
+
+def available_memory() -> int:
+    """Bytes of memory available to a new allocation: ``MemAvailable`` of
+    ``/proc/meminfo`` (Linux), else :data:`FALLBACK_MEMORY`."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return FALLBACK_MEMORY
+
+
+def memory_estimate(
+    n: int, K: int, arcs: int, *, problem: bool = True, propagator: bool = True
+) -> int:
+    """Estimated peak bytes of a problem with ``n`` cells, ``K`` labels and ``arcs`` arcs.
+
+    With ``problem``: the problem keeps two ``(n, K)`` bool arrays (``domains``,
+    ``base_domains``) and its ``(arcs, 3)`` int64 arcs, and builds them with about as much
+    again. With
+    ``propagator`` it adds what :class:`csplab.catalog.Propagator` allocates: two packed
+    catalogs of ``W = ceil(K / 64)`` words per cell (``bits``, ``prev``), the CSR adjacency
+    (``2 arcs`` neighbours and relation ids) and the larger of its transients (packing the
+    domains: ``n`` rows of ``64 W`` bools and two ``n x W`` word copies; sorting the arcs).
+
+    Examples
+    --------
+    >>> round(memory_estimate(2000 * 2000 * 10, 119, 3 * 2000 * 2000 * 10) / 2**30, 1)
+    35.9
+    >>> memory_estimate(4, 2, 4) < 2000
+    True
+    """
+    W = max(1, (K + 63) // 64)
+    total = 4 * n * K + 48 * arcs + 8 * n if problem else 0
+    if propagator:
+        keeps = 16 * n * W + 32 * arcs + 17 * n
+        transient = max(64 * n * W + 16 * n * W, 64 * arcs)
+        total += keeps + transient
+    return total
+
+
+def _gib(b: float) -> str:
+    return f"{b / 2**30:.1f} GiB" if b >= 2**29 else f"{b / 2**20:.0f} MiB"
+
+
+def check_memory(
+    shape: Sequence[int],
+    K: int,
+    arcs: int | None = None,
+    *,
+    problem: bool = True,
+    propagator: bool = True,
+) -> int:
+    """Raise :class:`~csplab.errors.MemoryLimitError` (one line with the estimate) when a
+    problem on ``shape`` with ``K`` labels (and ``arcs`` arcs, default one per cell and
+    axis) would not fit in :func:`available_memory`; returns the estimate in bytes
+    (``problem`` and ``propagator`` as in :func:`memory_estimate`).
+
+    Examples
+    --------
+    >>> check_memory((10, 10), 3) < 2**20
+    True
+    """
+    n = math.prod(int(s) for s in shape)
+    a = len(shape) * n if arcs is None else int(arcs)
+    need = memory_estimate(n, K, a, problem=problem, propagator=propagator)
+    if need <= _SMALL:  # not worth reading /proc/meminfo (blocks build many small problems)
+        return need
+    have = available_memory()
+    if need > have:
+        size = "x".join(str(int(s)) for s in shape)
+        raise MemoryLimitError(
+            f"{size} with K={K} needs about {_gib(need)}; {_gib(have)} available "
+            "(a smaller --size, or fewer labels)"
+        )
+    return need

@@ -107,6 +107,9 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
         for extra in msg[1:6]:
             print(f"  {extra}", file=sys.stderr)
         return 2
+    except MemoryError:  # an allocation the estimate did not foresee
+        print("csplab: error: out of memory (try a smaller --size)", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("csplab: interrupted", file=sys.stderr)
         return 130
