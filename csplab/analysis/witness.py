@@ -440,8 +440,8 @@ def find_failure(
 
     The search escalates: every run on outputs of at most ``exhaustive_cells`` cells
     (exhaustive, at most ``max_states`` catalogs per size and half of the time, all of it
-    without random runs; 3D: a third of ``max_states`` catalogs in all, a tenth of that
-    per size, and a tenth of the time), then seeded
+    without random runs; 3D with random runs: a third of ``max_states`` catalogs in all,
+    a tenth of that per size, and a tenth of the time), then seeded
     random runs on growing outputs; a failing random run is shrunk, output size first
     (smaller windows of the failing run, then fresh seeds), then choices (the run at the
     final size that fails soonest, and after its first choice outside C* the shortest
@@ -503,7 +503,8 @@ def find_failure(
     deadline = math.inf if time_limit is None else t0 + float(time_limit)
     ndim = example.ndim
     auto = max_size is None and ndim >= 3
-    rounds = ndim >= 3  # 3D: exhaustive phase on a budget, rounds of random runs
+    # 3D with random runs: exhaustive phase on a budget, then rounds of random runs
+    rounds = ndim >= 3 and random_runs > 0 and not late
     if max_size is None and not auto:
         max_size = (4, 4)[:ndim] if ndim <= 2 else (4,) * ndim
     if auto:
