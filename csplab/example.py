@@ -1,7 +1,10 @@
 """The example model E: an integer label grid of 1 to 4 dimensions (thesis Sec. 3.1).
 
 Labels are indexed ``E[x, y, z]`` as in the thesis; the label count is
-``K = max label + 1`` (ids that never occur get no support). :meth:`ExampleModel.transitions`
+``K = max label + 1`` (ids that never occur get no support). Sparse ids (``max label`` at
+least :data:`COMPACT_ABOVE` and more than twice the number of labels in use) are
+compacted to ``0..k-1``; ``meta["label_ids"]`` maps them back, and the writers of
+:mod:`csplab.io` write the file's ids. :meth:`ExampleModel.transitions`
 computes the transition matrices of Eq. 3.2.
 
 Examples
@@ -29,7 +32,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import InputError
 
-__all__ = ["ExampleModel", "pair_transitions"]
+__all__ = ["COMPACT_ABOVE", "ExampleModel", "file_labels", "pair_transitions"]
 
 MAX_NDIM = 4
 
@@ -56,6 +59,54 @@ def pair_transitions(grid: NDArray[np.integer[Any]], K: int) -> NDArray[np.bool_
         ok = (b >= 0) & (c >= 0)
         T[d, b[ok], c[ok]] = True
     return T
+
+
+#: label ids are compacted when ``max label + 1`` exceeds this and twice the labels in use
+COMPACT_ABOVE = 256
+
+
+def _compact(
+    raw: NDArray[Any], weights: ArrayLike | None, meta: dict[str, Any]
+) -> tuple[NDArray[Any], ArrayLike | None]:
+    """Sparse label ids (``{0, 100000}``) -> ``0..k-1`` with ``meta["label_ids"]`` mapping
+    back (an example with ``K = max + 1`` would allocate memory for every unused id)."""
+    ids = meta.get("label_ids")
+    if ids is not None:  # already compact (a model rebuilt from a compacted one)
+        if int(raw.max()) >= len(ids):
+            raise InputError(f"label {int(raw.max())} has no entry in meta['label_ids']")
+        return raw, weights
+    top = int(raw.max())
+    if top > np.iinfo(np.int64).max:
+        raise InputError(f"label {top} does not fit in 64 bits")
+    if top < COMPACT_ABOVE:
+        return raw, weights
+    used = np.unique(raw)
+    if top + 1 <= 2 * used.size:
+        return raw, weights
+    meta["label_ids"] = tuple(int(v) for v in used)
+    if weights is not None:
+        w = np.asarray(weights, dtype=np.float64).reshape(-1)
+        if w.size == top + 1:
+            weights = w[used]
+    return np.searchsorted(used, raw).astype(np.int32), weights
+
+
+def file_labels(grid: ArrayLike, meta: Mapping[str, Any]) -> NDArray[np.int64]:
+    """A label grid with the ids of the file it came from (``meta["label_ids"]`` of a
+    compacted :class:`ExampleModel`; the grid itself when there is none). ``-1`` (an
+    unassigned cell) stays ``-1``.
+
+    Examples
+    --------
+    >>> file_labels([[0, 1], [-1, 1]], {"label_ids": (0, 100000)}).tolist()
+    [[0, 100000], [-1, 100000]]
+    """
+    g = np.asarray(grid, dtype=np.int64)
+    ids = meta.get("label_ids")
+    if ids is None:
+        return g
+    table = np.array([*ids, -1], dtype=np.int64)  # index -1 -> -1
+    return table[np.where(g >= 0, g, len(ids))]
 
 
 @dataclass(frozen=True, eq=False)
@@ -96,6 +147,9 @@ class ExampleModel:
         num_labels: int | None = None,
     ) -> None:
         raw = np.asarray(labels)
+        if raw.dtype == object and raw.size and all(isinstance(v, int) for v in raw.flat):
+            big = max(raw.flat, key=abs)
+            raise InputError(f"label {big} does not fit in 64 bits")
         if raw.dtype == bool or not (np.issubdtype(raw.dtype, np.integer) or raw.size == 0):
             if np.issubdtype(raw.dtype, np.floating) and np.all(np.mod(raw, 1) == 0):
                 raw = raw.astype(np.int64)
@@ -110,6 +164,9 @@ class ExampleModel:
         if raw.min() < 0:
             bad = tuple(int(i) for i in np.argwhere(raw < 0)[0])
             raise InputError(f"negative label {int(raw[bad])} at {bad} in example model")
+        meta = dict(meta or {})
+        if names is None and num_labels is None:
+            raw, weights = _compact(raw, weights, meta)
         if raw.max() > np.iinfo(np.int32).max // 2:
             raise InputError(f"label {int(raw.max())} is too large")
         arr = np.ascontiguousarray(raw, dtype=np.int32)
@@ -134,7 +191,7 @@ class ExampleModel:
         object.__setattr__(self, "names", names)
         object.__setattr__(self, "weights", w)
         object.__setattr__(self, "name", name)
-        object.__setattr__(self, "meta", dict(meta or {}))
+        object.__setattr__(self, "meta", meta)
         object.__setattr__(self, "num_labels", K)
 
     # ------------------------------------------------------------------ basic properties
@@ -166,6 +223,12 @@ class ExampleModel:
         """Transition matrices ``T[d, b, c]`` of Eq. 3.2, shape ``(ndim, K, K)``."""
         return pair_transitions(self.labels, self.K)
 
+    def file_labels(self, grid: ArrayLike | None = None) -> NDArray[np.int64]:
+        """``grid`` (default: the example's labels) with the file's label ids: the inverse
+        of the compaction of sparse ids (``meta["label_ids"]``); ``-1`` stays ``-1``."""
+        g = self.labels if grid is None else grid
+        return file_labels(g, self.meta)
+
     def label_name(self, b: int) -> str:
         """Name of label ``b`` (its number when the example has no names)."""
         if self.names is not None and 0 <= b < len(self.names):
@@ -183,6 +246,8 @@ class ExampleModel:
             h.update("\0".join(self.names).encode())
         if self.weights is not None:
             h.update(self.weights.tobytes())
+        if self.meta.get("label_ids") is not None:
+            h.update(str(tuple(self.meta["label_ids"])).encode())
         return h.hexdigest()[:16]
 
     def __repr__(self) -> str:

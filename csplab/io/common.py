@@ -280,6 +280,9 @@ class Output:
         g = np.asarray(grid, dtype=np.int32)
         if names is None and model is not None:
             names = model.names
+        meta = dict(meta or {})
+        if isinstance(model, ExampleModel) and "label_ids" in model.meta:
+            meta.setdefault("label_ids", model.meta["label_ids"])  # write the file's ids
         colors = empty = None
         pieces: dict[int, str] = {}
         if isinstance(model, RuleSet):
@@ -301,6 +304,13 @@ class Output:
             pieces=pieces,
             example=example,
         )
+
+    def file_grid(self) -> NDArray[np.int64]:
+        """The grid with the label ids of the model's file (see
+        :func:`csplab.example.file_labels`)."""
+        from csplab.example import file_labels
+
+        return file_labels(self.grid, self.meta)
 
     def to_example(self) -> ExampleModel:
         """The grid as an :class:`ExampleModel` (``example`` when set)."""

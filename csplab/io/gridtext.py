@@ -119,6 +119,8 @@ def parse_grid(text: str, *, path: object = "<string>", name: str = "") -> Examp
             ) from None
         if v < 0:
             raise FormatError(f"negative label {v}", path=path, line=lineno)
+        if v >= 2**63:
+            raise FormatError(f"label {v} does not fit in 64 bits", path=path, line=lineno)
         return v
 
     # every row must have the same length, every slice the same number of rows
@@ -235,7 +237,7 @@ def read_grid(path: str | Path) -> ExampleModel:
 
 def format_grid(example: ExampleModel, comments: str = "") -> str:
     """csplab grid text for an example (1D to 4D)."""
-    lab = example.labels
+    lab = example.file_labels()
     out = [MAGIC]
     for c in comments.splitlines():
         out.append(f"# {c}" if c else "#")

@@ -107,6 +107,8 @@ def parse_merrell(text: str, *, path: object = "<string>", name: str = "") -> Ex
                 raise FormatError(f"label {t!r} is not an integer", path=path, line=i + 1) from None
             if v < 0:
                 raise FormatError(f"negative label {v}", path=path, line=i + 1)
+            if v >= 2**63:
+                raise FormatError(f"label {v} does not fit in 64 bits", path=path, line=i + 1)
             values[got] = v
             got += 1
         i += 1
@@ -132,7 +134,7 @@ def read_merrell(path: str | Path) -> ExampleModel:
 
 def format_merrell(example: ExampleModel) -> str:
     """Merrell-format text for an example of up to 3 dimensions (header and trailer kept)."""
-    lab = example.labels
+    lab = example.file_labels()
     if lab.ndim > 3:
         raise FormatError(
             f"Merrell's format holds at most 3 dimensions; this model has shape {lab.shape}"

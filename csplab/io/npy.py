@@ -48,5 +48,6 @@ def read_npy(path: str | Path) -> ExampleModel:
 
 
 def write_output(out: Output, path: Path) -> None:
-    """The grid as an int32 array."""
-    np.save(path, out.grid)
+    """The grid as an int32 array (int64 when the file's label ids need it)."""
+    g = out.file_grid()
+    np.save(path, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)
