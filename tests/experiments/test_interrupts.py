@@ -87,17 +87,45 @@ def test_ctrl_c_stops_a_one_process_sweep(monkeypatch: Any, tmp_path: Path) -> N
         assert len(st.rows("demo")) == len(trials)
 
 
-def test_cli_ctrl_c_in_sat_exits_130(monkeypatch: Any, capsys: Any, tmp_path: Path) -> None:
+@pytest.mark.parametrize("solver", ["sat", "perfect"])
+def test_cli_ctrl_c_in_sat_exits_130(monkeypatch: Any, capsys: Any, solver: str) -> None:
     from csplab.cli import main
 
     def raw(self: Any, *a: Any) -> bool:
         raise _PysolversError("Caught keyboard interrupt")
 
     monkeypatch.setattr(sat.SatOracle, "_raw", raw)
-    code = main(["synthesize", "line", "--size", "5x5", "--solver", "perfect", "--seed", "0"])
+    code = main(["synthesize", "line", "--size", "5x5", "--solver", solver, "--seed", "0"])
     assert code == 130
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["csplab: interrupted"]
+
+
+def test_cli_one_process_sweep_stops_on_ctrl_c(
+    monkeypatch: Any, capsys: Any, tmp_path: Path
+) -> None:
+    from csplab.cli import main
+    from csplab.experiments import runner
+
+    real = runner.execute
+    calls = {"n": 0}
+
+    def execute(t: Trial, example: Any) -> Any:
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise KeyboardInterrupt
+        return real(t, example)
+
+    monkeypatch.setattr(runner, "execute", execute)
+    store = tmp_path / "r.sqlite"
+    argv = ["experiment", "fig3_8", "--quick", "--jobs", "1", "--store", str(store)]
+    code = main([*argv, "--out", str(tmp_path / "out")])
+    assert code == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "csplab: interrupted"
+    assert calls["n"] == 3  # the sweep stopped
+    with ResultsStore(store) as st:
+        assert len(st.done_keys("fig3_8")) == 2  # the rows stored before stay
+    assert not (tmp_path / "out").exists() or not any((tmp_path / "out").iterdir())
 
 
 _SLOW = textwrap.dedent(
