@@ -105,9 +105,8 @@ def test_cli_one_process_sweep_stops_on_ctrl_c(
     monkeypatch: Any, capsys: Any, tmp_path: Path
 ) -> None:
     from csplab.cli import main
-    from csplab.experiments import runner
+    from csplab.experiments.trial import execute as real
 
-    real = runner.execute
     calls = {"n": 0}
 
     def execute(t: Trial, example: Any) -> Any:
@@ -116,7 +115,7 @@ def test_cli_one_process_sweep_stops_on_ctrl_c(
             raise KeyboardInterrupt
         return real(t, example)
 
-    monkeypatch.setattr(runner, "execute", execute)
+    monkeypatch.setattr("csplab.experiments.runner.execute", execute)
     store = tmp_path / "r.sqlite"
     argv = ["experiment", "fig3_8", "--quick", "--jobs", "1", "--store", str(store)]
     code = main([*argv, "--out", str(tmp_path / "out")])
