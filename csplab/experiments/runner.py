@@ -170,6 +170,7 @@ def run_trials(
     _check_dependencies(todo)
     summary = RunSummary(experiment, len(unique), len(unique) - len(todo))
     summary.stale = stale_counts(store, experiment, [t.key for t in unique if t.key in done])
+    store.mark_abandoned(experiment)  # runs killed with SIGKILL could not say so
     run_id = store.start_run(
         experiment, cfg, chash, trials=len(unique), skipped=summary.skipped, command=command
     )

@@ -235,6 +235,23 @@ def _check_store_file(path: Path) -> None:
         raise InputError(f"results store {path}: the file is not writable")
 
 
+def _process_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists on this host (a zombie counts as gone)."""
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OSError):
+        return True
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii", errors="replace") as fh:
+            return fh.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except (OSError, IndexError):
+        return True
+
+
 class ResultsStore:
     """A SQLite file holding the trials of any number of experiments.
 
@@ -253,8 +270,10 @@ class ResultsStore:
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=NORMAL")
             self._db.executescript(_SCHEMA)
-            if "status" not in {r[1] for r in self._db.execute("PRAGMA table_info(runs)")}:
-                self._db.execute("ALTER TABLE runs ADD COLUMN status TEXT")  # older stores
+            have = {r[1] for r in self._db.execute("PRAGMA table_info(runs)")}
+            for col, typ in (("status", "TEXT"), ("pid", "INTEGER")):
+                if col not in have:  # stores written before these columns existed
+                    self._db.execute(f"ALTER TABLE runs ADD COLUMN {col} {typ}")
         except sqlite3.DatabaseError as e:  # OperationalError too: one line naming the file
             raise store_error(self.path, e) from None
 
@@ -304,13 +323,29 @@ class ResultsStore:
         """Record the start of a sweep; returns its run id."""
         cur = self._db.execute(
             "INSERT INTO runs (experiment, config_hash, config, command, started_at, trials, "
-            "skipped, git_rev, host) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)",
+            "skipped, git_rev, host, pid) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)",
             (
                 experiment, config_hash, json.dumps(config, sort_keys=True), command, time.time(),
-                trials, skipped, git_revision(), socket.gethostname(),
+                trials, skipped, git_revision(), socket.gethostname(), os.getpid(),
             ),
         )  # fmt: skip
         return int(cur.lastrowid or 0)
+
+    def mark_abandoned(self, experiment: str) -> int:
+        """Mark the unfinished runs of ``experiment`` on this host whose process is gone
+        (killed with SIGKILL, so it could not record its end) as ``"interrupted"``;
+        returns how many. Their trials that finished are stored; the others are missing
+        and run again."""
+        host = socket.gethostname()
+        cur = self._db.execute(
+            "SELECT id, pid FROM runs WHERE experiment = ? AND finished_at IS NULL "
+            "AND status IS NULL AND host = ? AND pid IS NOT NULL",
+            (experiment, host),
+        )
+        gone = [rid for rid, pid in cur.fetchall() if not _process_alive(int(pid))]
+        for rid in gone:
+            self._db.execute("UPDATE runs SET status = 'interrupted' WHERE id = ?", (rid,))
+        return len(gone)
 
     def finish_run(self, run_id: int, *, ran: int, errors: int, interrupted: bool = False) -> None:
         """Record the end of a sweep (``status`` ``"finished"`` or ``"interrupted"``)."""

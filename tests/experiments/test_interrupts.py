@@ -238,6 +238,8 @@ def test_killed_sweep_leaves_no_workers_and_resumes(tmp_path: Path, sig: int) ->
     db.close()
     if sig == signal.SIGTERM:
         assert [r[0] for r in runs] == ["interrupted"] and runs[0][1] is not None
+    else:  # nobody could record the end: the next sweep marks it
+        assert runs == [(None, None)]
     E = load_example("line")
     trials = [Trial("demo", "line", E.hash(), (8, 8), "catalog", {}, seed=s) for s in range(n)]
     with ResultsStore(store) as st:
@@ -247,3 +249,26 @@ def test_killed_sweep_leaves_no_workers_and_resumes(tmp_path: Path, sig: int) ->
         assert (s.skipped, s.ran, s.errors) == (before, n - before, [])
         keys = [r["trial_key"] for r in st.rows("demo")]
     assert sorted(keys) == sorted(t.key for t in trials)  # every trial exactly once
+    db = sqlite3.connect(store)
+    runs = db.execute("SELECT status FROM runs ORDER BY id").fetchall()
+    db.close()
+    assert runs == [("interrupted",), ("finished",)]
+
+
+def test_mark_abandoned_only_marks_dead_runs(tmp_path: Path) -> None:
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    with ResultsStore(tmp_path / "r.sqlite") as st:
+        live = st.start_run("demo", {}, "c", trials=1, skipped=0)
+        gone = st.start_run("demo", {}, "c", trials=1, skipped=0)
+        other = st.start_run("other", {}, "c", trials=1, skipped=0)
+        db = sqlite3.connect(tmp_path / "r.sqlite")
+        db.execute("UPDATE runs SET pid = ? WHERE id IN (?, ?)", (dead.pid, gone, other))
+        db.commit()
+        db.close()
+        assert st.mark_abandoned("demo") == 1
+        assert st.mark_abandoned("demo") == 0
+    db = sqlite3.connect(tmp_path / "r.sqlite")
+    got = dict(db.execute("SELECT id, status FROM runs").fetchall())
+    db.close()
+    assert got == {live: None, gone: "interrupted", other: None}
