@@ -71,12 +71,23 @@ class RunSummary:
     stale: dict[str, int] = field(default_factory=dict)
 
     def line(self) -> str:
+        """One sentence, e.g. ``fig3_8: 12 trials, all 12 already stored; nothing to run``."""
         st = ", ".join(f"{k} {v}" for k, v in sorted(self.statuses.items()))
         n_stale = sum(self.stale.values())
         old = f" ({n_stale} by other code)" if n_stale else ""
+        head = f"{self.experiment}: {self.total} trial{'' if self.total == 1 else 's'}"
+        if self.total == 0:
+            return f"{self.experiment}: no trials; nothing to run"
+        every = "all " if self.total > 1 and self.skipped == self.total else ""
+        stored = f"{head}, {every}{self.skipped} already stored{old}"
+        if not self.ran and not self.errors and "report only" in self.executor:
+            return f"{stored}; report only, nothing run"
+        if not self.ran and not self.errors and self.skipped == self.total:
+            return f"{stored}; nothing to run"
         return (
-            f"{self.experiment}: {self.total} trials, {self.skipped} already stored{old}, "
-            f"{self.ran} run ({st or 'none'}) on {self.executor} in {self.time_s:.1f} s"
+            f"{head}, {self.skipped} already stored{old}, {self.ran} run"
+            + (f" ({st})" if st else "")
+            + f" on {self.executor} in {self.time_s:.1f} s"
             + (f", {len(self.errors)} errors" if self.errors else "")
         )
 

@@ -59,7 +59,7 @@ def test_resume_reports_rows_from_other_code_and_rerun_stale_recomputes_them(cap
     _age(db, 1, skip=2, rev=code_revision()[0], version="0.0.1")  # same sources, older version
     # resuming reuses them but says so: one line on stderr, exit 0
     code, out, err = _cli(capsys, *args)
-    assert code == 0 and "4 already stored (3 by other code), 0 run" in out
+    assert code == 0 and "all 4 already stored (3 by other code); nothing to run" in out
     (line,) = [ln for ln in err.splitlines() if ln.strip()]
     assert line.startswith("csplab: warning: fig3_8: 3 of the 4 stored trials")
     assert f"2 by git {OTHER} (csplab {__version__})" in line
