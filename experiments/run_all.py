@@ -82,6 +82,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--quick", action="store_true")
     p.add_argument("--report-only", action="store_true")
     p.add_argument("--rerun", action="store_true", help="run the sweeps' trials again")
+    p.add_argument("--rerun-stale", action="store_true",
+                   help="run again the stored trials that other code computed")  # fmt: skip
     a = p.parse_args(argv)
     installed = {s["name"] for s in available_solvers() if s.get("installed")}
     code = 0
@@ -109,13 +111,17 @@ def main(argv: list[str] | None = None) -> int:
             summary, report = run(
                 exp, quick=a.quick, store=a.store, out=Path(a.out) / name, jobs=a.jobs,
                 scheduler=a.scheduler, report_only=a.report_only, rerun=a.rerun,
+                rerun_stale=a.rerun_stale,
                 command=f"experiments/run_all.py --only {name}", **over,
             )  # fmt: skip
         except CsplabError as e:
             print(f"{name}: error: {e}", file=sys.stderr)
             code = 1
             continue
-        print(f"{name}: {summary.line()} ({time.perf_counter() - t0:.0f} s)")
+        print(f"{summary.line()} ({time.perf_counter() - t0:.0f} s)")
+        stale = summary.stale_line()
+        if stale:
+            print(stale, file=sys.stderr)
         if summary.errors or report.missing:
             code = 1
     return code
