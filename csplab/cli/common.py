@@ -43,20 +43,26 @@ COMPILING = "compiling csplab's kernels once (about 5 s; cached afterwards)"
 Model = ExampleModel | RuleSet
 
 
-def model_options(items: list[str] | None) -> dict[str, Any]:
-    """``KEY=VALUE`` strings (values parsed as JSON when possible) as a dict."""
+def key_values(items: list[str] | None, flag: str, form: str = "KEY=VALUE") -> dict[str, Any]:
+    """``KEY=VALUE`` strings of a repeatable ``flag`` as a dict (values parsed as JSON when
+    possible, else kept as strings); a malformed item is one line naming the flag."""
     import json
 
     opts: dict[str, Any] = {}
     for kv in items or []:
         key, sep, val = kv.partition("=")
         if not sep or not key:
-            raise InputError(f"--model-option {kv!r} must be KEY=VALUE")
+            raise InputError(f"{flag} {kv!r} must be {form}")
         try:
             opts[key] = json.loads(val)
         except json.JSONDecodeError:
             opts[key] = val
     return opts
+
+
+def model_options(items: list[str] | None) -> dict[str, Any]:
+    """The ``--model-option KEY=VALUE`` items as a dict."""
+    return key_values(items, "--model-option")
 
 
 def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
@@ -226,12 +232,9 @@ def load_grid(path: str, ndim: int | None, model: Model | None = None) -> NDArra
 
 def _npy_labels(p: Path) -> NDArray[np.int64]:
     """An ``.npy`` result grid: labels ``>= 0`` and ``-1`` for unassigned cells."""
-    try:
-        arr = np.load(p, allow_pickle=False)
-    except Exception as e:  # numpy raises many kinds of errors on damaged files
-        raise FormatError(f"not a readable .npy array ({e})", path=p) from None
-    if not np.issubdtype(arr.dtype, np.integer):
-        raise FormatError(f".npy array must hold integers, got {arr.dtype}", path=p)
+    from csplab.io.npy import load_int_array
+
+    arr = load_int_array(p)
     if arr.size and (int(arr.min()) < -1 or int(arr.max()) > np.iinfo(np.int32).max):
         bad = int(arr.min()) if int(arr.min()) < -1 else int(arr.max())
         raise FormatError(f"label {bad} is not a label id (0, 1, ... or -1 unassigned)", path=p)

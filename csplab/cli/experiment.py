@@ -21,7 +21,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from csplab.cli.common import check_output_dir, check_time_limit
+from csplab.cli.common import check_output_dir, check_time_limit, key_values
 from csplab.errors import InputError
 
 # common option -> (flags, argparse kwargs)
@@ -121,16 +121,7 @@ def _split(values: list[str] | None) -> list[str] | None:
 def _options(items: list[str] | None) -> dict[str, Any] | None:
     if items is None:
         return None
-    out: dict[str, Any] = {}
-    for kv in items:
-        key, sep, val = kv.partition("=")
-        if not sep or not key:
-            raise InputError(f"--option {kv!r} must be KEY=VALUE or SOLVER.KEY=VALUE")
-        try:
-            out[key] = json.loads(val)
-        except json.JSONDecodeError:
-            out[key] = val
-    return out
+    return key_values(items, "--option", "KEY=VALUE or SOLVER.KEY=VALUE")
 
 
 def _list() -> int:

@@ -10,6 +10,7 @@ from typing import Any
 from csplab.cli.common import (
     add_problem_args,
     check_output_path,
+    key_values,
     load_model,
     model_options,
     problem_from_args,
@@ -108,14 +109,7 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
                 f"--{flag.replace('_', '-')} does not apply to --solver {name} "
                 f"(it applies to {', '.join(solvers_taking(flag))})"
             )
-    for kv in args.option:
-        key, sep, val = kv.partition("=")
-        if not sep:
-            raise InputError(f"--option {kv!r} must be KEY=VALUE")
-        try:
-            opts[key] = json.loads(val)
-        except json.JSONDecodeError:
-            opts[key] = val
+    opts.update(key_values(args.option, "--option"))
     return opts
 
 

@@ -15,8 +15,10 @@ Examples
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
@@ -32,8 +34,9 @@ def sniff(head: bytes) -> int:
     return SURE if head.startswith(MAGIC) else NO
 
 
-def read_npy(path: str | Path) -> ExampleModel:
-    """An example model from an ``.npy`` int array (no pickles)."""
+def load_int_array(path: str | Path) -> NDArray[np.integer[Any]]:
+    """The integer array of an ``.npy`` file (no pickles); one :class:`FormatError` line
+    for a damaged file or another dtype."""
     p = Path(path)
     try:
         arr = np.load(p, allow_pickle=False)
@@ -41,6 +44,13 @@ def read_npy(path: str | Path) -> ExampleModel:
         raise FormatError(f"not a readable .npy array ({e})", path=p) from None
     if not np.issubdtype(arr.dtype, np.integer):
         raise FormatError(f".npy array must hold integers, got {arr.dtype}", path=p)
+    return np.asarray(arr)
+
+
+def read_npy(path: str | Path) -> ExampleModel:
+    """An example model from an ``.npy`` int array (no pickles)."""
+    p = Path(path)
+    arr = load_int_array(p)
     try:
         return ExampleModel(arr, name=p.stem, meta={"format": "npy", "source": str(p)})
     except InputError as e:

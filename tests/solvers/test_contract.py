@@ -78,7 +78,7 @@ def test_validation_comes_from_the_declaration():
         cls.validate({"block": 3})
     with pytest.raises(InputError, match="choice must be one of uniform, weighted"):
         cls.validate({"choice": "heavy"})
-    with pytest.raises(InputError, match="at least 0"):
+    with pytest.raises(InputError, match="time_limit must be a positive number of seconds"):
         cls.validate({"time_limit": -1})
     assert solver_class("blocks").validate({"block": "4x3"})["block"] == (4, 3)
     P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
