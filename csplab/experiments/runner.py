@@ -291,18 +291,25 @@ def _kill_workers(pool: ProcessPoolExecutor) -> None:
 
 
 def _check_dependencies(todo: Sequence[Trial]) -> None:
-    """One :class:`DependencyError` line, before anything runs, when a solver of the trials
-    to run needs a package that is not installed (an unknown solver is left to its trials,
-    which report it)."""
+    """One line, before anything runs, when a solver of the trials to run needs a package
+    that is not installed (:class:`DependencyError`) or is given an option it does not
+    declare or a bad value (:class:`InputError`, e.g. ``catalog@order=zigzag`` or
+    ``--option time_limit=0``). An unknown solver is left to its trials, which report it."""
     from csplab.solvers import get_solver
 
-    for spec in sorted({t.solver for t in todo}):
+    seen: set[str] = set()
+    for t in todo:
+        key = f"{t.solver}|{sorted(t.options.items(), key=str)!r}"
+        if key in seen:
+            continue
+        seen.add(key)
         try:
-            get_solver(spec)
+            cls, backend = get_solver(t.solver)
         except DependencyError:
             raise
         except CsplabError:
-            pass
+            continue
+        cls.validate(t.options, backend)
 
 
 Stream = Iterator[tuple[Trial, dict[str, Any] | None, str | None]]

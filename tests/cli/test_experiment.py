@@ -46,6 +46,8 @@ def test_quick_run_json_then_report_only(capsys, tmp_path):
         (["--example", "nosuchmodel"], "neither a model file"),
         (["--option", "novalue"], "KEY=VALUE"),
         (["--solver", "nosuchsolver", "--seeds", "1"], "unknown solver 'nosuchsolver'"),
+        (["--solver", "catalog@order=zigzag"], "order must be one of"),
+        (["--option", "catalog.choice=heavy"], "choice must be one of"),
         (["--jobs", "0"], "--jobs"),
     ],
 )
