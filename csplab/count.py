@@ -54,6 +54,7 @@ from csplab.catalog import Propagator
 from csplab.deps import available, require
 from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
+from csplab.progress import progress_bar
 from csplab.rng import RngLike, make_rng
 
 if TYPE_CHECKING:
@@ -167,7 +168,7 @@ def frontier_order(problem: Problem, domains: NDArray[np.bool_] | None = None) -
 
 
 def _count_transfer(
-    problem: Problem, max_states: int, deadline: float | None = None
+    problem: Problem, max_states: int, deadline: float | None = None, progress: bool = False
 ) -> tuple[int, dict[str, Any]]:
     eng = Propagator(problem)
     if not eng.ok:
@@ -195,7 +196,8 @@ def _count_transfer(
     counts: NDArray[Any] = np.ones(1, dtype=np.int64)
     big = False
     peak = 1
-    for step, v in enumerate(order):
+    steps = progress_bar(enumerate(order), total=n, desc="transfer matrix", enabled=progress)
+    for step, v in steps:
         if deadline is not None and time.perf_counter() > deadline:
             raise CountTimeoutError("transfer", f"after {step} of {n} cells")
         D = np.flatnonzero(dom[v]).astype(np.int32)
@@ -396,8 +398,12 @@ def count_solutions(
     epsilon: float = 0.8,
     delta: float = 0.2,
     time_limit: float | None = None,
+    progress: bool = False,
 ) -> Count:
     """The number of solutions of ``problem`` (see the module docstring for methods).
+
+    ``progress=True`` shows a bar on stderr (after 2 s) while the transfer matrix sweeps the
+    cells (the CLI turns it on).
 
     Parameters
     ----------
@@ -440,7 +446,7 @@ def count_solutions(
     deadline = None if time_limit is None else t0 + time_limit
     if method in ("auto", "transfer"):
         try:
-            val, st = _count_transfer(problem, max_states, deadline)
+            val, st = _count_transfer(problem, max_states, deadline, progress)
             return Count(val, "transfer", True, time.perf_counter() - t0, st)
         except _TooBig as e:
             if method == "transfer":

@@ -72,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     try:
         c = count_solutions(
             problem, args.method, rng=args.seed, epsilon=args.epsilon, delta=args.delta,
-            time_limit=time_limit,
+            time_limit=time_limit, progress=True,
         )  # fmt: skip
     except CountTimeoutError as stop:
         size = "x".join(map(str, problem.shape))

@@ -136,6 +136,8 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
         else:
             settings[key] = f"{o.default} ({'solver default' if suggested else source})"
     settings["restarts"] = 0 if cls.complete else args.restarts
+    if cls.takes("progress"):
+        opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
     return settings
 
 

@@ -37,6 +37,7 @@ from csplab.engine.sat import SAT_STAT_KEYS, SatOracle
 from csplab.engine.sat import backends as sat_backends
 from csplab.errors import CsplabError
 from csplab.problem import Problem
+from csplab.progress import progress_bar
 from csplab.result import Result
 from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Option, Solver, order_option
 
@@ -57,13 +58,16 @@ class PerfectSolver(Solver):
         order_option(("scanline", "random", "scan:AXES")),
         CHOICE,
         Option("pool", int, 16, "witness solutions kept (labels known to be in C*)", minimum=1),
+        Option("progress", bool, False, "a progress bar on stderr (after 2 s; the CLI's default)"),
         TIME_LIMIT,
     )  # fmt: skip
     backends = staticmethod(sat_backends)
 
     def run(self, problem: Problem, call: Call) -> Result:
         rng, backend = call.rng, call.backend
-        order, choice, pool, time_limit = call.get("order", "choice", "pool", "time_limit")
+        order, choice, pool, time_limit, progress = call.get(
+            "order", "choice", "pool", "time_limit", "progress"
+        )
         t0 = time.perf_counter()
         deadline = None if time_limit is None else t0 + float(time_limit)
         n = problem.n
@@ -89,7 +93,8 @@ class PerfectSolver(Solver):
             wit = WitnessPool(n, pool)
             assert o.grid is not None
             wit.add(o.grid.reshape(-1))
-            for p in perm.tolist():
+            cells = progress_bar(perm.tolist(), total=n, desc="perfect", enabled=progress)
+            for p in cells:
                 if deadline is not None and time.perf_counter() > deadline:
                     return self.result("timeout", grid, problem, stats, t0)
                 labels = eng.domain(p)
