@@ -147,6 +147,10 @@ class Problem:
         A short name for reports.
     meta : mapping
         Free-form provenance (example name and hash, boundary labels, periodicity ...).
+    positions : array_like of float, shape ``(n, d)``, optional
+        Where each cell is, for problems whose cells are not a grid (continuous model
+        synthesis: arrangement vertices and edges, in line spacings). ``blocks`` cuts such
+        a problem into boxes of these coordinates; grid problems leave it ``None``.
 
     Notes
     -----
@@ -169,6 +173,7 @@ class Problem:
         base_domains: ArrayLike | None = None,
         name: str = "",
         meta: Mapping[str, Any] | None = None,
+        positions: ArrayLike | None = None,
     ) -> None:
         self.shape: tuple[int, ...] = tuple(int(s) for s in shape)
         if not self.shape or any(s < 1 for s in self.shape):
@@ -212,6 +217,13 @@ class Problem:
             relation_names = tuple(relation_names)
             if len(relation_names) != rel.shape[0]:
                 raise InputError("one relation name per relation is needed")
+        pos = None
+        if positions is not None:
+            pos = np.array(positions, dtype=np.float64)
+            if pos.ndim != 2 or pos.shape[0] != n:
+                raise InputError(f"positions must have shape ({n}, d), got {pos.shape}")
+            pos.setflags(write=False)
+        self.positions: NDArray[np.float64] | None = pos
         for arr in (dom, rel, a, w, base):
             arr.setflags(write=False)
         self.domains: NDArray[np.bool_] = dom
@@ -371,6 +383,7 @@ class Problem:
             shape=self.shape, domains=self.domains, relations=self.relations, arcs=self.arcs,
             weights=self.weights, names=self.names, relation_names=self.relation_names,
             unary=self.unary, base_domains=self.base_domains, name=self.name, meta=self.meta,
+            positions=self.positions,
         )  # fmt: skip
         args.update(changes)
         return Problem(**args)
@@ -458,6 +471,7 @@ class Problem:
             relation_names=self.relation_names,
             name=self.name,
             meta={**self.meta, "subproblem_of": self.shape},
+            positions=None if self.positions is None else self.positions[idx],
         )
 
 

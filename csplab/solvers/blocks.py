@@ -171,7 +171,8 @@ def run_blocks(
     t0 = time.perf_counter()
     if retries < 0 or sweeps < 1:
         raise InputError("retries must be >= 0 and sweeps >= 1")
-    m = _block_shape(block, problem.shape)
+    boxes = _position_boxes(problem, block) if problem.positions is not None else None
+    m = _block_shape(block, problem.shape) if boxes is None else (0,)
     if init is None:
         grid = trivial_solution(problem).reshape(-1).copy()
         init_kind = "trivial"
@@ -185,19 +186,24 @@ def run_blocks(
         grid = g0.reshape(-1).astype(np.int32).copy()
         init_kind = "given"
     idx = np.arange(problem.n, dtype=np.int64).reshape(problem.shape)
-    starts = [block_starts(s, b) for s, b in zip(problem.shape, m, strict=True)]
+    if boxes is None:
+        starts = [block_starts(s, b) for s, b in zip(problem.shape, m, strict=True)]
+        boxes = [
+            idx[tuple(slice(a, a + b) for a, b in zip(q, m, strict=True))].reshape(-1)
+            for q in itertools.product(*starts)
+        ]
     tried = accepted = retry_count = 0
     revisions = 0
     deadline = None if time_limit is None else t0 + float(time_limit)
     status: Status = "solved"
     for _sweep in range(sweeps):
-        for q in itertools.product(*starts):
+        for cells in boxes:
             if deadline is not None and time.perf_counter() > deadline:
                 status = "timeout"
                 break
-            box = tuple(slice(a, a + b) for a, b in zip(q, m, strict=True))
-            cells = idx[box].reshape(-1)
-            sub = problem.subproblem(cells, grid, shape=m)
+            if not cells.size:
+                continue
+            sub = problem.subproblem(cells, grid, shape=None if m == (0,) else m)
             tried += 1
             for attempt in range(retries + 1):
                 left = None if deadline is None else max(0.0, deadline - time.perf_counter())
@@ -219,7 +225,7 @@ def run_blocks(
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
     stats: dict[str, Any] = {
-        "block": list(m),
+        "block": list(m) if m != (0,) else _block_list(block, problem),
         "blocks_tried": tried,
         "blocks_accepted": accepted,
         "retries": retry_count,
@@ -233,6 +239,37 @@ def run_blocks(
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
+
+
+def _block_list(block: int | Sequence[int], problem: Problem) -> list[int]:
+    d = 1 if problem.positions is None else problem.positions.shape[1]
+    return [int(block)] * d if isinstance(block, int | np.integer) else [int(b) for b in block]
+
+
+def _position_boxes(problem: Problem, block: int | Sequence[int]) -> list[NDArray[np.int64]]:
+    """Cells in overlapping boxes of ``block`` position units per axis (problems with
+    :attr:`Problem.positions`, such as continuous models: boxes in line spacings), shifted
+    by half a box, x outermost; a cell on a box's border belongs to it."""
+    pos = problem.positions
+    assert pos is not None
+    d = pos.shape[1]
+    m = _block_list(block, problem)
+    if len(m) == 1:
+        m = m * d
+    if len(m) != d or any(b < 1 for b in m):
+        raise InputError(f"block size {block!r} must be positive, one per axis of {d}")
+    lo, hi = pos.min(axis=0), pos.max(axis=0)
+    starts = [
+        [lo[a] + s for s in block_starts(max(1, int(np.ceil(hi[a] - lo[a]))), m[a])]
+        for a in range(d)
+    ]
+    out = []
+    for q in itertools.product(*starts):
+        inside = np.ones(problem.n, dtype=bool)
+        for a in range(d):
+            inside &= (pos[:, a] >= q[a] - 1e-9) & (pos[:, a] <= q[a] + m[a] + 1e-9)
+        out.append(np.flatnonzero(inside).astype(np.int64))
+    return out
 
 
 def _block_arg(value: Any) -> int | tuple[int, ...]:

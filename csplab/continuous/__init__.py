@@ -1,0 +1,1 @@
+"""Continuous model synthesis (thesis Ch. 4)."""

@@ -1,0 +1,347 @@
+"""The line arrangement of continuous model synthesis (Alg. 4.1 step 1), exact.
+
+**The lattice.** The example's vertices are put on an integer lattice: ``origin`` is the
+lower-left corner of its bounding box and ``spacing`` the largest length ``s`` such that every
+vertex is ``origin + s * (i, j)`` for integers ``i, j`` (the example's own vertices then lie on
+lines, and stretched copies of the example are solutions; ``--spacing`` overrides it, and
+``snap=True`` rounds vertices that are off the lattice). Every edge direction is then an
+integer vector; directions equal up to sign are one family. For each family with primitive
+integer normal ``n = (p, q)`` the lines are ``p x + q y = k`` for *every* integer ``k`` (in
+lattice units): lines of one family are equally spaced (``s / |n|`` apart), and every lattice
+point lies on a line of every family, which is Sec. 4.5.8's requirement (several families meet
+where the example has a vertex of several edges) met by construction in 2D.
+
+**Exactness.** Two lines of families ``f, g`` meet at a point with rational coordinates of
+denominator ``det(n_f, n_g)``; with ``D`` the least common multiple of all these
+determinants, every arrangement vertex has integer coordinates ``(X, Y) = D * (x, y)``. All
+incidences (which lines pass through a vertex, consecutive vertices along a line) are integer
+arithmetic, so three or more lines meeting at a point are found exactly.
+
+**The region** is ``[0, W] x [0, H]`` in lattice units. Its sides are lines of the horizontal
+and vertical families; when the example has no such edges these families are added as
+*boundary-only* families with just the two side lines (the example never has an edge of their
+direction, so only empty space may touch a side that is not an example direction).
+
+Families are sorted by the angle of their direction ``d`` in ``[0, pi)``; rays are numbered
+``f`` (along ``+d_f``) and ``F + f`` (along ``-d_f``), so ray numbers are in angular order.
+
+Examples
+--------
+>>> lat = Lattice.of([[(0, 0), (4, 0), (2, 3)]])
+>>> lat.spacing, lat.directions
+(Fraction(1, 1), ((1, 0), (2, 3), (-2, 3)))
+>>> A = Arrangement(lat, 4, 3)
+>>> A.D, A.n_vertices > 0, sorted(set(A.edge_family.tolist()))
+(12, True, [0, 1, 2, 3])
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.errors import InputError
+
+__all__ = ["Arrangement", "Lattice", "MAX_FAMILIES"]
+
+#: rays are bits of an int64 mask (two per family)
+MAX_FAMILIES = 31
+_DEN = 10**6  # largest denominator when reading a float coordinate as a rational
+_REL = 1e-9  # a float coordinate is that rational if within this relative distance
+_SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
+
+
+def _frac(x: float) -> Fraction:
+    return Fraction(x).limit_denominator(_DEN)
+
+
+def _gcd_fractions(fs: Iterable[Fraction]) -> Fraction:
+    g = Fraction(0)
+    for f in fs:
+        f = abs(f)
+        if f == 0:
+            continue
+        if g == 0:
+            g = f
+        else:
+            lcm_den = g.denominator * f.denominator // math.gcd(g.denominator, f.denominator)
+            g = Fraction(
+                math.gcd(g.numerator * (lcm_den // g.denominator),
+                         f.numerator * (lcm_den // f.denominator)),
+                lcm_den,
+            )  # fmt: skip
+    return g
+
+
+def _primitive(dx: int, dy: int) -> tuple[int, int]:
+    g = math.gcd(dx, dy)
+    dx, dy = dx // g, dy // g
+    if dy < 0 or (dy == 0 and dx < 0):
+        dx, dy = -dx, -dy
+    return dx, dy
+
+
+def _angle(d: tuple[int, int]) -> float:
+    return math.atan2(d[1], d[0])
+
+
+@dataclass(frozen=True)
+class Lattice:
+    """Origin, spacing and edge directions (integer, primitive, angle in ``[0, pi)``)
+    of an example; see the module docstring. Build with :meth:`of`."""
+
+    origin: tuple[Fraction, Fraction]
+    spacing: Fraction
+    directions: tuple[tuple[int, int], ...]
+    #: largest distance (in spacings) a vertex was moved by ``snap`` (0 when exact)
+    snapped: float = 0.0
+
+    @classmethod
+    def of(
+        cls,
+        rings: Sequence[Sequence[tuple[float, float]]],
+        spacing: float | None = None,
+        *,
+        snap: bool = False,
+        max_extent: int = 256,
+        where: str = "<model>",
+    ) -> Lattice:
+        """The lattice of a set of rings (see the module docstring).
+
+        ``max_extent`` bounds the example's size in spacings (a default spacing that is
+        tiny because coordinates share no common unit asks for ``spacing=``).
+        """
+        pts = np.concatenate([np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings])
+        lo = pts.min(axis=0)
+        if spacing is not None:
+            if not (math.isfinite(spacing) and spacing > 0):
+                raise InputError(f"spacing must be a positive number, not {spacing!r}")
+            s = _frac(float(spacing))
+            origin = (_frac(float(lo[0])), _frac(float(lo[1])))
+        else:
+            fr = [[_frac(float(v)) for v in p] for p in pts.tolist()]
+            for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
+                for v, q in zip(p, f, strict=True):
+                    if abs(float(q) - v) > _REL * max(1.0, abs(v)):
+                        raise InputError(
+                            f"{where}: vertex {i} ({p[0]:g}, {p[1]:g}) has no exact rational "
+                            "form; pass a spacing (and snap=true to round vertices onto it)"
+                        )
+            origin = (min(f[0] for f in fr), min(f[1] for f in fr))
+            s = _gcd_fractions([f[a] - origin[a] for f in fr for a in (0, 1)])
+            if s == 0:
+                raise InputError(f"{where}: the example has no extent")
+        u = (pts - np.array([float(origin[0]), float(origin[1])])) / float(s)
+        iu = np.rint(u)
+        off = float(np.abs(u - iu).max()) if u.size else 0.0
+        if off > _SNAP_TOL and not snap:
+            k = int(np.abs(u - iu).max(axis=1).argmax())
+            raise InputError(
+                f"{where}: vertex ({pts[k, 0]:g}, {pts[k, 1]:g}) is {off:.3g} spacings off the "
+                f"lattice of spacing {float(s):g}; choose another spacing or snap=true"
+            )
+        ext = int(iu.max()) if iu.size else 0
+        if ext > max_extent:
+            raise InputError(
+                f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
+                f"{max_extent}); pass a larger spacing (with snap=true if vertices are off it)"
+            )
+        dirs: set[tuple[int, int]] = set()
+        start = 0
+        for r in rings:
+            m = len(r)
+            ring = iu[start : start + m].astype(np.int64)
+            start += m
+            nxt = np.roll(ring, -1, axis=0)
+            for (x0, y0), (x1, y1) in zip(ring.tolist(), nxt.tolist(), strict=True):
+                if (x0, y0) != (x1, y1):
+                    dirs.add(_primitive(x1 - x0, y1 - y0))
+        if len(dirs) > MAX_FAMILIES - 2:
+            raise InputError(
+                f"{where}: {len(dirs)} edge directions; at most {MAX_FAMILIES - 2} are supported "
+                "(use bounding shapes, Sec. 4.6.4, or a coarser spacing with snap=true)"
+            )
+        return cls(origin, s, tuple(sorted(dirs, key=_angle)), off if snap else 0.0)
+
+    def to_lattice(self, xy: NDArray[np.float64]) -> NDArray[np.int64]:
+        """World coordinates -> integer lattice coordinates (rounded)."""
+        o = np.array([float(self.origin[0]), float(self.origin[1])])
+        return np.rint((np.asarray(xy, dtype=np.float64) - o) / float(self.spacing)).astype(
+            np.int64
+        )
+
+    def to_world(self, uv: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Lattice coordinates (floats) -> world coordinates."""
+        o = np.array([float(self.origin[0]), float(self.origin[1])])
+        return o + np.asarray(uv, dtype=np.float64) * float(self.spacing)
+
+    def families(self) -> tuple[tuple[tuple[int, int], ...], tuple[bool, ...]]:
+        """Directions of all line families in angular order, with the horizontal and
+        vertical ones added if missing, and which of them are boundary-only."""
+        ds = list(self.directions)
+        extra = [d for d in ((1, 0), (0, 1)) if d not in ds]
+        allds = sorted(ds + extra, key=_angle)
+        return tuple(allds), tuple(d in extra for d in allds)
+
+
+def _lcm(a: int, b: int) -> int:
+    return a * b // math.gcd(a, b)
+
+
+class Arrangement:
+    """Vertices and edges of the lines of ``lattice``'s families in ``[0, W] x [0, H]``
+    (lattice units); see the module docstring.
+
+    Attributes
+    ----------
+    dirs : int array ``(F, 2)``
+        Family directions (angular order); ``normals`` ``(F, 2)`` is ``(dy, -dx)``.
+    boundary_only : bool array ``(F,)``
+    D : int
+        Scale: vertex ``v`` is at ``(X[v], Y[v]) / D`` lattice units.
+    X, Y : int64 arrays
+        Vertices, sorted by ``(X, Y)`` (the thesis' scan order, x outermost).
+    edge_src, edge_dst, edge_family : int64 arrays
+        Edges, each from ``edge_src`` to ``edge_dst`` along ``+d`` of its family; consecutive
+        vertices on one line.
+    ray_mask : int64 array
+        Bit ``f`` (ray along ``+d_f``) and bit ``F + f`` (along ``-d_f``) of each vertex.
+    """
+
+    def __init__(self, lattice: Lattice, W: int, H: int) -> None:
+        if W < 1 or H < 1:
+            raise InputError(f"the region must be at least 1x1 spacings, not {W}x{H}")
+        self.lattice, self.W, self.H = lattice, int(W), int(H)
+        dirs, bonly = lattice.families()
+        self.dirs = np.array(dirs, dtype=np.int64).reshape(-1, 2)
+        self.boundary_only = np.array(bonly, dtype=bool)
+        self.normals = np.stack([self.dirs[:, 1], -self.dirs[:, 0]], axis=1)
+        F = self.F = len(dirs)
+        D = 1
+        for f in range(F):
+            for g in range(f + 1, F):
+                D = _lcm(D, abs(self._det(f, g)))
+        self.D = D
+        WD, HD = self.W * D, self.H * D
+        corners = np.array([[0, 0], [W, 0], [0, H], [W, H]], dtype=np.int64)
+        self.k_range: list[NDArray[np.int64]] = []
+        for f in range(F):
+            kc = corners @ self.normals[f]
+            lo, hi = int(kc.min()), int(kc.max())
+            ks = np.array([lo, hi]) if bonly[f] else np.arange(lo, hi + 1)
+            self.k_range.append(ks.astype(np.int64))
+        keys = []
+        for f in range(F):
+            for g in range(f + 1, F):
+                det = self._det(f, g)
+                (pf, qf), (pg, qg) = self.normals[f], self.normals[g]
+                kf, kg = np.meshgrid(self.k_range[f], self.k_range[g], indexing="ij")
+                m = D // det
+                X = (kf * qg - kg * qf) * m
+                Y = (pf * kg - pg * kf) * m
+                ok = (X >= 0) & (X <= WD) & (Y >= 0) & (Y <= HD)
+                keys.append(X[ok] * (HD + 1) + Y[ok])
+        key = np.unique(np.concatenate(keys))
+        self.X, self.Y = key // (HD + 1), key % (HD + 1)
+        nv = self.n_vertices
+        # families through each vertex, and the edges along each line
+        src, dst, fam = [], [], []
+        mask = np.zeros(nv, dtype=np.int64)
+        for f in range(F):
+            p, q = self.normals[f]
+            s = p * self.X + q * self.Y
+            on = s % D == 0
+            k = s // D
+            if bonly[f]:
+                on &= np.isin(k, self.k_range[f])
+            idx = np.flatnonzero(on)
+            dx, dy = self.dirs[f]
+            t = dx * self.X[idx] + dy * self.Y[idx]
+            o = np.lexsort((t, k[idx]))
+            idx, kk = idx[o], k[idx][o]
+            same = kk[1:] == kk[:-1]
+            a, b = idx[:-1][same], idx[1:][same]
+            src.append(a)
+            dst.append(b)
+            fam.append(np.full(a.size, f, dtype=np.int64))
+            mask[a] |= np.int64(1) << f
+            mask[b] |= np.int64(1) << (F + f)
+        self.edge_src = np.concatenate(src)
+        self.edge_dst = np.concatenate(dst)
+        self.edge_family = np.concatenate(fam)
+        self.ray_mask = mask
+
+    def _det(self, f: int, g: int) -> int:
+        (pf, qf), (pg, qg) = self.normals[f], self.normals[g]
+        return int(pf * qg - pg * qf)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_vertices(self) -> int:
+        return int(self.X.size)
+
+    @property
+    def n_edges(self) -> int:
+        return int(self.edge_src.size)
+
+    # ------------------------------------------------------------------ geometry
+    @cached_property
+    def ray_angles(self) -> NDArray[np.float64]:
+        """Angle of ray ``r`` (``2F`` values, increasing)."""
+        a = np.arctan2(self.dirs[:, 1], self.dirs[:, 0]).astype(np.float64)
+        return np.concatenate([a, a + np.pi])
+
+    def vertex_xy(self) -> NDArray[np.float64]:
+        """Vertices in lattice units, ``(n, 2)`` floats."""
+        return np.stack([self.X, self.Y], axis=1) / self.D
+
+    def edge_xy(self) -> NDArray[np.float64]:
+        """Edge midpoints in lattice units."""
+        v = self.vertex_xy()
+        return 0.5 * (v[self.edge_src] + v[self.edge_dst])
+
+    def on_side(self) -> NDArray[np.int64]:
+        """Per vertex, bits 1 (x=0), 2 (x=W), 4 (y=0), 8 (y=H) of the sides it lies on."""
+        WD, HD = self.W * self.D, self.H * self.D
+        return (
+            (self.X == 0) * 1 + (self.X == WD) * 2 + (self.Y == 0) * 4 + (self.Y == HD) * 8
+        ).astype(np.int64)
+
+    def outside_sectors(self, rays: Sequence[int], side: int) -> tuple[bool, ...]:
+        """For a vertex with ``rays`` (sorted) on the sides ``side`` (bits of
+        :meth:`on_side`), which sectors (sector ``i`` runs counter-clockwise from ray ``i``)
+        lie outside the region."""
+        ang = self.ray_angles
+        out = []
+        m = len(rays)
+        for i in range(m):
+            a = ang[rays[i]]
+            b = ang[rays[(i + 1) % m]] if m > 1 else a + 2 * np.pi
+            if b <= a:
+                b += 2 * np.pi
+            mid = 0.5 * (a + b)
+            c, s = math.cos(mid), math.sin(mid)
+            o = ((side & 1) and c < -1e-9) or ((side & 2) and c > 1e-9)
+            o = o or ((side & 4) and s < -1e-9) or ((side & 8) and s > 1e-9)
+            out.append(bool(o))
+        return tuple(out)
+
+    def edge_outside(self) -> NDArray[np.int8]:
+        """Per edge: 0 inside, 1 if its left side is outside the region, 2 if its right."""
+        side = self.on_side()
+        common = side[self.edge_src] & side[self.edge_dst]
+        out = np.zeros(self.n_edges, dtype=np.int8)
+        for bit, outward in ((1, (-1, 0)), (2, (1, 0)), (4, (0, -1)), (8, (0, 1))):
+            sel = (common & bit) != 0
+            if not sel.any():
+                continue
+            d = self.dirs[self.edge_family[sel]]
+            left = -d[:, 1] * outward[0] + d[:, 0] * outward[1]  # left normal . outward
+            out[np.flatnonzero(sel)] = np.where(left > 0, 1, 2)
+        return out

@@ -1,0 +1,462 @@
+"""Continuous model synthesis as a binary CSP (thesis Sec. 4.5.1-4.5.6; 2008 paper Sec. 3.2-3.3).
+
+**Neighbourhoods.** Around any point, a model looks like a set of rays (boundary directions)
+with a label in each sector between consecutive rays. A neighbourhood is written *reduced*:
+the rays whose two sides carry different labels, each with the label counter-clockwise after
+it, in angular order; a point inside one label is ``((-1, label),)``. Eq. 4.1 asks that every
+neighbourhood of the output occurs in the example.
+
+**The example's neighbourhoods** are found as in the paper's Fig. 2(b): the example is cut by
+the same line families (:class:`~csplab.continuous.arrangement.Arrangement` over its bounding
+box plus one spacing), each face gets the label of the example there, and the reduced
+neighbourhoods of every vertex, edge and face are collected. (The checker,
+:func:`csplab.continuous.check.violations`, derives them independently from the polygons.)
+
+**Variables** are the arrangement's vertices and edges (the paper's states live there; faces
+are implied). An edge's value is the pair (label on its left, label on its right) w.r.t. its
+family's direction, value ``left * K_l + right`` over the ``K_l`` labels (0 and the
+example's object labels, compacted); it is allowed if the two labels are equal or the example
+has an edge of that direction with those sides. A vertex's value indexes the list of allowed
+states of its *type* (its rays, and which of its sectors are outside the region): the
+expansions of the example's neighbourhoods whose rays are all among the vertex's rays (the
+parallel-line assumption of Sec. 4.5.2), with outside sectors equal to the boundary label.
+Value 0 is always all-empty. **Constraints**: one binary relation per (vertex type, ray): a
+vertex state agrees with an edge value only when the edge's two labels are the vertex's
+sectors on either side of that ray (paper Sec. 3.3). Every csplab solver runs unchanged on
+the resulting :class:`~csplab.problem.Problem`; its ``positions`` (in spacings) let
+``blocks`` modify it in boxes (Fig. 4.23).
+
+Examples
+--------
+>>> from csplab.continuous.model import PolygonModel
+>>> E = PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [4, 0], [2, 3]]}]})
+>>> C = ContinuousCSP(E, (8, 6))
+>>> C.problem.n == C.arrangement.n_vertices + C.arrangement.n_edges
+True
+>>> sorted(len(s) for s in C.type_states)[-1]       # vertices where 3 families meet
+8
+>>> C.edge_states_allowed(0)                         # horizontal edges: 3 of 4 (Fig. 4.15)
+[(0, 0), (1, 0), (1, 1)]
+"""
+
+from __future__ import annotations
+
+import bisect
+from collections.abc import Sequence
+from fractions import Fraction
+from typing import Any
+
+import numpy as np
+import shapely
+from numpy.typing import ArrayLike, NDArray
+
+from csplab.continuous.arrangement import Arrangement, Lattice
+from csplab.continuous.model import PolygonModel
+from csplab.errors import InputError
+from csplab.problem import Problem
+
+__all__ = ["ContinuousCSP", "Signature", "example_signatures", "reduce_signature"]
+
+Signature = tuple[tuple[int, int], ...]
+_EPS = 1e-6  # offset (in lattice units / D) of the sample points beside an edge
+
+
+def reduce_signature(rays: Sequence[int], labels: Sequence[int]) -> Signature:
+    """The reduced neighbourhood of rays (angular order) with ``labels[i]`` in the sector
+    counter-clockwise after ``rays[i]``.
+
+    >>> reduce_signature([0, 1, 2, 3], [1, 1, 0, 0])
+    ((1, 0), (3, 1))
+    >>> reduce_signature([0, 2], [5, 5])
+    ((-1, 5),)
+    """
+    m = len(rays)
+    keep = [i for i in range(m) if labels[i - 1] != labels[i]]
+    if not keep:
+        return ((-1, int(labels[0]) if m else 0),)
+    return tuple((int(rays[i]), int(labels[i])) for i in keep)
+
+
+def _expand(sig: Signature, rays: Sequence[int]) -> tuple[int, ...] | None:
+    """Sector labels of ``rays`` realising ``sig``, or None if ``sig`` uses another ray."""
+    if sig[0][0] == -1:
+        return (sig[0][1],) * len(rays)
+    srays = [r for r, _ in sig]
+    if not set(srays) <= set(rays):
+        return None
+    out = []
+    for r in rays:
+        j = bisect.bisect_right(srays, r) - 1
+        out.append(sig[j][1])  # j == -1 wraps to the last ray
+    return tuple(out)
+
+
+def _edge_labels(
+    A: Arrangement, shapes: dict[int, Any], offset: tuple[float, float]
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Labels left and right of each edge of ``A`` by point location in ``shapes``
+    (``{label: geometry}`` in lattice units shifted by ``offset``)."""
+    mid = A.edge_xy() - np.asarray(offset)
+    d = A.dirs[A.edge_family].astype(np.float64)
+    nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.hypot(d[:, 0], d[:, 1])[:, None]
+    eps = _EPS / A.D
+    out = []
+    for side in (1.0, -1.0):
+        p = mid + side * eps * nrm
+        lab = np.zeros(len(p), dtype=np.int64)
+        for b, g in shapes.items():
+            lab[shapely.contains_xy(g, p[:, 0], p[:, 1])] = b
+        out.append(lab)
+    return out[0], out[1]
+
+
+def _vertex_sectors(
+    A: Arrangement, left: NDArray[np.int64], right: NDArray[np.int64]
+) -> list[tuple[list[int], list[int]]]:
+    """Per vertex: its rays (sorted) and the label after each, from the edges' labels."""
+    F = A.F
+    after: list[dict[int, int]] = [{} for _ in range(A.n_vertices)]
+    for e, (a, b, f) in enumerate(
+        zip(A.edge_src.tolist(), A.edge_dst.tolist(), A.edge_family.tolist(), strict=True)
+    ):
+        after[a][f] = int(left[e])
+        after[b][F + f] = int(right[e])
+    out = []
+    for d in after:
+        rays = sorted(d)
+        out.append((rays, [d[r] for r in rays]))
+    return out
+
+
+def example_signatures(
+    example: PolygonModel, lattice: Lattice, label_index: dict[int, int]
+) -> set[Signature]:
+    """Every reduced neighbourhood of ``example`` (labels compacted by ``label_index``),
+    from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b))."""
+    lo = lattice.to_lattice(np.array([example.bounds[:2]]))[0]
+    hi = lattice.to_lattice(np.array([example.bounds[2:]]))[0]
+    A = Arrangement(lattice, int(hi[0] - lo[0]) + 2, int(hi[1] - lo[1]) + 2)
+    s = float(lattice.spacing)
+    o = np.array([float(lattice.origin[0]), float(lattice.origin[1])])
+    shapes = {}
+    for b in example.labels:
+        g = example.shape(b)
+        g = shapely.transform(g, lambda xy: (xy - o) / s - lo + 1.0)
+        shapely.prepare(g)
+        shapes[label_index[b]] = g
+    left, right = _edge_labels(A, shapes, (0.0, 0.0))
+    sigs: set[Signature] = {((-1, 0),)} | {((-1, i),) for i in shapes}
+    F = A.F
+    for f, L, R in zip(A.edge_family.tolist(), left.tolist(), right.tolist(), strict=True):
+        sigs.add(reduce_signature([f, F + f], [L, R]))
+    for rays, labs in _vertex_sectors(A, left, right):
+        if rays:
+            sigs.add(reduce_signature(rays, labs))
+    return sigs
+
+
+class ContinuousCSP:
+    """The binary CSP of continuous model synthesis for ``example`` in a ``W x H`` region
+    (in spacings); see the module docstring.
+
+    Parameters
+    ----------
+    example : PolygonModel
+    size : (int, int)
+        Region ``W x H`` in line spacings.
+    spacing : float, optional
+        Line spacing in the example's units (default: derived, see
+        :class:`~csplab.continuous.arrangement.Lattice`).
+    snap : bool
+        Round example vertices onto the lattice of ``spacing``.
+    boundary : int
+        The label outside the region (default 0, empty space).
+
+    Attributes
+    ----------
+    problem : Problem
+        The CSP; ``shape == (n,)``, cells in scan order (x outermost) of their positions.
+    arrangement : Arrangement
+    labels : tuple of int
+        Compact label index -> model label (index 0 is empty space).
+    type_rays, type_states : lists
+        Per vertex type, its rays and its allowed sector-label tuples (compact labels).
+    """
+
+    def __init__(
+        self,
+        example: PolygonModel,
+        size: Sequence[int],
+        *,
+        spacing: float | None = None,
+        snap: bool = False,
+        boundary: int = 0,
+        lattice: Lattice | None = None,
+    ) -> None:
+        if len(size) != 2:
+            raise InputError(f"a continuous 2D region needs WxH, not {tuple(size)}")
+        W, H = (int(v) for v in size)
+        if not example.polygons:
+            raise InputError(f"{example.source}: an example needs at least one polygon")
+        self.example = example
+        self.lattice = lattice or Lattice.of(
+            [r for p in example.polygons for r in p.rings()],
+            spacing,
+            snap=snap,
+            where=example.source,
+        )
+        if self.lattice.snapped:
+            example = _snapped(example, self.lattice)
+            self.example = example
+        self.labels: tuple[int, ...] = (0, *example.labels)
+        index = {b: i for i, b in enumerate(self.labels)}
+        if boundary not in index:
+            raise InputError(f"boundary label {boundary} does not occur in the example")
+        self.boundary = boundary
+        self.signatures = example_signatures(example, self.lattice, index)
+        A = self.arrangement = Arrangement(self.lattice, W, H)
+        F, Kl = A.F, len(self.labels)
+        self.Kl = Kl
+        b0 = index[boundary]
+        # vertex types
+        side = A.on_side()
+        tkey = (A.ray_mask << 4) | side
+        ukeys, vtype = np.unique(tkey, return_inverse=True)
+        self.vertex_type = vtype.astype(np.int64)
+        self.type_rays: list[list[int]] = []
+        self.type_states: list[list[tuple[int, ...]]] = []
+        for key in ukeys.tolist():
+            mask, sd = key >> 4, key & 15
+            rays = [r for r in range(2 * F) if (mask >> r) & 1]
+            outside = A.outside_sectors(rays, sd) if sd else (False,) * len(rays)
+            states = set()
+            for sig in self.signatures:
+                st = _expand(sig, rays)
+                if st is not None and all(st[i] == b0 for i in range(len(rays)) if outside[i]):
+                    states.add(st)
+            ordered = sorted(states, key=lambda st: (any(st), st))
+            if not ordered:
+                raise InputError(
+                    f"{example.source}: no neighbourhood of the example fits a vertex with rays "
+                    f"{rays} (boundary label {boundary})"
+                )
+            self.type_rays.append(rays)
+            self.type_states.append(ordered)
+        nst = max(len(s) for s in self.type_states)
+        K = self.K = max(nst, Kl * Kl)
+        # edge domains per family
+        edge_ok = np.zeros((F, Kl * Kl), dtype=bool)
+        for f in range(F):
+            for L in range(Kl):
+                for R in range(Kl):
+                    edge_ok[f, L * Kl + R] = reduce_signature([f, F + f], [L, R]) in self.signatures
+        eout = A.edge_outside()
+        nv, ne = A.n_vertices, A.n_edges
+        dom = np.zeros((nv + ne, K), dtype=bool)
+        nstates = np.array([len(s) for s in self.type_states], dtype=np.int64)
+        dom[:nv] = np.arange(K)[None, :] < nstates[vtype][:, None]
+        dom[nv:, : Kl * Kl] = edge_ok[A.edge_family]
+        Ls, Rs = np.divmod(np.arange(Kl * Kl), Kl)
+        for code, labs in ((1, Ls), (2, Rs)):
+            sel = np.flatnonzero(eout == code)
+            dom[nv + sel, : Kl * Kl] &= (labs == b0)[None, :]
+        # relations per (type, ray position), deduplicated
+        rel_ids: dict[bytes, int] = {}
+        rels: list[NDArray[np.bool_]] = []
+        pos_rel = np.full((len(ukeys), 2 * F), -1, dtype=np.int64)
+        for t, (rays, states) in enumerate(zip(self.type_rays, self.type_states, strict=True)):
+            S = np.array(states, dtype=np.int64).reshape(len(states), len(rays))
+            for i, r in enumerate(rays):
+                before, after = S[:, i - 1], S[:, i]
+                L, R = (after, before) if r < F else (before, after)
+                M = np.zeros((K, K), dtype=bool)
+                M[np.arange(len(states)), L * Kl + R] = True
+                k = M.tobytes()
+                if k not in rel_ids:
+                    rel_ids[k] = len(rels)
+                    rels.append(M)
+                pos_rel[t, r] = rel_ids[k]
+        # variables in scan order of their positions
+        pos = np.concatenate([A.vertex_xy(), A.edge_xy()])
+        order = np.lexsort((pos[:, 1], pos[:, 0]))
+        var = np.empty(nv + ne, dtype=np.int64)
+        var[order] = np.arange(nv + ne)
+        self.var_vertex, self.var_edge = var[:nv], var[nv:]
+        e = np.arange(ne)
+        f = A.edge_family
+        arcs = np.concatenate([
+            np.stack([var[A.edge_src], var[nv + e], pos_rel[vtype[A.edge_src], f]], axis=1),
+            np.stack([var[A.edge_dst], var[nv + e], pos_rel[vtype[A.edge_dst], F + f]], axis=1),
+        ])  # fmt: skip
+        if (arcs[:, 2] < 0).any():  # pragma: no cover - every incidence is a ray
+            raise AssertionError("an edge end without its ray")
+        self.problem = Problem(
+            (nv + ne,),
+            dom[order],
+            np.stack(rels),
+            arcs,
+            name=example.name or "continuous",
+            meta={
+                "continuous": True,
+                "example": example.name,
+                "size": [W, H],
+                "spacing": float(self.lattice.spacing),
+                "families": A.dirs.tolist(),
+                "vertices": nv,
+                "edges": ne,
+                "boundary": boundary,
+            },
+            positions=pos[order],
+        )
+
+    # ------------------------------------------------------------------ queries
+    def edge_states_allowed(self, family: int) -> list[tuple[int, int]]:
+        """The (left, right) model labels an inside edge of ``family`` may take."""
+        Kl, F = self.Kl, self.arrangement.F
+        return [
+            (self.labels[L], self.labels[R])
+            for L in range(Kl)
+            for R in range(Kl)
+            if reduce_signature([family, F + family], [L, R]) in self.signatures
+        ]
+
+    def vertex_state_counts(self) -> dict[tuple[int, ...], int]:
+        """Allowed states per inside vertex type, keyed by its families."""
+        F = self.arrangement.F
+        out: dict[tuple[int, ...], int] = {}
+        for rays, st in zip(self.type_rays, self.type_states, strict=True):
+            if len(rays) % 2 == 0 and all((r + F) in rays for r in rays if r < F):
+                fams = tuple(r for r in rays if r < F)
+                if len(fams) * 2 == len(rays):
+                    out[fams] = len(st)
+        return out
+
+    # ------------------------------------------------------------------ decoding
+    def edge_labels(self, grid: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+        """Compact (left, right) labels of every edge in a solution ``grid``."""
+        g = np.asarray(grid, dtype=np.int64).reshape(-1)
+        v = g[self.var_edge]
+        return v // self.Kl, v % self.Kl
+
+    def model(self, grid: ArrayLike, *, name: str = "") -> PolygonModel:
+        """The output polygons of a solution (faces merged per label, collinear vertices
+        dropped), in the example's coordinates."""
+        A = self.arrangement
+        g = np.asarray(grid, dtype=np.int64).reshape(-1)
+        if g.shape != (self.problem.n,) or (g < 0).any():
+            raise InputError("model() needs a complete solution of this problem")
+        F = A.F
+        left, right = self.edge_labels(g)
+        edge_at = {}
+        for e, (a, b, f) in enumerate(
+            zip(A.edge_src.tolist(), A.edge_dst.tolist(), A.edge_family.tolist(), strict=True)
+        ):
+            edge_at[(a, f)] = (e, b)
+            edge_at[(b, F + f)] = (e, a)
+        vstate = g[self.var_vertex]
+        shapes: dict[int, Any] = {}
+        xy = [(Fraction(int(x), A.D), Fraction(int(y), A.D)) for x, y in zip(A.X, A.Y, strict=True)]
+        s, (ox, oy) = self.lattice.spacing, self.lattice.origin
+        for L in range(1, self.Kl):
+            starts = []
+            for e in np.flatnonzero((left == L) & (right != L)).tolist():
+                starts.append((int(A.edge_src[e]), int(A.edge_family[e])))
+            for e in np.flatnonzero((right == L) & (left != L)).tolist():
+                starts.append((int(A.edge_dst[e]), F + int(A.edge_family[e])))
+            used: set[tuple[int, int]] = set()
+            rings = []
+            for start in starts:
+                if start in used:
+                    continue
+                ring: list[int] = []
+                v, r = start
+                while (v, r) not in used:
+                    used.add((v, r))
+                    _, w = edge_at[(v, r)]
+                    back = (r + F) % (2 * F)
+                    rays = self.type_rays[self.vertex_type[w]]
+                    sect = self.type_states[self.vertex_type[w]][vstate[w]]
+                    j = rays.index(back)
+                    i = j - 1
+                    while sect[i - 1] == L:
+                        i -= 1
+                    nxt = rays[i % len(rays)]
+                    if nxt != r:
+                        ring.append(w)
+                    v, r = w, nxt
+                pts = [(float(ox + s * xy[w][0]), float(oy + s * xy[w][1])) for w in ring]
+                rings.append(pts)
+            shapes[self.labels[L]] = _assemble(rings)
+        return PolygonModel.from_shapes(
+            shapes, name=name or f"{self.example.name or 'model'}-synth",
+            meta={"example": self.example.name, "size": self.problem.meta["size"],
+                  "spacing": float(self.lattice.spacing)},
+        )  # fmt: skip
+
+    # ------------------------------------------------------------------ encoding
+    def encode(self, model: PolygonModel) -> NDArray[np.int32]:
+        """The CSP assignment that a model lying on the lines describes (every vertex and
+        edge valued by point location beside the edges); vertices whose neighbourhood is not
+        an allowed state get -1 and edges with disallowed label pairs keep their value, so
+        :meth:`Problem.violations` tells whether ``model`` is a solution."""
+        A, lat = self.arrangement, self.lattice
+        index = {b: i for i, b in enumerate(self.labels)}
+        s = float(lat.spacing)
+        o = np.array([float(lat.origin[0]), float(lat.origin[1])])
+        shapes = {}
+        for b in model.labels:
+            if b not in index:
+                raise InputError(f"label {b} does not occur in the example")
+            gm = shapely.transform(model.shape(b), lambda xy: (xy - o) / s)
+            shapely.prepare(gm)
+            shapes[index[b]] = gm
+        left, right = _edge_labels(A, shapes, (0.0, 0.0))
+        eout = A.edge_outside()
+        b0 = index[self.boundary]
+        left[eout == 1] = b0
+        right[eout == 2] = b0
+        grid = np.full(self.problem.n, -1, dtype=np.int32)
+        grid[self.var_edge] = left * self.Kl + right
+        lookup = [{st: i for i, st in enumerate(sts)} for sts in self.type_states]
+        for v, (rays, labs) in enumerate(_vertex_sectors(A, left, right)):
+            t = self.vertex_type[v]
+            grid[self.var_vertex[v]] = lookup[t].get(tuple(labs), -1)
+        return grid
+
+
+def _assemble(rings: list[list[tuple[float, float]]]) -> Any:
+    """Counter-clockwise rings are shells, clockwise ones holes of the shell containing
+    them; returns a shapely (Multi)Polygon."""
+    from shapely.geometry import Polygon as SP
+
+    shells, holes = [], []
+    for r in rings:
+        a = np.asarray(r)
+        area = 0.5 * float(np.dot(a[:, 0], np.roll(a[:, 1], -1)) - np.dot(np.roll(a[:, 0], -1), a[:, 1]))
+        (shells if area > 0 else holes).append(r)
+    shell_polys = [SP(r) for r in shells]
+    owned: list[list[list[tuple[float, float]]]] = [[] for _ in shells]
+    if holes:
+        tree = shapely.STRtree(shell_polys)
+        for h in holes:
+            cand = tree.query(SP(h), predicate="covered_by")
+            best = min(cand.tolist(), key=lambda i: shell_polys[i].area) if len(cand) else None
+            if best is None:  # pragma: no cover - a hole always has a shell around it
+                raise AssertionError("a hole outside every shell")
+            owned[best].append(h)
+    return shapely.MultiPolygon([SP(s, hs) for s, hs in zip(shells, owned, strict=True)])
+
+
+def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
+    """The example with every vertex rounded onto ``lattice``."""
+
+    def snap(r: Sequence[tuple[float, float]]) -> list[list[float]]:
+        uv = lattice.to_lattice(np.asarray(r, dtype=np.float64)).astype(np.float64)
+        return lattice.to_world(uv).tolist()  # type: ignore[no-any-return]
+
+    polys = [
+        {"label": p.label, "points": snap(p.points), "holes": [snap(h) for h in p.holes],
+         **dict(p.extra)}
+        for p in example.polygons
+    ]  # fmt: skip
+    return PolygonModel(polys, name=example.name, meta=example.meta, source=example.source)
