@@ -66,7 +66,7 @@ def reduce_signature(rays: Sequence[int], labels: Sequence[int]) -> Signature:
     counter-clockwise after ``rays[i]``.
 
     >>> reduce_signature([0, 1, 2, 3], [1, 1, 0, 0])
-    ((1, 0), (3, 1))
+    ((0, 1), (2, 0))
     >>> reduce_signature([0, 2], [5, 5])
     ((-1, 5),)
     """

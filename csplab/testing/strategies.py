@@ -71,6 +71,7 @@ __all__ = [
     "csp_problems",
     "example_models",
     "label_grids",
+    "polygon_models",
     "problems",
     "random_problems",
     "shapes",
@@ -252,3 +253,59 @@ def csp_problems(draw: Any, max_side: int = 3, max_labels: int = 4, max_ndim: in
         c = draw(st.integers(0, P.n - 1))
         P = P.with_fixed({P.coords(c): draw(st.integers(0, P.K - 1))})
     return P
+
+
+@_composite
+def polygon_models(draw: Any, max_extent: int = 6, max_pieces: int = 3, max_labels: int = 3,
+                   kinds: tuple[str, ...] = ("convex", "cells", "cut")) -> Any:  # fmt: skip
+    """Random continuous examples (:class:`~csplab.continuous.model.PolygonModel`) with every
+    vertex on the integer lattice ``[0, max_extent]^2``: non-overlapping convex hulls of
+    random points (``convex``: arbitrary directions), unions of unit cells with several
+    labels, touching and with holes (``cells``), or cells with a diamond cut away (``cut``:
+    45-degree edges, reflex vertices)."""
+    import shapely
+
+    from csplab.continuous.model import PolygonModel
+
+    kind = draw(st.sampled_from(kinds))
+    k = draw(st.integers(1, max_labels))
+    pieces: dict[int, Any] = {}
+
+    def hull() -> Any:
+        n = draw(st.integers(3, 5))
+        pts = [(draw(st.integers(0, max_extent)), draw(st.integers(0, max_extent)))
+               for _ in range(n)]  # fmt: skip
+        return shapely.MultiPoint(pts).convex_hull
+
+    def free(g: Any) -> bool:  # touching is fine, overlapping would add off-lattice vertices
+        return all(g.intersection(h).area == 0 for h in pieces.values())
+
+    if kind == "convex":
+        for _ in range(draw(st.integers(1, max_pieces))):
+            g, b = hull(), draw(st.integers(1, k))
+            if g.area > 0 and free(g):
+                pieces[b] = g.union(pieces[b]) if b in pieces else g
+    else:
+        side = draw(st.integers(2, min(max_extent, 4)))
+        cells = draw(st.lists(st.integers(0, k), min_size=side * side, max_size=side * side))
+        for i, b in enumerate(cells):
+            if b:
+                x, y = divmod(i, side)
+                box = shapely.box(x, y, x + 1, y + 1)
+                pieces[b] = box.union(pieces[b]) if b in pieces else box
+        if kind == "cut" and pieces:
+            cx, cy = draw(st.integers(0, side)), draw(st.integers(0, side))
+            r = draw(st.integers(1, 2))
+            g = shapely.Polygon([(cx - r, cy), (cx, cy - r), (cx + r, cy), (cx, cy + r)])
+            if g.area > 0:
+                pieces = {b: h.difference(g) for b, h in pieces.items()}
+                pieces = {b: h for b, h in pieces.items() if h.area > 0}
+    if not pieces:
+        pieces = {1: shapely.box(0, 0, 1, 1)}
+    # keep polygonal parts only (differences may leave slivers of lower dimension)
+    clean = {}
+    for b, g in pieces.items():
+        polys = [p for p in getattr(g, "geoms", [g]) if p.geom_type == "Polygon" and p.area > 0]
+        if polys:
+            clean[b] = shapely.MultiPolygon(polys)
+    return PolygonModel.from_shapes(clean or {1: shapely.box(0, 0, 1, 1)}, name=f"random-{kind}")

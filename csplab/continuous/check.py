@@ -1,0 +1,313 @@
+"""The checker of continuous model synthesis: Eq. 4.1 on the polygons themselves.
+
+:func:`violations` asks whether every point of an output model ``M`` is *locally
+identical* to some point of the example ``E`` (thesis Eq. 4.1, 2008 paper Eq. 1). It works on
+the two polygon sets only, independently of the arrangement and the CSP that produced ``M``
+(it is the truth for tests, like :meth:`csplab.problem.Problem.violations` for grids):
+
+1. ``E``'s edge directions, up to sign, are its *families* (equal within ``angle_tol``
+   radians); an edge of ``M`` in any other direction is a violation.
+2. For each model, every point where a ring has a vertex, or where a vertex of one ring lies
+   on an edge of another, is a *node*; its neighbourhood is the rays of the ring edges
+   through it and, between consecutive rays, the label on that side (the interior of a
+   polygon is left of its rings, every other side is label 0). Points on an edge between
+   nodes look like the two rays of that edge; points off the boundaries like their label.
+3. Neighbourhoods are compared in reduced form (rays whose sides differ, each with the label
+   after it; see :func:`csplab.continuous.csp.reduce_signature`); a node or node-side of an
+   edge of ``M`` whose neighbourhood never occurs in ``E`` is a violation.
+
+Coordinates are floats; two points are one node if they agree to ``1e-9`` of the models'
+extent. Polygons with the same label are merged first (touching same-label pieces are one
+object).
+
+Examples
+--------
+>>> from csplab.continuous.model import PolygonModel
+>>> E = PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [4, 0], [2, 3]]}]})
+>>> len(violations(E, E)), len(violations(E, PolygonModel.from_json(
+...     {"polygons": [{"label": 1, "points": [[0, 0], [8, 0], [4, 6]]}]})))
+(0, 0)
+>>> bad = PolygonModel.from_json(                       # upside down
+...     {"polygons": [{"label": 1, "points": [[0, 3], [4, 3], [2, 0]]}]})
+>>> v = violations(E, bad)
+>>> v.counts()
+{'edge': 3, 'vertex': 3}
+>>> print(v.describe(1))
+6 violations of Eq. 4.1 (3 edge, 3 vertex)
+  edge at (0, 3): an edge of direction 0 degrees with label 0 on its left, 1 on its right
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import shapely
+from shapely.geometry.polygon import orient
+
+from csplab.continuous.csp import Signature, reduce_signature
+from csplab.continuous.model import PolygonModel
+
+__all__ = ["Defect", "Violations", "neighbourhoods", "violations"]
+
+ANGLE_TOL = 1e-7
+_FOREIGN = 1 << 20  # ray ids of directions the example does not have start here
+
+
+@dataclass(frozen=True)
+class Defect:
+    """One violation: ``kind`` is ``"direction"``, ``"edge"``, ``"vertex"`` or ``"label"``."""
+
+    kind: str
+    point: tuple[float, float]
+    detail: str
+
+    def __str__(self) -> str:
+        x, y = self.point
+        return f"{self.kind} at ({x:.6g}, {y:.6g}): {self.detail}"
+
+
+class Violations:
+    """The defects :func:`violations` found (a sequence; empty means Eq. 4.1 holds)."""
+
+    def __init__(self, defects: list[Defect]) -> None:
+        self.defects = defects
+
+    def __len__(self) -> int:
+        return len(self.defects)
+
+    def __iter__(self) -> Iterator[Defect]:
+        return iter(self.defects)
+
+    def __getitem__(self, i: int) -> Defect:
+        return self.defects[i]
+
+    def __bool__(self) -> bool:
+        return bool(self.defects)
+
+    def counts(self) -> dict[str, int]:
+        out: dict[str, int] = {}
+        for d in self.defects:
+            out[d.kind] = out.get(d.kind, 0) + 1
+        return dict(sorted(out.items()))
+
+    def describe(self, limit: int = 10) -> str:
+        """A summary line and the first ``limit`` defects."""
+        c = ", ".join(f"{v} {k}" for k, v in self.counts().items())
+        head = f"{len(self)} violations of Eq. 4.1" + (f" ({c})" if c else "")
+        return "\n".join([head, *(f"  {d}" for d in self.defects[:limit])])
+
+
+class _Families:
+    """The example's edge directions (angles in ``[0, pi)``), for naming rays."""
+
+    def __init__(self, angles: list[float], tol: float) -> None:
+        self.tol = tol
+        angles = sorted(angles)
+        fam: list[float] = []
+        for a in angles:
+            if not fam or a - fam[-1] > tol:
+                fam.append(a)
+        if len(fam) > 1 and fam[0] + math.pi - fam[-1] <= tol:
+            fam.pop()
+        self.angles = fam
+        self.F = len(fam)
+        self._foreign: dict[int, float] = {}
+
+    def ray(self, dx: float, dy: float) -> int:
+        """Ray id: ``f`` along family ``f``'s direction, ``F + f`` against it, or a foreign
+        id (>= ``_FOREIGN``) for other directions (equal directions share an id)."""
+        a = math.atan2(dy, dx) % (2 * math.pi)
+        for f, t in enumerate(self.angles):
+            for base, off in ((t, 0), (t + math.pi, self.F)):
+                d = abs(a - base)
+                if min(d, 2 * math.pi - d) <= self.tol:
+                    return f + off
+        key = round(a / self.tol)
+        for k, v in self._foreign.items():
+            d = abs(v - a)
+            if min(d, 2 * math.pi - d) <= self.tol:
+                return k
+        k = _FOREIGN + int(key) % (1 << 30)
+        self._foreign[k] = a
+        return k
+
+    def angle_of(self, ray: int) -> float:
+        if ray >= _FOREIGN:
+            return self._foreign[ray]
+        return self.angles[ray % self.F] + (math.pi if ray >= self.F else 0.0)
+
+
+def _edge_angles(model: PolygonModel) -> list[float]:
+    out = []
+    for p in model.polygons:
+        for r in p.rings():
+            a = np.asarray(r, dtype=np.float64)
+            d = np.roll(a, -1, axis=0) - a
+            out.extend((np.arctan2(d[:, 1], d[:, 0]) % np.pi).tolist())
+    return [a if a < math.pi - 1e-12 else 0.0 for a in out]
+
+
+def _segments(model: PolygonModel) -> tuple[np.ndarray[Any, Any], list[int]]:
+    """Directed ring segments ``(m, 2, 2)`` of the per-label unions (interior on the left)
+    and their labels."""
+    segs, labs = [], []
+    for b in model.labels:
+        g = model.shape(b)
+        for poly in getattr(g, "geoms", [g]):
+            if poly.is_empty or poly.geom_type != "Polygon":
+                continue
+            poly = orient(poly, 1.0)
+            for ring in (poly.exterior, *poly.interiors):
+                c = np.asarray(ring.coords)[:-1]
+                segs.append(np.stack([c, np.roll(c, -1, axis=0)], axis=1))
+                labs.extend([b] * len(c))
+    if not segs:
+        return np.zeros((0, 2, 2)), []
+    return np.concatenate(segs), labs
+
+
+@dataclass
+class _Node:
+    point: tuple[float, float]
+    after: dict[int, set[int]]
+    before: dict[int, set[int]]
+
+
+def _nodes(model: PolygonModel, fams: _Families, scale: float) -> list[_Node]:
+    segs, labs = _segments(model)
+    if not len(segs):
+        return []
+    q = 1e-9 * scale
+    pts = segs[:, 0]
+    keys = np.rint(pts / q).astype(np.int64)
+    _, first, inv = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    inv = inv.reshape(-1)
+    nodes = [_Node((float(pts[i, 0]), float(pts[i, 1])), {}, {}) for i in first]
+
+    def add(n: _Node, dx: float, dy: float, label: int, side: str) -> None:
+        r = fams.ray(dx, dy)
+        (n.after if side == "after" else n.before).setdefault(r, set()).add(label)
+
+    m = len(segs)
+    end_node = inv[(np.arange(m) + 1) % m]
+    # segments of one ring are consecutive; the end of segment i is the start of the next
+    # segment of the same ring, which the key lookup below finds exactly
+    end_keys = np.rint(segs[:, 1] / q).astype(np.int64)
+    lookup = {tuple(k): int(inv[i]) for i, k in zip(first.tolist(), keys[first].tolist(), strict=True)}
+    for i in range(m):
+        (ax, ay), (bx, by) = segs[i]
+        a = int(inv[i])
+        b = lookup.get(tuple(end_keys[i].tolist()), int(end_node[i]))
+        add(nodes[a], bx - ax, by - ay, labs[i], "after")
+        add(nodes[b], ax - bx, ay - by, labs[i], "before")
+    # vertices lying inside another ring's edge (T-junctions)
+    lines = shapely.linestrings(segs)
+    tree = shapely.STRtree(lines)
+    node_pts = shapely.points(np.array([n.point for n in nodes]))
+    ni, si = tree.query(node_pts, predicate="dwithin", distance=q)
+    for k, s in zip(ni.tolist(), si.tolist(), strict=True):
+        (ax, ay), (bx, by) = segs[s]
+        px, py = nodes[k].point
+        dx, dy = bx - ax, by - ay
+        L2 = dx * dx + dy * dy
+        t = ((px - ax) * dx + (py - ay) * dy) / L2
+        length = math.sqrt(L2)
+        if t * length <= q or (1 - t) * length <= q:
+            continue  # an endpoint: already counted
+        add(nodes[k], dx, dy, labs[s], "after")
+        add(nodes[k], -dx, -dy, labs[s], "before")
+    return nodes
+
+
+def neighbourhoods(
+    model: PolygonModel, fams: _Families, scale: float
+) -> tuple[dict[Signature, tuple[float, float]], dict[Signature, tuple[float, float]],
+           list[Defect]]:  # fmt: skip
+    """Reduced neighbourhoods of ``model``'s nodes and of its edges (beside each node), each
+    with one point where it occurs, and defects that are not about matching (foreign
+    directions, overlapping labels)."""
+    F = fams.F
+    vsig: dict[Signature, tuple[float, float]] = {}
+    esig: dict[Signature, tuple[float, float]] = {}
+    defects: list[Defect] = []
+    for n in _nodes(model, fams, scale):
+        rays = sorted(set(n.after) | set(n.before))
+        m = len(rays)
+        sect = []
+        for i in range(m):
+            cand = n.after.get(rays[i], set()) | n.before.get(rays[(i + 1) % m], set())
+            if len(cand) > 1:
+                defects.append(Defect("label", n.point, f"labels {sorted(cand)} overlap here"))
+            sect.append(min(cand) if cand else 0)
+        vsig.setdefault(reduce_signature(rays, sect), n.point)
+        for i, r in enumerate(rays):
+            after, before = sect[i], sect[i - 1]
+            if r >= _FOREIGN:
+                continue  # reported once per edge by violations()
+            f = r % F
+            L, R = (after, before) if r < F else (before, after)
+            esig.setdefault(reduce_signature([f, F + f], [L, R]), n.point)
+    return vsig, esig, defects
+
+
+def violations(
+    example: PolygonModel, model: PolygonModel, *, angle_tol: float = ANGLE_TOL
+) -> Violations:
+    """Every place where ``model`` breaks Eq. 4.1 w.r.t. ``example`` (see the module
+    docstring); ``len() == 0`` means the model is a valid output."""
+    lo = np.minimum(np.array(example.bounds[:2]), np.array(model.bounds[:2]) if len(model) else np.inf)
+    hi = np.maximum(np.array(example.bounds[2:]), np.array(model.bounds[2:]) if len(model) else -np.inf)
+    scale = float(max(1.0, np.abs(lo).max(), np.abs(hi).max(), (hi - lo).max()))
+    fams = _Families(_edge_angles(example), angle_tol)
+    ev, ee, _ = neighbourhoods(example, fams, scale)
+    allowed = set(ev) | set(ee) | {((-1, 0),)} | {((-1, b),) for b in example.labels}
+    defects: list[Defect] = []
+    for b in model.labels:
+        if b not in example.labels:
+            c = model.shape(b).representative_point()
+            defects.append(Defect("label", (c.x, c.y), f"label {b} does not occur in the example"))
+    mv, me, extra = neighbourhoods(model, fams, scale)
+    segs, _ = _segments(model)
+    for (ax, ay), (bx, by) in segs.tolist():
+        r = fams.ray(bx - ax, by - ay)
+        if r >= _FOREIGN:
+            deg = math.degrees(fams.angle_of(r)) % 180
+            defects.append(Defect(
+                "direction", ((ax + bx) / 2, (ay + by) / 2),
+                f"an edge of direction {deg:.6g} degrees, which the example does not have",
+            ))  # fmt: skip
+    defects.extend(extra)
+    F = fams.F
+    for sig, pt in me.items():
+        if sig not in allowed:
+            deg = math.degrees(fams.angle_of(sig[0][0] % F)) % 180
+            labs = _edge_sides(sig, F)
+            defects.append(Defect(
+                "edge", pt,
+                f"an edge of direction {deg:.6g} degrees with label {labs[0]} on its left, "
+                f"{labs[1]} on its right",
+            ))  # fmt: skip
+    for sig, pt in mv.items():
+        if sig not in allowed and sig not in me:
+            defects.append(Defect("vertex", pt, f"a vertex neighbourhood {_show(sig, fams)} "
+                                                "that the example does not have"))
+    return Violations(defects)
+
+
+def _edge_sides(sig: Signature, F: int) -> tuple[int, int]:
+    """(left, right) labels of a reduced two-ray edge neighbourhood ``((f, L), (F+f, R))``."""
+    d = dict(sig)
+    f = min(r for r in d) % F
+    return d.get(f, 0), d.get(F + f, 0)
+
+
+def _show(sig: Signature, fams: _Families) -> str:
+    if sig[0][0] == -1:
+        return f"[label {sig[0][1]}]"
+    rays = sorted(sig, key=lambda rb: fams.angle_of(rb[0]))
+    parts = [f"{math.degrees(fams.angle_of(r)):.4g}deg->{b}" for r, b in rays]
+    return "[" + ", ".join(parts) + "]"
