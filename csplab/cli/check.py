@@ -12,11 +12,13 @@ from csplab.cli.common import (
     model_options,
     problem_from_args,
 )
+from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 
-HELP = "count the violations of a grid file against an example"
+HELP = "count the violations of a grid file (or an output polygon file) against an example"
 DESCRIPTION = (
-    "Check a grid against an example model or a tileset's rules. Exit 0 when it is "
+    "Check a grid against an example model or a tileset's rules, or an output polygon "
+    "model against a polygon example (Eq. 4.1 on the polygons). Exit 0 when it is "
     "consistent, 1 when it violates something or has unassigned cells (-1 in the .npy "
     "of a failed or timed-out run)."
 )
@@ -40,6 +42,10 @@ def run(args: argparse.Namespace) -> int:
     if args.limit < 0:
         raise InputError("--limit must be >= 0")
     model = load_model(args.model, model_options(args.model_option))
+    if isinstance(model, PolygonModel):
+        from csplab.cli import _continuous
+
+        return _continuous.check(args, model)
     grid = load_grid(args.grid, model.ndim, model)
     problem = problem_from_args(args, model, shape=tuple(grid.shape))
     unassigned = int((grid < 0).sum())

@@ -15,13 +15,15 @@ from csplab.cli.common import (
     model_options,
     problem_from_args,
 )
+from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 
 HELP = "synthesize a model from an example"
 DESCRIPTION = (
     "Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 "
-    "or any registered solver). Exit 0 when solved, 1 when the algorithm failed or the "
+    "or any registered solver); for a polygon example (.json, .svg), continuous model "
+    "synthesis in a WxH region of line spacings, written as .json, .svg or .png. Exit 0 when solved, 1 when the algorithm failed or the "
     "problem is unsatisfiable, 2 on bad input."
 )
 
@@ -60,6 +62,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="run an incomplete solver again, with a fresh derived seed, up to N times while "
         "it fails (default 10, as WaveFunctionCollapse per output; Merrell's code retries "
         "20 times per block; 0: one run, as the thesis' experiments)",
+    )
+    p.add_argument(
+        "--spacing",
+        type=float,
+        help="continuous models: line spacing in the example's units (default: the largest "
+        "that puts every example vertex on the lattice)",
+    )
+    p.add_argument(
+        "--snap",
+        action="store_true",
+        help="continuous models: round example vertices onto the --spacing lattice",
     )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     p.add_argument("--time-limit", type=float, help="seconds")
@@ -151,6 +164,12 @@ def run(args: argparse.Namespace) -> int:
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
     example = load_model(args.model, model_options(args.model_option))
+    if isinstance(example, PolygonModel):
+        from csplab.cli import _continuous
+
+        return _continuous.synthesize(args, example, _options(args))
+    if args.spacing is not None or args.snap:
+        raise InputError("--spacing and --snap apply to continuous (polygon) models only")
     problem = problem_from_args(args, example)
     opts = _options(args)
     settings = _settings(args, example, opts)
