@@ -73,7 +73,9 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
     for key in ("order", "choice"):
         o = cls.option(key)
         if o is not None:
-            settings[key] = f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
+            settings[key] = (
+                f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
+            )
     settings["restarts"] = restarts
     s = run(
         example, size, solver=args.solver, rng=args.seed, spacing=args.spacing,

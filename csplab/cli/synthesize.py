@@ -23,8 +23,9 @@ HELP = "synthesize a model from an example"
 DESCRIPTION = (
     "Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 "
     "or any registered solver); for a polygon example (.json, .svg), continuous model "
-    "synthesis in a WxH region of line spacings, written as .json, .svg or .png. Exit 0 when solved, 1 when the algorithm failed or the "
-    "problem is unsatisfiable, 2 on bad input."
+    "synthesis in a WxH region of line spacings, written as .json, .svg or .png. Exit 0 "
+    "when solved, 1 when the algorithm failed or the problem is unsatisfiable, 2 on bad "
+    "input."
 )
 
 

@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 from csplab.errors import InputError
 
-__all__ = ["Arrangement", "Lattice", "MAX_FAMILIES"]
+__all__ = ["MAX_FAMILIES", "Arrangement", "Lattice"]
 
 #: rays are bits of an int64 mask (two per family)
 MAX_FAMILIES = 31
@@ -172,9 +172,10 @@ class Lattice:
     def to_lattice(self, xy: NDArray[np.float64]) -> NDArray[np.int64]:
         """World coordinates -> integer lattice coordinates (rounded)."""
         o = np.array([float(self.origin[0]), float(self.origin[1])])
-        return np.rint((np.asarray(xy, dtype=np.float64) - o) / float(self.spacing)).astype(
-            np.int64
-        )
+        out: NDArray[np.int64] = np.rint(
+            (np.asarray(xy, dtype=np.float64) - o) / float(self.spacing)
+        ).astype(np.int64)
+        return out
 
     def to_world(self, uv: NDArray[np.float64]) -> NDArray[np.float64]:
         """Lattice coordinates (floats) -> world coordinates."""
@@ -299,19 +300,22 @@ class Arrangement:
 
     def vertex_xy(self) -> NDArray[np.float64]:
         """Vertices in lattice units, ``(n, 2)`` floats."""
-        return np.stack([self.X, self.Y], axis=1) / self.D
+        out: NDArray[np.float64] = np.stack([self.X, self.Y], axis=1) / self.D
+        return out
 
     def edge_xy(self) -> NDArray[np.float64]:
         """Edge midpoints in lattice units."""
         v = self.vertex_xy()
-        return 0.5 * (v[self.edge_src] + v[self.edge_dst])
+        out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
+        return out
 
     def on_side(self) -> NDArray[np.int64]:
         """Per vertex, bits 1 (x=0), 2 (x=W), 4 (y=0), 8 (y=H) of the sides it lies on."""
         WD, HD = self.W * self.D, self.H * self.D
-        return (
+        out: NDArray[np.int64] = (
             (self.X == 0) * 1 + (self.X == WD) * 2 + (self.Y == 0) * 4 + (self.Y == HD) * 8
         ).astype(np.int64)
+        return out
 
     def outside_sectors(self, rays: Sequence[int], side: int) -> tuple[bool, ...]:
         """For a vertex with ``rays`` (sorted) on the sides ``side`` (bits of

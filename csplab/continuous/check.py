@@ -22,7 +22,7 @@ object).
 
 Examples
 --------
->>> from csplab.continuous.model import PolygonModel
+>>> from csplab.continuous.model import Polygon, PolygonModel
 >>> E = PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [4, 0], [2, 3]]}]})
 >>> len(violations(E, E)), len(violations(E, PolygonModel.from_json(
 ...     {"polygons": [{"label": 1, "points": [[0, 0], [8, 0], [4, 6]]}]})))
@@ -49,7 +49,7 @@ import shapely
 from shapely.geometry.polygon import orient
 
 from csplab.continuous.csp import Signature, reduce_signature
-from csplab.continuous.model import PolygonModel
+from csplab.continuous.model import Polygon, PolygonModel
 
 __all__ = ["Defect", "Violations", "neighbourhoods", "violations"]
 
@@ -197,7 +197,9 @@ def _nodes(model: PolygonModel, fams: _Families, scale: float) -> list[_Node]:
     # segments of one ring are consecutive; the end of segment i is the start of the next
     # segment of the same ring, which the key lookup below finds exactly
     end_keys = np.rint(segs[:, 1] / q).astype(np.int64)
-    lookup = {tuple(k): int(inv[i]) for i, k in zip(first.tolist(), keys[first].tolist(), strict=True)}
+    lookup = {
+        tuple(k): int(inv[i]) for i, k in zip(first.tolist(), keys[first].tolist(), strict=True)
+    }
     for i in range(m):
         (ax, ay), (bx, by) = segs[i]
         a = int(inv[i])
@@ -255,12 +257,35 @@ def neighbourhoods(
 
 
 def violations(
-    example: PolygonModel, model: PolygonModel, *, angle_tol: float = ANGLE_TOL
+    example: PolygonModel,
+    model: PolygonModel,
+    *,
+    angle_tol: float = ANGLE_TOL,
+    region: tuple[float, float, float, float] | None = None,
+    outside: int = 0,
 ) -> Violations:
     """Every place where ``model`` breaks Eq. 4.1 w.r.t. ``example`` (see the module
-    docstring); ``len() == 0`` means the model is a valid output."""
-    lo = np.minimum(np.array(example.bounds[:2]), np.array(model.bounds[:2]) if len(model) else np.inf)
-    hi = np.maximum(np.array(example.bounds[2:]), np.array(model.bounds[2:]) if len(model) else -np.inf)
+    docstring); ``len() == 0`` means the model is a valid output.
+
+    ``region`` ``(x0, y0, x1, y1)`` and ``outside``: the model fills that rectangle and
+    the plane around it has label ``outside`` (a synthesis with a boundary label other than
+    0); only points in the closed region are checked.
+    """
+    if region is not None and outside != 0:
+        x0, y0, x1, y1 = region
+        m = max(x1 - x0, y1 - y0)
+        frame = Polygon(
+            outside,
+            ((x0 - m, y0 - m), (x1 + m, y0 - m), (x1 + m, y1 + m), (x0 - m, y1 + m)),
+            (((x0, y0), (x0, y1), (x1, y1), (x1, y0)),),
+        )
+        model = PolygonModel._trusted([*model.polygons, frame], name=model.name)
+    lo = np.minimum(
+        np.array(example.bounds[:2]), np.array(model.bounds[:2]) if len(model) else np.inf
+    )
+    hi = np.maximum(
+        np.array(example.bounds[2:]), np.array(model.bounds[2:]) if len(model) else -np.inf
+    )
     scale = float(max(1.0, np.abs(lo).max(), np.abs(hi).max(), (hi - lo).max()))
     fams = _Families(_edge_angles(example), angle_tol)
     ev, ee, _ = neighbourhoods(example, fams, scale)
@@ -293,8 +318,18 @@ def violations(
             ))  # fmt: skip
     for sig, pt in mv.items():
         if sig not in allowed and sig not in me:
-            defects.append(Defect("vertex", pt, f"a vertex neighbourhood {_show(sig, fams)} "
-                                                "that the example does not have"))
+            defects.append(
+                Defect(
+                    "vertex",
+                    pt,
+                    f"a vertex neighbourhood {_show(sig, fams)} that the example does not have",
+                )
+            )
+    if region is not None:
+        x0, y0, x1, y1 = region
+        t = 1e-9 * scale
+        defects = [d for d in defects if x0 - t <= d.point[0] <= x1 + t
+                   and y0 - t <= d.point[1] <= y1 + t]  # fmt: skip
     return Violations(defects)
 
 

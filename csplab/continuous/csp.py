@@ -28,7 +28,7 @@ the resulting :class:`~csplab.problem.Problem`; its ``positions`` (in spacings) 
 
 Examples
 --------
->>> from csplab.continuous.model import PolygonModel
+>>> from csplab.continuous.model import Polygon, PolygonModel
 >>> E = PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [4, 0], [2, 3]]}]})
 >>> C = ContinuousCSP(E, (8, 6))
 >>> C.problem.n == C.arrangement.n_vertices + C.arrangement.n_edges
@@ -43,7 +43,6 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Sequence
-from fractions import Fraction
 from typing import Any
 
 import numpy as np
@@ -51,7 +50,7 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
-from csplab.continuous.model import PolygonModel
+from csplab.continuous.model import Polygon, PolygonModel
 from csplab.errors import InputError
 from csplab.problem import Problem
 
@@ -225,16 +224,17 @@ class ContinuousCSP:
         self.vertex_type = vtype.astype(np.int64)
         self.type_rays: list[list[int]] = []
         self.type_states: list[list[tuple[int, ...]]] = []
+        self.type_outside: list[tuple[bool, ...]] = []
         for key in ukeys.tolist():
             mask, sd = key >> 4, key & 15
             rays = [r for r in range(2 * F) if (mask >> r) & 1]
             outside = A.outside_sectors(rays, sd) if sd else (False,) * len(rays)
-            states = set()
+            found: set[tuple[int, ...]] = set()
             for sig in self.signatures:
                 st = _expand(sig, rays)
                 if st is not None and all(st[i] == b0 for i in range(len(rays)) if outside[i]):
-                    states.add(st)
-            ordered = sorted(states, key=lambda st: (any(st), st))
+                    found.add(st)
+            ordered = sorted(found, key=lambda st: (any(st), st))
             if not ordered:
                 raise InputError(
                     f"{example.source}: no neighbourhood of the example fits a vertex with rays "
@@ -242,6 +242,7 @@ class ContinuousCSP:
                 )
             self.type_rays.append(rays)
             self.type_states.append(ordered)
+            self.type_outside.append(outside)
         nst = max(len(s) for s in self.type_states)
         K = self.K = max(nst, Kl * Kl)
         # edge domains per family
@@ -268,9 +269,9 @@ class ContinuousCSP:
             S = np.array(states, dtype=np.int64).reshape(len(states), len(rays))
             for i, r in enumerate(rays):
                 before, after = S[:, i - 1], S[:, i]
-                L, R = (after, before) if r < F else (before, after)
+                lab_l, lab_r = (after, before) if r < F else (before, after)
                 M = np.zeros((K, K), dtype=bool)
-                M[np.arange(len(states)), L * Kl + R] = True
+                M[np.arange(len(states)), lab_l * Kl + lab_r] = True
                 k = M.tobytes()
                 if k not in rel_ids:
                     rel_ids[k] = len(rels)
@@ -283,10 +284,10 @@ class ContinuousCSP:
         var[order] = np.arange(nv + ne)
         self.var_vertex, self.var_edge = var[:nv], var[nv:]
         e = np.arange(ne)
-        f = A.edge_family
+        fe = A.edge_family
         arcs = np.concatenate([
-            np.stack([var[A.edge_src], var[nv + e], pos_rel[vtype[A.edge_src], f]], axis=1),
-            np.stack([var[A.edge_dst], var[nv + e], pos_rel[vtype[A.edge_dst], F + f]], axis=1),
+            np.stack([var[A.edge_src], var[nv + e], pos_rel[vtype[A.edge_src], fe]], axis=1),
+            np.stack([var[A.edge_dst], var[nv + e], pos_rel[vtype[A.edge_dst], F + fe]], axis=1),
         ])  # fmt: skip
         if (arcs[:, 2] < 0).any():  # pragma: no cover - every incidence is a ray
             raise AssertionError("an edge end without its ray")
@@ -347,22 +348,27 @@ class ContinuousCSP:
             raise InputError("model() needs a complete solution of this problem")
         F = A.F
         left, right = self.edge_labels(g)
-        edge_at = {}
-        for e, (a, b, f) in enumerate(
-            zip(A.edge_src.tolist(), A.edge_dst.tolist(), A.edge_family.tolist(), strict=True)
-        ):
-            edge_at[(a, f)] = (e, b)
-            edge_at[(b, F + f)] = (e, a)
-        vstate = g[self.var_vertex]
-        shapes: dict[int, Any] = {}
-        xy = [(Fraction(int(x), A.D), Fraction(int(y), A.D)) for x, y in zip(A.X, A.Y, strict=True)]
-        s, (ox, oy) = self.lattice.spacing, self.lattice.origin
+        # outside the region is not part of the output: its sides bound every polygon
+        eout = A.edge_outside()
+        left[eout == 1] = -1
+        right[eout == 2] = -1
+        edge_at = np.full((A.n_vertices, 2 * F), -1, dtype=np.int64)
+        edge_at[A.edge_src, A.edge_family] = np.arange(A.n_edges)
+        edge_at[A.edge_dst, F + A.edge_family] = np.arange(A.n_edges)
+        ends = A.edge_src + A.edge_dst
+        vstate = g[self.var_vertex].tolist()
+        vtype = self.vertex_type.tolist()
+        sp, (ox, oy) = float(self.lattice.spacing), self.lattice.origin
+        wx = (float(ox) + sp * (A.X / A.D)).tolist()
+        wy = (float(oy) + sp * (A.Y / A.D)).tolist()
+        polys: list[Polygon] = []
         for L in range(1, self.Kl):
-            starts = []
-            for e in np.flatnonzero((left == L) & (right != L)).tolist():
-                starts.append((int(A.edge_src[e]), int(A.edge_family[e])))
-            for e in np.flatnonzero((right == L) & (left != L)).tolist():
-                starts.append((int(A.edge_dst[e]), F + int(A.edge_family[e])))
+            e1 = np.flatnonzero((left == L) & (right != L))
+            e2 = np.flatnonzero((right == L) & (left != L))
+            starts = list(zip(A.edge_src[e1].tolist(), A.edge_family[e1].tolist(), strict=True))
+            starts += list(
+                zip(A.edge_dst[e2].tolist(), (F + A.edge_family[e2]).tolist(), strict=True)
+            )
             used: set[tuple[int, int]] = set()
             rings = []
             for start in starts:
@@ -372,26 +378,35 @@ class ContinuousCSP:
                 v, r = start
                 while (v, r) not in used:
                     used.add((v, r))
-                    _, w = edge_at[(v, r)]
+                    w = int(ends[edge_at[v, r]]) - v
                     back = (r + F) % (2 * F)
-                    rays = self.type_rays[self.vertex_type[w]]
-                    sect = self.type_states[self.vertex_type[w]][vstate[w]]
-                    j = rays.index(back)
-                    i = j - 1
+                    rays = self.type_rays[vtype[w]]
+                    sect = self._sectors(vtype[w], vstate[w])
+                    i = rays.index(back) - 1
                     while sect[i - 1] == L:
                         i -= 1
                     nxt = rays[i % len(rays)]
                     if nxt != r:
                         ring.append(w)
                     v, r = w, nxt
-                pts = [(float(ox + s * xy[w][0]), float(oy + s * xy[w][1])) for w in ring]
-                rings.append(pts)
-            shapes[self.labels[L]] = _assemble(rings)
-        return PolygonModel.from_shapes(
-            shapes, name=name or f"{self.example.name or 'model'}-synth",
+                rings.append(tuple((wx[w], wy[w]) for w in ring))
+            polys.extend(_assemble(self.labels[L], rings))
+        return PolygonModel._trusted(
+            polys, name=name or f"{self.example.name or 'model'}-synth",
             meta={"example": self.example.name, "size": self.problem.meta["size"],
                   "spacing": float(self.lattice.spacing)},
         )  # fmt: skip
+
+    def _sectors(self, t: int, state: int) -> tuple[int, ...]:
+        """Sector labels of a vertex state, -1 for the sectors outside the region."""
+        st, out = self.type_states[t][state], self.type_outside[t]
+        return tuple(-1 if o else b for b, o in zip(st, out, strict=True))
+
+    def region(self) -> tuple[float, float, float, float]:
+        """The output region ``(x0, y0, x1, y1)`` in the example's coordinates."""
+        s, (ox, oy) = float(self.lattice.spacing), self.lattice.origin
+        W, H = self.problem.meta["size"]
+        return (float(ox), float(oy), float(ox) + s * W, float(oy) + s * H)
 
     # ------------------------------------------------------------------ encoding
     def encode(self, model: PolygonModel) -> NDArray[np.int32]:
@@ -418,33 +433,40 @@ class ContinuousCSP:
         grid = np.full(self.problem.n, -1, dtype=np.int32)
         grid[self.var_edge] = left * self.Kl + right
         lookup = [{st: i for i, st in enumerate(sts)} for sts in self.type_states]
-        for v, (rays, labs) in enumerate(_vertex_sectors(A, left, right)):
+        for v, (_, labs) in enumerate(_vertex_sectors(A, left, right)):
             t = self.vertex_type[v]
             grid[self.var_vertex[v]] = lookup[t].get(tuple(labs), -1)
         return grid
 
 
-def _assemble(rings: list[list[tuple[float, float]]]) -> Any:
-    """Counter-clockwise rings are shells, clockwise ones holes of the shell containing
-    them; returns a shapely (Multi)Polygon."""
+def _area(r: Sequence[tuple[float, float]]) -> float:
+    return 0.5 * sum(
+        x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in zip(r, (*r[1:], r[0]), strict=True)
+    )
+
+
+def _assemble(label: int, rings: list[tuple[tuple[float, float], ...]]) -> list[Polygon]:
+    """Polygons of one label from traced rings: counter-clockwise rings are shells,
+    clockwise ones holes of the smallest shell covering them."""
     from shapely.geometry import Polygon as SP
 
-    shells, holes = [], []
-    for r in rings:
-        a = np.asarray(r)
-        area = 0.5 * float(np.dot(a[:, 0], np.roll(a[:, 1], -1)) - np.dot(np.roll(a[:, 0], -1), a[:, 1]))
-        (shells if area > 0 else holes).append(r)
-    shell_polys = [SP(r) for r in shells]
-    owned: list[list[list[tuple[float, float]]]] = [[] for _ in shells]
+    shells = [r for r in rings if _area(r) > 0]
+    holes = [r for r in rings if _area(r) <= 0]
+    owned: list[list[tuple[tuple[float, float], ...]]] = [[] for _ in shells]
     if holes:
-        tree = shapely.STRtree(shell_polys)
+        box = np.array([[min(x for x, _ in r), min(y for _, y in r),
+                         max(x for x, _ in r), max(y for _, y in r)] for r in shells])  # fmt: skip
         for h in holes:
-            cand = tree.query(SP(h), predicate="covered_by")
-            best = min(cand.tolist(), key=lambda i: shell_polys[i].area) if len(cand) else None
-            if best is None:  # pragma: no cover - a hole always has a shell around it
+            hb = (min(x for x, _ in h), min(y for _, y in h),
+                  max(x for x, _ in h), max(y for _, y in h))  # fmt: skip
+            cand = np.flatnonzero((box[:, 0] <= hb[0]) & (box[:, 1] <= hb[1])
+                                  & (box[:, 2] >= hb[2]) & (box[:, 3] >= hb[3]))  # fmt: skip
+            hp = SP(h)
+            inside = [int(i) for i in cand if SP(shells[i]).covers(hp)]
+            if not inside:  # pragma: no cover - a hole always has a shell around it
                 raise AssertionError("a hole outside every shell")
-            owned[best].append(h)
-    return shapely.MultiPolygon([SP(s, hs) for s, hs in zip(shells, owned, strict=True)])
+            owned[min(inside, key=lambda i: abs(_area(shells[i])))].append(h)
+    return [Polygon(label, s, tuple(hs)) for s, hs in zip(shells, owned, strict=True)]
 
 
 def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:

@@ -16,10 +16,11 @@ Examples
 ((0.0, 0.0), (2.0, 0.0), (0.0, 2.0))
 >>> M.labels, M.area(1)
 ((1,), 2.0)
->>> PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [1, 1], [1, 0], [0, 1]]}]})
+>>> PolygonModel.from_json({"polygons": [
+...     {"label": 1, "points": [[0, 0], [1, 1], [1, 0], [0, 1]]}]}, source="bow.json")
 Traceback (most recent call last):
 ...
-csplab.errors.InputError: <model>: polygon 0: its boundary crosses itself (Self-intersection[0.5 0.5])
+csplab.errors.InputError: bow.json: polygon 0: its boundary crosses itself (Self-intersection...
 """
 
 from __future__ import annotations
@@ -139,9 +140,17 @@ class PolygonModel:
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def from_json(
-        cls, data: Any, *, name: str = "", source: str = "<model>"
+    def _trusted(
+        cls, polygons: list[Polygon], *, name: str = "", meta: Mapping[str, Any] | None = None
     ) -> PolygonModel:
+        """A model from already normalised polygons, without validation (csplab's own
+        outputs, which the checker verifies instead)."""
+        m = cls.__new__(cls)
+        m.polygons, m.name, m.meta, m.source = tuple(polygons), name, dict(meta or {}), "<model>"
+        return m
+
+    @classmethod
+    def from_json(cls, data: Any, *, name: str = "", source: str = "<model>") -> PolygonModel:
         """From the JSON schema ``{"polygons": [{"label", "points", "holes"?}, ...]}``."""
         if not isinstance(data, Mapping) or "polygons" not in data:
             raise InputError(f'{source}: expected an object with a "polygons" list')
@@ -231,6 +240,8 @@ class PolygonModel:
             if not g.is_valid:
                 raise InputError(f"{where}: invalid polygon ({shapely.is_valid_reason(g)})")
             shapes.append(g)
+        if len(shapes) < 2:
+            return
         tree = shapely.STRtree(shapes)
         a, b = tree.query(shapes, predicate="intersects")
         for i, j in zip(a.tolist(), b.tolist(), strict=True):

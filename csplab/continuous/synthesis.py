@@ -88,7 +88,11 @@ def synthesize(
     t2 = time.perf_counter()
     model = csp.model(result.grid) if result.ok else None
     t3 = time.perf_counter()
-    v = violations(csp.example, model) if (check and model is not None) else Violations([])
+    v = (
+        violations(csp.example, model, region=csp.region(), outside=boundary)
+        if (check and model is not None)
+        else Violations([])
+    )
     t4 = time.perf_counter()
     times = {"csp": t1 - t0, "solve": t2 - t1, "geometry": t3 - t2, "check": t4 - t3}
     return Synthesis(result, csp, model, v, times)
