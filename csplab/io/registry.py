@@ -1,7 +1,8 @@
 """The file-format registry: every format csplab reads or writes is declared here, once.
 
 A :class:`Format` names its extensions, what reading gives (an
-:class:`~csplab.example.ExampleModel` or a :class:`~csplab.io.ruleset.RuleSet`), a content
+:class:`~csplab.example.ExampleModel`, a :class:`~csplab.io.ruleset.RuleSet` or, for
+continuous model synthesis, a :class:`~csplab.continuous.model.PolygonModel`), a content
 sniffer, its loader options (the ``--model-option`` keys), its reader and writer (lazy
 ``"module:function"`` targets, imported on first use; ``None`` when the format is only
 written or only read) and the texts of the README table and of ``csplab info``.
@@ -31,7 +32,7 @@ Examples
 Traceback (most recent call last):
 ...
 csplab.errors.InputError: unknown model format 'stl'; use merrell, grid, npy, wfc, \
-overlapping, poms, debroglie, markovjunior, png, vox or obj
+overlapping, poms, debroglie, markovjunior, png, vox, obj, polygons, svg or polygon-png
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ from csplab.errors import FormatError, InputError
 from csplab.io.common import NO, Output, read_bytes
 
 if TYPE_CHECKING:
+    from csplab.continuous.model import PolygonModel
     from csplab.example import ExampleModel
     from csplab.io.ruleset import RuleSet
 
@@ -65,7 +67,8 @@ __all__ = [
     "synthesis_defaults",
 ]
 
-Gives = Literal["ExampleModel", "RuleSet"]
+Gives = Literal["ExampleModel", "RuleSet", "PolygonModel"]
+Writes = Literal["grid", "PolygonModel"]
 HEAD_SIZE = 1 << 20  # bytes a sniffer sees
 FALLBACK = "grid"  # text that no sniffer recognises (its parser then says what is wrong)
 BEGIN, END = "<!-- formats:begin -->", "<!-- formats:end -->"
@@ -176,15 +179,20 @@ class Format:
     extensions : tuple of str
         Lower-case extensions with the dot; the first format declared for an extension is
         its default (for writing, and for reading files no sniffer recognises).
-    gives : {"ExampleModel", "RuleSet"} or None
+    gives : {"ExampleModel", "RuleSet", "PolygonModel"} or None
         What reading gives (``None``: only written).
+    writes : {"grid", "PolygonModel"}
+        What the writer takes: a label grid (an :class:`~csplab.io.common.Output`; the
+        default) or a :class:`~csplab.continuous.model.PolygonModel` (continuous model
+        synthesis). Grid outputs (:func:`output_format`, :func:`output_extensions` without
+        ``gives="PolygonModel"``) never pick a polygon writer, and the other way round.
     description : str
         One line, for ``csplab info`` and the README's format column.
     reader : str, optional
         ``"module:function"``; ``function(path, **options)`` reads a file.
     writer : str, optional
         ``"module:function"``; ``function(output, path)`` writes an
-        :class:`~csplab.io.common.Output`.
+        :class:`~csplab.io.common.Output` (``function(model, path)`` a polygon model).
     sniffer : str, optional
         ``"module:function"``; ``function(head: bytes) -> int`` scores the first bytes.
     options : tuple of Option
@@ -207,6 +215,7 @@ class Format:
     extensions: tuple[str, ...]
     gives: Gives | None
     description: str
+    writes: Writes = "grid"
     reader: str | None = None
     writer: str | None = None
     sniffer: str | None = None
@@ -253,19 +262,27 @@ class Format:
             )
         return {k: declared[k].check(v, self.name) for k, v in options.items()}
 
-    def read(self, path: str | Path, **options: Any) -> ExampleModel | RuleSet:
+    def read(self, path: str | Path, **options: Any) -> ExampleModel | RuleSet | PolygonModel:
         """Read a file of this format."""
         if self.reader is None:
             raise InputError(f"csplab writes {self.name} files but does not read them")
         opts = self.check_options(options)
-        reader = cast("Callable[..., ExampleModel | RuleSet]", resolve(self.reader))
+        reader = cast("Callable[..., ExampleModel | RuleSet | PolygonModel]", resolve(self.reader))
         return reader(Path(path), **opts)
 
-    def write(self, out: Output, path: str | Path) -> None:
-        """Write ``out`` in this format."""
+    def write(self, out: Output | PolygonModel, path: str | Path) -> None:
+        """Write ``out`` in this format: a grid (:class:`~csplab.io.common.Output`), or a
+        polygon model for the formats that write polygons (:attr:`writes`)."""
         p = Path(path)
         if self.writer is None:
             raise InputError(f"csplab reads {self.name} files but does not write them")
+        if self.writes == "PolygonModel" or not isinstance(out, Output):
+            if self.writes != "PolygonModel":
+                raise InputError(f"{p}: {self.name} files hold label grids, not polygon models")
+            if isinstance(out, Output):
+                raise InputError(f"{p}: {self.name} files hold polygon models, not label grids")
+            resolve(self.writer)(out, p)
+            return
         if not self.partial and out.grid.size and int(out.grid.min()) < 0:
             exts = output_extensions(partial=True)
             raise InputError(f"{p}: the grid has unassigned cells; write it as {_or(exts)}")
@@ -279,6 +296,7 @@ class Format:
             "description": self.description,
             "extensions": list(self.extensions),
             "gives": self.gives,
+            "writes": self.writes,
             "read": self.readable,
             "write": self.writable,
             "options": [
@@ -290,6 +308,7 @@ class Format:
 
 
 _SHARED = "`../shared/anchors-data/`"
+_CONT = "csplab/examples/continuous"  # polygon examples (continuous model synthesis)
 _EMPTY6 = "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0"
 
 # WaveFunctionCollapse's own settings (minimum entropy, weights), for its kind of inputs
@@ -505,6 +524,56 @@ FORMATS: dict[str, Format] = {
             example="csplab synthesize PunchOutModelSynthesis/brutal-plum_poms.json "
             "--size 20x20x10 --solver blocks --seed 1 --out plum.obj",
         ),
+        Format(
+            name="polygons",
+            extensions=(".json",),
+            gives="PolygonModel",
+            writes="PolygonModel",
+            description="labelled polygons (continuous model synthesis)",
+            reader="csplab.io.polygons:read_polygons_json",
+            writer="csplab.io.polygons:write_polygons_json",
+            sniffer="csplab.io.polygons:sniff_json",
+            files='with `"polygons"`',
+            details='`{"polygons": [{"label": 1, "points": [[x, y], ...], "holes": '
+            "[[[x, y], ...]]}]}`: simple polygons, holes allowed, label `>= 1` (0 is empty "
+            "space); rings are normalised (exterior counter-clockwise, holes clockwise); "
+            "polygons of different labels must not overlap; other keys are kept when "
+            "written back",
+            example=f"csplab synthesize {_CONT}/two_objects.json --size 12x8 --seed 1 "
+            "--out two.json "
+            f"&& csplab check {_CONT}/two_objects.json two.json",
+        ),
+        Format(
+            name="svg",
+            extensions=(".svg",),
+            gives="PolygonModel",
+            writes="PolygonModel",
+            description="SVG polygons (continuous model synthesis)",
+            reader="csplab.io.polygons:read_svg",
+            writer="csplab.io.polygons:write_svg",
+            sniffer="csplab.io.polygons:sniff_svg",
+            files="with root `<svg>`",
+            details="in: `<polygon>`, `<rect>`, `<path>` with straight segments (`M L H V Z`), "
+            "nested `<g>`, `transform`s; label from `data-label`, else one per fill colour "
+            "(white/`none` is empty space); a path's subpaths nested inside a polygon are "
+            "its holes; `y` is flipped (SVG's `y` points down); out: one `<path>` per "
+            "polygon (even-odd), `data-label`, label colours",
+            example=f"csplab synthesize {_CONT}/concave.json --size 12x8 --seed 1 "
+            "--out concave.svg "
+            f"&& csplab check {_CONT}/concave.json concave.svg",
+        ),
+        Format(
+            name="polygon-png",
+            extensions=(".png",),
+            gives=None,
+            writes="PolygonModel",
+            description="PNG picture of polygons",
+            writer="csplab.io.polygons:write_png",
+            details="the polygons in their label colours on white, equal aspect, `y` up "
+            "(`.png` files are read as overlapping-model samples, never as polygons)",
+            example=f"csplab synthesize {_CONT}/two_objects.json --size 12x8 --seed 1 "
+            "--out two.png",
+        ),
     )
 }
 
@@ -583,12 +652,27 @@ def sniff(head: bytes, pool: Sequence[Format], default: Format | None = None) ->
     return next((f for f in pool if f.name == FALLBACK), pool[0])
 
 
+def _writers(gives: Gives | None) -> list[Format]:
+    """The formats that write models of ``gives`` (polygon models: every polygon writer;
+    otherwise the grid writers, of formats giving ``gives`` when given)."""
+    if gives == "PolygonModel":
+        return [f for f in formats(writable=True) if f.writes == "PolygonModel"]
+    return [f for f in formats(gives=gives, writable=True) if f.writes == "grid"]
+
+
 def _writer_for(ext: str, gives: Gives | None) -> Format | None:
-    return next((f for f in formats(gives=gives, writable=True) if ext in f.extensions), None)
+    return next((f for f in _writers(gives) if ext in f.extensions), None)
 
 
 def output_format(path: str | Path, *, gives: Gives | None = None) -> Format:
-    """The format written for ``path``'s extension (of the formats giving ``gives``)."""
+    """The format written for ``path``'s extension (of the formats giving ``gives``; a
+    label grid unless ``gives="PolygonModel"``).
+
+    Examples
+    --------
+    >>> [output_format(f"m{e}", gives="PolygonModel").name for e in (".json", ".svg", ".png")]
+    ['polygons', 'svg', 'polygon-png']
+    """
     p = Path(path)
     f = _writer_for(p.suffix.lower(), gives)
     if f is None:
@@ -605,9 +689,11 @@ def output_extensions(*, gives: Gives | None = None, partial: bool | None = None
     --------
     >>> output_extensions(), output_extensions(partial=True)
     (['.txt', '.grid', '.npy', '.png', '.vox', '.obj'], ['.npy', '.png', '.vox', '.obj'])
+    >>> output_extensions(gives="PolygonModel")
+    ['.json', '.svg', '.png']
     """
     out: list[str] = []
-    for f in formats(gives=gives, writable=True):
+    for f in _writers(gives):
         if partial is None or f.partial == partial:
             out += [e for e in f.extensions if e not in out and _writer_for(e, gives) is f]
     return out
