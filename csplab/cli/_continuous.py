@@ -121,6 +121,9 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
             print(f"  wrote {wrote}")
         elif args.out:
             print(f"  not written: {args.out} (no solution)", file=sys.stderr)
+        if r.status == "failed" and not cls.complete and cls.name != "blocks":
+            print("  hint: --solver blocks modifies the model in parts (Fig. 4.23) and never "
+                  "fails; an exact solver (sat) decides", file=sys.stderr)  # fmt: skip
     return 0 if s.ok else 1
 
 

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab.continuous.model import PolygonModel
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.grids import parse_boundary, parse_shape
@@ -40,7 +41,7 @@ __all__ = [
 #: The line the CLI prints on stderr before numba compiles csplab's kernels for the first time.
 COMPILING = "compiling csplab's kernels once (about 5 s; cached afterwards)"
 
-Model = ExampleModel | RuleSet
+Model = ExampleModel | RuleSet | PolygonModel
 
 
 def key_values(items: list[str] | None, flag: str, form: str = "KEY=VALUE") -> dict[str, Any]:
@@ -300,6 +301,12 @@ def problem_from_args(
     args: argparse.Namespace, model: Model, shape: tuple[int, ...] | None = None
 ) -> Problem:
     """The problem for ``--size`` (or ``shape``), ``--boundary`` and ``--periodic``."""
+    if isinstance(model, PolygonModel):
+        raise InputError(
+            f"{model.name or args.model} is a polygon model (continuous model synthesis): "
+            "`csplab synthesize`, `check` and `show` take it; this command takes grid "
+            "examples and tilesets"
+        )
     if shape is None and args.size:
         shape = parse_shape(args.size, what="--size")
     boundary = parse_boundary(args.boundary)

@@ -16,12 +16,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.cli.common import check_output_path, load_model, model_options
+from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 
-HELP = "write a PNG picture of a model file (grid, tileset or sample)"
+HELP = "write a PNG picture of a model file (grid, tileset, sample or polygons)"
 DESCRIPTION = (
     "Write a PNG of any model file: 2D grids as cells, 3D grids as an "
-    "isometric rendering, tilesets as a sheet of their labels. Cells a failed or "
+    "isometric rendering, tilesets as a sheet of their labels, polygon models (continuous "
+    "model synthesis) filled in their label colours. Cells a failed or "
     "timed-out run left unassigned (-1 in its .npy) are drawn dark in 2D and left out in "
     "3D. An existing picture is kept unless --force is given. Exit 0 on success, 2 on "
     "bad input."
@@ -87,6 +89,13 @@ def run(args: argparse.Namespace) -> int:
         what = f"{'x'.join(map(str, partial.shape))} grid {src.stem}"
     else:
         model = load_model(args.file, opts)
+        if isinstance(model, PolygonModel):
+            from csplab.io.polygons import write_png
+
+            write_png(model, out)
+            print(f"wrote {out}: {len(model)} polygons of {model.name or src.stem}, labels "
+                  f"{list(model.labels)}")  # fmt: skip
+            return 0
         if isinstance(model, RuleSet):
             img = model.sheet()
             what = f"{model.K} labels of {model.meta.get('format')} tileset {model.name}"

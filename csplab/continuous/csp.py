@@ -394,7 +394,9 @@ class ContinuousCSP:
         return PolygonModel._trusted(
             polys, name=name or f"{self.example.name or 'model'}-synth",
             meta={"example": self.example.name, "size": self.problem.meta["size"],
-                  "spacing": float(self.lattice.spacing)},
+                  "spacing": float(self.lattice.spacing),
+                  **({"colors": self.example.meta["colors"]}
+                     if "colors" in self.example.meta else {})},
         )  # fmt: skip
 
     def _sectors(self, t: int, state: int) -> tuple[int, ...]:

@@ -54,6 +54,8 @@ def _ring(raw: Any, where: str) -> Ring:
             raise InputError(f"{where}: point {i} must be [x, y], not {p!r}")
         try:
             x, y = float(p[0]), float(p[1])
+        except OverflowError:
+            raise InputError(f"{where}: point {i} has coordinates too large {p!r}") from None
         except (TypeError, ValueError):
             raise InputError(f"{where}: point {i} has non-numeric coordinates {p!r}") from None
         if not (math.isfinite(x) and math.isfinite(y)):
@@ -189,6 +191,9 @@ class PolygonModel:
         return cls(polys, name=name, meta=meta)
 
     # ------------------------------------------------------------------ queries
+    #: continuous models are planar
+    ndim = 2
+
     @property
     def labels(self) -> tuple[int, ...]:
         """The object labels used (sorted; 0 is implicit everywhere else)."""

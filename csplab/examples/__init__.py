@@ -59,8 +59,12 @@ def example_names() -> list[str]:
 
 
 def example_info() -> list[tuple[str, str]]:
-    """``(name, description)`` of every built-in example."""
-    return [(k, v[1]) for k, v in EXAMPLES.items()]
+    """``(name, description)`` of every built-in example, grids then polygon models
+    (continuous model synthesis, :mod:`csplab.examples.continuous`)."""
+    from csplab.examples.continuous import CONTINUOUS_EXAMPLES
+
+    grids = [(k, v[1]) for k, v in EXAMPLES.items()]
+    return grids + [(k, f"polygons: {v[1]}") for k, v in CONTINUOUS_EXAMPLES.items()]
 
 
 def load_example(name: str) -> ExampleModel:

@@ -29,6 +29,7 @@ from typing import Any
 
 from numpy.typing import ArrayLike
 
+from csplab.continuous.model import PolygonModel
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.io.common import Output
@@ -73,8 +74,8 @@ def model_format(path: str | Path) -> str:
 
 def read_model(
     path: str | Path, format: str | None = None, **options: Any
-) -> ExampleModel | RuleSet:
-    """Read any model file: an example grid or a rule set.
+) -> ExampleModel | RuleSet | PolygonModel:
+    """Read any model file: an example grid, a rule set or a polygon model.
 
     ``options`` are the format's loader options (``csplab info`` lists them), e.g.
     ``subset=`` (WFC), ``up=`` (POMS), ``strict=`` (DeBroglie), ``N=``, ``symmetry=``,
@@ -87,7 +88,9 @@ def read_model(
     return fmt.read(p, **options)
 
 
-def load_model(spec: str | Path, options: dict[str, Any] | None = None) -> ExampleModel | RuleSet:
+def load_model(
+    spec: str | Path, options: dict[str, Any] | None = None
+) -> ExampleModel | RuleSet | PolygonModel:
     """A built-in example name (``csplab info`` lists them) or a model file path (any
     format of :func:`read_model`, with its loader ``options``).
 
@@ -102,6 +105,7 @@ def load_model(spec: str | Path, options: dict[str, Any] | None = None) -> Examp
 example 'line'
     """
     from csplab.examples import ALIASES, EXAMPLES, load_example
+    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
 
     p = Path(spec)
     if p.exists():
@@ -113,11 +117,17 @@ example 'line'
                 f"model options apply to model files only, not to the built-in example {text!r}"
             )
         return load_example(text)
+    if text in CONTINUOUS_EXAMPLES:
+        if options:
+            raise InputError(
+                f"model options apply to model files only, not to the built-in example {text!r}"
+            )
+        return load_polygon_example(text)
     if p.suffix or "/" in text or "\\" in text:
         raise FormatError("no such file", path=text)
     raise InputError(
         f"{text!r} is neither a model file nor a built-in example "
-        f"({', '.join(EXAMPLES)}); see `csplab info`"
+        f"({', '.join([*EXAMPLES, *CONTINUOUS_EXAMPLES])}); see `csplab info`"
     )
 
 
