@@ -17,7 +17,7 @@ Examples
 >>> M.labels, M.area(1)
 ((1,), 2.0)
 >>> PolygonModel.from_json({"polygons": [
-...     {"label": 1, "points": [[0, 0], [2, 2], [2, 0], [0, 1]]}]}, source="bow.json")
+...     {"label": 1, "points": [[0, 0], [1, 1], [1, 0], [0, 1]]}]}, source="bow.json")
 Traceback (most recent call last):
 ...
 csplab.errors.InputError: bow.json: polygon 0: its boundary crosses itself (Self-intersection...
@@ -235,12 +235,16 @@ class PolygonModel:
             where = f"{src}: polygon {i}"
             for j, r in enumerate(p.rings()):
                 what = "its boundary" if j == 0 else f"hole {j - 1}"
-                if abs(_signed_area(r)) <= 1e-12 * max(1.0, _scale(r)) ** 2:
-                    raise InputError(f"{where}: {what} has zero area")
+                a = np.asarray(r, dtype=np.float64)
+                flat = np.linalg.matrix_rank(a - a.mean(axis=0), tol=1e-12 * _scale(r)) < 2
+                if flat:
+                    raise InputError(f"{where}: {what} has zero area (its points are collinear)")
                 ring = shapely.LinearRing(r)
                 if not ring.is_simple:
                     why = shapely.is_valid_reason(ShapelyPolygon(r))
                     raise InputError(f"{where}: {what} crosses itself ({why})")
+                if abs(_signed_area(r)) <= 1e-12 * max(1.0, _scale(r)) ** 2:
+                    raise InputError(f"{where}: {what} has zero area")
             g = p.shape
             if not g.is_valid:
                 raise InputError(f"{where}: invalid polygon ({shapely.is_valid_reason(g)})")

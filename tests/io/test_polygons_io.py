@@ -259,7 +259,7 @@ BAD_JSON = [
     ({"polygons": [{"label": "a", "points": TRI}]}, "polygon 0: label must be an integer"),
     (
         {"polygons": [{"label": 1, "points": [[0, 0], [1, 0], [0, 10**400]]}]},
-        "cannot build the polygon model",
+        "polygon 0: point 2 has coordinates too large",
     ),
     ({"shapes": []}, 'expected an object with a "polygons" list'),
 ]
