@@ -52,6 +52,10 @@ CONTINUOUS_EXAMPLES: dict[str, tuple[str, str]] = {
         "fallible.json",
         "a dart with a reflex vertex; catalog 0/50 at 40x40, blocks 50/50",
     ),
+    "pentagon": (
+        "pentagon.json",
+        "a pentagon with 5 edge directions; catalog 50/50 at 40x40",
+    ),
 }
 
 
