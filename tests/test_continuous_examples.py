@@ -61,7 +61,7 @@ def test_loads_small_with_description(name: str) -> None:
     xmin, ymin, xmax, ymax = E.bounds
     ext = max(xmax - xmin, ymax - ymin) / float(lat.spacing)
     assert ext <= 12
-    assert len(lat.directions) <= 4
+    assert len(lat.directions) <= 5
 
 
 def test_unknown_name_lists_names() -> None:
