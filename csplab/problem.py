@@ -436,6 +436,7 @@ class Problem:
         cells: ArrayLike,
         grid: ArrayLike,
         shape: Sequence[int] | None = None,
+        arc_ids: ArrayLike | None = None,
     ) -> Problem:
         """The problem on ``cells`` with every other cell fixed to its label in ``grid``.
 
@@ -443,12 +444,14 @@ class Problem:
         labelled outside cell become domain restrictions on the inside cell (this is how a
         block of Alg. 3.4 sees the fixed labels around it); arcs to unlabelled (negative)
         outside cells are dropped. ``shape`` gives the sub-grid's shape (default: flat).
+        ``arc_ids`` (sorted) may name a subset of the arcs that contains every arc touching
+        ``cells`` (a speed-up for many small blocks; the result is the same).
         """
         idx = np.asarray(cells, dtype=np.int64).ravel()
         lab = self._flat_grid(grid)
         local = np.full(self.n, -1, dtype=np.int64)
         local[idx] = np.arange(idx.size)
-        a = self.arcs
+        a = self.arcs if arc_ids is None else self.arcs[np.asarray(arc_ids, dtype=np.int64)]
         ls, ld = local[a[:, 0]], local[a[:, 1]]
         inside = (ls >= 0) & (ld >= 0)
         dom = self.domains[idx].copy()

@@ -192,6 +192,7 @@ def run_blocks(
             idx[tuple(slice(a, a + b) for a, b in zip(q, m, strict=True))].reshape(-1)
             for q in itertools.product(*starts)
         ]
+    touching = _arc_index(problem) if len(boxes) > 1 else None
     tried = accepted = retry_count = 0
     revisions = 0
     deadline = None if time_limit is None else t0 + float(time_limit)
@@ -203,7 +204,8 @@ def run_blocks(
                 break
             if not cells.size:
                 continue
-            sub = problem.subproblem(cells, grid, shape=None if m == (0,) else m)
+            arc_ids = None if touching is None else _arcs_touching(cells, *touching)
+            sub = problem.subproblem(cells, grid, shape=None if m == (0,) else m, arc_ids=arc_ids)
             tried += 1
             for attempt in range(retries + 1):
                 left = None if deadline is None else max(0.0, deadline - time.perf_counter())
@@ -239,6 +241,26 @@ def run_blocks(
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
+
+
+def _arc_index(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Arcs by cell (CSR ``indptr, arc ids``): each arc listed under both its ends."""
+    a = problem.arcs
+    ends = np.concatenate([a[:, 0], a[:, 1]])
+    ids = np.concatenate([np.arange(len(a)), np.arange(len(a))]).astype(np.int64)
+    order = np.argsort(ends, kind="stable")
+    indptr = np.searchsorted(ends[order], np.arange(problem.n + 1)).astype(np.int64)
+    return indptr, ids[order]
+
+
+def _arcs_touching(
+    cells: NDArray[np.int64], indptr: NDArray[np.int64], ids: NDArray[np.int64]
+) -> NDArray[np.int64]:
+    """The sorted ids of the arcs with an end in ``cells``."""
+    start, lens = indptr[cells], indptr[cells + 1] - indptr[cells]
+    first = np.cumsum(lens) - lens
+    pos = np.repeat(start - first, lens) + np.arange(int(lens.sum()))
+    return np.unique(ids[pos])
 
 
 def _block_list(block: int | Sequence[int], problem: Problem) -> list[int]:
