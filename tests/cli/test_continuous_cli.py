@@ -76,8 +76,8 @@ def test_file_example_spacing_and_boundary(
     ex.write_text(json.dumps({"polygons": [{"label": 1, "points": [[0, 0], [10, 0], [5, 7.5]]}]}))
     code, stdout, _ = run(capsys, "synthesize", str(ex), "--size", "12x10", "--seed", "2")
     assert code == 0 and "spacings of 2.5" in stdout
-    code, stdout, _ = run(capsys, "synthesize", str(ex), "--size", "12x10", "--seed", "2",
-                          "--spacing", "5", "--snap", "--boundary", "1", "--solver", "sat")  # fmt: skip
+    args = ["--spacing", "5", "--snap", "--boundary", "1", "--solver", "sat"]
+    code, stdout, _ = run(capsys, "synthesize", str(ex), "--size", "12x10", "--seed", "2", *args)
     assert code == 0 and "spacings of 5" in stdout
 
 
