@@ -177,8 +177,9 @@ class _Node:
     before: dict[int, set[int]]
 
 
-def _nodes(model: PolygonModel, fams: _Families, scale: float) -> list[_Node]:
-    segs, labs = _segments(model)
+def _nodes(
+    segs: np.ndarray[Any, Any], labs: list[int], fams: _Families, scale: float
+) -> list[_Node]:
     if not len(segs):
         return []
     q = 1e-9 * scale
@@ -226,7 +227,10 @@ def _nodes(model: PolygonModel, fams: _Families, scale: float) -> list[_Node]:
 
 
 def neighbourhoods(
-    model: PolygonModel, fams: _Families, scale: float
+    model: PolygonModel,
+    fams: _Families,
+    scale: float,
+    segments: tuple[np.ndarray[Any, Any], list[int]] | None = None,
 ) -> tuple[dict[Signature, tuple[float, float]], dict[Signature, tuple[float, float]],
            list[Defect]]:  # fmt: skip
     """Reduced neighbourhoods of ``model``'s nodes and of its edges (beside each node), each
@@ -236,7 +240,8 @@ def neighbourhoods(
     vsig: dict[Signature, tuple[float, float]] = {}
     esig: dict[Signature, tuple[float, float]] = {}
     defects: list[Defect] = []
-    for n in _nodes(model, fams, scale):
+    segs, labs = segments if segments is not None else _segments(model)
+    for n in _nodes(segs, labs, fams, scale):
         rays = sorted(set(n.after) | set(n.before))
         m = len(rays)
         sect = []
@@ -295,8 +300,8 @@ def violations(
         if b not in example.labels:
             c = model.shape(b).representative_point()
             defects.append(Defect("label", (c.x, c.y), f"label {b} does not occur in the example"))
-    mv, me, extra = neighbourhoods(model, fams, scale)
-    segs, _ = _segments(model)
+    segs, labs = _segments(model)
+    mv, me, extra = neighbourhoods(model, fams, scale, (segs, labs))
     for (ax, ay), (bx, by) in segs.tolist():
         r = fams.ray(bx - ax, by - ay)
         if r >= _FOREIGN:
