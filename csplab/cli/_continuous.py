@@ -122,8 +122,11 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
         elif args.out:
             print(f"  not written: {args.out} (no solution)", file=sys.stderr)
         if r.status == "failed" and not cls.complete and cls.name != "blocks":
-            print("  hint: --solver blocks modifies the model in parts (Fig. 4.23) and never "
-                  "fails; an exact solver (sat) decides", file=sys.stderr)  # fmt: skip
+            hint = (
+                "  hint: --solver blocks modifies the model in parts (Fig. 4.23) and always "
+                "returns a consistent model; an exact solver (sat) decides"
+            )
+            print(hint, file=sys.stderr)
     return 0 if s.ok else 1
 
 
