@@ -205,3 +205,31 @@ def test_bad_examples_end_in_one_line(bad: dict[str, object], match: str) -> Non
     with pytest.raises(InputError, match=match) as e:
         ContinuousCSP(PolygonModel.from_json(bad, source="bad.json"), (4, 4))
     assert "\n" not in str(e.value) and "bad.json" in str(e.value)
+
+
+@pytest.mark.parametrize("name", ["triangle", "pentagon", "fallible"])
+def test_equal_line_spacing(name: str) -> None:
+    """``lines="equal"``: every family about one spacing apart (the 2008 paper); fewer
+    vertices, outputs still satisfy Eq. 4.1, and the example stretched by the lcm of the
+    line steps is still a solution."""
+    from csplab.examples.continuous import load_polygon_example
+
+    E = load_polygon_example(name)
+    C = ContinuousCSP(E, (30, 30), lines="equal")
+    L = ContinuousCSP(E, (30, 30))
+    A = C.arrangement
+    assert C.problem.meta["lines"] == "equal"
+    if (A.step > 1).any():
+        assert A.n_vertices < L.arrangement.n_vertices
+    norm = np.hypot(A.normals[:, 0], A.normals[:, 1])
+    gap = A.step / norm  # distance between a family's lines, in spacings
+    assert (np.abs(gap - 1) <= 0.5).all()
+    t = int(np.lcm.reduce(A.step))
+    x0, y0, x1, y1 = E.bounds
+    s = float(C.lattice.spacing)
+    if ((x1 - x0) / s + 1) * t <= 30 and ((y1 - y0) / s + 1) * t <= 30:
+        M = _stretched(E, t, t * s)  # corners on lines of every family: multiples of t
+        assert len(C.problem.violations(C.encode(M))) == 0
+    r = solve(C.problem, "sat", rng=1)
+    assert r.status == "solved"
+    assert len(violations(E, C.model(r.grid), region=C.region())) == 0

@@ -77,9 +77,10 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
     settings["restarts"] = restarts
+    settings["lines"] = args.lines
     s = run(
         example, size, solver=args.solver, rng=args.seed, spacing=args.spacing,
-        snap=args.snap, boundary=boundary, restarts=restarts, **opts,
+        snap=args.snap, boundary=boundary, lines=args.lines, restarts=restarts, **opts,
     )  # fmt: skip
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None

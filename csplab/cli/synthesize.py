@@ -71,6 +71,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "that puts every example vertex on the lattice)",
     )
     p.add_argument(
+        "--lines",
+        choices=("lattice", "equal"),
+        default="lattice",
+        help="continuous models: 'lattice' puts every family's lines through every lattice "
+        "point (exact corners anywhere; sloped families are denser), 'equal' spaces every "
+        "family's lines about one spacing apart (as the 2008 paper)",
+    )
+    p.add_argument(
         "--snap",
         action="store_true",
         help="continuous models: round example vertices onto the --spacing lattice",
@@ -169,8 +177,8 @@ def run(args: argparse.Namespace) -> int:
         from csplab.cli import _continuous
 
         return _continuous.synthesize(args, example, _options(args))
-    if args.spacing is not None or args.snap:
-        raise InputError("--spacing and --snap apply to continuous (polygon) models only")
+    if args.spacing is not None or args.snap or args.lines != "lattice":
+        raise InputError("--spacing, --snap and --lines apply to continuous (polygon) models only")
     problem = problem_from_args(args, example)
     opts = _options(args)
     settings = _settings(args, example, opts)

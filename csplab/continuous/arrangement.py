@@ -48,7 +48,13 @@ from numpy.typing import NDArray
 
 from csplab.errors import InputError
 
-__all__ = ["MAX_FAMILIES", "Arrangement", "Lattice"]
+__all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice"]
+
+#: how the lines of a family are spaced: ``lattice`` (every integer ``k``: every lattice
+#: point on every family, exact copies of the example's corners anywhere) or ``equal``
+#: (``k`` a multiple of the integer nearest ``|n|``: all families about one spacing apart,
+#: as the 2008 paper spaces them; the example's corners then appear where those lines meet)
+LINES = ("lattice", "equal")
 
 #: rays are bits of an int64 mask (two per family)
 MAX_FAMILIES = 31
@@ -215,15 +221,25 @@ class Arrangement:
         Bit ``f`` (ray along ``+d_f``) and bit ``F + f`` (along ``-d_f``) of each vertex.
     """
 
-    def __init__(self, lattice: Lattice, W: int, H: int) -> None:
+    def __init__(self, lattice: Lattice, W: int, H: int, *, lines: str = "lattice") -> None:
         if W < 1 or H < 1:
             raise InputError(f"the region must be at least 1x1 spacings, not {W}x{H}")
-        self.lattice, self.W, self.H = lattice, int(W), int(H)
+        if lines not in LINES:
+            raise InputError(f"lines must be one of {', '.join(LINES)}, not {lines!r}")
+        self.lattice, self.W, self.H, self.lines = lattice, int(W), int(H), lines
         dirs, bonly = lattice.families()
         self.dirs = np.array(dirs, dtype=np.int64).reshape(-1, 2)
         self.boundary_only = np.array(bonly, dtype=bool)
         self.normals = np.stack([self.dirs[:, 1], -self.dirs[:, 0]], axis=1)
         F = self.F = len(dirs)
+        # lines p x + q y = k for k a multiple of step[f]: 1 ("lattice"), or the integer
+        # nearest to |n| ("equal": every family's lines about one spacing apart, Sec. 3.2)
+        norm = np.hypot(self.normals[:, 0], self.normals[:, 1])
+        self.step = (
+            np.maximum(1, np.rint(norm)).astype(np.int64)
+            if lines == "equal"
+            else np.ones(F, dtype=np.int64)
+        )
         D = 1
         for f in range(F):
             for g in range(f + 1, F):
@@ -235,7 +251,8 @@ class Arrangement:
         for f in range(F):
             kc = corners @ self.normals[f]
             lo, hi = int(kc.min()), int(kc.max())
-            ks = np.array([lo, hi]) if bonly[f] else np.arange(lo, hi + 1)
+            st = int(self.step[f])
+            ks = np.array([lo, hi]) if bonly[f] else np.arange(-(-lo // st) * st, hi + 1, st)
             self.k_range.append(ks.astype(np.int64))
         keys = []
         for f in range(F):
@@ -257,10 +274,10 @@ class Arrangement:
         for f in range(F):
             p, q = self.normals[f]
             s = p * self.X + q * self.Y
-            on = s % D == 0
+            on = s % (D * int(self.step[f])) == 0
             k = s // D
             if bonly[f]:
-                on &= np.isin(k, self.k_range[f])
+                on = (s % D == 0) & np.isin(k, self.k_range[f])
             idx = np.flatnonzero(on)
             dx, dy = self.dirs[f]
             t = dx * self.X[idx] + dy * self.Y[idx]

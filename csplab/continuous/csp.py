@@ -170,6 +170,8 @@ class ContinuousCSP:
         Round example vertices onto the lattice of ``spacing``.
     boundary : int
         The label outside the region (default 0, empty space).
+    lines : {"lattice", "equal"}
+        Line spacing per family (:data:`~csplab.continuous.arrangement.LINES`).
 
     Attributes
     ----------
@@ -190,6 +192,7 @@ class ContinuousCSP:
         spacing: float | None = None,
         snap: bool = False,
         boundary: int = 0,
+        lines: str = "lattice",
         lattice: Lattice | None = None,
     ) -> None:
         if len(size) != 2:
@@ -213,7 +216,7 @@ class ContinuousCSP:
             raise InputError(f"boundary label {boundary} does not occur in the example")
         self.boundary = boundary
         self.signatures = example_signatures(example, self.lattice, index)
-        A = self.arrangement = Arrangement(self.lattice, W, H)
+        A = self.arrangement = Arrangement(self.lattice, W, H, lines=lines)
         F, Kl = A.F, len(self.labels)
         self.Kl = Kl
         b0 = index[boundary]
@@ -306,6 +309,7 @@ class ContinuousCSP:
                 "vertices": nv,
                 "edges": ne,
                 "boundary": boundary,
+                "lines": lines,
             },
             positions=pos[order],
         )

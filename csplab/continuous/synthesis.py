@@ -60,6 +60,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int = 0,
+    lines: str = "lattice",
     restarts: int = 0,
     check: bool = True,
     **options: Any,
@@ -74,7 +75,7 @@ def synthesize(
         Any registered solver name (``NAME:BACKEND`` too); ``options`` go to it.
     rng : int or numpy Generator, optional
         Seed (recorded in the result).
-    spacing, snap, boundary
+    spacing, snap, boundary, lines
         See :class:`~csplab.continuous.csp.ContinuousCSP`.
     restarts : int
         Run an incomplete solver again with a fresh derived seed while it fails.
@@ -82,7 +83,7 @@ def synthesize(
         Run the checker on the output (default; it is the truth, not the CSP).
     """
     t0 = time.perf_counter()
-    csp = ContinuousCSP(example, size, spacing=spacing, snap=snap, boundary=boundary)
+    csp = ContinuousCSP(example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines)
     t1 = time.perf_counter()
     result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
     t2 = time.perf_counter()
