@@ -315,11 +315,11 @@ def violations(
     for sig, pt in me.items():
         if sig not in allowed:
             deg = math.degrees(fams.angle_of(sig[0][0] % F)) % 180
-            labs = _edge_sides(sig, F)
+            sides = _edge_sides(sig, F)
             defects.append(Defect(
                 "edge", pt,
-                f"an edge of direction {deg:.6g} degrees with label {labs[0]} on its left, "
-                f"{labs[1]} on its right",
+                f"an edge of direction {deg:.6g} degrees with label {sides[0]} on its left, "
+                f"{sides[1]} on its right",
             ))  # fmt: skip
     for sig, pt in mv.items():
         if sig not in allowed and sig not in me:
