@@ -44,7 +44,9 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(2)
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(only: str | None = None) -> argparse.ArgumentParser:
+    """The parser of every command; with ``only``, that command's parser in full and the
+    others as bare names (their modules are not imported: a faster start)."""
     from csplab import __version__
 
     parser = _Parser(
@@ -55,6 +57,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
     for name, modname in COMMANDS.items():
+        if only is not None and name != only:
+            sub.add_parser(name)
+            continue
         mod = importlib.import_module(modname)
         desc = getattr(mod, "DESCRIPTION", None)
         if hasattr(mod, "description"):
@@ -87,7 +92,10 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
     line on stderr before numba's one-time compilation of the kernels, when its cache is
     cold.
     """
-    parser = build_parser()
+    words = list(sys.argv[1:] if argv is None else argv)
+    first = next((w for w in words if not w.startswith("-")), None)
+    plain = first in COMMANDS and words and words[0] == first
+    parser = build_parser(only=first if plain else None)
     args = parser.parse_args(argv)
     if announce is None:
         announce = argv is None
