@@ -68,15 +68,40 @@ def model_options(items: list[str] | None) -> dict[str, Any]:
 
 def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     """:func:`csplab.io.load_model`, printing the loader's warnings to stderr, one line
-    each."""
+    each.
+
+    A model file that takes longer than :data:`csplab.progress.DELAY_S` to read (a tileset
+    of many megabytes) gets one line on stderr, ``csplab: reading FILE (N MB) ...``, once
+    that time has passed; the XML and picture readers parse in one call, so there is no
+    bar. Quick reads print nothing.
+    """
     import sys
+    import threading
     import warnings
 
+    from csplab import progress
     from csplab.io import load_model as load
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        model = load(spec, options)
+    def notice() -> None:
+        try:
+            mb = os.path.getsize(spec) / 1e6
+        except OSError:
+            mb = 0.0
+        size = f" ({mb:.0f} MB)" if mb >= 1 else ""
+        print(f"csplab: reading {spec}{size} ...", file=sys.stderr, flush=True)
+
+    timer = None
+    if os.path.isfile(spec):  # a file, not a built-in example
+        timer = threading.Timer(progress.DELAY_S, notice)
+        timer.daemon = True
+        timer.start()
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            model = load(spec, options)
+    finally:
+        if timer is not None:
+            timer.cancel()
     for w in caught:  # one line each, no source location
         print(f"csplab: warning: {w.message}", file=sys.stderr)
     return model

@@ -32,7 +32,8 @@ Examples
 Traceback (most recent call last):
 ...
 csplab.errors.InputError: unknown model format 'stl'; use merrell, grid, npy, wfc, \
-overlapping, poms, debroglie, markovjunior, png, vox, obj, polygons, svg or polygon-png
+overlapping, wfc-samples, poms, debroglie, markovjunior, png, vox, obj, polygons, svg or \
+polygon-png
 """
 
 from __future__ import annotations
@@ -419,6 +420,36 @@ FORMATS: dict[str, Format] = {
             "along each axis (2D or 3D samples)",
             example="csplab synthesize tests/io/data/sample.png --size 48x24 --periodic "
             "--model-option symmetry=2 --seed 1 --out flowers.png",
+        ),
+        Format(
+            name="wfc-samples",
+            synthesis=_WFC_LIKE,
+            extensions=(".xml",),
+            gives="RuleSet",
+            description="WaveFunctionCollapse samples list",
+            reader="csplab.io.wfc_samples:read_wfc_samples",
+            sniffer="csplab.io.wfc_samples:sniff",
+            options=(
+                Option("name", str, None, "the entry (needed when the list has several)"),
+                Option("index", int, None, "the K-th entry (from 0) of those called `name`"),
+                Option("N", int, None, "overlapping entries: overrides `N`"),
+                Option("symmetry", int, None, "overlapping entries: overrides `symmetry`"),
+                Option(
+                    "periodic_input", bool, None, "overlapping entries: overrides `periodicInput`"
+                ),
+                Option("ground", str, None, "overlapping entries: overrides `ground`"),
+                Option("subset", str, None, "simple tiled entries: overrides `subset`"),
+                Option("images", bool, None, "simple tiled entries: read the tile pictures"),
+            ),
+            files="with root `<samples>`",
+            details="one `<overlapping>` (`samples/NAME.png`) or `<simpletiled>` "
+            "(`tilesets/NAME.xml`) entry, read as those formats with the entry's `N`, "
+            "`symmetry`, `periodicInput`, `ground`, `subset`; its `heuristic` "
+            "(Entropy/MRV/Scanline) is the cell order, `periodic` and `width`/`height`/`size` "
+            "the default output (a non-periodic overlapping output is `width - N + 1` cells "
+            "across: WFC's picture size)",
+            example="csplab synthesize tests/io/data/wfc_samples.xml --model-option "
+            "name=sample --seed 1 --out flowers.png",
         ),
         Format(
             name="poms",
