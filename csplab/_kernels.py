@@ -580,9 +580,13 @@ def alg31(
     hp: Heap,
     use_heap: bool,
     weighted: bool,
+    key_weighted: bool,
     max_steps: int,
 ) -> int:
     """Run Alg. 3.1 from step ``run.state[0]`` for at most ``max_steps`` assignments.
+
+    Labels are drawn by weight with ``weighted``; the heap's entropy keys are weighted with
+    ``key_weighted`` (min-entropy) or plain domain-size logarithms (min-domain, MRV).
 
     ``state = [step, heap_size, fail_cell]``. Returns :attr:`Code.SOLVED` when every cell is
     assigned, :attr:`Code.FAILED` when a domain emptied (``state[2]`` is that cell),
@@ -631,7 +635,8 @@ def alg31(
             start[0] = p
             wiped = _propagate(
                 dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
-                heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw, weighted,
+                heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw,
+                key_weighted,
             )  # fmt: skip
             if wiped >= 0:
                 state[2] = wiped

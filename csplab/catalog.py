@@ -227,12 +227,13 @@ class Propagator:
 
     def alg31(
         self, run: Run, heap: Heap | None = None, *, weighted: bool = False,
-        max_steps: int | None = None,
+        max_steps: int | None = None, key_weighted: bool | None = None,
     ) -> Code:  # fmt: skip
         """Run (or resume) Alg. 3.1 on this catalog: :func:`csplab._kernels.alg31`.
 
         The cells come from ``run.order``, or from the entropy ``heap`` when one is given;
-        labels are drawn uniformly or, with ``weighted``, by the problem's weights. Stops
+        labels are drawn uniformly or, with ``weighted``, by the problem's weights (the heap's
+        entropy keys too, unless ``key_weighted`` says otherwise). Stops
         after ``max_steps`` assignments (default: none) with :attr:`~csplab._kernels.Code.PAUSED`.
         On :attr:`~csplab._kernels.Code.FAILED` the engine is marked wiped out (``ok``,
         ``wiped``). The catalog must be arc consistent (``ok``) when the run starts.
@@ -240,7 +241,8 @@ class Propagator:
         n = self.c.n
         code = kern.alg31(
             self.c.arcs, self._ac(), run, _NO_HEAP if heap is None else heap,
-            heap is not None, weighted, n + 1 if max_steps is None else int(max_steps),
+            heap is not None, weighted, weighted if key_weighted is None else key_weighted,
+            n + 1 if max_steps is None else int(max_steps),
         )  # fmt: skip
         result = Code(code)
         if result is Code.FAILED:

@@ -142,7 +142,7 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
     from csplab.solvers import solver_class
 
     cls = solver_class(args.solver.partition(":")[0])
-    suggested, source = synthesis_defaults(example)
+    suggested, sources = synthesis_defaults(example)
     settings: dict[str, Any] = {}
     for key in ("order", "choice"):
         o = cls.option(key)
@@ -154,9 +154,10 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
         value = suggested.get(key)
         if value is not None and (o.values is None or value in o.values):
             opts[key] = value
-            settings[key] = f"{value} ({source})"
+            settings[key] = f"{value} ({sources[key]})"
         else:
-            settings[key] = f"{o.default} ({'solver default' if suggested else source})"
+            origin = "solver default" if suggested else sources.get("*", "solver default")
+            settings[key] = f"{o.default} ({origin})"
     settings["restarts"] = 0 if cls.complete else args.restarts
     if cls.takes("progress"):
         opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s

@@ -11,7 +11,9 @@ Orders (:data:`ORDERS`): ``scanline`` is the thesis' loop order (x outermost, z 
 ``scan:AXES`` scans with the named axes from outermost to innermost, e.g. ``scan:yx``, the
 order of the thesis' 2D figures; ``random`` a random permutation; ``min-entropy`` the
 unassigned cell of least Shannon entropy (weighted when ``choice="weighted"``) with tiny
-random tie-breaking, as WaveFunctionCollapse does. Choices (:data:`CHOICES`): ``uniform``
+random tie-breaking, as WaveFunctionCollapse does; ``min-domain`` the unassigned cell with
+the fewest labels left (WaveFunctionCollapse's ``MRV`` heuristic; same tie-breaking), whatever
+the choice. Choices (:data:`CHOICES`): ``uniform``
 over the catalog (thesis) or ``weighted`` by the problem's label weights.
 
 Examples
@@ -48,7 +50,8 @@ __all__ = [
     "scan_order",
 ]
 
-ORDERS = ("scanline", "random", "min-entropy", "scan:AXES")
+ORDERS = ("scanline", "random", "min-entropy", "min-domain", "scan:AXES")
+_HEAP_ORDERS = ("min-entropy", "min-domain")
 CHOICES = ("uniform", "weighted")
 _CHUNK = 4096
 
@@ -67,7 +70,7 @@ def run_alg31(
     ``engine`` may supply an already propagated :class:`~csplab.catalog.Propagator` for the
     problem (it is consumed). Random numbers are drawn in this order: the cell permutation
     (``random`` order only), one uniform per step for the label choice, one tie-breaking
-    number per cell (``min-entropy`` only).
+    number per cell (``min-entropy`` and ``min-domain`` only).
     """
     scan = scan_order(problem.shape, order)
     if choice not in CHOICES:
@@ -76,7 +79,7 @@ def run_alg31(
     n = problem.n
     perm = rng.permutation(n).astype(np.int64) if order == "random" else scan
     ustream = rng.random(n)
-    noise = rng.random(n) if order == "min-entropy" else np.zeros(n)
+    noise = rng.random(n) if order in _HEAP_ORDERS else np.zeros(n)
     eng = engine if engine is not None else Propagator(problem)
     grid = np.full(n, -1, dtype=np.int32)
     stats: dict[str, Any] = {"order": order, "choice": choice}
@@ -90,10 +93,11 @@ def run_alg31(
         )  # fmt: skip
     weighted = choice == "weighted"
     heap: kern.Heap | None = None
-    if order == "min-entropy":
+    key_weighted = weighted and order == "min-entropy"  # min-domain (MRV): label counts
+    if order in _HEAP_ORDERS:
         heap = kern.Heap(
             heap=np.arange(n, dtype=np.int64), pos=np.zeros(n, dtype=np.int64),
-            key=_entropies(eng, weighted) + 1e-6 * noise, noise=noise,
+            key=_entropies(eng, key_weighted) + 1e-6 * noise, noise=noise,
         )  # fmt: skip
         kern.heap_build(heap.heap, heap.pos, heap.key, n)
     run = kern.Run(
@@ -105,7 +109,7 @@ def run_alg31(
     deadline = None if time_limit is None else t0 + float(time_limit)
     status: Status
     while True:
-        code = eng.alg31(run, heap, weighted=weighted,
+        code = eng.alg31(run, heap, weighted=weighted, key_weighted=key_weighted,
                          max_steps=_CHUNK if deadline is not None else None)  # fmt: skip
         if code is kern.Code.SOLVED:
             status = "solved"
@@ -128,7 +132,8 @@ def run_alg31(
 
 
 def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:
-    """Cell sequence of a scan order (``None`` for ``random`` and ``min-entropy``).
+    """Cell sequence of a scan order (``None`` for ``random``, ``min-entropy`` and
+    ``min-domain``).
 
     Examples
     --------
@@ -140,7 +145,7 @@ def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:
     n = int(np.prod(shape))
     if order == "scanline":
         return np.arange(n, dtype=np.int64)
-    if order in ("random", "min-entropy"):
+    if order in ("random", *_HEAP_ORDERS):
         return None
     if order.startswith("scan:"):
         names = order[5:]
@@ -204,7 +209,7 @@ def alg31_reference(
     scan orders and ``random``, so both return the same grid for the same seed.
     Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
     """
-    if order == "min-entropy":
+    if order in _HEAP_ORDERS:
         raise InputError("the reference Alg. 3.1 supports the scan and random orders")
     n, K = problem.n, problem.K
     scan = scan_order(problem.shape, order)

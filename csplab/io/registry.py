@@ -315,7 +315,7 @@ _EMPTY6 = "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0"
 # WaveFunctionCollapse's own settings (minimum entropy, weights), for its kind of inputs
 _WFC_LIKE = (("order", "min-entropy"), ("choice", "weighted"))
 # a file's own heuristic (WFC's samples list names one per entry) -> csplab's order
-_HEURISTICS = {"entropy": "min-entropy", "mrv": "min-entropy", "scanline": "scanline"}
+_HEURISTICS = {"entropy": "min-entropy", "mrv": "min-domain", "scanline": "scanline"}
 
 #: Every format, in the order of the README table; the first format declared for an
 #: extension is its default.
@@ -731,28 +731,36 @@ def output_extensions(*, gives: Gives | None = None, partial: bool | None = None
 
 
 # ---------------------------------------------------------------------------- derived texts
-def synthesis_defaults(model: Any) -> tuple[dict[str, str], str]:
-    """The synthesis settings that suit ``model`` and where they come from.
+def synthesis_defaults(model: Any) -> tuple[dict[str, str], dict[str, str]]:
+    """The synthesis settings that suit ``model`` and, per setting, where it comes from.
 
     A model read from a file records its format (``meta["format"]``); the format declares
     its settings (:attr:`Format.synthesis`), and a file that names its own heuristic
-    (``meta["heuristic"]``: WFC's ``Entropy``, ``MRV``, ``Scanline``) wins for the order.
+    (``meta["heuristic"]``: WFC's ``Entropy`` -> ``min-entropy``, ``MRV`` -> ``min-domain``,
+    ``Scanline`` -> ``scanline``) wins for the order. Settings no one suggests come from
+    the thesis (the key ``"*"`` of the sources says so).
 
     Examples
     --------
     >>> import csplab
     >>> synthesis_defaults(csplab.load_example("line"))
-    ({}, 'the thesis defaults')
+    ({}, {'*': 'the thesis defaults'})
+    >>> from types import SimpleNamespace
+    >>> synthesis_defaults(SimpleNamespace(meta={"format": "wfc", "heuristic": "MRV"}))
+    ({'order': 'min-domain', 'choice': 'weighted'}, {'order': "the file's heuristic MRV", \
+'choice': 'wfc defaults'})
     """
     meta = getattr(model, "meta", {}) or {}
     fmt = FORMATS.get(str(meta.get("format")))
     out = dict(fmt.synthesis) if fmt is not None else {}
-    source = f"{fmt.name} defaults" if out and fmt is not None else "the thesis defaults"
+    sources: dict[str, str] = {k: f"{fmt.name} defaults" for k in out} if fmt else {}
     heuristic = str(meta.get("heuristic") or "").lower()
     if heuristic in _HEURISTICS:
         out["order"] = _HEURISTICS[heuristic]
-        source = f"the file's heuristic {meta['heuristic']}"
-    return out, source
+        sources["order"] = f"the file's heuristic {meta['heuristic']}"
+    if not out:
+        sources["*"] = "the thesis defaults"
+    return out, sources
 
 
 def option_help() -> str:

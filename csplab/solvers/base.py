@@ -158,7 +158,8 @@ def order_option(
     (:data:`csplab.engine.alg31.ORDERS`, plus solver-specific ones such as ``min-domain``)."""
     return Option(
         "order", str, default,
-        doc or "cell order: scanline (thesis), random, min-entropy (WFC), scan:AXES (scan:yx)",
+        doc or "cell order: scanline (thesis), random, min-entropy (WFC), min-domain (WFC's "
+        "MRV), scan:AXES (scan:yx)",
         values=orders, convert=_check_order_value(orders),
     )  # fmt: skip
 

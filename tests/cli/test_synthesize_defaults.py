@@ -59,11 +59,14 @@ def test_settings_follow_the_input(capsys):
 
 
 def test_a_files_own_heuristic_wins():
-    d, source = synthesis_defaults(SimpleNamespace(meta={"format": "wfc", "heuristic": "Scanline"}))
-    assert d == {"order": "scanline", "choice": "weighted"} and "Scanline" in source
+    d, src = synthesis_defaults(SimpleNamespace(meta={"format": "wfc", "heuristic": "Scanline"}))
+    assert d == {"order": "scanline", "choice": "weighted"}
+    assert "Scanline" in src["order"] and src["choice"] == "wfc defaults"
+    d, src = synthesis_defaults(SimpleNamespace(meta={"format": "wfc", "heuristic": "MRV"}))
+    assert d["order"] == "min-domain"
     assert synthesis_defaults(SimpleNamespace(meta={"format": "merrell"})) == (
         {},
-        "the thesis defaults",
+        {"*": "the thesis defaults"},
     )
 
 

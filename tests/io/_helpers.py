@@ -48,3 +48,13 @@ def format_sample(name: str) -> tuple[str, bytes]:
             fmt.write(Output.of(grid, names=["air", "ground", "wall"]), p)
             return p.name, p.read_bytes()
     pytest.fail(f"no sample of the {name} format: add a small file to {DATA}")
+
+
+def copy_companions(folder: Path) -> None:
+    """Copy the folders that sample files refer to (``samples/``, ``tilesets/``: the files
+    a WFC samples list names) from ``DATA`` into ``folder``."""
+    import shutil
+
+    for sub in ("samples", "tilesets"):
+        if (DATA / sub).is_dir() and not (folder / sub).exists():
+            shutil.copytree(DATA / sub, folder / sub)

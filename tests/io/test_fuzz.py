@@ -16,7 +16,7 @@ from csplab.io import model_format, read_model
 from csplab.io.registry import formats
 from csplab.testing.strategies import corrupted, tile_rule_sets
 
-from ._helpers import ANCHORS, format_sample
+from ._helpers import ANCHORS, copy_companions, format_sample
 
 READABLE = [f.name for f in formats(readable=True)]
 EXTRA = {  # larger real files, when the shared test data is there
@@ -48,6 +48,7 @@ def load(tmp_path, name, data):
 def test_every_readable_format_has_a_sample_that_loads(tmp_path, fmt):
     name, data = format_sample(fmt)
     (tmp_path / name).write_bytes(data)
+    copy_companions(tmp_path)  # a WFC samples list names files beside it
     assert model_format(tmp_path / name) == fmt
     assert load(tmp_path, name, data) is not None
 

@@ -226,7 +226,8 @@ def test_cli_prints_the_files_heuristic(wfc, capsys, tmp_path):
         "--model-option", "index=0", "--size", "4x3", "--seed", "1",
     )  # fmt: skip
     assert code == 0 and "Coast 4x3" in stdout
-    assert "order=min-entropy (the file's heuristic MRV)" in stdout
+    assert "order=min-domain (the file's heuristic MRV)" in stdout
+    assert "choice=weighted (wfc defaults)" in stdout
     code, stdout, _ = run(
         capsys, "synthesize", str(wfc), "--model-option", "name=Flowers", "--order", "random",
         "--seed", "1",
