@@ -1,0 +1,398 @@
+"""Wave schedule of modify-in-blocks: independent blocks solved in parallel.
+
+Blocks that neither overlap nor are joined by an arc are independent: solving one does not
+change what another sees, so they may run at the same time against the same grid. The
+blocks of Alg. 3.4 (thesis Sec. 3.3.6) are laid out on a lattice of block indices (one per
+axis, shifted by half a block); :func:`colour_classes` colours each block by its index
+modulo 3 on each axis (``3 ** d`` colours). Two blocks of one colour are three half-blocks
+apart on some axis, so a gap of at least half a block separates them and no nearest-neighbour
+arc joins them. :func:`waves` checks this on the arcs themselves (a block that shares an arc
+or a cell with an earlier block of its wave is deferred to a following wave: this happens
+only for a flush last block, a periodic axis, odd block sizes below 4 or boxes of positions
+whose arcs are longer than the gap), so every wave it yields is independent whatever the
+problem. :func:`independent` is the brute-force check the tests use.
+
+Each block draws its random numbers from its own generator, :func:`block_rng`, seeded with
+``numpy.random.SeedSequence([root, sweep, block])``; the outcome of a wave therefore does
+not depend on which process solves which block, nor in which order. Executors:
+
+* in-process (``workers=1``): :func:`solve_block` on each block in turn;
+* :class:`PoolRunner`: a local :class:`~concurrent.futures.ProcessPoolExecutor`; each task
+  carries a few blocks (:class:`BlockTask`: packed domains and the block's arcs; the
+  relations and weights, the same for every block, reach each worker once);
+* :class:`DaskRunner`: a Dask ``distributed`` cluster (``"local"``: a
+  ``distributed.LocalCluster``; the optional extra ``csplab[dask]``).
+
+Examples
+--------
+>>> colour_classes((4, 2))
+[[0, 6], [1, 7], [2], [3], [4], [5]]
+>>> int(block_rng(7, 0, 3).integers(100)) == int(block_rng(7, 0, 3).integers(100))
+True
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import os
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import FIRST_EXCEPTION, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass
+from typing import Any, NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.engine.alg31 import run_alg31
+from csplab.errors import InputError
+from csplab.problem import Problem
+
+__all__ = [
+    "BlockContext",
+    "BlockOutcome",
+    "BlockTask",
+    "DaskRunner",
+    "PoolRunner",
+    "block_rng",
+    "colour_classes",
+    "independent",
+    "pack_block",
+    "run_tasks",
+    "solve_block",
+    "waves",
+]
+
+#: seconds the parent waits past the time limit for a wave before it stops the workers
+GRACE_S = 2.0
+
+
+def colour_classes(counts: Sequence[int]) -> list[list[int]]:
+    """Flat block indices grouped by colour (block index modulo 3 on each axis).
+
+    Parameters
+    ----------
+    counts : sequence of int
+        Blocks per axis; blocks are numbered in C order (x outermost, the thesis' sweep).
+
+    Returns
+    -------
+    list of list of int
+        One list per non-empty colour, colours in C order, blocks in sweep order.
+    """
+    counts = tuple(int(c) for c in counts)
+    classes: dict[tuple[int, ...], list[int]] = {}
+    for flat, q in enumerate(itertools.product(*(range(c) for c in counts))):
+        classes.setdefault(tuple(i % 3 for i in q), []).append(flat)
+    return [classes[k] for k in sorted(classes)]
+
+
+class WaveBlock(NamedTuple):
+    """A block of a wave: its flat index, its cells and the sorted ids of its arcs."""
+
+    block: int
+    cells: NDArray[np.int64]
+    arc_ids: NDArray[np.int64] | None
+
+
+def waves(
+    classes: Sequence[Sequence[int]],
+    cells: Sequence[NDArray[np.int64]],
+    n_cells: int,
+    n_arcs: int,
+    touching: Callable[[NDArray[np.int64]], NDArray[np.int64]],
+) -> Iterator[list[WaveBlock]]:
+    """The waves of one sweep: colour classes split so that every wave is independent.
+
+    Within a colour class, a block joins the current wave unless it shares a cell or an arc
+    (``touching(cells)``: the sorted ids of the arcs with an end in ``cells``) with a block
+    already in it; such a block waits for the next wave of the class (first fit, in sweep
+    order, so the schedule depends on the problem only). Empty blocks are skipped. The
+    generator is lazy: the caller may change the grid between waves.
+    """
+    arc_mark = np.zeros(n_arcs, dtype=bool)
+    cell_mark = np.zeros(n_cells, dtype=bool)
+    for cls in classes:
+        pending = [b for b in cls if cells[b].size]
+        while pending:
+            wave: list[WaveBlock] = []
+            deferred: list[int] = []
+            for b in pending:
+                c = cells[b]
+                ids = touching(c)
+                if arc_mark[ids].any() or cell_mark[c].any():
+                    deferred.append(b)
+                    continue
+                arc_mark[ids] = True
+                cell_mark[c] = True
+                wave.append(WaveBlock(b, c, ids))
+            for w in wave:  # unmark for the next wave
+                assert w.arc_ids is not None
+                arc_mark[w.arc_ids] = False
+                cell_mark[w.cells] = False
+            yield wave
+            pending = deferred
+
+
+def independent(arcs: NDArray[np.int64], n_cells: int, blocks: Sequence[NDArray[np.int64]]) -> bool:
+    """Brute force: no two of ``blocks`` share a cell and no arc joins two of them."""
+    owner = np.full(n_cells, -1, dtype=np.int64)
+    for i, c in enumerate(blocks):
+        if (owner[c] >= 0).any():
+            return False
+        owner[c] = i
+    a, b = owner[arcs[:, 0]], owner[arcs[:, 1]]
+    return not bool(((a >= 0) & (b >= 0) & (a != b)).any())
+
+
+def block_rng(root: int, sweep: int, index: int) -> np.random.Generator:
+    """The generator of block ``index`` in sweep ``sweep`` of a run with seed ``root``."""
+    return np.random.default_rng(np.random.SeedSequence([int(root), int(sweep), int(index)]))
+
+
+class BlockOutcome(NamedTuple):
+    """What solving one block gives: ``labels`` (``None`` unless ``status == "solved"``),
+    the status of the last Alg. 3.1 run, the retries and the AC revisions spent."""
+
+    block: int
+    labels: NDArray[np.int32] | None
+    status: str
+    retries: int
+    revisions: int
+
+
+def solve_block(
+    sub: Problem,
+    rng: np.random.Generator,
+    block: int,
+    *,
+    retries: int,
+    order: str,
+    choice: str,
+    deadline: float | None,
+) -> BlockOutcome:
+    """Alg. 3.1 on a block's subproblem, retried up to ``retries`` times on failure (the
+    inner loop of Alg. 3.4); ``deadline`` is a ``time.perf_counter()`` value."""
+    revisions = retry_count = 0
+    status = "failed"
+    for attempt in range(retries + 1):
+        left = None if deadline is None else max(0.0, deadline - time.perf_counter())
+        r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left)
+        revisions += int(r.stats.get("revisions", 0))
+        status = r.status
+        if r.status == "solved":
+            return BlockOutcome(block, r.grid.reshape(-1), status, retry_count, revisions)
+        if r.status == "timeout":
+            break
+        if attempt < retries:
+            retry_count += 1
+    return BlockOutcome(block, None, status, retry_count, revisions)
+
+
+@dataclass(frozen=True)
+class BlockContext:
+    """What every block task shares: relations, label weights and Alg. 3.1's settings."""
+
+    relations: NDArray[np.bool_]
+    weights: NDArray[np.float64]
+    retries: int
+    order: str
+    choice: str
+    root: int
+
+
+class BlockTask(NamedTuple):
+    """A block's subproblem as sent to a worker: flat index, sweep, shape, domains packed
+    8 labels a byte, and the arcs inside the block (int32, local cell numbers)."""
+
+    block: int
+    sweep: int
+    shape: tuple[int, ...]
+    domains: NDArray[np.uint8]
+    arcs: NDArray[np.int32]
+
+
+def pack_block(sub: Problem, block: int, sweep: int) -> BlockTask:
+    """The :class:`BlockTask` of subproblem ``sub`` (built by :meth:`Problem.subproblem`)."""
+    return BlockTask(
+        block, sweep, sub.shape, np.packbits(sub.domains, axis=1), sub.arcs.astype(np.int32)
+    )
+
+
+def _unpack(task: BlockTask, ctx: BlockContext) -> Problem:
+    K = int(ctx.relations.shape[1])
+    dom = np.unpackbits(task.domains, axis=1, count=K).astype(bool)
+    return Problem(task.shape, dom, ctx.relations, task.arcs, weights=ctx.weights)
+
+
+_CONTEXT: BlockContext | None = None
+
+
+def run_tasks(
+    tasks: Sequence[BlockTask], wall_deadline: float | None, ctx: BlockContext | None = None
+) -> list[BlockOutcome]:
+    """Worker side: solve ``tasks`` by ``wall_deadline`` (a ``time.time()`` value, or
+    ``None``); ``ctx`` defaults to the one the pool initializer installed."""
+    c = _CONTEXT if ctx is None else ctx
+    if c is None:
+        raise RuntimeError("run_tasks needs a BlockContext (none installed in this process)")
+    deadline = (
+        None if wall_deadline is None else time.perf_counter() + (wall_deadline - time.time())
+    )
+    return [
+        solve_block(
+            _unpack(t, c),
+            block_rng(c.root, t.sweep, t.block),
+            t.block,
+            retries=c.retries,
+            order=c.order,
+            choice=c.choice,
+            deadline=deadline,
+        )
+        for t in tasks
+    ]
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Make this worker exit as soon as its parent ``parent`` dies (SIGKILL of the parent
+    leaves no chance to shut the pool down): ``PR_SET_PDEATHSIG`` on Linux, and a thread
+    polling ``os.getppid()`` everywhere (the pattern of the experiments' process pools)."""
+    import signal
+
+    try:  # Ctrl-C reaches the whole process group: the parent decides what stops
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    except (ValueError, OSError):
+        pass
+    if sys.platform.startswith("linux"):
+        try:
+            import ctypes
+
+            libc = ctypes.CDLL(None, use_errno=True)
+            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
+    if os.getppid() != parent:
+        os._exit(1)
+
+    def poll() -> None:
+        while True:
+            if os.getppid() != parent:
+                os._exit(1)
+            time.sleep(0.5)
+
+    threading.Thread(target=poll, name="csplab-parent-watch", daemon=True).start()
+
+
+def _init_worker(parent: int, ctx: BlockContext) -> None:
+    global _CONTEXT
+    _exit_with_parent(parent)
+    _CONTEXT = ctx
+
+
+class PoolRunner:
+    """Blocks on a local process pool of ``workers`` processes (fork on Linux).
+
+    :meth:`submit` sends a few blocks as one task; :meth:`gather` waits for tasks until a
+    ``timeout`` and returns the outcomes that arrived and whether all did; :meth:`close`
+    shuts the pool down (``kill=True``: now, killing running workers).
+    """
+
+    def __init__(self, workers: int, ctx: BlockContext) -> None:
+        import multiprocessing as mp
+
+        method = "fork" if sys.platform.startswith("linux") else "spawn"
+        self.workers = workers
+        self.pool = ProcessPoolExecutor(
+            max_workers=workers, mp_context=mp.get_context(method),
+            initializer=_init_worker, initargs=(os.getpid(), ctx),
+        )  # fmt: skip
+
+    def submit(self, tasks: Sequence[BlockTask], wall_deadline: float | None) -> Future[Any]:
+        return self.pool.submit(run_tasks, list(tasks), wall_deadline)
+
+    def gather(
+        self, futures: Sequence[Future[Any]], timeout: float | None
+    ) -> tuple[list[BlockOutcome], bool]:
+        done, pending = wait(futures, timeout=timeout, return_when=FIRST_EXCEPTION)
+        out: list[BlockOutcome] = []
+        for f in done:
+            out.extend(f.result())  # re-raises a worker's exception
+        return out, not pending
+
+    def close(self, kill: bool = False) -> None:
+        procs = list((getattr(self.pool, "_processes", None) or {}).values())
+        self.pool.shutdown(wait=not kill, cancel_futures=True)
+        if kill:
+            for p in procs:
+                try:
+                    p.kill()
+                    p.join(timeout=5)
+                except (OSError, ValueError, AttributeError, AssertionError):
+                    pass
+
+
+class DaskRunner:
+    """Blocks on a Dask ``distributed`` cluster: ``scheduler`` is an address such as
+    ``tcp://host:8786`` or ``"local"`` (a ``LocalCluster`` of ``workers`` single-threaded
+    processes, closed by :meth:`close`). The context is scattered to every worker once."""
+
+    def __init__(self, scheduler: str, workers: int, ctx: BlockContext) -> None:
+        from csplab.deps import require
+
+        distributed: Any = require("distributed", "dask", "solver 'blocks' with scheduler=")
+        self._wait = distributed.wait
+        self.cluster: Any = None
+        if scheduler == "local":
+            self.cluster = distributed.LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True,
+                dashboard_address=":0",
+            )  # fmt: skip
+            self.client: Any = distributed.Client(self.cluster)
+        else:
+            try:
+                self.client = distributed.Client(scheduler, timeout=30)
+            except OSError as e:
+                raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
+        try:
+            self.client.wait_for_workers(1, timeout=120)
+            self.workers = max(1, sum(self.client.nthreads().values()))
+            self.ctx = self.client.scatter(ctx, broadcast=True)
+        except BaseException:
+            self.close()
+            raise
+
+    def submit(self, tasks: Sequence[BlockTask], wall_deadline: float | None) -> Any:
+        return self.client.submit(run_tasks, list(tasks), wall_deadline, self.ctx, pure=False)
+
+    def gather(
+        self, futures: Sequence[Any], timeout: float | None
+    ) -> tuple[list[BlockOutcome], bool]:
+        try:
+            self._wait(list(futures), timeout=timeout)
+        except TimeoutError:
+            pass
+        out: list[BlockOutcome] = []
+        complete = True
+        for f in futures:
+            if f.status == "finished":
+                out.extend(f.result())
+            elif f.status == "error":
+                f.result()  # re-raises the task's exception
+            else:
+                complete = False
+        return out, complete
+
+    def close(self, kill: bool = False) -> None:
+        try:
+            self.client.close()
+        finally:
+            if self.cluster is not None:
+                self.cluster.close()
+
+
+def chunk_size(blocks: int, workers: int) -> int:
+    """Blocks per task: about eight tasks per worker and wave, at most 32 blocks each."""
+    return max(1, min(32, math.ceil(blocks / (8 * max(1, workers)))))
