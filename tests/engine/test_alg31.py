@@ -1,3 +1,4 @@
+"""Alg. 3.1 orders."""
 
 
 def test_min_domain_is_mrv_whatever_the_choice():
