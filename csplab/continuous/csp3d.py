@@ -1,0 +1,373 @@
+"""Continuous model synthesis in 3D as a binary CSP (thesis Sec. 4.5.3-4.5.6; 2008 paper
+Sec. 3.4, Alg. 2).
+
+A neighbourhood is a label per cell of the central arrangement of all plane families
+(:func:`csplab.continuous.space.central_cells`): the thesis' Boolean expression of
+half-spaces (Fig. 4.17, 4.18), evaluated on every cell. The example's neighbourhoods
+(:func:`example_signatures3`) come from the example cut by the same planes: at every vertex
+and edge of that arrangement the label of each local cell is found by point location (the
+generalised winding number of the example's triangles, :func:`labels_at`) just off the point
+in a direction inside the cell; faces and solid interiors are derived from the edges and the
+labels. A vertex of the output arrangement may take every example neighbourhood that uses
+only its planes (Sec. 4.5.4; the tetrahedron's top vertex: the nine states of the 2008
+paper's Fig. 9), an edge likewise with the planes containing it.
+
+Variables are the arrangement's vertices and edges (values: indices into their type's state
+list; value 0 is all-empty); one relation per (vertex type, ray, edge type): a vertex state
+and an edge state agree when the vertex's labels, evaluated in the direction of the edge,
+are the edge's labels (Sec. 4.5.5). It is an ordinary :class:`~csplab.problem.Problem`, so
+every solver runs on it; ``positions`` are in plane spacings for ``blocks``.
+
+Examples
+--------
+>>> from csplab.continuous.polyhedra import PolyhedralModel
+>>> tet = PolyhedralModel([{"label": 1, "vertices": [[0, 0, 0], [4, 0, 0], [0, 4, 0],
+...     [0, 0, 4]], "faces": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]}])
+>>> C = ContinuousCSP3(tet, (3, 3, 3))
+>>> len(C.signatures)                  # Sec. 4.5.3: the tetrahedron's 16 labels
+16
+>>> C.states_at_planes([(1, 0, 0), (0, 1, 0), (1, 1, 1)])   # its top vertex (Fig. 9)
+9
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.continuous.space import Arrangement3, Lattice3
+from csplab.errors import InputError
+from csplab.problem import Problem
+
+__all__ = ["ContinuousCSP3", "example_signatures3", "labels_at"]
+
+Labeling = tuple[int, ...]
+
+
+def _solid_angles(p: NDArray[np.float64], tri: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Signed solid angles ``(len(p),)`` of the triangles ``tri`` ``(m, 3, 3)`` summed, seen
+    from the points ``p`` (Van Oosterom & Strackee)."""
+    out = np.zeros(len(p))
+    for start in range(0, len(p), 4096):
+        q = p[start : start + 4096, None, None, :]
+        r = tri[None, :, :, :] - q  # (P, m, 3, 3)
+        ln = np.linalg.norm(r, axis=3)
+        a, b, c = r[:, :, 0], r[:, :, 1], r[:, :, 2]
+        la, lb, lc = ln[:, :, 0], ln[:, :, 1], ln[:, :, 2]
+        num = np.einsum("pmi,pmi->pm", a, np.cross(b, c))
+        ab = np.einsum("pmi,pmi->pm", a, b)
+        ac = np.einsum("pmi,pmi->pm", a, c)
+        bc = np.einsum("pmi,pmi->pm", b, c)
+        den = la * lb * lc + ab * lc + ac * lb + bc * la
+        out[start : start + 4096] = 2 * np.arctan2(num, den).sum(axis=1)
+    return out
+
+
+def labels_at(
+    points: NDArray[np.float64], triangles: dict[int, NDArray[np.float64]]
+) -> NDArray[np.int64]:
+    """The label at each point: the label whose closed triangle mesh (``(m, 3, 3)``, outward
+    orientation) winds around it (generalised winding number > 1/2), else 0."""
+    lab = np.zeros(len(points), dtype=np.int64)
+    for b, tri in triangles.items():
+        w = _solid_angles(points, tri) / (4 * np.pi)
+        lab[w > 0.5] = b
+    return lab
+
+
+def _groups(signs: NDArray[np.int8], fams: NDArray[np.int64]) -> tuple[NDArray[np.int64], int]:
+    """Group id of each full cell by its signs on ``fams`` (the local cells there)."""
+    if fams.size == 0:
+        return np.zeros(len(signs), dtype=np.int64), 1
+    _, inv = np.unique(signs[:, fams], axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    return inv.astype(np.int64), int(inv.max()) + 1
+
+
+def _triangles(model: Any, lattice: Lattice3, shift: float) -> dict[int, NDArray[np.float64]]:
+    out: dict[int, list[NDArray[np.float64]]] = {}
+    for s in model.solids:
+        v = lattice.to_lattice(np.asarray(s.vertices, dtype=np.float64)) + shift
+        out.setdefault(int(s.label), []).append(v[np.asarray(s.faces, dtype=np.int64)])
+    return {b: np.concatenate(t) for b, t in out.items()}
+
+
+def _local_labels(
+    A: Arrangement3,
+    points: NDArray[np.float64],
+    fams_on: NDArray[np.bool_],
+    tris: dict[int, NDArray[np.float64]],
+    index: dict[int, int],
+) -> list[Labeling]:
+    """Full labelings (over the central cells) of the neighbourhoods at ``points`` whose
+    planes are ``fams_on`` (per point), by point location just off each point."""
+    signs, dirs = A.cells
+    eps = 1e-3 / (A.D * float(np.abs(A.normals).sum(axis=1).max()))
+    cache: dict[bytes, tuple[NDArray[np.int64], int, NDArray[np.int64]]] = {}
+    queries, owners = [], []
+    for i, fo in enumerate(fams_on):
+        key = fo.tobytes()
+        if key not in cache:
+            g, ng = _groups(signs, np.flatnonzero(fo))
+            rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
+            cache[key] = (g, ng, rep)
+        g, ng, rep = cache[key]
+        queries.append(points[i] + eps * dirs[rep])
+        owners.append(i)
+    q = np.concatenate(queries) if queries else np.zeros((0, 3))
+    lab = labels_at(q, tris)
+    lab = np.array([index[int(b)] if b else 0 for b in lab], dtype=np.int64)
+    out = []
+    pos = 0
+    for fo in fams_on:
+        g, ng, _ = cache[fo.tobytes()]
+        local = lab[pos : pos + ng]
+        pos += ng
+        out.append(tuple(int(x) for x in local[g]))
+    return out
+
+
+def example_signatures3(example: Any, lattice: Lattice3, index: dict[int, int]) -> set[Labeling]:
+    """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
+    of the central cells: vertices and edges of its own arrangement (its bounding box plus
+    one spacing), the faces next to those edges, and the solid interiors."""
+    pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
+    lo = np.floor(lattice.to_lattice(pts).min(axis=0) + 1e-9)
+    hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
+    shift = 1.0 - lo
+    A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)))
+    tris = _triangles(example, lattice, 0.0)
+    tris = {b: t + shift for b, t in tris.items()}
+    signs, _ = A.cells
+    sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
+    sigs |= set(_local_labels(A, A.vertex_xyz(), A.on, tris, index))
+    efam = A.edge_families()
+    edge_sigs = _local_labels(A, A.edge_xyz(), efam, tris, index)
+    sigs |= set(edge_sigs)
+    # faces beside each edge: in each plane through the edge, both half-planes
+    N = A.normals
+    for e, lab in enumerate(edge_sigs):
+        u = A.lines[A.edge_line[e]]
+        for f in np.flatnonzero(efam[e]):
+            for d in (np.cross(N[f], u), -np.cross(N[f], u)):
+                sd = np.sign(N @ d)
+                others = [k for k in np.flatnonzero(efam[e]) if k != f]
+                sel = np.all(signs[:, others] == sd[others], axis=1) if others else None
+                face: dict[int, int] = {}
+                for c in np.flatnonzero(sel) if sel is not None else range(len(signs)):
+                    face[int(signs[c, f])] = lab[c]
+                sigs.add(tuple(face[int(signs[c, f])] for c in range(len(signs))))
+    return sigs
+
+
+class ContinuousCSP3:
+    """The binary CSP of continuous model synthesis for a polyhedral ``example`` in an
+    ``A x B x C`` box of plane spacings (see the module docstring).
+
+    Attributes
+    ----------
+    problem : Problem
+    arrangement : Arrangement3
+    labels : tuple of int
+        Compact label index -> model label (0: empty space).
+    signatures : set
+        The example's neighbourhoods (full labelings of the central cells).
+    """
+
+    def __init__(
+        self,
+        example: Any,
+        size: Sequence[int],
+        *,
+        spacing: float | None = None,
+        snap: bool = False,
+        boundary: int = 0,
+    ) -> None:
+        if not example.solids:
+            raise InputError(f"{example.source}: an example needs at least one solid")
+        pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
+        polys, base = [], 0
+        for s in example.solids:
+            polys += [[base + int(i) for i in p] for p in s.polygons]
+            base += len(s.vertices)
+        self.example = example
+        self.lattice = Lattice3.of(pts, polys, spacing, snap=snap, where=example.source)
+        self.labels: tuple[int, ...] = (0, *example.labels)
+        index = {b: i for i, b in enumerate(self.labels)}
+        if boundary not in index:
+            raise InputError(f"boundary label {boundary} does not occur in the example")
+        self.boundary = boundary
+        b0 = index[boundary]
+        self.signatures = example_signatures3(example, self.lattice, index)
+        sig = np.array(sorted(self.signatures), dtype=np.int64)
+        A = self.arrangement = Arrangement3(self.lattice, size)
+        signs, _ = A.cells
+        F, N = A.F, A.normals
+        side_fam = [A.axis_family(a) for a in range(3)]
+
+        def outside_groups(fams: NDArray[np.int64], sides: int, g: NDArray[np.int64],
+                           ng: int) -> NDArray[np.bool_]:  # fmt: skip
+            out = np.zeros(ng, dtype=bool)
+            for a in range(3):
+                for bit, bad in ((1 << (2 * a), -1), (2 << (2 * a), 1)):
+                    if sides & bit:
+                        out[np.unique(g[signs[:, side_fam[a]] == bad])] = True
+            return out
+
+        def states(fams: NDArray[np.int64], sides: int) -> tuple[list[Labeling], Any]:
+            g, ng = _groups(signs, fams)
+            rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
+            local = sig[:, rep]  # (nsig, ng)
+            ok = (sig == local[:, g]).all(axis=1)  # factors through these planes
+            out = outside_groups(fams, sides, g, ng)
+            ok &= (local[:, out] == b0).all(axis=1)
+            found = sorted({tuple(int(x) for x in row) for row in local[ok]},
+                           key=lambda st: (any(st), st))  # fmt: skip
+            return found, (g, ng)
+
+        # vertex types
+        vside = A.on_side()
+        vmask = A.on.astype(np.int64) @ (1 << np.arange(F, dtype=np.int64))
+        vkeys, vtype = np.unique((vmask << 6) | vside, return_inverse=True)
+        vtype = vtype.reshape(-1)
+        self.vertex_type = vtype
+        self.vtypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
+        for key in vkeys.tolist():
+            fams = np.array([f for f in range(F) if (key >> 6) >> f & 1], dtype=np.int64)
+            st, (g, _) = states(fams, key & 63)
+            if not st:
+                raise InputError(f"{example.source}: no neighbourhood of the example fits a "
+                                 f"vertex on planes {N[fams].tolist()}")  # fmt: skip
+            self.vtypes.append((fams, st, g))
+        # edge types
+        efam = A.edge_families()
+        eside = vside[A.edge_src] & vside[A.edge_dst]
+        emask = efam.astype(np.int64) @ (1 << np.arange(F, dtype=np.int64))
+        ekeys, etype = np.unique((emask << 6) | eside, return_inverse=True)
+        etype = etype.reshape(-1)
+        self.etypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
+        for key in ekeys.tolist():
+            fams = np.array([f for f in range(F) if (key >> 6) >> f & 1], dtype=np.int64)
+            st, (g, _) = states(fams, key & 63)
+            self.etypes.append((fams, st, g))
+        nst = max(len(t[1]) for t in (*self.vtypes, *self.etypes))
+        K = self.K = nst
+        nv, ne = A.n_vertices, A.n_edges
+        dom = np.zeros((nv + ne, K), dtype=bool)
+        vn = np.array([len(t[1]) for t in self.vtypes])
+        en = np.array([len(t[1]) for t in self.etypes])
+        dom[:nv] = np.arange(K)[None, :] < vn[vtype][:, None]
+        dom[nv:] = np.arange(K)[None, :] < en[etype][:, None]
+        # relations per (vertex type, ray, edge type)
+        rel_ids: dict[bytes, int] = {}
+        rels: list[NDArray[np.bool_]] = []
+        memo: dict[tuple[int, int, int, int], int] = {}
+
+        def relation(t: int, line: int, sgn: int, et: int) -> int:
+            k = (t, line, sgn, et)
+            if k in memo:
+                return memo[k]
+            vf, vst, vg = self.vtypes[t]
+            _, est, eg = self.etypes[et]
+            r = sgn * A.lines[line]
+            sr = np.sign(N @ r)
+            # the full cell just off the edge in direction r: signs of the planes through
+            # the vertex but not the edge from r, the edge's own planes free
+            target = {}
+            for c in range(len(signs)):
+                want = signs[c].copy()
+                away = [f for f in vf if sr[f] != 0]
+                want[away] = sr[away]
+                match = np.flatnonzero((signs[:, vf] == want[vf]).all(axis=1))
+                target[int(eg[c])] = int(vg[match[0]])
+            eidx = {st: i for i, st in enumerate(est)}
+            M = np.zeros((K, K), dtype=bool)
+            ne_groups = len(est[0]) if est else 0
+            for i, st in enumerate(vst):
+                induced = tuple(st[target[j]] for j in range(ne_groups))
+                jj = eidx.get(induced)
+                if jj is not None:
+                    M[i, jj] = True
+            kb = M.tobytes()
+            if kb not in rel_ids:
+                rel_ids[kb] = len(rels)
+                rels.append(M)
+            memo[k] = rel_ids[kb]
+            return memo[k]
+
+        pos = np.concatenate([A.vertex_xyz(), A.edge_xyz()])
+        order = np.lexsort((pos[:, 2], pos[:, 1], pos[:, 0]))
+        var = np.empty(nv + ne, dtype=np.int64)
+        var[order] = np.arange(nv + ne)
+        self.var_vertex, self.var_edge = var[:nv], var[nv:]
+        arcs = np.empty((2 * ne, 3), dtype=np.int64)
+        for e in range(ne):
+            a, b, li, et = (
+                int(A.edge_src[e]),
+                int(A.edge_dst[e]),
+                int(A.edge_line[e]),
+                int(etype[e]),
+            )
+            arcs[2 * e] = (var[a], var[nv + e], relation(int(vtype[a]), li, 1, et))
+            arcs[2 * e + 1] = (var[b], var[nv + e], relation(int(vtype[b]), li, -1, et))
+        self.edge_type = etype
+        self.problem = Problem(
+            (nv + ne,), dom[order], np.stack(rels), arcs,
+            name=getattr(example, "name", "") or "continuous3d",
+            meta={"continuous": True, "dim": 3, "size": list(A.size),
+                  "spacing": float(self.lattice.spacing), "families": N.tolist(),
+                  "vertices": nv, "edges": ne, "boundary": boundary},
+            positions=pos[order],
+        )  # fmt: skip
+
+    def states_at_planes(self, normals: Sequence[Sequence[int]]) -> int:
+        """How many example neighbourhoods use only planes with these normals (a vertex
+        where exactly those planes meet, inside the region)."""
+        A = self.arrangement
+        want = {tuple(int(x) for x in n) for n in normals}
+        fams = np.array([f for f in range(A.F) if tuple(A.normals[f].tolist()) in want])
+        if len(fams) != len(want):
+            raise InputError(f"not all of {sorted(want)} are plane families here")
+        signs, _ = A.cells
+        g, ng = _groups(signs, fams)
+        sig = np.array(sorted(self.signatures), dtype=np.int64)
+        rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
+        return int((sig == sig[:, rep][:, g]).all(axis=1).sum())
+
+    def encode(self, model: Any) -> NDArray[np.int32]:
+        """The assignment that a polyhedral model lying on the planes describes (point
+        location around every vertex and edge); -1 where a neighbourhood is not a state."""
+        A = self.arrangement
+        index = {b: i for i, b in enumerate(self.labels)}
+        for b in model.labels:
+            if b not in index:
+                raise InputError(f"label {b} does not occur in the example")
+        tris = _triangles(model, self.lattice, 0.0)
+        grid = np.full(self.problem.n, -1, dtype=np.int32)
+        bl = index[self.boundary]
+        for what, pts, fams_on, types, tlist, var in (
+            ("v", A.vertex_xyz(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
+            ("e", A.edge_xyz(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
+        ):
+            labs = _local_labels(A, pts, fams_on, tris, index)
+            size = np.array(A.size, dtype=np.float64)
+            for i, full in enumerate(labs):
+                _, st, g = tlist[int(types[i])]
+                ng = int(g.max()) + 1
+                local = [0] * ng
+                for c, b in enumerate(full):
+                    local[int(g[c])] = b
+                # outside the region: the boundary label
+                _, dirs = A.cells
+                for k in range(ng):
+                    c = int(np.flatnonzero(g == k)[0])
+                    q = pts[i] + 1e-3 * dirs[c]
+                    if (q < 0).any() or (q > size).any():
+                        local[k] = bl
+                lookup = {s: j for j, s in enumerate(st)}
+                grid[var[i]] = lookup.get(tuple(local), -1)
+            del what
+        return grid

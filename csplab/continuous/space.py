@@ -1,0 +1,382 @@
+"""The plane arrangement of continuous model synthesis in 3D (thesis Sec. 4.5.3-4.5.8), exact.
+
+The 2D construction of :mod:`csplab.continuous.arrangement`, one dimension up. The example's
+vertices are put on an integer lattice (``origin``, ``spacing``: the largest length putting
+every vertex on a lattice point, or ``spacing=`` with ``snap=``); every face normal is then an
+integer vector, and normals equal up to sign are one *family*. A family with primitive
+normal ``n`` has the planes ``n . x = k`` for every integer ``k`` (in lattice units), so every
+lattice point lies on a plane of every family: vertices where four or more planes meet (the
+apex of a four-sided pyramid, Sec. 4.5.8, Eq. 4.23-4.25) exist at every lattice point by
+construction, and no spacing equations need solving. Three planes with independent normals
+meet at a point with rational coordinates of denominator ``det``; with ``D`` the least common
+multiple of these determinants every vertex has integer coordinates ``D * (x, y, z)``, and
+all incidences are integer arithmetic.
+
+The region is ``[0, A] x [0, B] x [0, C]`` (lattice units); its sides are planes of the axis
+families, added as *boundary-only* families (just the two side planes) when the example has
+no faces of that orientation.
+
+Neighbourhoods are described on the *cells* of the central arrangement of all families'
+planes through one point (:func:`central_cells`): a cell is a sign vector over the families
+(which side of each plane a direction lies on). The neighbourhood of any point is a label
+per cell that depends only on the signs of the planes through that point (thesis Sec. 4.5.5:
+the Boolean expression of half-spaces, evaluated on each cell).
+
+Examples
+--------
+>>> tet = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]]
+>>> lat = Lattice3.of(np.array(tet, dtype=float), [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+>>> lat.spacing, lat.normals
+(Fraction(4, 1), ((0, 0, 1), (0, 1, 0), (1, 0, 0), (1, 1, 1)))
+>>> A = Arrangement3(lat, (4, 4, 4))
+>>> A.D, A.F, int(A.on.all(axis=1).sum())     # lattice points: every family meets there
+(1, 4, 125)
+>>> len(central_cells(A.normals)[0])            # cells of 4 planes in general position
+14
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.continuous.arrangement import _frac, _gcd_fractions
+from csplab.errors import InputError
+
+__all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells"]
+
+#: most plane families (the central arrangement has O(F^2) cells and a neighbourhood is a
+#: label per cell)
+MAX_FAMILIES3 = 16
+_REL = 1e-9
+_SNAP_TOL = 1e-6
+_AXES = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+
+
+def _primitive3(v: Sequence[int]) -> tuple[int, int, int]:
+    a, b, c = (int(x) for x in v)
+    g = math.gcd(math.gcd(a, b), c)
+    a, b, c = a // g, b // g, c // g
+    first = next(x for x in (a, b, c) if x != 0)
+    if first < 0:
+        a, b, c = -a, -b, -c
+    return a, b, c
+
+
+@dataclass(frozen=True)
+class Lattice3:
+    """Origin, spacing and face normals (integer, primitive, first non-zero component
+    positive, sorted) of a 3D example; build with :meth:`of`."""
+
+    origin: tuple[Fraction, Fraction, Fraction]
+    spacing: Fraction
+    normals: tuple[tuple[int, int, int], ...]
+    snapped: float = 0.0
+
+    @classmethod
+    def of(
+        cls,
+        points: NDArray[np.float64],
+        polygons: Sequence[Sequence[int]],
+        spacing: float | None = None,
+        *,
+        snap: bool = False,
+        max_extent: int = 128,
+        where: str = "<model>",
+    ) -> Lattice3:
+        """The lattice of ``points`` (``(n, 3)``) whose faces are ``polygons`` (vertex
+        indices); see the module docstring."""
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        lo = pts.min(axis=0)
+        if spacing is not None:
+            if not (math.isfinite(spacing) and spacing > 0):
+                raise InputError(f"spacing must be a positive number, not {spacing!r}")
+            s = _frac(float(spacing))
+            origin = tuple(_frac(float(v)) for v in lo)
+        else:
+            fr = [[_frac(float(v)) for v in p] for p in pts.tolist()]
+            for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
+                for v, q in zip(p, f, strict=True):
+                    if abs(float(q) - v) > _REL * max(1.0, abs(v)):
+                        raise InputError(
+                            f"{where}: vertex {i} {tuple(p)} has no exact rational form; "
+                            "pass a spacing (and snap=true to round vertices onto it)"
+                        )
+            origin = tuple(min(f[a] for f in fr) for a in range(3))
+            s = _gcd_fractions([f[a] - origin[a] for f in fr for a in range(3)])
+            if s == 0:
+                raise InputError(f"{where}: the example has no extent")
+        o = np.array([float(v) for v in origin])
+        u = (pts - o) / float(s)
+        iu = np.rint(u)
+        off = float(np.abs(u - iu).max()) if u.size else 0.0
+        if off > _SNAP_TOL and not snap:
+            k = int(np.abs(u - iu).max(axis=1).argmax())
+            raise InputError(
+                f"{where}: vertex {tuple(pts[k])} is {off:.3g} spacings off the lattice of "
+                f"spacing {float(s):g}; choose another spacing or snap=true"
+            )
+        ext = int(iu.max()) if iu.size else 0
+        if ext > max_extent:
+            raise InputError(
+                f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
+                f"{max_extent}); pass a larger spacing (with snap=true if vertices are off it)"
+            )
+        ip = iu.astype(np.int64)
+        normals: set[tuple[int, int, int]] = set()
+        for poly in polygons:
+            q = ip[list(poly)]
+            nxt = np.roll(q, -1, axis=0)
+            # Newell's normal, exact in integers (twice the area vector)
+            n = (
+                int(((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum()),
+                int(((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum()),
+                int(((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()),
+            )
+            if n != (0, 0, 0):
+                normals.add(_primitive3(n))
+        if len(normals | set(_AXES)) > MAX_FAMILIES3:
+            raise InputError(
+                f"{where}: {len(normals)} face orientations; at most {MAX_FAMILIES3} planes "
+                "families are supported (use bounding shapes, Sec. 4.6.4)"
+            )
+        return cls(origin, s, tuple(sorted(normals)), off if snap else 0.0)  # type: ignore[arg-type]
+
+    def to_lattice(self, xyz: NDArray[np.float64]) -> NDArray[np.float64]:
+        """World coordinates -> lattice coordinates (floats)."""
+        o = np.array([float(v) for v in self.origin])
+        out: NDArray[np.float64] = (np.asarray(xyz, dtype=np.float64) - o) / float(self.spacing)
+        return out
+
+    def to_world(self, uvw: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Lattice coordinates -> world coordinates."""
+        o = np.array([float(v) for v in self.origin])
+        out: NDArray[np.float64] = o + np.asarray(uvw, dtype=np.float64) * float(self.spacing)
+        return out
+
+    def families(self) -> tuple[tuple[tuple[int, int, int], ...], tuple[bool, ...]]:
+        """All plane families (the example's, then the missing axis ones) and which are
+        boundary-only."""
+        extra = [a for a in _AXES if a not in self.normals]
+        return (*self.normals, *extra), (False,) * len(self.normals) + (True,) * len(extra)
+
+
+def _lcm(a: int, b: int) -> int:
+    return a * b // math.gcd(a, b)
+
+
+def _det3(m: NDArray[np.int64]) -> int:
+    """Exact determinant of an integer 3x3 matrix."""
+    a = [[int(x) for x in row] for row in m]
+    return (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]))  # fmt: skip
+
+
+def _adj3(m: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Exact adjugate (``det * inverse``) of an integer 3x3 matrix."""
+    out = np.zeros((3, 3), dtype=np.int64)
+    for i in range(3):
+        for j in range(3):
+            minor = np.delete(np.delete(m, i, axis=0), j, axis=1)
+            out[j, i] = (-1) ** (i + j) * (int(minor[0, 0]) * int(minor[1, 1])
+                                           - int(minor[0, 1]) * int(minor[1, 0]))  # fmt: skip
+    return out
+
+
+def central_cells(
+    normals: NDArray[np.int64],
+) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+    """The cells of the central arrangement of the planes ``n . x = 0`` (``normals``
+    ``(F, 3)``, at least two independent): their sign vectors ``(c, F)`` (+1/-1) and one unit
+    direction inside each.
+
+    Every cell has a vertex of the spherical arrangement (a direction ``+-n_i x n_j``) on its
+    boundary; around each such vertex the sectors between the great circles through it are
+    sampled on their bisectors (signs of the planes through the vertex from the bisector,
+    the others from the vertex), which finds every cell exactly for integer normals.
+    """
+    N = np.asarray(normals, dtype=np.int64)
+    F = len(N)
+    found: dict[bytes, list[NDArray[np.float64]]] = {}
+    for i, j in itertools.combinations(range(F), 2):
+        p0 = np.cross(N[i], N[j])
+        if not p0.any():
+            continue
+        for p in (p0, -p0):
+            on = np.flatnonzero(N @ p == 0)
+            pf = p.astype(np.float64) / np.linalg.norm(p)
+            tang = []
+            for k in on:
+                t = np.cross(N[k], p).astype(np.float64)
+                t /= np.linalg.norm(t)
+                tang.extend([t, -t])
+            e1 = tang[0]
+            e2 = np.cross(pf, e1)
+            ang = np.array([math.atan2(float(t @ e2), float(t @ e1)) for t in tang])
+            o = np.argsort(ang)
+            base = np.sign(N @ p).astype(np.int8)
+            for a in range(len(o)):
+                ta, tb = tang[o[a]], tang[o[(a + 1) % len(o)]]
+                b = ta + tb
+                if np.linalg.norm(b) < 1e-9:  # a sector of exactly pi: take the normal side
+                    b = np.cross(pf, ta)
+                b /= np.linalg.norm(b)
+                sig = base.copy()
+                sig[on] = np.sign(N[on] @ b).astype(np.int8)
+                if (sig == 0).any():  # pragma: no cover - bisectors avoid the circles
+                    continue
+                w = pf + 1e-3 * b
+                found.setdefault(sig.tobytes(), []).append(w / np.linalg.norm(w))
+    signs = np.array([np.frombuffer(k, dtype=np.int8) for k in sorted(found)], dtype=np.int8)
+    dirs = np.array([np.mean(found[k], axis=0) for k in sorted(found)])
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    # a cell's mean sample direction is inside it (cells are convex cones)
+    ok = np.sign(dirs @ N.T.astype(np.float64)).astype(np.int8) == signs
+    if not ok.all():  # pragma: no cover - convexity
+        raise AssertionError("a cell's representative direction left the cell")
+    return signs, dirs
+
+
+class Arrangement3:
+    """Vertices and edges of the planes of ``lattice``'s families in the box ``size``
+    (lattice units); see the module docstring.
+
+    Attributes
+    ----------
+    normals : int array ``(F, 3)``; ``boundary_only`` bool ``(F,)``
+    D : int
+        Vertex ``v`` is at ``(X[v], Y[v], Z[v]) / D`` lattice units.
+    X, Y, Z : int64 arrays
+        Vertices sorted by ``(X, Y, Z)``.
+    on : bool array ``(n_vertices, F)``
+        Which families have a plane through each vertex.
+    edge_src, edge_dst, edge_line : int64 arrays
+        Edges between consecutive vertices of one line, from ``edge_src`` to ``edge_dst``
+        along ``lines[edge_line]`` (a primitive integer direction).
+    """
+
+    def __init__(self, lattice: Lattice3, size: Sequence[int]) -> None:
+        if len(size) != 3 or any(int(s) < 1 for s in size):
+            raise InputError(f"the region must be AxBxC with positive sides, not {tuple(size)}")
+        self.lattice = lattice
+        self.size = tuple(int(s) for s in size)
+        fams, bonly = lattice.families()
+        self.normals = np.array(fams, dtype=np.int64).reshape(-1, 3)
+        self.boundary_only = np.array(bonly, dtype=bool)
+        F = self.F = len(fams)
+        N = self.normals
+        triples = [t for t in itertools.combinations(range(F), 3) if _det3(N[list(t)])]
+        D = 1
+        for t in triples:
+            D = _lcm(D, abs(_det3(N[list(t)])))
+        self.D = D
+        ext = np.array(self.size, dtype=np.int64) * D
+        corners = np.array(list(itertools.product(*[(0, s) for s in self.size])), dtype=np.int64)
+        self.k_range: list[NDArray[np.int64]] = []
+        for f in range(F):
+            kc = corners @ N[f]
+            lo, hi = int(kc.min()), int(kc.max())
+            ks = np.array([lo, hi]) if bonly[f] else np.arange(lo, hi + 1)
+            self.k_range.append(ks.astype(np.int64))
+        keys = []
+        stride = (ext + 1).astype(np.int64)
+        for t in triples:
+            M = N[list(t)]
+            det = _det3(M)
+            adj = _adj3(M)
+            m = D // det
+            gg, hh = np.meshgrid(self.k_range[t[1]], self.k_range[t[2]], indexing="ij")
+            kg, kh = gg.ravel(), hh.ravel()
+            for kf in self.k_range[t[0]].tolist():
+                P = (adj[:, 0:1] * kf + adj[:, 1:2] * kg + adj[:, 2:3] * kh) * m
+                ok = ((P >= 0) & (P <= ext[:, None])).all(axis=0)
+                if ok.any():
+                    q = P[:, ok]
+                    keys.append((q[0] * stride[1] + q[1]) * stride[2] + q[2])
+        key = np.unique(np.concatenate(keys)) if keys else np.zeros(0, dtype=np.int64)
+        self.X = key // (stride[1] * stride[2])
+        self.Y = (key // stride[2]) % stride[1]
+        self.Z = key % stride[2]
+        XYZ = np.stack([self.X, self.Y, self.Z], axis=1)
+        s = XYZ @ N.T  # (nv, F)
+        on = s % D == 0
+        for f in range(F):
+            if bonly[f]:
+                on[:, f] &= np.isin(s[:, f] // D, self.k_range[f])
+        self.on = on
+        # edges: consecutive vertices on the line of two planes
+        lines: dict[tuple[int, int, int], int] = {}
+        src, dst, lid = [], [], []
+        for f, g in itertools.combinations(range(F), 2):
+            u0 = np.cross(N[f], N[g])
+            if not u0.any():
+                continue
+            u = _primitive3(u0.tolist())
+            li = lines.setdefault(u, len(lines))
+            idx = np.flatnonzero(on[:, f] & on[:, g])
+            if idx.size < 2:
+                continue
+            kf, kg = s[idx, f] // D, s[idx, g] // D
+            tpos = XYZ[idx] @ np.array(u)
+            o = np.lexsort((tpos, kg, kf))
+            idx, kf, kg = idx[o], kf[o], kg[o]
+            same = (kf[1:] == kf[:-1]) & (kg[1:] == kg[:-1])
+            src.append(idx[:-1][same])
+            dst.append(idx[1:][same])
+            lid.append(np.full(int(same.sum()), li, dtype=np.int64))
+        self.lines = np.array(sorted(lines, key=lines.__getitem__), dtype=np.int64).reshape(-1, 3)
+        e = np.stack([np.concatenate(src), np.concatenate(dst), np.concatenate(lid)], axis=1)
+        e = np.unique(e, axis=0)  # a line in three or more planes comes from several pairs
+        self.edge_src, self.edge_dst, self.edge_line = e[:, 0], e[:, 1], e[:, 2]
+
+    @property
+    def n_vertices(self) -> int:
+        return int(self.X.size)
+
+    @property
+    def n_edges(self) -> int:
+        return int(self.edge_src.size)
+
+    def vertex_xyz(self) -> NDArray[np.float64]:
+        """Vertices in lattice units."""
+        out: NDArray[np.float64] = np.stack([self.X, self.Y, self.Z], axis=1) / self.D
+        return out
+
+    def edge_xyz(self) -> NDArray[np.float64]:
+        """Edge midpoints in lattice units."""
+        v = self.vertex_xyz()
+        out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
+        return out
+
+    def on_side(self) -> NDArray[np.int64]:
+        """Per vertex, bits 1/2 (x = 0 / A), 4/8 (y), 16/32 (z) of the region's sides."""
+        e = np.array(self.size) * self.D
+        out = np.zeros(self.n_vertices, dtype=np.int64)
+        for a, c in enumerate((self.X, self.Y, self.Z)):
+            out |= (c == 0) * (1 << (2 * a)) | (c == e[a]) * (2 << (2 * a))
+        return out
+
+    def edge_families(self) -> NDArray[np.bool_]:
+        """``(n_edges, F)``: the families with a plane containing each edge."""
+        u = self.lines[self.edge_line]
+        out: NDArray[np.bool_] = (u @ self.normals.T == 0) & self.on[self.edge_src]
+        return out
+
+    @cached_property
+    def cells(self) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+        """:func:`central_cells` of all families."""
+        return central_cells(self.normals)
+
+    def axis_family(self, axis: int) -> int:
+        """The family whose planes are the region's sides across ``axis``."""
+        target = np.zeros(3, dtype=np.int64)
+        target[axis] = 1
+        return int(np.flatnonzero((self.normals == target).all(axis=1))[0])

@@ -1,0 +1,104 @@
+"""Continuous model synthesis in 3D (thesis Sec. 4.5.3-4.5.6, 2008 paper Sec. 3.4): the exact
+plane arrangement, the example's neighbourhoods and the binary CSP."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from csplab.continuous.csp3d import ContinuousCSP3, labels_at
+from csplab.continuous.space import Arrangement3, Lattice3, central_cells
+from csplab.solvers import solve
+
+polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
+pytest.importorskip("trimesh")
+
+TET = {"label": 1, "vertices": [[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]],
+       "faces": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]}  # fmt: skip
+
+
+def _box(label: int, lo: list[int], hi: list[int]) -> dict[str, object]:
+    x0, y0, z0 = lo
+    x1, y1, z1 = hi
+    v = [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
+         [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]]  # fmt: skip
+    f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]]
+    return {"label": label, "vertices": v, "faces": f}
+
+
+def _scaled(d: dict[str, object], t: int, off: int) -> dict[str, object]:
+    return {**d, "vertices": (np.array(d["vertices"]) * t + off).tolist()}
+
+
+def test_tetrahedron_labels_and_fig9() -> None:
+    """Sec. 4.5.3: the tetrahedron has 16 labels; 2008 paper Fig. 9: its top vertex (three
+    planes) has 9 states; a vertex on the three axis planes (a corner) 9 as well; a vertex
+    on two planes only edge/face/empty/full states."""
+    C = ContinuousCSP3(polyhedra.PolyhedralModel([TET]), (3, 3, 3))
+    assert len(C.signatures) == 16
+    assert C.states_at_planes([(1, 0, 0), (0, 1, 0), (1, 1, 1)]) == 9
+    assert C.states_at_planes([(1, 0, 0), (0, 1, 0), (0, 0, 1)]) == 9
+    assert C.states_at_planes([(1, 0, 0), (0, 1, 0)]) == 5  # empty, full, 2 faces, 1 edge
+
+
+def test_central_cells_count() -> None:
+    """k planes through a point in general position cut space into k(k-1)+2 cells."""
+    for k, normals in ((3, [(1, 0, 0), (0, 1, 0), (0, 0, 1)]),
+                       (4, [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1)])):  # fmt: skip
+        signs, dirs = central_cells(np.array(normals))
+        assert len(signs) == k * (k - 1) + 2
+        assert (np.sign(dirs @ np.array(normals).T) == signs).all()
+
+
+def test_every_lattice_point_meets_every_family() -> None:
+    """Sec. 4.5.8 by construction: the pyramid's apex needs four planes to meet."""
+    pyr = {"label": 1, "vertices": [[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0], [1, 1, 1]],
+           "faces": [[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]}  # fmt: skip
+    E = polyhedra.PolyhedralModel([pyr])
+    lat = Lattice3.of(np.array(pyr["vertices"], dtype=float), pyr["faces"])
+    assert len(lat.normals) == 5
+    A = Arrangement3(lat, (4, 4, 3))
+    lattice_pts = (A.X % A.D == 0) & (A.Y % A.D == 0) & (A.Z % A.D == 0)
+    assert A.on[lattice_pts][:, ~A.boundary_only].all()  # the side planes: sides only
+    C = ContinuousCSP3(E, (4, 4, 3))
+    apex = [tuple(n) for n in lat.normals if n != (0, 0, 1)]
+    assert C.states_at_planes(apex) >= 6  # empty, full, apex, ...: the apex label exists
+
+
+@pytest.mark.parametrize("solver", ["catalog", "sat", "blocks"])
+def test_solvers_run_unchanged(solver: str) -> None:
+    C = ContinuousCSP3(polyhedra.PolyhedralModel([TET]), (4, 4, 3))
+    r = solve(C.problem, solver, rng=2, restarts=10, **({"block": 2} if solver == "blocks" else {}))
+    assert r.status == "solved" and C.problem.is_solution(r.grid)
+
+
+@pytest.mark.parametrize("t", [1, 2])
+def test_stretched_copies_are_solutions(t: int) -> None:
+    """Sec. 4.5.6: the example and its stretched copies satisfy its own constraints."""
+    E = polyhedra.PolyhedralModel([TET])
+    C = ContinuousCSP3(E, (2 * t + 2, 2 * t + 2, 2 * t + 2))
+    s = int(C.lattice.spacing)
+    M = polyhedra.PolyhedralModel([_scaled(TET, t, s)])
+    g = C.encode(M)
+    assert len(C.problem.violations(g)) == 0
+
+
+def test_two_labels_stacked() -> None:
+    """Two boxes of different labels, one on the other: both labels and the contact face
+    are states; a stretched copy is a solution; a copy upside down is not."""
+    E = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 1]), _box(2, [0, 0, 1], [2, 2, 2])])
+    C = ContinuousCSP3(E, (5, 5, 5))
+    g = C.encode(polyhedra.PolyhedralModel([_box(1, [1, 1, 1], [3, 3, 2]),
+                                            _box(2, [1, 1, 2], [3, 3, 4])]))  # fmt: skip
+    assert len(C.problem.violations(g)) == 0
+    g = C.encode(polyhedra.PolyhedralModel([_box(2, [1, 1, 1], [3, 3, 2]),
+                                            _box(1, [1, 1, 2], [3, 3, 3])]))  # fmt: skip
+    assert len(C.problem.violations(g)) > 0
+    r = solve(C.problem, "sat", rng=0)
+    assert r.status == "solved"
+
+
+def test_point_location_by_winding_number() -> None:
+    tri = {1: np.array(TET["vertices"], dtype=float)[np.array(TET["faces"])]}
+    pts = np.array([[0.5, 0.5, 0.5], [3, 3, 3], [1, 1, 1.9], [1, 1, 2.1], [-1, 0, 0]])
+    assert labels_at(pts, tri).tolist() == [1, 0, 1, 0, 0]
