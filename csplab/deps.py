@@ -1,6 +1,7 @@
 """Optional dependencies: one place that imports them and says which extra installs them.
 
-Every path that needs python-sat, OR-Tools, clingo, Ganak, ApproxMC or Dask calls
+Every path that needs python-sat, OR-Tools, clingo, Ganak, ApproxMC, Dask or the mesh
+packages (trimesh, manifold3d, scipy, mapbox-earcut) calls
 :func:`require` (or :func:`available`), so a missing package ends in one
 :class:`~csplab.errors.DependencyError` line naming the extra -- never a raw
 ``ModuleNotFoundError`` (the CLI turns it into exit code 2).
@@ -36,6 +37,10 @@ EXTRAS: dict[str, str] = {
     "pyganak": "count",
     "pyapproxmc": "count",
     "distributed": "dask",
+    "trimesh": "mesh",
+    "manifold3d": "mesh",
+    "scipy": "mesh",
+    "mapbox_earcut": "mesh",
 }
 
 

@@ -2,7 +2,8 @@
 
 A :class:`Format` names its extensions, what reading gives (an
 :class:`~csplab.example.ExampleModel`, a :class:`~csplab.io.ruleset.RuleSet` or, for
-continuous model synthesis, a :class:`~csplab.continuous.model.PolygonModel`), a content
+continuous model synthesis, a :class:`~csplab.continuous.model.PolygonModel` in 2D or a
+:class:`~csplab.continuous.polyhedra.PolyhedralModel` in 3D), a content
 sniffer, its loader options (the ``--model-option`` keys), its reader and writer (lazy
 ``"module:function"`` targets, imported on first use; ``None`` when the format is only
 written or only read) and the texts of the README table and of ``csplab info``.
@@ -16,9 +17,10 @@ readable format), the one whose sniffer scores the first bytes highest
 (:mod:`csplab.io.common`: 0 no, 1 plausible, 2 the right kind of file, 3 certain); on a tie
 the one declared first; when nothing scores, the first format of the extension or, for an
 unknown extension, :data:`FALLBACK`. An extension that only formats of another kind claim
-(``.obj``, never read; ``.xml`` when an example grid is wanted) is a one-line
+(``.xml`` when an example grid is wanted, ``.obj`` -- read as polyhedra only) is a one-line
 :class:`~csplab.errors.FormatError`. Writing (:func:`output_format`) takes the first
-writable format that claims the extension.
+writable format that claims the extension and writes what is written (a label grid, a
+polygon model or a polyhedral model: ``.obj`` and ``.png`` have one writer of each kind).
 
 Examples
 --------
@@ -28,12 +30,12 @@ Examples
 ['N', 'symmetry', 'periodic_input', 'ground']
 >>> output_format("out.txt").name, output_format("out.png").name
 ('merrell', 'png')
->>> get_format("stl")
+>>> get_format("zip")
 Traceback (most recent call last):
 ...
-csplab.errors.InputError: unknown model format 'stl'; use merrell, grid, npy, wfc, \
-overlapping, wfc-samples, poms, debroglie, markovjunior, png, vox, obj, polygons, svg or \
-polygon-png
+csplab.errors.InputError: unknown model format 'zip'; use merrell, grid, npy, wfc, \
+overlapping, wfc-samples, poms, debroglie, markovjunior, png, vox, obj, polygons, svg, \
+polygon-png, mesh-obj, off, stl or mesh-png
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ from csplab.io.common import NO, Output, read_bytes
 
 if TYPE_CHECKING:
     from csplab.continuous.model import PolygonModel
+    from csplab.continuous.polyhedra import PolyhedralModel
     from csplab.example import ExampleModel
     from csplab.io.ruleset import RuleSet
 
@@ -68,8 +71,14 @@ __all__ = [
     "synthesis_defaults",
 ]
 
-Gives = Literal["ExampleModel", "RuleSet", "PolygonModel"]
-Writes = Literal["grid", "PolygonModel"]
+Gives = Literal["ExampleModel", "RuleSet", "PolygonModel", "PolyhedralModel"]
+Writes = Literal["grid", "PolygonModel", "PolyhedralModel"]
+#: what each kind of writer takes, for messages
+_HOLDS = {
+    "grid": "label grids",
+    "PolygonModel": "polygon models",
+    "PolyhedralModel": "polyhedral models",
+}
 HEAD_SIZE = 1 << 20  # bytes a sniffer sees
 FALLBACK = "grid"  # text that no sniffer recognises (its parser then says what is wrong)
 BEGIN, END = "<!-- formats:begin -->", "<!-- formats:end -->"
@@ -180,20 +189,23 @@ class Format:
     extensions : tuple of str
         Lower-case extensions with the dot; the first format declared for an extension is
         its default (for writing, and for reading files no sniffer recognises).
-    gives : {"ExampleModel", "RuleSet", "PolygonModel"} or None
+    gives : {"ExampleModel", "RuleSet", "PolygonModel", "PolyhedralModel"} or None
         What reading gives (``None``: only written).
-    writes : {"grid", "PolygonModel"}
+    writes : {"grid", "PolygonModel", "PolyhedralModel"}
         What the writer takes: a label grid (an :class:`~csplab.io.common.Output`; the
-        default) or a :class:`~csplab.continuous.model.PolygonModel` (continuous model
-        synthesis). Grid outputs (:func:`output_format`, :func:`output_extensions` without
-        ``gives="PolygonModel"``) never pick a polygon writer, and the other way round.
+        default), a :class:`~csplab.continuous.model.PolygonModel` or a
+        :class:`~csplab.continuous.polyhedra.PolyhedralModel` (continuous model synthesis
+        in 2D, 3D). Grid outputs (:func:`output_format`, :func:`output_extensions` without
+        ``gives="PolygonModel"`` or ``"PolyhedralModel"``) never pick a polygon or mesh
+        writer, and each kind of model picks only its own writers.
     description : str
         One line, for ``csplab info`` and the README's format column.
     reader : str, optional
         ``"module:function"``; ``function(path, **options)`` reads a file.
     writer : str, optional
         ``"module:function"``; ``function(output, path)`` writes an
-        :class:`~csplab.io.common.Output` (``function(model, path)`` a polygon model).
+        :class:`~csplab.io.common.Output` (``function(model, path)`` a polygon or
+        polyhedral model).
     sniffer : str, optional
         ``"module:function"``; ``function(head: bytes) -> int`` scores the first bytes.
     options : tuple of Option
@@ -271,17 +283,17 @@ class Format:
         reader = cast("Callable[..., ExampleModel | RuleSet | PolygonModel]", resolve(self.reader))
         return reader(Path(path), **opts)
 
-    def write(self, out: Output | PolygonModel, path: str | Path) -> None:
+    def write(self, out: Output | PolygonModel | PolyhedralModel, path: str | Path) -> None:
         """Write ``out`` in this format: a grid (:class:`~csplab.io.common.Output`), or a
-        polygon model for the formats that write polygons (:attr:`writes`)."""
+        polygon (polyhedral) model for the formats that write them (:attr:`writes`)."""
         p = Path(path)
         if self.writer is None:
             raise InputError(f"csplab reads {self.name} files but does not write them")
-        if self.writes == "PolygonModel" or not isinstance(out, Output):
-            if self.writes != "PolygonModel":
-                raise InputError(f"{p}: {self.name} files hold label grids, not polygon models")
-            if isinstance(out, Output):
-                raise InputError(f"{p}: {self.name} files hold polygon models, not label grids")
+        kind = "grid" if isinstance(out, Output) else type(out).__name__
+        if kind != self.writes:
+            what = _HOLDS.get(kind, type(out).__name__)
+            raise InputError(f"{p}: {self.name} files hold {_HOLDS[self.writes]}, not {what}")
+        if not isinstance(out, Output):
             resolve(self.writer)(out, p)
             return
         if not self.partial and out.grid.size and int(out.grid.min()) < 0:
@@ -605,6 +617,93 @@ FORMATS: dict[str, Format] = {
             example=f"csplab synthesize {_CONT}/two_objects.json --size 12x8 --seed 1 "
             "--out two.png",
         ),
+        Format(
+            name="mesh-obj",
+            extensions=(".obj",),
+            gives="PolyhedralModel",
+            writes="PolyhedralModel",
+            description="Wavefront OBJ polyhedra (3D continuous model synthesis)",
+            reader="csplab.io.meshes:read_obj_model",
+            writer="csplab.io.meshes:write_obj_model",
+            sniffer="csplab.io.meshes:sniff_obj",
+            options=(
+                Option(
+                    "labels",
+                    str,
+                    "auto",
+                    "what makes a label: `auto` is `materials` when faces have materials, "
+                    "else `groups` when there are `o`/`g` groups, else `one`",
+                    choices=("auto", "materials", "groups", "components", "one"),
+                ),
+            ),
+            files="+ `.mtl`",
+            details="in: closed, oriented solids (`v`, polygon `f`, `o`/`g`, `usemtl`); a "
+            "material or group named `label_N` is label `N`, other names get 1, 2, … in "
+            "order of first appearance, a `# csplab label N` comment labels the rest of its "
+            "group; a solid is one connected shell of one label and group; validated "
+            "(watertight, manifold, consistent winding, no zero-area face, different labels "
+            "do not overlap), inside-out solids are reversed with a warning; out: one "
+            "`o solid_I` per solid, one material `label_N` per label with its colour in the "
+            "`.mtl` (`.obj` results of label grids are the `obj` format)",
+            example="csplab info  # in Python: "
+            "csplab.io.read_model('tests/io/data/tiny_mesh.obj').volume(1)",
+        ),
+        Format(
+            name="off",
+            extensions=(".off",),
+            gives="PolyhedralModel",
+            description="OFF polyhedra (3D continuous model synthesis)",
+            reader="csplab.io.meshes:read_off",
+            sniffer="csplab.io.meshes:sniff_off",
+            options=(
+                Option(
+                    "labels",
+                    str,
+                    "one",
+                    "`one` label for the file or one per connected `components`",
+                    choices=("one", "components"),
+                ),
+            ),
+            files="starting with `OFF`",
+            details="`OFF`, counts, vertices, `k i1 … ik` polygon faces (colours ignored); "
+            "every connected shell is a solid, validated as for `mesh-obj`",
+            example="csplab info  # in Python: "
+            "csplab.io.read_model('tests/io/data/tiny.off', labels='components')",
+        ),
+        Format(
+            name="stl",
+            extensions=(".stl",),
+            gives="PolyhedralModel",
+            description="STL polyhedra (3D continuous model synthesis)",
+            reader="csplab.io.meshes:read_stl",
+            sniffer="csplab.io.meshes:sniff_stl",
+            options=(
+                Option(
+                    "labels",
+                    str,
+                    "one",
+                    "`one` label for the file or one per connected `components`",
+                    choices=("one", "components"),
+                ),
+            ),
+            files="ASCII or binary",
+            details="triangles; coincident vertices are merged and adjacent coplanar "
+            "triangles counted as one input polygon; every connected shell is a solid, "
+            "validated as for `mesh-obj`",
+            example="csplab info  # in Python: "
+            "csplab.io.read_model('tests/io/data/tiny.stl').n_polygons",
+        ),
+        Format(
+            name="mesh-png",
+            extensions=(".png",),
+            gives=None,
+            writes="PolyhedralModel",
+            description="PNG picture of polyhedra",
+            writer="csplab.io.meshes:write_png",
+            details="a shaded view of the solids in their label colours (matplotlib; "
+            "`csplab.io.meshes.write_png(model, path)`)",
+            example="csplab info  # in Python: csplab.io.meshes.write_png(model, 'mesh.png')",
+        ),
     )
 }
 
@@ -684,10 +783,11 @@ def sniff(head: bytes, pool: Sequence[Format], default: Format | None = None) ->
 
 
 def _writers(gives: Gives | None) -> list[Format]:
-    """The formats that write models of ``gives`` (polygon models: every polygon writer;
-    otherwise the grid writers, of formats giving ``gives`` when given)."""
-    if gives == "PolygonModel":
-        return [f for f in formats(writable=True) if f.writes == "PolygonModel"]
+    """The formats that write models of ``gives`` (polygon or polyhedral models: every
+    writer of that kind; otherwise the grid writers, of formats giving ``gives`` when
+    given)."""
+    if gives in ("PolygonModel", "PolyhedralModel"):
+        return [f for f in formats(writable=True) if f.writes == gives]
     return [f for f in formats(gives=gives, writable=True) if f.writes == "grid"]
 
 
@@ -697,12 +797,16 @@ def _writer_for(ext: str, gives: Gives | None) -> Format | None:
 
 def output_format(path: str | Path, *, gives: Gives | None = None) -> Format:
     """The format written for ``path``'s extension (of the formats giving ``gives``; a
-    label grid unless ``gives="PolygonModel"``).
+    label grid unless ``gives="PolygonModel"`` or ``"PolyhedralModel"``).
 
     Examples
     --------
     >>> [output_format(f"m{e}", gives="PolygonModel").name for e in (".json", ".svg", ".png")]
     ['polygons', 'svg', 'polygon-png']
+    >>> [output_format(f"m{e}", gives="PolyhedralModel").name for e in (".obj", ".png")]
+    ['mesh-obj', 'mesh-png']
+    >>> output_format("m.obj").name
+    'obj'
     """
     p = Path(path)
     f = _writer_for(p.suffix.lower(), gives)
@@ -722,6 +826,8 @@ def output_extensions(*, gives: Gives | None = None, partial: bool | None = None
     (['.txt', '.grid', '.npy', '.png', '.vox', '.obj'], ['.npy', '.png', '.vox', '.obj'])
     >>> output_extensions(gives="PolygonModel")
     ['.json', '.svg', '.png']
+    >>> output_extensions(gives="PolyhedralModel")
+    ['.obj', '.png']
     """
     out: list[str] = []
     for f in _writers(gives):

@@ -1,0 +1,565 @@
+"""Polyhedral models (3D continuous model synthesis) as OBJ, OFF and STL files, and a PNG
+preview.
+
+* OBJ in (format ``mesh-obj``): ``v``, ``f`` (polygons; ``i``, ``i/t``, ``i//n``,
+  ``i/t/n``, negative indices relative), ``o``/``g``, ``usemtl`` and ``# csplab label N``;
+  other statements are ignored. The ``labels`` option says what makes a label:
+
+  - ``auto`` (default): the materials when any face has one, else the ``o``/``g`` groups
+    when there are any, else one label for the file;
+  - ``materials`` / ``groups``: a material (group) named ``label_N`` (or ``labelN``,
+    ``label N``, any case) has label ``N``; other names get labels 1, 2, ... in order of
+    first appearance, skipping the labels named explicitly (faces before any name count
+    as one more name);
+  - ``components``: every connected component its own label, 1, 2, ... in file order;
+  - ``one``: label 1 for everything.
+
+  A ``# csplab label N`` comment gives the faces after it in the same ``o``/``g`` group
+  label ``N``, whatever the option (a new ``o``/``g`` statement ends it). A solid is one
+  edge-connected shell of faces with one label and one ``o``/``g`` group. Coordinates are
+  kept as they are (no axis change).
+* OFF and STL (ASCII or binary) in (formats ``off``, ``stl``): one label for the file
+  (``labels=one``) or one per connected component (``labels=components``); every connected
+  shell is a solid.
+* OBJ out (``mesh-obj``): one ``o solid_I`` per solid, ``usemtl label_N``, the solid's
+  polygons; the ``.mtl`` next to it (``newmtl label_N`` with the label's colour, ``Kd``),
+  both written atomically (a temporary file, then renamed) -- so a written model reads back
+  with the same labels, solids, vertices and polygons.
+* PNG out (``mesh-png``): a shaded view of the solids in their label colours (matplotlib).
+
+Every problem is one line: a :class:`~csplab.errors.FormatError` naming the file and line
+for syntax, an :class:`~csplab.errors.InputError` naming the file and the solid/face for
+geometry (:class:`~csplab.continuous.polyhedra.PolyhedralModel`).
+
+Examples
+--------
+>>> import tempfile, pathlib
+>>> with tempfile.TemporaryDirectory() as d:
+...     p = pathlib.Path(d) / "t.off"
+...     _ = p.write_text("OFF\\n4 4 0\\n0 0 0\\n1 0 0\\n0 1 0\\n0 0 1\\n"
+...                      "3 0 2 1\\n3 0 1 3\\n3 1 2 3\\n3 0 3 2\\n")
+...     M = read_off(p)
+...     write_obj_model(M, pathlib.Path(d) / "t.obj")
+...     B = read_obj_model(pathlib.Path(d) / "t.obj")
+>>> B.labels, round(B.volume(1), 6), B.n_polygons, B.meta["format"]
+((1,), 0.166667, 4, 'mesh-obj')
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import re
+import struct
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.deps import require
+from csplab.errors import CsplabError, FormatError, InputError
+from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, read_bytes
+
+__all__ = [
+    "read_obj_model",
+    "read_off",
+    "read_stl",
+    "sniff_obj",
+    "sniff_off",
+    "sniff_stl",
+    "write_obj_model",
+    "write_png",
+]
+
+_LABEL_NAME = re.compile(r"label[_\s-]?(\d+)", re.IGNORECASE)
+_LABEL_COMMENT = re.compile(r"#\s*csplab\s+label\s+(\S+)", re.IGNORECASE)
+
+
+# ---------------------------------------------------------------------------- sniffing
+def sniff_obj(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for text with ``v`` and ``f`` lines.
+
+    Examples
+    --------
+    >>> sniff_obj(b"# x\\nv 0 0 0\\nf 1 2 3\\n"), sniff_obj(b"v 0 0 0\\n"), sniff_obj(b"0 1")
+    (3, 1, 0)
+    """
+    if b"\0" in head[:4096]:
+        return NO
+    has_v = re.search(rb"^[ \t]*v[ \t]", head, re.MULTILINE) is not None
+    has_f = re.search(rb"^[ \t]*f[ \t]", head, re.MULTILINE) is not None
+    return SURE if has_v and has_f else PLAUSIBLE if has_v else NO
+
+
+def sniff_off(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for text starting with ``OFF`` (after comments).
+
+    Examples
+    --------
+    >>> sniff_off(b"# c\\nOFF\\n4 4 0\\n"), sniff_off(b"OFFSET 1")
+    (3, 0)
+    """
+    for line in head[:4096].splitlines():
+        text = line.split(b"#", 1)[0].strip()
+        if text:
+            word = text.split()[0]
+            return SURE if word in (b"OFF", b"COFF", b"NOFF", b"CNOFF") else NO
+    return NO
+
+
+def sniff_stl(head: bytes) -> int:
+    """:data:`~csplab.io.common.SURE` for ASCII STL (``solid`` ... ``facet``),
+    :data:`~csplab.io.common.KIND` for a binary STL whose triangle count fits the size.
+
+    Examples
+    --------
+    >>> sniff_stl(b"solid t\\n facet normal 0 0 1\\n"), sniff_stl(b"\\0" * 80 + bytes(4))
+    (3, 2)
+    """
+    if head.lstrip().lower().startswith(b"solid") and b"facet" in head[:4096].lower():
+        return SURE
+    if len(head) >= 84:
+        (n,) = struct.unpack_from("<I", head, 80)
+        if len(head) == 84 + 50 * n:
+            return KIND
+    return NO
+
+
+# ---------------------------------------------------------------------------- helpers
+def _atomic_write(path: Path, data: bytes) -> None:
+    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
+    except OSError as e:
+        raise InputError(f"{path}: cannot write: {e.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except OSError as e:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"{path}: cannot write: {e.strerror}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _text(path: Path) -> str:
+    data = read_bytes(path)
+    if b"\0" in data:
+        raise FormatError("a binary file, not text", path=path)
+    return data.decode("utf-8", errors="replace")
+
+
+def _components(polys: Sequence[Sequence[int]], n_vertices: int) -> list[list[int]]:
+    """The faces grouped into edge-connected components (indices, in file order)."""
+    if not polys:
+        return []
+    graph = require("scipy.sparse", "mesh", "the face graph of polyhedral models")
+    csgraph = require("scipy.sparse.csgraph", "mesh", "the face graph of polyhedral models")
+    edges: dict[tuple[int, int], int] = {}
+    rows: list[int] = []
+    cols: list[int] = []
+    for j, p in enumerate(polys):
+        for k in range(len(p)):
+            a, b = p[k], p[(k + 1) % len(p)]
+            if a == b:
+                continue
+            key = (a, b) if a < b else (b, a)
+            if key in edges:
+                rows.append(edges[key])
+                cols.append(j)
+            else:
+                edges[key] = j
+    n = len(polys)
+    adj = graph.coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    _, comp = csgraph.connected_components(adj, directed=False)
+    order: dict[int, list[int]] = {}
+    for j, c in enumerate(comp.tolist()):
+        order.setdefault(int(c), []).append(j)
+    return list(order.values())
+
+
+def _merged_ids(v: NDArray[np.float64], polys: list[list[int]]) -> list[list[int]]:
+    """Faces with coincident vertices given one index (for the connectivity only)."""
+    if not len(v):
+        return polys
+    _, inv = np.unique(v + 0.0, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    return [[int(inv[i]) for i in p] for p in polys]
+
+
+def _solids(
+    v: NDArray[np.float64],
+    polys: list[list[int]],
+    labels: list[int],
+    groups: list[str],
+    names: dict[int, str],
+    path: Path,
+    fmt: str,
+    by_component: bool,
+) -> PolyhedralModel:
+    """Solids (edge-connected shells of one label and group) and the model."""
+    merged = _merged_ids(v, polys)
+    keys = list(dict.fromkeys(zip(groups, labels, strict=True)))
+    solids: list[dict[str, Any]] = []
+    for g, b in keys:
+        idx = [j for j in range(len(polys)) if groups[j] == g and labels[j] == b]
+        for comp in _components([merged[j] for j in idx], len(v)):
+            faces = [polys[idx[c]] for c in comp]
+            used = sorted({i for f in faces for i in f})
+            where = {old: new for new, old in enumerate(used)}
+            s: dict[str, Any] = {
+                "label": b,
+                "vertices": v[used],
+                "faces": [[where[i] for i in f] for f in faces],
+            }
+            if g:
+                s["group"] = g
+            solids.append(s)
+    if by_component:
+        for k, s in enumerate(solids, 1):
+            s["label"] = k
+    if not solids:
+        raise InputError(f"{path}: no faces: a polyhedral example needs closed solids")
+    meta: dict[str, Any] = {"format": fmt}
+    if names and not by_component:
+        meta["label_names"] = {str(b): n for b, n in sorted(names.items())}
+    try:
+        return PolyhedralModel(solids, name=path.stem, meta=meta, source=str(path))
+    except CsplabError:
+        raise
+    except (ValueError, TypeError, OverflowError, IndexError, MemoryError) as e:
+        raise InputError(f"{path}: cannot build the polyhedral model ({e})") from None
+
+
+def _number_labels(
+    keys: list[str | None], explicit_taken: set[int], path: Path
+) -> tuple[list[int], dict[int, str]]:
+    """Labels for names: ``label_N`` -> N, others 1, 2, ... in order of first appearance."""
+    out: dict[str | None, int] = {}
+    named: dict[int, str] = {}
+    taken = set(explicit_taken)
+    for k in keys:
+        m = _LABEL_NAME.fullmatch(k or "")
+        if m is not None:
+            b = int(m.group(1))
+            if b < 1:
+                raise InputError(f"{path}: {k!r}: label must be >= 1 (0 is empty space)")
+            out[k] = b
+            taken.add(b)
+    nxt = 1
+    for k in dict.fromkeys(keys):
+        if k in out:
+            continue
+        while nxt in taken:
+            nxt += 1
+        out[k] = nxt
+        taken.add(nxt)
+        if k:
+            named[nxt] = k
+    return [out[k] for k in keys], named
+
+
+# ---------------------------------------------------------------------------- OBJ in
+def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
+    """A polyhedral model from a Wavefront OBJ file (rules in the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.obj`` file (its ``.mtl`` is not needed).
+    labels : {"auto", "materials", "groups", "components", "one"}
+        What makes a label.
+    """
+    p = Path(path)
+    if labels not in ("auto", "materials", "groups", "components", "one"):
+        raise InputError(f"{p}: labels must be auto, materials, groups, components or one")
+    verts: list[tuple[float, float, float]] = []
+    polys: list[list[int]] = []
+    lines: list[int] = []
+    groups: list[str] = []
+    mats: list[str | None] = []
+    explicit: list[int | None] = []
+    group, mat, label = "", None, None
+    any_group = False
+    for n, raw in enumerate(_text(p).splitlines(), 1):
+        line = raw.strip()
+        if not line:
+            continue
+        if line.startswith("#"):
+            m = _LABEL_COMMENT.match(line)
+            if m is not None:
+                try:
+                    label = int(m.group(1))
+                except ValueError:
+                    raise FormatError(f"bad label {m.group(1)!r}", path=p, line=n) from None
+                if label < 1:
+                    raise FormatError("label must be >= 1 (0 is empty space)", path=p, line=n)
+            continue
+        tok = line.split("#", 1)[0].split()
+        if not tok:
+            continue
+        key = tok[0]
+        if key == "v":
+            try:
+                x, y, z = (float(t) for t in tok[1:4])
+            except ValueError:
+                raise FormatError("a vertex needs 3 numbers", path=p, line=n) from None
+            verts.append((x, y, z))
+        elif key == "f":
+            face: list[int] = []
+            for t in tok[1:]:
+                try:
+                    i = int(t.split("/", 1)[0])
+                except ValueError:
+                    raise FormatError(f"bad vertex reference {t!r}", path=p, line=n) from None
+                k = i - 1 if i > 0 else len(verts) + i
+                if i == 0 or not 0 <= k < len(verts):
+                    raise FormatError(
+                        f"vertex {i} does not exist ({len(verts)} so far)", path=p, line=n
+                    )
+                face.append(k)
+            if len(face) < 3:
+                raise FormatError("a face needs at least 3 vertices", path=p, line=n)
+            polys.append(face)
+            lines.append(n)
+            groups.append(group)
+            mats.append(mat)
+            explicit.append(label)
+        elif key in ("o", "g"):
+            group = " ".join(tok[1:])
+            any_group = True
+            label = None
+        elif key == "usemtl":
+            mat = " ".join(tok[1:])
+    if not polys:
+        raise FormatError(
+            "no faces (`f` lines): csplab writes .obj files of label grids too, but reads .obj "
+            "files only as polyhedral examples (closed solids)",
+            path=p,
+        )
+    v = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
+    mode = labels
+    if mode == "auto":
+        mode = "materials" if any(mats) else "groups" if any_group else "one"
+    taken = {b for b in explicit if b is not None}
+    free = [j for j, b in enumerate(explicit) if b is None]  # faces a name labels
+    names: dict[int, str] = {}
+    labs = [1 if b is None else b for b in explicit]
+    if mode in ("materials", "groups"):
+        keys = mats if mode == "materials" else [g or None for g in groups]
+        got, names = _number_labels([keys[j] for j in free], taken, p)
+        for j, b in zip(free, got, strict=True):
+            labs[j] = b
+    return _solids(v, polys, labs, groups, names, p, "mesh-obj", mode == "components")
+
+
+# ---------------------------------------------------------------------------- OFF in
+def read_off(path: str | Path, labels: str = "one") -> PolyhedralModel:
+    """A polyhedral model from an OFF file (``OFF``, counts, vertices, ``k i1 ... ik``
+    faces; colours and comments ignored); ``labels`` is ``one`` or ``components``."""
+    p = Path(path)
+    by = _labels_option(p, labels)
+    rows: list[tuple[int, list[str]]] = []
+    for n, raw in enumerate(_text(p).splitlines(), 1):
+        tok = raw.split("#", 1)[0].split()
+        if tok:
+            rows.append((n, tok))
+    if not rows or not rows[0][1][0].endswith("OFF"):
+        raise FormatError("an OFF file starts with OFF", path=p, line=rows[0][0] if rows else 1)
+    first = rows[0][1][1:]
+    rest = rows[1:]
+    if not first:
+        if not rest:
+            raise FormatError("missing the counts line", path=p)
+        n0, first = rest[0]
+        rest = rest[1:]
+    else:
+        n0 = rows[0][0]
+    try:
+        nv, nf = int(first[0]), int(first[1])
+    except (ValueError, IndexError):
+        raise FormatError("the counts line is `vertices faces edges`", path=p, line=n0) from None
+    if nv < 0 or nf < 0 or nv + nf > len(rest):
+        raise FormatError(
+            f"{nv} vertices and {nf} faces announced, {len(rest)} lines follow", path=p, line=n0
+        )
+    verts: list[list[float]] = []
+    for n, tok in rest[:nv]:
+        try:
+            verts.append([float(t) for t in tok[:3]])
+        except ValueError:
+            raise FormatError("a vertex needs 3 numbers", path=p, line=n) from None
+        if len(verts[-1]) != 3:
+            raise FormatError("a vertex needs 3 numbers", path=p, line=n)
+    polys: list[list[int]] = []
+    for n, tok in rest[nv : nv + nf]:
+        try:
+            k = int(tok[0])
+            face = [int(t) for t in tok[1 : 1 + k]]
+        except ValueError:
+            raise FormatError("a face is `k i1 ... ik`", path=p, line=n) from None
+        if k < 3 or len(face) != k:
+            raise FormatError("a face is `k i1 ... ik` with k >= 3", path=p, line=n)
+        if any(not 0 <= i < nv for i in face):
+            raise FormatError(f"a face refers to a vertex outside 0..{nv - 1}", path=p, line=n)
+        polys.append(face)
+    v = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
+    return _solids(v, polys, [1] * len(polys), [""] * len(polys), {}, p, "off", by)
+
+
+def _labels_option(p: Path, labels: str) -> bool:
+    if labels not in ("one", "components"):
+        raise InputError(f"{p}: labels must be one or components, not {labels!r}")
+    return labels == "components"
+
+
+# ---------------------------------------------------------------------------- STL in
+_STL_DTYPE = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+_STL_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)", re.IGNORECASE)
+
+
+def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
+    """A polyhedral model from an STL file, ASCII or binary (triangles; coincident
+    vertices are merged, adjacent coplanar triangles make one polygon); ``labels`` is
+    ``one`` or ``components``."""
+    p = Path(path)
+    by = _labels_option(p, labels)
+    data = read_bytes(p)
+    ascii_ = data.lstrip().lower().startswith(b"solid") and b"facet" in data[:4096].lower()
+    if ascii_:
+        try:
+            tri = np.asarray(
+                [[float(x) for x in m.groups()] for m in _STL_VERTEX.finditer(data)],
+                dtype=np.float64,
+            ).reshape(-1, 3)
+        except ValueError:
+            raise FormatError("a vertex needs 3 numbers", path=p) from None
+        if len(tri) % 3:
+            raise FormatError(f"{len(tri)} vertices: not 3 per facet", path=p)
+    else:
+        if len(data) < 84:
+            raise FormatError("too short for a binary STL (no triangle count)", path=p)
+        (n,) = struct.unpack_from("<I", data, 80)
+        if len(data) < 84 + 50 * n:
+            raise FormatError(
+                f"{n} triangles announced, the file holds {(len(data) - 84) // 50}", path=p
+            )
+        rec = np.frombuffer(data, dtype=_STL_DTYPE, count=n, offset=84)
+        tri = rec["v"].astype(np.float64).reshape(-1, 3)
+    if not len(tri):
+        raise InputError(f"{p}: no triangles: a polyhedral example needs closed solids")
+    polys = np.arange(len(tri)).reshape(-1, 3).tolist()
+    return _solids(tri, polys, [1] * len(polys), [""] * len(polys), {}, p, "stl", by)
+
+
+# ---------------------------------------------------------------------------- OBJ out
+def _num(x: float) -> str:
+    """Shortest exact text of a float (integral values without ``.0``)."""
+    if x == 0:
+        return "0"
+    if x.is_integer() and abs(x) < 2**53:
+        return str(int(x))
+    return repr(x)
+
+
+def _colours(model: PolyhedralModel) -> dict[int, tuple[int, int, int]]:
+    from csplab.render import palette
+
+    pal = palette(max(model.labels, default=0) + 1)
+    return {b: (int(pal[b][0]), int(pal[b][1]), int(pal[b][2])) for b in model.labels}
+
+
+def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as OBJ + MTL (the ``.mtl`` next to it, same stem; both atomic):
+    one ``o solid_I`` per solid with ``usemtl label_N`` and its polygons, exact numbers."""
+    p = Path(path)
+    mtl = p.with_suffix(".mtl")
+    cols = _colours(model)
+    m_lines = ["# csplab polyhedral model: one material per label"]
+    for b, c in cols.items():
+        r, g, bl = (x / 255 for x in c)
+        m_lines += [f"newmtl label_{b}", f"Kd {r:.6g} {g:.6g} {bl:.6g}", "Ka 0 0 0", ""]
+    lines = [
+        f"# csplab polyhedral model {model.name}".rstrip()
+        + f": {len(model)} solids, labels {list(model.labels)}",
+        f"mtllib {mtl.name}",
+    ]
+    base = 1
+    for i, s in enumerate(model.solids):
+        lines += [f"o solid_{i}", f"usemtl label_{s.label}"]
+        lines += [f"v {_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        lines += ["f " + " ".join(str(base + k) for k in poly) for poly in s.polygons]
+        base += len(s.vertices)
+    _atomic_write(mtl, ("\n".join(m_lines) + "\n").encode("utf-8"))
+    _atomic_write(p, ("\n".join(lines) + "\n").encode("utf-8"))
+
+
+# ---------------------------------------------------------------------------- PNG out
+def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -> None:
+    """A shaded view of ``model`` as a PNG (atomically; matplotlib, no display needed):
+    the solids in their label colours (those of :func:`write_obj_model`), lit from the
+    viewer's upper left, equal aspect, ``size_px`` pixels square.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from PIL import Image
+    >>> from csplab.continuous.polyhedra import PolyhedralModel
+    >>> T = PolyhedralModel([{"label": 1, "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0],
+    ...     [0, 0, 1]], "faces": [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]]}])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_png(T, pathlib.Path(d) / "t.png", size_px=96)
+    ...     Image.open(pathlib.Path(d) / "t.png").size
+    (96, 96)
+    """
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    if isinstance(size_px, bool) or not isinstance(size_px, int) or not 16 <= size_px <= 8192:
+        raise InputError(f"{path}: size_px must be an integer from 16 to 8192, not {size_px!r}")
+    p = Path(path)
+    dpi = 100
+    fig = Figure(figsize=(size_px / dpi, size_px / dpi), dpi=dpi)
+    FigureCanvasAgg(fig)
+    ax: Any = fig.add_axes((0.0, 0.0, 1.0, 1.0), projection="3d")
+    ax.set_axis_off()
+    ax.view_init(elev=25, azim=-60)
+    cols = _colours(model)
+    light = np.asarray([-0.4, -0.6, 0.7])
+    light /= np.linalg.norm(light)
+    tris: list[NDArray[np.float64]] = []
+    shades: list[NDArray[np.float64]] = []
+    for s in model.solids:
+        t = s.vertices[s.faces]
+        nrm = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+        nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+        lam = 0.35 + 0.65 * np.clip(nrm @ light, 0.0, 1.0)
+        base = np.asarray(cols[s.label], dtype=np.float64) / 255
+        tris.append(t)
+        shades.append(np.clip(lam[:, None] * base[None, :], 0, 1))
+    if tris:
+        allt = np.concatenate(tris)
+        ax.add_collection3d(
+            Poly3DCollection(list(allt), facecolors=np.concatenate(shades), linewidths=0)
+        )
+        lo, hi = allt.reshape(-1, 3).min(axis=0), allt.reshape(-1, 3).max(axis=0)
+        mid, half = (lo + hi) / 2, max(float((hi - lo).max()) / 2, 1e-12)
+        ax.set_xlim(mid[0] - half, mid[0] + half)
+        ax.set_ylim(mid[1] - half, mid[1] + half)
+        ax.set_zlim(mid[2] - half, mid[2] + half)
+        ax.set_box_aspect((1, 1, 1), zoom=1.3)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
+    _atomic_write(p, buf.getvalue())
