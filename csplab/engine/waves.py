@@ -4,13 +4,15 @@ Blocks that neither overlap nor are joined by an arc are independent: solving on
 change what another sees, so they may run at the same time against the same grid. The
 blocks of Alg. 3.4 (thesis Sec. 3.3.6) are laid out on a lattice of block indices (one per
 axis, shifted by half a block); :func:`colour_classes` colours each block by its index
-modulo 3 on each axis (``3 ** d`` colours). Two blocks of one colour are three half-blocks
-apart on some axis, so a gap of at least half a block separates them and no nearest-neighbour
-arc joins them. :func:`waves` checks this on the arcs themselves (a block that shares an arc
-or a cell with an earlier block of its wave is deferred to a following wave: this happens
-only for a flush last block, a periodic axis, odd block sizes below 4 or boxes of positions
-whose arcs are longer than the gap), so every wave it yields is independent whatever the
-problem. :func:`independent` is the brute-force check the tests use.
+modulo 3 on each axis (``3 ** d`` colours). Two blocks of one colour are at least three
+half-block steps apart on some axis, so a gap of ``3 * (m // 2) - m`` cells separates them
+(half a block for an even ``m``) and no nearest-neighbour arc joins them. :func:`waves`
+checks this on the arcs themselves: a block that shares an arc or a cell with an earlier
+block of its wave is deferred to a following wave. That happens only where the lattice is
+not regular or the gap is too small -- a last block flush with the end of its axis, a
+periodic axis (wrap-around arcs), blocks of 3 cells (no gap), boxes of positions joined by
+arcs longer than the gap -- so every wave it yields is independent whatever the problem.
+:func:`independent` is the brute-force check the tests use.
 
 Each block draws its random numbers from its own generator, :func:`block_rng`, seeded with
 ``numpy.random.SeedSequence([root, sweep, block])``; the outcome of a wave therefore does

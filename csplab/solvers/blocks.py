@@ -550,7 +550,7 @@ class BlocksSolver(Solver):
         CHOICE,
         TIME_LIMIT,
         Option("workers", int, 0,
-               "0: the thesis' sweep; N: waves of independent blocks on N processes "
+               "the thesis' sweep (0) or waves of independent blocks on N processes "
                "(1: in-process; another order and random stream, the same for every N)",
                minimum=0),
         Option("scheduler", str, None,
