@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.grids import parse_boundary, parse_shape
@@ -41,7 +42,7 @@ __all__ = [
 #: The line the CLI prints on stderr before numba compiles csplab's kernels for the first time.
 COMPILING = "compiling csplab's kernels once (about 5 s; cached afterwards)"
 
-Model = ExampleModel | RuleSet | PolygonModel
+Model = ExampleModel | RuleSet | PolygonModel | PolyhedralModel
 
 
 def key_values(items: list[str] | None, flag: str, form: str = "KEY=VALUE") -> dict[str, Any]:
@@ -326,9 +327,10 @@ def problem_from_args(
     args: argparse.Namespace, model: Model, shape: tuple[int, ...] | None = None
 ) -> Problem:
     """The problem for ``--size`` (or ``shape``), ``--boundary`` and ``--periodic``."""
-    if isinstance(model, PolygonModel):
+    if isinstance(model, PolygonModel | PolyhedralModel):
+        kind = "polygon" if isinstance(model, PolygonModel) else "polyhedral"
         raise InputError(
-            f"{model.name or args.model} is a polygon model (continuous model synthesis): "
+            f"{model.name or args.model} is a {kind} model (continuous model synthesis): "
             "`csplab synthesize`, `check` and `show` take it; this command takes grid "
             "examples and tilesets"
         )

@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 
 from csplab.cli.common import check_output_path, load_model, model_options
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
 
 HELP = "write a PNG picture of a model file (grid, tileset, sample or polygons)"
@@ -89,6 +90,13 @@ def run(args: argparse.Namespace) -> int:
         what = f"{'x'.join(map(str, partial.shape))} grid {src.stem}"
     else:
         model = load_model(args.file, opts)
+        if isinstance(model, PolyhedralModel):
+            from csplab.io.meshes import write_png as write_mesh_png
+
+            write_mesh_png(model, out)
+            print(f"wrote {out}: {len(model.solids)} solids of {model.name or src.stem}, "
+                  f"labels {list(model.labels)}, {model.n_polygons} polygons")  # fmt: skip
+            return 0
         if isinstance(model, PolygonModel):
             from csplab.io.polygons import write_png
 

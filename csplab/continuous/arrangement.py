@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 
 from csplab.errors import InputError
 
-__all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice"]
+__all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice", "gcd_fractions", "rational"]
 
 #: how the lines of a family are spaced: ``lattice`` (every integer ``k``: every lattice
 #: point on every family, exact copies of the example's corners anywhere) or ``equal``
@@ -63,11 +63,18 @@ _REL = 1e-9  # a float coordinate is that rational if within this relative dista
 _SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
 
 
-def _frac(x: float) -> Fraction:
+def rational(x: float) -> Fraction:
+    """A float as the nearest fraction of denominator at most 10^6 (the example's
+    coordinates are checked against it)."""
     return Fraction(x).limit_denominator(_DEN)
 
 
-def _gcd_fractions(fs: Iterable[Fraction]) -> Fraction:
+def gcd_fractions(fs: Iterable[Fraction]) -> Fraction:
+    """The largest fraction of which every ``fs`` is an integer multiple (0 if all are 0).
+
+    >>> gcd_fractions([Fraction(5, 2), Fraction(15, 2), Fraction(10)])
+    Fraction(5, 2)
+    """
     g = Fraction(0)
     for f in fs:
         f = abs(f)
@@ -128,10 +135,10 @@ class Lattice:
         if spacing is not None:
             if not (math.isfinite(spacing) and spacing > 0):
                 raise InputError(f"spacing must be a positive number, not {spacing!r}")
-            s = _frac(float(spacing))
-            origin = (_frac(float(lo[0])), _frac(float(lo[1])))
+            s = rational(float(spacing))
+            origin = (rational(float(lo[0])), rational(float(lo[1])))
         else:
-            fr = [[_frac(float(v)) for v in p] for p in pts.tolist()]
+            fr = [[rational(float(v)) for v in p] for p in pts.tolist()]
             for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
                 for v, q in zip(p, f, strict=True):
                     if abs(float(q) - v) > _REL * max(1.0, abs(v)):
@@ -140,7 +147,7 @@ class Lattice:
                             "form; pass a spacing (and snap=true to round vertices onto it)"
                         )
             origin = (min(f[0] for f in fr), min(f[1] for f in fr))
-            s = _gcd_fractions([f[a] - origin[a] for f in fr for a in (0, 1)])
+            s = gcd_fractions([f[a] - origin[a] for f in fr for a in (0, 1)])
             if s == 0:
                 raise InputError(f"{where}: the example has no extent")
         u = (pts - np.array([float(origin[0]), float(origin[1])])) / float(s)

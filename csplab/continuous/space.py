@@ -47,7 +47,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.arrangement import _frac, _gcd_fractions
+from csplab.continuous.arrangement import rational, gcd_fractions
 from csplab.errors import InputError
 
 __all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells"]
@@ -98,10 +98,10 @@ class Lattice3:
         if spacing is not None:
             if not (math.isfinite(spacing) and spacing > 0):
                 raise InputError(f"spacing must be a positive number, not {spacing!r}")
-            s = _frac(float(spacing))
-            origin = tuple(_frac(float(v)) for v in lo)
+            s = rational(float(spacing))
+            origin = tuple(rational(float(v)) for v in lo)
         else:
-            fr = [[_frac(float(v)) for v in p] for p in pts.tolist()]
+            fr = [[rational(float(v)) for v in p] for p in pts.tolist()]
             for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
                 for v, q in zip(p, f, strict=True):
                     if abs(float(q) - v) > _REL * max(1.0, abs(v)):
@@ -110,7 +110,7 @@ class Lattice3:
                             "pass a spacing (and snap=true to round vertices onto it)"
                         )
             origin = tuple(min(f[a] for f in fr) for a in range(3))
-            s = _gcd_fractions([f[a] - origin[a] for f in fr for a in range(3)])
+            s = gcd_fractions([f[a] - origin[a] for f in fr for a in range(3)])
             if s == 0:
                 raise InputError(f"{where}: the example has no extent")
         o = np.array([float(v) for v in origin])

@@ -30,6 +30,7 @@ from typing import Any
 from numpy.typing import ArrayLike
 
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.io.common import Output
@@ -74,8 +75,8 @@ def model_format(path: str | Path) -> str:
 
 def read_model(
     path: str | Path, format: str | None = None, **options: Any
-) -> ExampleModel | RuleSet | PolygonModel:
-    """Read any model file: an example grid, a rule set or a polygon model.
+) -> ExampleModel | RuleSet | PolygonModel | PolyhedralModel:
+    """Read any model file: an example grid, a rule set, a polygon or a polyhedral model.
 
     ``options`` are the format's loader options (``csplab info`` lists them), e.g.
     ``subset=`` (WFC), ``up=`` (POMS), ``strict=`` (DeBroglie), ``N=``, ``symmetry=``,
@@ -90,7 +91,7 @@ def read_model(
 
 def load_model(
     spec: str | Path, options: dict[str, Any] | None = None
-) -> ExampleModel | RuleSet | PolygonModel:
+) -> ExampleModel | RuleSet | PolygonModel | PolyhedralModel:
     """A built-in example name (``csplab info`` lists them) or a model file path (any
     format of :func:`read_model`, with its loader ``options``).
 

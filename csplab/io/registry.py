@@ -275,12 +275,12 @@ class Format:
             )
         return {k: declared[k].check(v, self.name) for k, v in options.items()}
 
-    def read(self, path: str | Path, **options: Any) -> ExampleModel | RuleSet | PolygonModel:
+    def read(self, path: str | Path, **options: Any) -> ExampleModel | RuleSet | PolygonModel | PolyhedralModel:
         """Read a file of this format."""
         if self.reader is None:
             raise InputError(f"csplab writes {self.name} files but does not read them")
         opts = self.check_options(options)
-        reader = cast("Callable[..., ExampleModel | RuleSet | PolygonModel]", resolve(self.reader))
+        reader = cast("Callable[..., ExampleModel | RuleSet | PolygonModel | PolyhedralModel]", resolve(self.reader))
         return reader(Path(path), **opts)
 
     def write(self, out: Output | PolygonModel | PolyhedralModel, path: str | Path) -> None:

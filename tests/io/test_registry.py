@@ -118,7 +118,7 @@ def test_detection(tmp_path, name, data, want):
 
 def test_wrong_kind_of_file_is_one_clear_error(tmp_path):
     (tmp_path / "m.obj").write_text("v 0 0 0\n")
-    with pytest.raises(FormatError, match=r"csplab writes \.obj files"):
+    with pytest.raises(FormatError, match=r"no faces .*reads \.obj files only as polyhedral"):
         read_model(tmp_path / "m.obj")
     with pytest.raises(FormatError, match=r"\.xml files are read as .*not as example grids"):
         read_example(DATA / "pipes.xml")
