@@ -2,19 +2,33 @@
 
 ``model="onehot"`` (default): one Boolean per ``(cell, label)`` of the arc-consistent
 catalog, ``ExactlyOne`` per cell and the support clauses of :mod:`csplab.cnf` as
-``BoolOr`` constraints (written straight into the model proto). ``model="table"``: one
-integer variable per cell with its catalog as domain and ``AddAllowedAssignments`` per arc
-(the natural CSP model). Both are complete: ``INFEASIBLE`` is a proof and gives ``unsat``.
+``BoolOr`` constraints. ``model="table"``: one integer variable per cell with its catalog
+as domain and ``AddAllowedAssignments`` per arc (the natural CSP model). Both are
+complete: ``INFEASIBLE`` is a proof and gives ``unsat``.
 
-Measured on this class of machine (see ``benchmarks/bench_solvers.py`` and the README):
-CP-SAT's presolve expands binary tables into clauses and probes them, which costs seconds
-to minutes on grids of a few thousand cells, so the defaults switch presolve, probing,
-symmetry detection and linearization off (``presolve=True`` turns them back on; table
-model with hints at 16×16×8: 27 s with them, 1.9 s without); building the model costs about
-10 µs per constraint in Python, which dominates at 40×40×10. Why one-hot is the default:
-at 40×40×10 on the built-in examples it solved 5 of 6 settings within 60 s (7–50 s, most
-of it building the model), the table model only 1 (11 s; it builds in 2–3 s but searches
-slowly); at 12×12×6 both take 3–5 s.
+Loading the one-hot model: OR-Tools' Python ``CpModelProto`` is a C++ message, and adding
+its constraints one by one costs about 10 µs each in Python (4.5–5.5 s for the 2.6M
+constraints of city or castle at 40×40×10). Instead the whole message is serialized in
+the protobuf wire format (a compiled loop for the clauses, numpy for the variables and the
+hint; field numbers from the installed ``cp_model_pb2`` descriptor) and parsed into the
+model's proto with one ``ParseFromArray`` call (:func:`_proto_parser`; the C++ pointer
+comes from pybind11's type-checked conduit). Same model, field for field (a test compares
+it with the element-by-element build, which stays as the fallback: ``stats["loader"]`` is
+``"proto-bytes"`` or ``"proto-api"``); at 40×40×10 (60 MB) it takes 0.3–0.45 s.
+The table model is still built through the API (0.8–1.0 s at 40×40×10, small next to
+its search).
+
+Measured on this class of machine (2 cores, shared; see ``benchmarks/bench_solvers.py``
+and the README): CP-SAT's presolve expands binary tables into clauses and probes them,
+which costs seconds to minutes on grids of a few thousand cells, so the defaults switch
+presolve, probing, symmetry detection and linearization off (``presolve=True`` turns them
+back on; table model with hints at 16×16×8: 27 s with them, 1.9 s without). At
+40×40×10 (``boundary="auto"``, one-hot, medians of 3 runs) end to end: city 4.0 s
+(was 9.9 s), castle 3.8 s (was 8.0 s), canal 2.0 s (was 4.7 s), against 1.5, 1.7 and
+0.85 s for ``sat``; what remains is CP-SAT's own work in ``Solve`` (copying, validating
+and loading the model, repairing the hint: 3.2–3.3 s at city and castle). Why one-hot is
+the default: the table model solved only 1 of 6 40×40×10 settings within 60 s (11 s; it
+searches slowly); at 12×12×6 both take 3–5 s.
 
 Diversity: CP-SAT returns the same solution for every ``random_seed`` by default.
 ``diversity="hint"`` (default) gives a solution hint with one random label per cell drawn
@@ -24,10 +38,11 @@ from the catalog with the rng (CP-SAT then repairs the hint, which is also fast:
 hint); ``"none"`` keeps CP-SAT's defaults. The seed is passed as ``random_seed``; with
 ``num_workers=1`` (default) runs are reproducible.
 
-Time limit: the model is built in chunks that check the deadline, and CP-SAT gets the time
-that is left; but CP-SAT loads a table model without looking at its limit (nor at
-``StopSearch``): on a 30×30×8 box town (4 labels) the call ended 1.7–2.1 s after a 0.3 s
-limit. The one-hot model stays within the limit.
+Time limit: the model is built in chunks that check the deadline (the one-hot model is
+checked again after its single parse, about half a second at 40×40×10), and CP-SAT gets
+the time that is left; but CP-SAT loads a table model without looking at its limit (nor
+at ``StopSearch``): on a 30×30×8 box town (4 labels) the call ended 1.7–2.1 s after a
+0.3 s limit. The one-hot model stays within the limit.
 
 Examples
 --------
@@ -46,6 +61,8 @@ import time
 from typing import Any
 
 import numpy as np
+from numba import njit
+from numpy.typing import NDArray
 
 from csplab.cnf import DeadlineExceeded, encode
 from csplab.deps import require
@@ -57,6 +74,7 @@ from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
 __all__ = ["CpsatSolver"]
 
 _CHUNK = 20_000
+_BULK_CHUNK = 1 << 20  # clauses serialized per kernel call (then the deadline is checked)
 
 
 class _Deadline(Exception):
@@ -122,15 +140,18 @@ class CpsatSolver(Solver):
             return Result("unsat", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
         pref = preferred_labels(enc.catalog, None, rng) if diversity == "hint" else None
         m = cp_model.CpModel()
+        t_load = time.perf_counter()
         try:
             if model == "onehot":
-                read = self._onehot(m, enc, pref, deadline)
+                read, stats["loader"] = self._onehot(m, enc, pref, deadline)
             else:
-                read = self._table(m, enc, pref, deadline)
+                read, stats["loader"] = self._table(m, enc, pref, deadline)
         except _Deadline:
+            stats["load_s"] = time.perf_counter() - t_load
             stats["build_s"] = time.perf_counter() - t0
             return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
         t1 = time.perf_counter()
+        stats["load_s"] = t1 - t_load
         stats["build_s"] = t1 - t0
         s = cp_model.CpSolver()
         prm = s.parameters
@@ -167,47 +188,28 @@ class CpsatSolver(Solver):
         return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
 
     @staticmethod
-    def _onehot(m: Any, enc: Any, pref: Any, deadline: float | None) -> Any:
-        """Booleans x[v, b] (proto index = SAT variable - 1) and the support clauses."""
-        p = m.proto
-        variables = p.variables
-        for a in range(0, enc.nx, _CHUNK):
-            _check(deadline)
-            for _ in range(a, min(a + _CHUNK, enc.nx)):
-                variables.add().domain.extend((0, 1))
-        nalo = int(enc.stats["alo_clauses"])
-        nsup = enc.nclauses - nalo
-        cons = p.constraints
-        for a in range(0, enc.nclauses, _CHUNK):
-            _check(deadline)
-            b = min(a + _CHUNK, enc.nclauses)
-            lo, hi = int(enc.starts[a]), int(enc.starts[b])
-            chunk = enc.lits[lo:hi]
-            lits = np.where(chunk > 0, chunk - 1, chunk).astype(np.int64).tolist()
-            st = (enc.starts[a : b + 1] - lo).tolist()
-            for i in range(b - a):
-                if a + i < nsup:
-                    cons.add().bool_or.literals.extend(lits[st[i] : st[i + 1]])
-                else:
-                    cons.add().exactly_one.literals.extend(lits[st[i] : st[i + 1]])
-        if pref is not None:
-            var = enc.var
-            has = var > 0
-            cells, labels = np.nonzero(has)
-            vals = (labels == pref[cells]).astype(np.int64)
-            p.solution_hint.vars.extend((var[has].astype(np.int64) - 1).tolist())
-            p.solution_hint.values.extend(vals.tolist())
+    def _onehot(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str]:
+        """Booleans x[v, b] (proto index = SAT variable - 1) and the support clauses.
 
-        def read(values: np.ndarray) -> np.ndarray:
-            truth = np.zeros(enc.nx + 1, dtype=bool)
-            truth[1:] = values[: enc.nx] > 0
-            grid, _multi = enc.decode(truth)
-            return np.asarray(grid, dtype=np.int32)
-
-        return read
+        The model is serialized in bulk (:func:`_onehot_bytes`) and parsed into
+        ``m``'s proto in one call; without the parser (:func:`_proto_parser`), or for a
+        model over 2 GB, it is built element by element (:func:`_onehot_elementwise`).
+        Returns the function from solution values to the grid and the loader's name
+        (``"proto-bytes"`` or ``"proto-api"``).
+        """
+        parse = _proto_parser()
+        buf = _onehot_bytes(enc, pref, deadline) if parse is not None else None
+        if parse is not None and buf is not None:
+            _check(deadline)
+            if not parse(m.proto, buf):
+                raise RuntimeError("CP-SAT could not parse the model csplab serialized")
+            _check(deadline)
+            return _onehot_reader(enc), "proto-bytes"
+        _onehot_elementwise(m, enc, pref, deadline)
+        return _onehot_reader(enc), "proto-api"
 
     @staticmethod
-    def _table(m: Any, enc: Any, pref: Any, deadline: float | None) -> Any:
+    def _table(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str]:
         """One integer variable per cell and ``AddAllowedAssignments`` per arc."""
         cp_model = require("ortools.sat.python.cp_model", "cpsat", "solver 'cpsat'")
 
@@ -232,4 +234,325 @@ class CpsatSolver(Solver):
         def read(values: np.ndarray) -> np.ndarray:
             return np.asarray(values[: P.n], dtype=np.int32)
 
-        return read
+        return read, "proto-api"
+
+
+def _onehot_elementwise(m: Any, enc: Any, pref: Any, deadline: float | None) -> None:
+    """Build the one-hot model element by element through the proto API (about 10 µs per
+    constraint: the fallback of :meth:`CpsatSolver._onehot` and the reference for tests).
+    """
+    p = m.proto
+    variables = p.variables
+    for a in range(0, enc.nx, _CHUNK):
+        _check(deadline)
+        for _ in range(a, min(a + _CHUNK, enc.nx)):
+            variables.add().domain.extend((0, 1))
+    nalo = int(enc.stats["alo_clauses"])
+    nsup = enc.nclauses - nalo
+    cons = p.constraints
+    for a in range(0, enc.nclauses, _CHUNK):
+        _check(deadline)
+        b = min(a + _CHUNK, enc.nclauses)
+        lo, hi = int(enc.starts[a]), int(enc.starts[b])
+        chunk = enc.lits[lo:hi]
+        lits = np.where(chunk > 0, chunk - 1, chunk).astype(np.int64).tolist()
+        st = (enc.starts[a : b + 1] - lo).tolist()
+        for i in range(b - a):
+            if a + i < nsup:
+                cons.add().bool_or.literals.extend(lits[st[i] : st[i + 1]])
+            else:
+                cons.add().exactly_one.literals.extend(lits[st[i] : st[i + 1]])
+    if pref is not None:
+        var = enc.var
+        has = var > 0
+        cells, labels = np.nonzero(has)
+        vals = (labels == pref[cells]).astype(np.int64)
+        p.solution_hint.vars.extend((var[has].astype(np.int64) - 1).tolist())
+        p.solution_hint.values.extend(vals.tolist())
+
+
+def _onehot_reader(enc: Any) -> Any:
+    """A function from CP-SAT's solution values to the grid (cell-major, flat)."""
+
+    def read(values: np.ndarray) -> np.ndarray:
+        truth = np.zeros(enc.nx + 1, dtype=bool)
+        truth[1:] = values[: enc.nx] > 0
+        grid, _multi = enc.decode(truth)
+        return np.asarray(grid, dtype=np.int32)
+
+    return read
+
+
+# ----------------------------------------------------------------------------- bulk proto
+
+_MAX_PROTO_BYTES = 2**31 - 1  # protobuf's ParseFromArray takes an int size
+
+
+def _varint_sizes(values: NDArray[np.int64]) -> NDArray[np.int64]:
+    """Bytes of each value as a protobuf varint: 10 for a negative value (two's
+    complement), else one per started 7 bits (values must be below ``2**53``).
+
+    Examples
+    --------
+    >>> _varint_sizes(np.array([0, 127, 128, 2**21, -1], dtype=np.int64)).tolist()
+    [1, 1, 2, 4, 10]
+    """
+    bits = np.frexp(values.astype(np.float64))[1].astype(np.int64)  # bit length of |x|
+    n = np.maximum((bits + 6) // 7, 1)
+    n[values < 0] = 10
+    return n
+
+
+def _varints(values: NDArray[np.int64]) -> NDArray[np.uint8]:
+    """The protobuf varint encoding of ``values`` (below ``2**53``), back to back.
+
+    Examples
+    --------
+    >>> _varints(np.array([1, 300, -1], dtype=np.int64)).tolist()
+    [1, 172, 2, 255, 255, 255, 255, 255, 255, 255, 255, 255, 1]
+    """
+    values = np.ascontiguousarray(values, dtype=np.int64)
+    u = values.view(np.uint64)
+    n = _varint_sizes(values)
+    ends = np.cumsum(n)
+    out = np.empty(int(ends[-1]) if n.size else 0, dtype=np.uint8)
+    off = ends - n
+    counts = np.bincount(n, minlength=11)
+    for size in np.flatnonzero(counts).tolist():  # one 2D pass per varint length
+        whole = counts[size] == n.size
+        idx = None if whole else np.flatnonzero(n == size)
+        w = u if idx is None else u[idx]
+        at = off if idx is None else off[idx]
+        shifts = np.arange(size, dtype=np.uint64) * np.uint64(7)
+        block = (w[:, None] >> shifts).astype(np.uint8)  # the low byte of each group
+        block &= 0x7F
+        block[:, :-1] |= 0x80
+        if whole:
+            out[:] = block.reshape(-1)
+        else:
+            out[at[:, None] + np.arange(size)] = block
+    return out
+
+
+def _tag(number: int) -> int:
+    """The key of a length-delimited field (wire type 2) as a varint value."""
+    return (number << 3) | 2
+
+
+def _field(message: str, name: str) -> int:
+    """Key of field ``name`` of ``message`` in ``cp_model.proto`` (from the installed
+    descriptor, so that a renumbering in OR-Tools cannot go unnoticed)."""
+    pb = require("ortools.sat.cp_model_pb2", "cpsat", "solver 'cpsat'")
+    return _tag(int(getattr(pb, message).DESCRIPTOR.fields_by_name[name].number))
+
+
+@njit(cache=True)
+def _clause_records(
+    lits: np.ndarray, starts: np.ndarray, a: int, b: int, nsup: int,
+    keys: np.ndarray, out: np.ndarray, write: bool,
+) -> int:  # fmt: skip
+    """Serialize clauses ``a..b-1`` as ``constraints`` entries of a ``CpModelProto``.
+
+    ``keys`` holds the field keys ``(constraints, bool_or, exactly_one, literals)``; clause
+    ``i`` is a ``bool_or`` if ``i < nsup``, else an ``exactly_one``; SAT literal ``v > 0``
+    becomes index ``v - 1`` and ``-v`` stays ``-v`` (CP-SAT's negation of ``v - 1``).
+    Returns the number of bytes; they are written to ``out`` only if ``write``. Self-
+    contained (no other csplab kernel is called: see :mod:`csplab._kernels`' cache rule).
+    """
+    head = np.empty(6, dtype=np.int64)
+    pos = 0
+    for i in range(a, b):
+        n0 = 0  # bytes of the packed literals
+        for j in range(starts[i], starts[i + 1]):
+            y = int(lits[j])
+            if y < 0:
+                n0 += 10
+                continue
+            y -= 1
+            n0 += 1
+            while y >= 128:
+                y >>= 7
+                n0 += 1
+        kind = keys[1] if i < nsup else keys[2]
+        n1 = n0 + 2  # BoolArgumentProto: key of literals, length, literals
+        y = keys[3]
+        while y >= 128:
+            y >>= 7
+            n1 += 1
+        y = n0
+        while y >= 128:
+            y >>= 7
+            n1 += 1
+        n2 = n1 + 2  # ConstraintProto: key of bool_or / exactly_one, length, argument
+        y = kind
+        while y >= 128:
+            y >>= 7
+            n2 += 1
+        y = n1
+        while y >= 128:
+            y >>= 7
+            n2 += 1
+        head[0] = keys[0]
+        head[1] = n2
+        head[2] = kind
+        head[3] = n1
+        head[4] = keys[3]
+        head[5] = n0
+        lo = starts[i]
+        for t in range(6 + starts[i + 1] - lo):
+            if t < 6:
+                y = head[t]
+            else:
+                y = int(lits[lo + t - 6])
+                if y > 0:
+                    y -= 1
+            u = np.uint64(y)  # two's complement: a negative value takes 10 bytes
+            while u >= np.uint64(128):
+                if write:
+                    out[pos] = np.uint8((u & np.uint64(127)) | np.uint64(128))
+                pos += 1
+                u >>= np.uint64(7)
+            if write:
+                out[pos] = np.uint8(u)
+            pos += 1
+    return pos
+
+
+def _packed(key: int, values: NDArray[np.int64]) -> NDArray[np.uint8]:
+    """A packed repeated varint field (nothing when ``values`` is empty, as protobuf writes)."""
+    if values.size == 0:
+        return np.zeros(0, dtype=np.uint8)
+    data = _varints(values)
+    return np.concatenate([_varints(np.array([key, data.size], dtype=np.int64)), data])
+
+
+def _onehot_bytes(enc: Any, pref: Any, deadline: float | None) -> NDArray[np.uint8] | None:
+    """The serialized ``CpModelProto`` of the one-hot model (compiled loop + numpy).
+
+    Field for field what :func:`_onehot_elementwise` builds: ``enc.nx`` Boolean variables
+    (domain ``[0, 1]``), one ``bool_or`` per support clause and one ``exactly_one`` per
+    at-least-one clause (SAT literal ``v`` is index ``v - 1``, ``-v`` is CP-SAT's negation
+    ``-(v - 1) - 1 = -v``), and the solution hint when ``pref`` is given.
+
+    Parameters
+    ----------
+    enc : Encoding
+        The support encoding with lazy at-most-one (:func:`csplab.cnf.encode`).
+    pref : int array ``(n,)`` or None
+        The hinted label per cell.
+    deadline : float, optional
+        Checked between chunks of clauses (raises ``_Deadline``).
+
+    Returns
+    -------
+    uint8 array or None
+        The message bytes, or None when they would exceed protobuf's 2 GB limit.
+    """
+    k_var = _field("CpModelProto", "variables")
+    k_con = _field("CpModelProto", "constraints")
+    k_hint = _field("CpModelProto", "solution_hint")
+    k_dom = _field("IntegerVariableProto", "domain")
+    k_or = _field("ConstraintProto", "bool_or")
+    k_one = _field("ConstraintProto", "exactly_one")
+    k_lits = _field("BoolArgumentProto", "literals")
+    k_hvars = _field("PartialVariableAssignment", "vars")
+    k_hvals = _field("PartialVariableAssignment", "values")
+    parts: list[NDArray[np.uint8]] = []
+    one_var = np.concatenate([_varints(np.array([k_var, 4], dtype=np.int64)),
+                              _packed(k_dom, np.array([0, 1], dtype=np.int64))])  # fmt: skip
+    parts.append(np.tile(one_var, enc.nx))
+    nsup = enc.nclauses - int(enc.stats["alo_clauses"])
+    keys = np.array([k_con, k_or, k_one, k_lits], dtype=np.int64)
+    size = 0
+    for a in range(0, enc.nclauses, _BULK_CHUNK):
+        _check(deadline)
+        b = min(a + _BULK_CHUNK, enc.nclauses)
+        nbytes = _clause_records(enc.lits, enc.starts, a, b, nsup, keys, parts[0], False)
+        size += nbytes
+        if size > _MAX_PROTO_BYTES:
+            return None
+        chunk = np.empty(nbytes, dtype=np.uint8)
+        _clause_records(enc.lits, enc.starts, a, b, nsup, keys, chunk, True)
+        parts.append(chunk)
+    if pref is not None:
+        cells, labels = np.nonzero(enc.var > 0)
+        hvars = enc.var[cells, labels].astype(np.int64) - 1
+        hvals = (labels == pref[cells]).astype(np.int64)
+        body = np.concatenate([_packed(k_hvars, hvars), _packed(k_hvals, hvals)])
+        parts.append(_varints(np.array([k_hint, body.size], dtype=np.int64)))
+        parts.append(body)
+    _check(deadline)
+    out = np.concatenate(parts)
+    return out if out.size <= _MAX_PROTO_BYTES else None
+
+
+_PARSER: list[Any] = []  # [parse function or None], filled on first use
+_TYPE_INFO_NAME = b"St9type_info"  # typeid(std::type_info).name() (Itanium C++ ABI)
+
+
+def _proto_parser() -> Any:
+    """A function ``parse(proto, buf) -> bool`` that replaces the contents of a CP-SAT
+    ``CpModelProto`` (OR-Tools' pybind11 wrapper) by the serialized message in ``buf``, or
+    None when this OR-Tools build does not offer the pieces.
+
+    OR-Tools' Python ``CpModelProto`` is a C++ message without ``ParseFromString``. The
+    C++ pointer comes from pybind11's cross-module conduit (``_pybind11_conduit_v1_``,
+    which checks the C++ type), and ``google::protobuf::MessageLite::ParseFromArray`` is
+    called through ctypes from the protobuf library the extension module links (found
+    through the module's own symbol lookup, so it is the same copy). Any missing piece
+    gives None and the caller builds the model element by element.
+    """
+    if _PARSER:
+        return _PARSER[0]
+    parse_fn: Any = None
+    try:
+        import builtins
+        import ctypes
+        import re
+
+        from ortools.sat.python import cp_model_helper as cmh
+
+        lib = ctypes.CDLL(cmh.__file__)
+        raw = lib["_ZN6google8protobuf11MessageLite14ParseFromArrayEPKvi"]
+        raw.argtypes = [ctypes.c_void_p, ctypes.c_void_p, ctypes.c_int]
+        raw.restype = ctypes.c_bool
+        tinfo = ctypes.addressof(
+            ctypes.c_char.in_dll(lib, "_ZTIN19operations_research3sat12CpModelProtoE")
+        )
+        # private prototypes: the shared ctypes.pythonapi attributes may be retyped elsewhere
+        api = ctypes.pythonapi
+        new_capsule = ctypes.PYFUNCTYPE(
+            ctypes.py_object, ctypes.c_void_p, ctypes.c_char_p, ctypes.c_void_p
+        )(("PyCapsule_New", api))
+        get_name = ctypes.PYFUNCTYPE(ctypes.c_void_p, ctypes.py_object)(("PyCapsule_GetName", api))
+        get_pointer = ctypes.PYFUNCTYPE(ctypes.c_void_p, ctypes.py_object, ctypes.c_void_p)(
+            ("PyCapsule_GetPointer", api)
+        )
+        capsule = new_capsule(tinfo, _TYPE_INFO_NAME, None)
+        abis = [mt.group(1).encode() for k in vars(builtins)
+                if (mt := re.fullmatch(r"__pybind11_internals_v\d+(_.*)__", k))]  # fmt: skip
+
+        def pointer(proto: Any) -> int | None:
+            for abi in abis:
+                c = proto._pybind11_conduit_v1_(abi, capsule, b"raw_pointer_ephemeral")
+                if c is not None:
+                    p = get_pointer(c, get_name(c))
+                    return int(p) if p else None
+            return None
+
+        def parse(proto: Any, buf: NDArray[np.uint8]) -> bool:
+            p = pointer(proto)
+            if p is None:
+                raise RuntimeError("no C++ pointer for CP-SAT's model proto")
+            data = np.ascontiguousarray(buf, dtype=np.uint8)
+            return bool(raw(p, data.ctypes.data, int(data.size)))
+
+        probe = cmh.CpModelProto()
+        k_var, k_dom = _field("CpModelProto", "variables"), _field("IntegerVariableProto", "domain")
+        one = np.array([k_var, 4, k_dom, 2, 0, 1], dtype=np.uint8)  # one variable in [0, 1]
+        if pointer(probe) is not None and parse(probe, one) and len(probe.variables) == 1:
+            parse_fn = parse
+    except (ImportError, OSError, AttributeError, ValueError, TypeError, RuntimeError):
+        parse_fn = None
+    _PARSER.append(parse_fn)
+    return parse_fn
