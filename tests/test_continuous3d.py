@@ -102,3 +102,17 @@ def test_point_location_by_winding_number() -> None:
     tri = {1: np.array(TET["vertices"], dtype=float)[np.array(TET["faces"])]}
     pts = np.array([[0.5, 0.5, 0.5], [3, 3, 3], [1, 1, 1.9], [1, 1, 2.1], [-1, 0, 0]])
     assert labels_at(pts, tri).tolist() == [1, 0, 1, 0, 0]
+
+
+@pytest.mark.parametrize("solver", ["catalog", "sat"])
+def test_output_solids_are_closed_and_describe_the_solution(solver: str) -> None:
+    """The output mesh of a solution: closed, outward solids (validated by PolyhedralModel),
+    and encoding it back gives the solution itself."""
+    E = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 1]), _box(2, [0, 0, 1], [2, 2, 2])])
+    for E_, size in ((E, (6, 6, 5)), (polyhedra.PolyhedralModel([TET]), (5, 5, 4))):
+        C = ContinuousCSP3(E_, size)
+        r = solve(C.problem, solver, rng=4, restarts=10)
+        assert r.status == "solved"
+        M = C.model(r.grid)
+        assert all(s.to_trimesh().is_watertight for s in M.solids)
+        assert (C.encode(M) == np.asarray(r.grid).reshape(-1)).all()

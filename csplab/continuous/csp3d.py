@@ -36,7 +36,7 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.space import Arrangement3, Lattice3
 from csplab.errors import InputError
@@ -323,6 +323,15 @@ class ContinuousCSP3:
             positions=pos[order],
         )  # fmt: skip
 
+    def model(self, grid: ArrayLike, *, name: str = "") -> Any:
+        """The output solids of a solution: on every plane the regions between two
+        different labels are traced from the vertex states (every vertex kept, so that the
+        surface is watertight), triangulated (constrained Delaunay) and given to the label
+        below (outward normal up) and the label above (down); each label's triangles
+        split into closed surfaces, validated as a
+        :class:`~csplab.continuous.polyhedra.PolyhedralModel`."""
+        return _model3(self, grid, name)
+
     def states_at_planes(self, normals: Sequence[Sequence[int]]) -> int:
         """How many example neighbourhoods use only planes with these normals (a vertex
         where exactly those planes meet, inside the region)."""
@@ -371,3 +380,194 @@ class ContinuousCSP3:
                 grid[var[i]] = lookup.get(tuple(local), -1)
             del what
         return grid
+
+
+def _plane_basis(n: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Orthonormal ``e1, e2`` with ``(e1, e2, n)`` right-handed (counter-clockwise in the
+    plane as seen from the side ``n`` points to)."""
+    nf = n.astype(np.float64) / np.linalg.norm(n)
+    a = np.eye(3)[int(np.argmin(np.abs(nf)))]
+    e1 = np.cross(nf, a)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(nf, e1)
+
+
+def _trace(
+    rays: dict[int, list[tuple[float, int, int]]],
+    sect: dict[int, list[tuple[int, int]]],
+    pair: tuple[int, int],
+) -> list[list[int]]:
+    """Rings (vertex ids, every vertex kept) around the in-plane region whose sectors carry
+    ``pair``, counter-clockwise; ``rays[v]`` are ``(angle, other vertex, ray id)`` sorted by
+    angle, ``sect[v][i]`` the pair of the sector after ray ``i``."""
+    where = {(v, int(w)): i for v, rs in rays.items() for i, (_, w, _) in enumerate(rs)}
+    starts = [(v, i) for v in rays for i in range(len(rays[v]))
+              if sect[v][i] == pair and sect[v][i - 1] != pair]  # fmt: skip
+    used: set[tuple[int, int]] = set()
+    rings = []
+    for start in starts:
+        if start in used:
+            continue
+        ring: list[int] = []
+        v, i = start
+        while (v, i) not in used:
+            used.add((v, i))
+            w = rays[v][i][1]
+            ring.append(w)
+            j = where[(w, v)]  # the ray at w pointing back to v
+            k = j - 1
+            m = len(rays[w])
+            while sect[w][(k - 1) % m] == pair:
+                k -= 1
+            v, i = w, k % m
+        rings.append(ring)
+    return rings
+
+
+def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
+    """See :meth:`ContinuousCSP3.model`."""
+    import shapely
+
+    from csplab.continuous.polyhedra import PolyhedralModel
+
+    A = self.arrangement
+    N = A.normals
+    signs, _ = A.cells
+    g = np.asarray(grid, dtype=np.int64).reshape(-1)
+    if g.shape != (self.problem.n,) or (g < 0).any():
+        raise InputError("model() needs a complete solution of this problem")
+    vstate = g[self.var_vertex]
+    XYZ = np.stack([A.X, A.Y, A.Z], axis=1)
+    s = XYZ @ N.T
+    xyz = A.vertex_xyz()
+    size = np.array(A.size, dtype=np.float64)
+    efam = A.edge_families()
+    lookups: dict[int, dict[tuple[int, ...], int]] = {}
+
+    def group_of(t: int, sig: tuple[int, ...]) -> int:
+        if t not in lookups:
+            fams, _, gid = self.vtypes[t]
+            lookups[t] = {tuple(int(x) for x in signs[c, fams]): int(gid[c])
+                          for c in range(len(signs))}  # fmt: skip
+        return lookups[t].get(sig, -1)
+
+    tris: dict[int, list[tuple[int, int, int]]] = {}
+    for f in range(A.F):
+        sel = np.flatnonzero(efam[:, f])
+        if not sel.size:
+            continue
+        e1, e2 = _plane_basis(N[f])
+        kk = s[A.edge_src[sel], f] // A.D
+        for k in np.unique(kk).tolist():
+            es = sel[kk == k]
+            rays: dict[int, list[tuple[float, int, int]]] = {}
+            for e in es.tolist():
+                a, b = int(A.edge_src[e]), int(A.edge_dst[e])
+                d = xyz[b] - xyz[a]
+                ang = float(np.arctan2(d @ e2, d @ e1))
+                rays.setdefault(a, []).append((ang, b, e))
+                rays.setdefault(b, []).append((float(np.arctan2(-d @ e2, -d @ e1)), a, e))
+            sect: dict[int, list[tuple[int, int]]] = {}
+            for v, rs in rays.items():
+                rs.sort()
+                t = int(self.vertex_type[v])
+                fams, states, _ = self.vtypes[t]
+                st = states[int(vstate[v])]
+                out = []
+                for i in range(len(rs)):
+                    a0 = rs[i][0]
+                    a1 = rs[(i + 1) % len(rs)][0] if len(rs) > 1 else a0 + 2 * np.pi
+                    if a1 <= a0:
+                        a1 += 2 * np.pi
+                    mid = 0.5 * (a0 + a1)
+                    d = np.cos(mid) * e1 + np.sin(mid) * e2
+                    q = xyz[v] + 1e-6 * d
+                    if (q < 0).any() or (q > size).any():
+                        out.append((-1, -1))
+                        continue
+                    proj = N[fams] @ d
+                    sig = [int(np.sign(x)) if abs(x) > 1e-9 else 0 for x in proj]
+                    labs = []
+                    for side in (1, -1):
+                        sg = tuple(side if int(fk) == f else sig[j] for j, fk in enumerate(fams))
+                        grp = group_of(t, sg) if 0 not in sg else -1
+                        labs.append(st[grp] if grp >= 0 else -1)
+                    out.append((labs[0], labs[1]))
+                sect[v] = out
+            pairs = {p for ps in sect.values() for p in ps if p[0] != p[1] and -1 not in p}
+            for pair in pairs:
+                rings = _trace(rays, sect, pair)
+                uv = {v: (float(xyz[v] @ e1), float(xyz[v] @ e2)) for r in rings for v in r}
+                key = {(round(x, 7), round(y, 7)): v for v, (x, y) in uv.items()}
+                polys = _rings_to_polygons([[uv[v] for v in r] for r in rings])
+                for poly in polys:
+                    for tri in shapely.constrained_delaunay_triangles(poly).geoms:
+                        c = np.asarray(tri.exterior.coords)[:3]
+                        ids = [key[(round(x, 7), round(y, 7))] for x, y in c]
+                        area = (c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1]) - (
+                            c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0])  # fmt: skip
+                        if area < 0:
+                            ids = [ids[0], ids[2], ids[1]]  # counter-clockwise seen from +n
+                        above, below = pair
+                        if below:  # solid below: outward normal +n
+                            tris.setdefault(below, []).append((ids[0], ids[1], ids[2]))
+                        if above:  # solid above: outward normal -n
+                            tris.setdefault(above, []).append((ids[0], ids[2], ids[1]))
+    world = self.lattice.to_world(xyz)
+    solids = []
+    for b in sorted(tris):
+        T = np.array(tris[b], dtype=np.int64)
+        for comp in _components(T):
+            used, inv = np.unique(comp, return_inverse=True)
+            solids.append({"label": self.labels[b], "vertices": world[used].tolist(),
+                           "faces": inv.reshape(-1, 3).tolist()})  # fmt: skip
+    return PolyhedralModel(
+        solids, name=name or f"{getattr(self.example, 'name', '') or 'model'}-synth",
+        meta={"size": list(A.size), "spacing": float(self.lattice.spacing)},
+        merge_coplanar=True,
+    )  # fmt: skip
+
+
+def _rings_to_polygons(rings: list[list[tuple[float, float]]]) -> list[Any]:
+    """Shapely polygons from counter-clockwise shells and clockwise holes."""
+    from shapely.geometry import Polygon as SP
+
+    def area(r: list[tuple[float, float]]) -> float:
+        pairs = zip(r, r[1:] + r[:1], strict=True)
+        return 0.5 * sum(x0 * y1 - x1 * y0 for (x0, y0), (x1, y1) in pairs)
+
+    shells = [r for r in rings if area(r) > 0]
+    holes = [r for r in rings if area(r) <= 0]
+    owned: list[list[list[tuple[float, float]]]] = [[] for _ in shells]
+    sp = [SP(r) for r in shells]
+    for h in holes:
+        hp = SP(h)
+        inside = [i for i, p in enumerate(sp) if p.covers(hp)]
+        if not inside:  # pragma: no cover - a hole always has a shell around it
+            raise AssertionError("a hole outside every shell")
+        owned[min(inside, key=lambda i: sp[i].area)].append(h)
+    return [SP(s, hs) for s, hs in zip(shells, owned, strict=True)]
+
+
+def _components(T: NDArray[np.int64]) -> list[NDArray[np.int64]]:
+    """Triangles split into groups connected through shared edges."""
+    parent = list(range(len(T)))
+
+    def find(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    first: dict[tuple[int, int], int] = {}
+    for i, t in enumerate(T.tolist()):
+        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
+            key = (min(a, b), max(a, b))
+            if key in first:
+                parent[find(i)] = find(first[key])
+            else:
+                first[key] = i
+    groups: dict[int, list[int]] = {}
+    for i in range(len(T)):
+        groups.setdefault(find(i), []).append(i)
+    return [T[idx] for idx in groups.values()]
