@@ -7,7 +7,7 @@ as domain and ``AddAllowedAssignments`` per arc (the natural CSP model). Both ar
 complete: ``INFEASIBLE`` is a proof and gives ``unsat``.
 
 Loading the one-hot model: OR-Tools' Python ``CpModelProto`` is a C++ message, and adding
-its constraints one by one costs about 10 µs each in Python (4.5–5.5 s for the 2.6M
+its constraints one by one costs 1.5–2 µs each in Python (3.7–5.5 s for the 2.6M
 constraints of city or castle at 40×40×10). Instead the whole message is serialized in
 the protobuf wire format (a compiled loop for the clauses, numpy for the variables and the
 hint; field numbers from the installed ``cp_model_pb2`` descriptor) and parsed into the
@@ -23,12 +23,13 @@ and the README): CP-SAT's presolve expands binary tables into clauses and probes
 which costs seconds to minutes on grids of a few thousand cells, so the defaults switch
 presolve, probing, symmetry detection and linearization off (``presolve=True`` turns them
 back on; table model with hints at 16×16×8: 27 s with them, 1.9 s without). At
-40×40×10 (``boundary="auto"``, one-hot, medians of 3 runs) end to end: city 4.0 s
-(was 9.9 s), castle 3.8 s (was 8.0 s), canal 2.0 s (was 4.7 s), against 1.5, 1.7 and
-0.85 s for ``sat``; what remains is CP-SAT's own work in ``Solve`` (copying, validating
-and loading the model, repairing the hint: 3.2–3.3 s at city and castle). Why one-hot is
-the default: the table model solved only 1 of 6 40×40×10 settings within 60 s (11 s; it
-searches slowly); at 12×12×6 both take 3–5 s.
+40×40×10 (``boundary="auto"``, one-hot, medians of 3 runs) end to end: city 2.5 s
+(was 5.9 s), castle 2.9 s (was 6.5 s), canal 1.1 s (was 2.9 s), against 0.8, 1.1–1.7
+and 0.45 s for ``sat``; what remains is CP-SAT's own work in ``Solve`` (2.0–2.3 s at city
+and castle: validating, importing and loading the model, then repairing the hint; the
+search itself is about 0.2 s). Why one-hot is the default: the table model solved only 1
+of 6 40×40×10 settings within 60 s (11 s; it searches slowly); at 12×12×6 both take
+3–5 s.
 
 Diversity: CP-SAT returns the same solution for every ``random_seed`` by default.
 ``diversity="hint"`` (default) gives a solution hint with one random label per cell drawn
