@@ -116,3 +116,35 @@ def test_output_solids_are_closed_and_describe_the_solution(solver: str) -> None
         M = C.model(r.grid)
         assert all(s.to_trimesh().is_watertight for s in M.solids)
         assert (C.encode(M) == np.asarray(r.grid).reshape(-1)).all()
+
+
+HOUSE = [_box(1, [0, 0, 0], [2, 2, 2]),
+         {"label": 2, "vertices": [[0, 0, 2], [2, 0, 2], [2, 2, 2], [0, 2, 2], [1, 0, 3],
+                                   [1, 2, 3]],
+          "faces": [[0, 1, 4], [3, 5, 2], [0, 4, 5, 3], [1, 2, 5, 4], [0, 3, 2, 1]]}]  # fmt: skip
+
+
+@pytest.mark.parametrize("solver", ["catalog", "sat", "blocks"])
+def test_outputs_pass_the_3d_checker(solver: str) -> None:
+    from csplab.continuous.check3d import violations3
+
+    E = polyhedra.PolyhedralModel(HOUSE)
+    C = ContinuousCSP3(E, (8, 8, 6))
+    assert len(violations3(E, E)) == 0
+    for seed in range(2):
+        r = solve(C.problem, solver, rng=seed, restarts=10,
+                  **({"block": 3} if solver == "blocks" else {}))  # fmt: skip
+        assert r.status == "solved"
+        v = violations3(E, C.model(r.grid))
+        assert len(v) == 0, v.describe()
+
+
+def test_3d_checker_catches_planted_defects() -> None:
+    from csplab.continuous.check3d import violations3
+
+    E = polyhedra.PolyhedralModel(HOUSE)
+    assert len(violations3(E, polyhedra.PolyhedralModel([_box(2, [0, 0, 0], [2, 2, 2])]))) > 0
+    tet = polyhedra.PolyhedralModel([TET])
+    assert violations3(E, tet).counts().get("direction", 0) >= 1
+    floating = polyhedra.PolyhedralModel([HOUSE[1]])  # a roof without its house
+    assert violations3(E, floating).counts().get("neighbourhood", 0) >= 1

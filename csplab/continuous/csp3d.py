@@ -51,8 +51,9 @@ def _solid_angles(p: NDArray[np.float64], tri: NDArray[np.float64]) -> NDArray[n
     """Signed solid angles ``(len(p),)`` of the triangles ``tri`` ``(m, 3, 3)`` summed, seen
     from the points ``p`` (Van Oosterom & Strackee)."""
     out = np.zeros(len(p))
-    for start in range(0, len(p), 4096):
-        q = p[start : start + 4096, None, None, :]
+    step = max(1, 200_000 // max(1, len(tri)))  # points per chunk: about 2e5 pairs
+    for start in range(0, len(p), step):
+        q = p[start : start + step, None, None, :]
         r = tri[None, :, :, :] - q  # (P, m, 3, 3)
         ln = np.linalg.norm(r, axis=3)
         a, b, c = r[:, :, 0], r[:, :, 1], r[:, :, 2]
@@ -62,19 +63,27 @@ def _solid_angles(p: NDArray[np.float64], tri: NDArray[np.float64]) -> NDArray[n
         ac = np.einsum("pmi,pmi->pm", a, c)
         bc = np.einsum("pmi,pmi->pm", b, c)
         den = la * lb * lc + ab * lc + ac * lb + bc * la
-        out[start : start + 4096] = 2 * np.arctan2(num, den).sum(axis=1)
+        out[start : start + step] = 2 * np.arctan2(num, den).sum(axis=1)
     return out
 
 
 def labels_at(
-    points: NDArray[np.float64], triangles: dict[int, NDArray[np.float64]]
+    points: NDArray[np.float64],
+    triangles: dict[int, NDArray[np.float64]] | list[tuple[int, NDArray[np.float64]]],
 ) -> NDArray[np.int64]:
     """The label at each point: the label whose closed triangle mesh (``(m, 3, 3)``, outward
-    orientation) winds around it (generalised winding number > 1/2), else 0."""
+    orientation; a dict by label, or a list of ``(label, mesh)`` per solid) winds around it
+    (generalised winding number > 1/2), else 0. A closed surface does not wind around points
+    outside its bounding box, so each mesh is evaluated only at the points inside its box."""
+    items = list(triangles.items()) if isinstance(triangles, dict) else list(triangles)
     lab = np.zeros(len(points), dtype=np.int64)
-    for b, tri in triangles.items():
-        w = _solid_angles(points, tri) / (4 * np.pi)
-        lab[w > 0.5] = b
+    for b, tri in items:
+        lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
+        inside = np.flatnonzero(((points >= lo) & (points <= hi)).all(axis=1))
+        if not inside.size:
+            continue
+        w = _solid_angles(points[inside], tri) / (4 * np.pi)
+        lab[inside[w > 0.5]] = b
     return lab
 
 
@@ -87,19 +96,22 @@ def _groups(signs: NDArray[np.int8], fams: NDArray[np.int64]) -> tuple[NDArray[n
     return inv.astype(np.int64), int(inv.max()) + 1
 
 
-def _triangles(model: Any, lattice: Lattice3, shift: float) -> dict[int, NDArray[np.float64]]:
-    out: dict[int, list[NDArray[np.float64]]] = {}
+def _triangles(
+    model: Any, lattice: Lattice3, shift: float
+) -> list[tuple[int, NDArray[np.float64]]]:
+    """Each solid's triangles in lattice units (plus ``shift``), with its label."""
+    out = []
     for s in model.solids:
         v = lattice.to_lattice(np.asarray(s.vertices, dtype=np.float64)) + shift
-        out.setdefault(int(s.label), []).append(v[np.asarray(s.faces, dtype=np.int64)])
-    return {b: np.concatenate(t) for b, t in out.items()}
+        out.append((int(s.label), v[np.asarray(s.faces, dtype=np.int64)]))
+    return out
 
 
 def _local_labels(
     A: Arrangement3,
     points: NDArray[np.float64],
     fams_on: NDArray[np.bool_],
-    tris: dict[int, NDArray[np.float64]],
+    tris: list[tuple[int, NDArray[np.float64]]],
     index: dict[int, int],
 ) -> list[Labeling]:
     """Full labelings (over the central cells) of the neighbourhoods at ``points`` whose
@@ -139,8 +151,7 @@ def example_signatures3(example: Any, lattice: Lattice3, index: dict[int, int]) 
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
     shift = 1.0 - lo
     A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)))
-    tris = _triangles(example, lattice, 0.0)
-    tris = {b: t + shift for b, t in tris.items()}
+    tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
     sigs |= set(_local_labels(A, A.vertex_xyz(), A.on, tris, index))

@@ -43,11 +43,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.arrangement import rational, gcd_fractions
+from csplab.continuous.arrangement import gcd_fractions, rational
 from csplab.errors import InputError
 
 __all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells"]
@@ -195,23 +196,32 @@ def central_cells(
     normals: NDArray[np.int64],
 ) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
     """The cells of the central arrangement of the planes ``n . x = 0`` (``normals``
-    ``(F, 3)``, at least two independent): their sign vectors ``(c, F)`` (+1/-1) and one unit
-    direction inside each.
+    ``(F, 3)``, at least two independent; integers are exact, floats use a relative
+    tolerance of 1e-9): their sign vectors ``(c, F)`` (+1/-1) and one unit direction inside
+    each.
 
     Every cell has a vertex of the spherical arrangement (a direction ``+-n_i x n_j``) on its
     boundary; around each such vertex the sectors between the great circles through it are
     sampled on their bisectors (signs of the planes through the vertex from the bisector,
     the others from the vertex), which finds every cell exactly for integer normals.
     """
-    N = np.asarray(normals, dtype=np.int64)
+    N = np.asarray(normals)
+    exact = np.issubdtype(N.dtype, np.integer)
+    N = N.astype(np.int64) if exact else N.astype(np.float64)
+    nn = np.linalg.norm(N.astype(np.float64), axis=1)
+
+    def zero(x: NDArray[Any], scale: float) -> NDArray[np.bool_]:
+        out: NDArray[np.bool_] = x == 0 if exact else np.abs(x) <= 1e-9 * nn * scale
+        return out
+
     F = len(N)
     found: dict[bytes, list[NDArray[np.float64]]] = {}
     for i, j in itertools.combinations(range(F), 2):
         p0 = np.cross(N[i], N[j])
-        if not p0.any():
+        if (np.abs(p0) <= (0 if exact else 1e-9 * nn[i] * nn[j])).all():
             continue
         for p in (p0, -p0):
-            on = np.flatnonzero(N @ p == 0)
+            on = np.flatnonzero(zero(N @ p, float(np.linalg.norm(p))))
             pf = p.astype(np.float64) / np.linalg.norm(p)
             tang = []
             for k in on:
@@ -223,6 +233,7 @@ def central_cells(
             ang = np.array([math.atan2(float(t @ e2), float(t @ e1)) for t in tang])
             o = np.argsort(ang)
             base = np.sign(N @ p).astype(np.int8)
+            base[on] = 0
             for a in range(len(o)):
                 ta, tb = tang[o[a]], tang[o[(a + 1) % len(o)]]
                 b = ta + tb

@@ -1,0 +1,231 @@
+"""The checker of continuous model synthesis in 3D: Eq. 4.1 on the output solids.
+
+:func:`violations3` works on the two polyhedral models only (not on the planes or the CSP
+that produced the output). The example's face orientations, up to sign and within
+``angle_tol``, are its plane families; an output face of another orientation is a violation.
+A neighbourhood is written as the label in every cell of the central arrangement of all
+families' planes through the point (:func:`~csplab.continuous.space.central_cells`): the
+label just off the point in a direction inside the cell, found by the generalised winding
+number of each label's triangles. Two points are locally identical exactly when these
+labelings agree.
+
+The example's neighbourhoods are sampled densely (every vertex; points along every edge;
+a grid of points on every triangle), so that features that change along an edge or across a
+face are all found. The output is sampled at every vertex, at the middle of every edge piece
+between the vertices lying on that edge, and at the centre of every triangle: the output's
+triangles must each have one neighbourhood, which holds for csplab's outputs (each is cut
+where the label on its other side changes); a hand-made output that another solid touches on
+part of one triangle needs that triangle split there.
+
+Examples
+--------
+>>> from csplab.continuous.polyhedra import PolyhedralModel
+>>> cube = lambda lo, hi, b=1: {"label": b, "vertices": [[x, y, z] for z in (lo, hi)
+...     for y in (lo, hi) for x in (lo, hi)], "faces": [[0, 2, 3, 1], [4, 5, 7, 6],
+...     [0, 1, 5, 4], [2, 6, 7, 3], [1, 3, 7, 5], [0, 4, 6, 2]]}
+>>> E = PolyhedralModel([cube(0, 1)])
+>>> len(violations3(E, PolyhedralModel([cube(2, 5)])))
+0
+>>> tet = PolyhedralModel([{"label": 1, "vertices": [[0, 0, 0], [1, 0, 0], [0, 1, 0],
+...     [0, 0, 1]], "faces": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]}])
+>>> violations3(E, tet).counts()["direction"]
+1
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.continuous.check import Defect, Violations
+from csplab.continuous.csp3d import labels_at
+from csplab.continuous.space import central_cells
+
+__all__ = ["violations3"]
+
+ANGLE_TOL = 1e-7
+
+
+def _normals(model: Any) -> list[tuple[NDArray[np.float64], float, tuple[float, ...]]]:
+    """(unit normal, plane offset, a point) of every polygon of every solid."""
+    out = []
+    for s in model.solids:
+        v = np.asarray(s.vertices, dtype=np.float64)
+        for poly in s.polygons:
+            q = v[list(poly)]
+            n = np.cross(q[1:-1] - q[0], q[2:] - q[0]).sum(axis=0)
+            n /= np.linalg.norm(n)
+            out.append((n, float(n @ q[0]), tuple(q.mean(axis=0))))
+    return out
+
+
+def _families(example: Any, tol: float) -> NDArray[np.float64]:
+    fams: list[NDArray[np.float64]] = []
+    for n, _, _ in _normals(example):
+        if not any(abs(abs(float(n @ f)) - 1) <= tol for f in fams):
+            first = next(x for x in n if abs(x) > 1e-12)
+            fams.append(n if first > 0 else -n)
+    return np.array(fams)
+
+
+def _triangles(model: Any) -> list[tuple[int, NDArray[np.float64]]]:
+    return [(int(s.label), np.asarray(s.vertices, dtype=np.float64)[np.asarray(s.faces)])
+            for s in model.solids]  # fmt: skip
+
+
+def _samples(model: Any, dense: int) -> NDArray[np.float64]:
+    """Points where ``model``'s neighbourhoods are taken: vertices, edge pieces, triangles
+    (``dense`` > 1: that many points along each edge and a grid on each triangle)."""
+    pts = [np.asarray(s.vertices, dtype=np.float64) for s in model.solids]
+    verts = np.unique(np.concatenate(pts), axis=0) if pts else np.zeros((0, 3))
+    out = [verts]
+    for s in model.solids:
+        v = np.asarray(s.vertices, dtype=np.float64)
+        f = np.asarray(s.faces, dtype=np.int64)
+        tri = v[f]
+        edges = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]),
+                                  axis=1), axis=0)  # fmt: skip
+        a, b = v[edges[:, 0]], v[edges[:, 1]]
+        if dense > 1:
+            ts = (np.arange(dense) + 0.5) / dense
+            out.append((a[:, None] + ts[None, :, None] * (b - a)[:, None]).reshape(-1, 3))
+            grid = [(i, j) for i in range(1, dense) for j in range(1, dense - i)]
+            for i, j in grid:
+                u, w = i / dense, j / dense
+                out.append(tri[:, 0] + u * (tri[:, 1] - tri[:, 0]) + w * (tri[:, 2] - tri[:, 0]))
+            out.append(tri.mean(axis=1))
+        else:
+            out.append(tri.mean(axis=1))
+            out.append(_edge_pieces(a, b, verts))
+    return np.concatenate(out)
+
+
+def _edge_pieces(
+    a: NDArray[np.float64], b: NDArray[np.float64], verts: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Midpoints of the pieces of the segments ``a -> b`` between the vertices on them."""
+    out = []
+    scale = float(np.ptp(verts, axis=0).max()) if len(verts) else 1.0
+    tol = 1e-9 * max(scale, 1.0)
+    for p, q in zip(a, b, strict=True):
+        d = q - p
+        L2 = float(d @ d)
+        lo, hi = np.minimum(p, q) - tol, np.maximum(p, q) + tol
+        near = verts[((verts >= lo) & (verts <= hi)).all(axis=1)]
+        t = (near - p) @ d / L2
+        off = np.linalg.norm(near - (p + t[:, None] * d), axis=1)
+        ts = np.unique(np.concatenate([[0.0, 1.0], t[(off <= tol) & (t > 0) & (t < 1)]]))
+        out.append(p + 0.5 * (ts[1:] + ts[:-1])[:, None] * d)
+    return np.concatenate(out) if out else np.zeros((0, 3))
+
+
+def _labelings(
+    points: NDArray[np.float64], cells: tuple[NDArray[np.int8], NDArray[np.float64]],
+    tris: list[tuple[int, NDArray[np.float64]]], planes: list[NDArray[np.float64]],
+    normals: NDArray[np.float64], eps: float,
+) -> NDArray[np.int64]:  # fmt: skip
+    """``(len(points), cells)``: the label just off each point in each cell's direction.
+
+    Only the planes through a point (``planes[f]``: the offsets of the model's faces of
+    family ``f``) can change the label around it, so one query per group of cells that agree
+    on those planes suffices."""
+    signs, dirs = cells
+    scale = max(1.0, float(np.abs(points).max()) if len(points) else 1.0)
+    through = np.zeros((len(points), len(normals)), dtype=bool)
+    for f, offs in enumerate(planes):
+        if len(offs):
+            d = points @ normals[f]
+            through[:, f] = (np.abs(d[:, None] - offs[None, :]) <= 1e-9 * scale).any(axis=1)
+    out = np.zeros((len(points), len(dirs)), dtype=np.int64)
+    keys, inv = np.unique(through, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    for k, key in enumerate(keys):
+        idx = np.flatnonzero(inv == k)
+        fams = np.flatnonzero(key)
+        if fams.size:
+            _, g = np.unique(signs[:, fams], axis=0, return_inverse=True)
+            g = g.reshape(-1)
+        else:
+            g = np.zeros(len(signs), dtype=np.int64)
+        rep = np.array([int(np.flatnonzero(g == j)[0]) for j in range(int(g.max()) + 1)])
+        q = (points[idx][:, None, :] + eps * dirs[rep][None, :, :]).reshape(-1, 3)
+        lab = labels_at(q, tris).reshape(len(idx), len(rep))
+        out[idx] = lab[:, g]
+    return out
+
+
+def _plane_offsets(models: list[Any], normals: NDArray[np.float64],
+                   tol: float) -> list[NDArray[np.float64]]:  # fmt: skip
+    """Per family, the offsets ``n . x`` of the models' faces of that orientation."""
+    out: list[list[float]] = [[] for _ in normals]
+    for m in models:
+        for n, c, _ in _normals(m):
+            for f, nf in enumerate(normals):
+                if abs(abs(float(n @ nf)) - 1) <= tol:
+                    out[f].append(c * float(np.sign(n @ nf)))
+    return [np.unique(np.round(np.array(o), 12)) for o in out]
+
+
+def violations3(
+    example: Any,
+    model: Any,
+    *,
+    angle_tol: float = ANGLE_TOL,
+    region: tuple[float, float, float, float, float, float] | None = None,
+    dense: int = 8,
+) -> Violations:
+    """Every place where ``model`` breaks Eq. 4.1 w.r.t. ``example`` (see the module
+    docstring); ``len() == 0`` means a valid output. ``region`` (``x0, y0, z0, x1, y1,
+    z1``): only points in it are checked (outside is empty space, like the example's)."""
+    defects: list[Defect] = []
+    fams = _families(example, angle_tol)
+    for b in model.labels:
+        if b not in example.labels:
+            defects.append(Defect("label", (math.nan, math.nan),
+                                  f"label {b} does not occur in the example"))  # fmt: skip
+    for n, _, c in _normals(model):
+        if not any(abs(abs(float(n @ f)) - 1) <= angle_tol for f in fams):
+            where = tuple(round(x, 6) for x in c)
+            msg = f"a face with normal {np.round(n, 6)} at {where}, an orientation the example"
+            defects.append(Defect("direction", (c[0], c[1]), msg + " does not have"))
+    if any(d.kind == "direction" for d in defects) or not len(model.solids):
+        return Violations(defects)
+    # every family plus the axes, so that at least three independent normals exist
+    N = np.concatenate([fams, np.eye(3)])
+    keep: list[int] = []
+    for i, n in enumerate(N):
+        if not any(abs(abs(float(n @ N[j])) - 1) <= angle_tol for j in keep):
+            keep.append(i)
+    N = N[keep]
+    cells = central_cells(N)
+    dirs = cells[1]
+    lo = np.minimum(np.array(example.bounds[:3]), np.array(model.bounds[:3]))
+    hi = np.maximum(np.array(example.bounds[3:]), np.array(model.bounds[3:]))
+    scale = float(max(1.0, (hi - lo).max()))
+    eps = 1e-5 * scale
+    E_tris, M_tris = _triangles(example), _triangles(model)
+    e_pts = _samples(example, dense)
+    e_planes = _plane_offsets([example], N, angle_tol)
+    allowed = {tuple(r) for r in _labelings(e_pts, cells, E_tris, e_planes, N, eps).tolist()}
+    allowed |= {(b,) * len(dirs) for b in (0, *example.labels)}
+    m_pts = _samples(model, 1)
+    if region is not None:
+        r = np.asarray(region, dtype=np.float64)
+        t = 1e-9 * scale
+        m_pts = m_pts[((m_pts >= r[:3] - t) & (m_pts <= r[3:] + t)).all(axis=1)]
+    seen: set[tuple[int, ...]] = set()
+    m_planes = _plane_offsets([model], N, angle_tol)
+    m_lab = _labelings(m_pts, cells, M_tris, m_planes, N, eps).tolist()
+    for p, lab in zip(m_pts, m_lab, strict=True):
+        key = tuple(lab)
+        if key in allowed or key in seen:
+            continue
+        seen.add(key)
+        defects.append(Defect("neighbourhood", (float(p[0]), float(p[1])),
+                              f"the neighbourhood at {tuple(round(float(x), 6) for x in p)} "
+                              f"(labels {sorted(set(lab))} around it) does not occur in the "
+                              "example"))  # fmt: skip
+    return Violations(defects)
