@@ -148,3 +148,26 @@ def test_3d_checker_catches_planted_defects() -> None:
     assert violations3(E, tet).counts().get("direction", 0) >= 1
     floating = polyhedra.PolyhedralModel([HOUSE[1]])  # a roof without its house
     assert violations3(E, floating).counts().get("neighbourhood", 0) >= 1
+
+
+def test_cli_synthesizes_a_mesh_example(tmp_path: pytest.TempPathFactory) -> None:
+    """``csplab synthesize HOUSE.obj --size AxBxC --out out.obj``, then ``check`` and
+    ``show``."""
+    from pathlib import Path
+
+    from csplab.cli import main
+    from csplab.io.meshes import write_obj_model as write_obj
+
+    d = Path(str(tmp_path))
+    ex, out, png = d / "house.obj", d / "town.obj", d / "town.png"
+    write_obj(polyhedra.PolyhedralModel(HOUSE), ex)
+    for solver in ("catalog", "sat", "blocks"):
+        args = ["synthesize", str(ex), "--size", "8x8x5", "--seed", "1", "--solver", solver,
+                "--out", str(out)]  # fmt: skip
+        if solver == "blocks":
+            args += ["--block", "4"]
+        assert main(args) == 0
+        assert main(["check", str(ex), str(out)]) == 0
+    assert main(["show", str(out), "--out", str(png)]) == 0 and png.exists()
+    assert main(["synthesize", str(ex), "--size", "8x8"]) == 2
+    assert main(["synthesize", str(ex), "--size", "8x8x5", "--lines", "equal"]) == 2

@@ -12,19 +12,21 @@ from csplab.errors import InputError
 from csplab.grids import parse_shape
 
 
-def region(args: argparse.Namespace) -> tuple[int, int]:
-    """``--size WxH`` in line spacings."""
+def region(args: argparse.Namespace, dim: int = 2) -> tuple[int, ...]:
+    """``--size WxH`` in line spacings (``AxBxC`` plane spacings in 3D)."""
+    form = "40x30, in line spacings" if dim == 2 else "20x20x8, in plane spacings"
     if not args.size:
-        raise InputError("--size is required (e.g. --size 40x30, in line spacings)")
+        raise InputError(f"--size is required (e.g. --size {form})")
     shp = parse_shape(args.size, what="--size")
-    while len(shp) > 2 and shp[-1] == 1:
+    while len(shp) > dim and shp[-1] == 1:
         shp = shp[:-1]
-    if len(shp) != 2:
-        raise InputError(f"--size {args.size}: a continuous 2D model needs WxH")
-    return shp[0], shp[1]
+    if len(shp) != dim:
+        need = "WxH" if dim == 2 else "AxBxC"
+        raise InputError(f"--size {args.size}: a continuous {dim}D model needs {need}")
+    return tuple(shp)
 
 
-def boundary_label(args: argparse.Namespace, example: PolygonModel) -> int:
+def boundary_label(args: argparse.Namespace, example: Any) -> int:
     """``--boundary``: the label outside the region (default 0, empty space)."""
     b = args.boundary
     if b is None or b in ("auto", "none", "0"):
@@ -41,22 +43,27 @@ def boundary_label(args: argparse.Namespace, example: PolygonModel) -> int:
     return label
 
 
-def polygon_output(path: str | None, flag: str = "--out") -> Any:
-    """The polygon format for an output path (checked before any work), or None."""
+def polygon_output(path: str | None, flag: str = "--out", gives: Any = "PolygonModel") -> Any:
+    """The polygon (or polyhedral) format for an output path (checked before any work),
+    or None."""
     if not path:
         return None
     from csplab.cli.common import check_output_path
     from csplab.io.registry import output_format
 
-    fmt = output_format(path, gives="PolygonModel")
+    fmt = output_format(path, gives=gives)
     check_output_path(path, flag)
     return fmt
 
 
-def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, Any]) -> int:
-    """``csplab synthesize POLYGONS.json --size WxH``."""
-    from csplab.continuous.synthesis import synthesize as run
+def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> int:
+    """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
+    AxBxC``)."""
+    from csplab.continuous.synthesis import synthesize as run2
+    from csplab.continuous.synthesis import synthesize3
     from csplab.solvers import solver_class
+
+    dim = 2 if isinstance(example, PolygonModel) else 3
 
     if args.periodic:
         raise InputError("--periodic: continuous models are not periodic")
@@ -64,9 +71,11 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
         raise InputError("--out-partial: a failed continuous run has no partial polygons")
     if args.spacing is not None and not args.spacing > 0:
         raise InputError(f"--spacing must be positive, not {args.spacing}")
-    size = region(args)
+    if dim == 3 and args.lines != "lattice":
+        raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
+    size = region(args, dim)
     boundary = boundary_label(args, example)
-    fmt = polygon_output(args.out)
+    fmt = polygon_output(args.out, gives="PolygonModel" if dim == 2 else "PolyhedralModel")
     cls = solver_class(args.solver.partition(":")[0])
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
@@ -77,11 +86,13 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
     settings["restarts"] = restarts
-    settings["lines"] = args.lines
-    s = run(
-        example, size, solver=args.solver, rng=args.seed, spacing=args.spacing,
-        snap=args.snap, boundary=boundary, lines=args.lines, restarts=restarts, **opts,
-    )  # fmt: skip
+    common = dict(solver=args.solver, rng=args.seed, spacing=args.spacing, snap=args.snap,
+                  boundary=boundary, restarts=restarts)  # fmt: skip
+    if dim == 2:
+        settings["lines"] = args.lines
+        s = run2(example, size, lines=args.lines, **common, **opts)
+    else:
+        s = synthesize3(example, size, **common, **opts)
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
     if fmt is not None and s.model is not None:
@@ -89,21 +100,30 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
         wrote = args.out
     A = csp.arrangement
     spacing = float(csp.lattice.spacing)
+    fams = int((~A.boundary_only).sum())
+    if s.model is None:
+        polys = None
+    elif dim == 2:
+        polys = len(s.model)
+    else:
+        polys = s.model.n_polygons
     if args.json:
         d = r.to_dict()
         d.update(
-            example=example.name, out=wrote, format="polygons", settings=settings,
-            size=list(size), spacing=spacing, vertices=A.n_vertices, edges=A.n_edges,
-            families=A.dirs.tolist(), violations=len(s.violations),
-            polygons=len(s.model) if s.model is not None else None,
+            example=example.name, out=wrote, format="polygons" if dim == 2 else "polyhedra",
+            settings=settings, size=list(size), spacing=spacing, vertices=A.n_vertices,
+            edges=A.n_edges, families=(A.dirs if dim == 2 else A.normals).tolist(),
+            violations=len(s.violations), polygons=polys,
+            solids=len(s.model.solids) if dim == 3 and s.model is not None else None,
             times={k: round(v, 6) for k, v in s.times.items()},
         )  # fmt: skip
         print(json.dumps(d))
     else:
-        fams = int((~A.boundary_only).sum())
+        what = "edge directions" if dim == 2 else "face orientations"
+        unit = "spacings" if dim == 2 else "plane spacings"
         print(
-            f"{r.status}: {example.name or args.model} {size[0]}x{size[1]} spacings of "
-            f"{spacing:g} ({fams} edge directions, {A.n_vertices} vertices, {A.n_edges} "
+            f"{r.status}: {example.name or args.model} {'x'.join(map(str, size))} {unit} of "
+            f"{spacing:g} ({fams} {what}, {A.n_vertices} vertices, {A.n_edges} "
             f"edges, K={P.K}) with {r.solver} in {r.time_s:.3f} s, seed {r.seed}"
         )
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
@@ -111,9 +131,12 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
         if keys:
             print("  " + ", ".join(f"{k}={r.stats[k]}" for k in keys))
         if s.model is not None:
+            made = f"{polys} polygons" if dim == 2 else (
+                f"{len(s.model.solids)} solids of {polys} polygons")  # fmt: skip
+            on = "polygons" if dim == 2 else "solids"
             print(
-                f"  {len(s.model)} polygons, labels {list(s.model.labels)}; "
-                f"Eq. 4.1 violations={len(s.violations)} (checked on the polygons); "
+                f"  {made}, labels {list(s.model.labels)}; "
+                f"Eq. 4.1 violations={len(s.violations)} (checked on the {on}); "
                 + ", ".join(f"{k} {v:.3f} s" for k, v in s.times.items())
             )
             if s.violations:
@@ -131,12 +154,28 @@ def synthesize(args: argparse.Namespace, example: PolygonModel, opts: dict[str, 
     return 0 if s.ok else 1
 
 
-def check(args: argparse.Namespace, example: PolygonModel) -> int:
-    """``csplab check EXAMPLE.json OUT.json``: violations of Eq. 4.1."""
+def check(args: argparse.Namespace, example: Any) -> int:
+    """``csplab check EXAMPLE.json OUT.json`` (or ``EXAMPLE.obj OUT.obj``): violations of
+    Eq. 4.1."""
     from csplab.cli.common import load_model
     from csplab.continuous.check import violations
+    from csplab.continuous.polyhedra import PolyhedralModel
 
     out = load_model(args.grid)
+    if isinstance(example, PolyhedralModel):
+        from csplab.continuous.check3d import violations3
+
+        if not isinstance(out, PolyhedralModel):
+            raise InputError(f"{args.grid} is not a polyhedral model (the example {args.model} is)")
+        v3 = violations3(example, out)
+        if args.json:
+            print(json.dumps({"violations": len(v3), **v3.counts(), "solids": len(out.solids)}))
+        else:
+            print(f"{len(v3)} violations in {args.grid} ({len(out.solids)} solids, labels "
+                  f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
+            if len(v3):
+                print(v3.describe(args.limit))
+        return 0 if len(v3) == 0 else 1
     if not isinstance(out, PolygonModel):
         raise InputError(f"{args.grid} is not a polygon model (the example {args.model} is)")
     v = violations(example, out)

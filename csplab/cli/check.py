@@ -13,6 +13,7 @@ from csplab.cli.common import (
     problem_from_args,
 )
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
 
 HELP = "count the violations of a grid file (or an output polygon file) against an example"
@@ -42,7 +43,7 @@ def run(args: argparse.Namespace) -> int:
     if args.limit < 0:
         raise InputError("--limit must be >= 0")
     model = load_model(args.model, model_options(args.model_option))
-    if isinstance(model, PolygonModel):
+    if isinstance(model, PolygonModel | PolyhedralModel):
         from csplab.cli import _continuous
 
         return _continuous.check(args, model)

@@ -16,6 +16,7 @@ from csplab.cli.common import (
     problem_from_args,
 )
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 
@@ -174,7 +175,7 @@ def run(args: argparse.Namespace) -> int:
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
     example = load_model(args.model, model_options(args.model_option))
-    if isinstance(example, PolygonModel):
+    if isinstance(example, PolygonModel | PolyhedralModel):
         from csplab.cli import _continuous
 
         return _continuous.synthesize(args, example, _options(args))

@@ -24,6 +24,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from csplab.continuous.check import Violations, violations
 from csplab.continuous.csp import ContinuousCSP
 from csplab.continuous.model import PolygonModel
@@ -31,7 +33,7 @@ from csplab.result import Result
 from csplab.rng import RngLike
 from csplab.solvers import solve
 
-__all__ = ["Synthesis", "synthesize"]
+__all__ = ["Synthesis", "synthesize", "synthesize3"]
 
 
 @dataclass
@@ -41,8 +43,8 @@ class Synthesis:
     ``violations`` of it, and the time of each phase in seconds (``times``)."""
 
     result: Result
-    csp: ContinuousCSP
-    model: PolygonModel | None
+    csp: Any
+    model: Any
     violations: Violations
     times: dict[str, float] = field(default_factory=dict)
 
@@ -91,6 +93,56 @@ def synthesize(
     t3 = time.perf_counter()
     v = (
         violations(csp.example, model, region=csp.region(), outside=boundary)
+        if (check and model is not None)
+        else Violations([])
+    )
+    t4 = time.perf_counter()
+    times = {"csp": t1 - t0, "solve": t2 - t1, "geometry": t3 - t2, "check": t4 - t3}
+    return Synthesis(result, csp, model, v, times)
+
+
+def synthesize3(
+    example: Any,
+    size: Sequence[int],
+    *,
+    solver: str = "catalog",
+    rng: RngLike = None,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int = 0,
+    restarts: int = 0,
+    check: bool = True,
+    **options: Any,
+) -> Synthesis:
+    """Continuous model synthesis in 3D of a polyhedral ``example`` in an ``A x B x C``
+    box of plane spacings (:class:`~csplab.continuous.csp3d.ContinuousCSP3`); the output
+    solids are checked with :func:`~csplab.continuous.check3d.violations3`. Parameters as
+    for :func:`synthesize`.
+
+    Examples
+    --------
+    >>> from csplab.continuous.polyhedra import PolyhedralModel
+    >>> tet = PolyhedralModel([{"label": 1, "vertices": [[0, 0, 0], [4, 0, 0], [0, 4, 0],
+    ...     [0, 0, 4]], "faces": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]}])
+    >>> s = synthesize3(tet, (5, 5, 4), solver="sat", rng=1)
+    >>> s.result.status, len(s.violations), s.model.labels
+    ('solved', 0, (1,))
+    """
+    from csplab.continuous.check3d import violations3
+    from csplab.continuous.csp3d import ContinuousCSP3
+
+    t0 = time.perf_counter()
+    csp = ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary)
+    t1 = time.perf_counter()
+    result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
+    t2 = time.perf_counter()
+    model = csp.model(result.grid) if result.ok else None
+    t3 = time.perf_counter()
+    lat = csp.lattice
+    lo = lat.to_world(np.zeros(3))
+    hi = lat.to_world(np.array(csp.arrangement.size, dtype=np.float64))
+    v = (
+        violations3(example, model, region=(*lo.tolist(), *hi.tolist()))
         if (check and model is not None)
         else Violations([])
     )
