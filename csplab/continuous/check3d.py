@@ -110,11 +110,14 @@ def _edge_pieces(
     out = []
     scale = float(np.ptp(verts, axis=0).max()) if len(verts) else 1.0
     tol = 1e-9 * max(scale, 1.0)
+    vs = verts[np.argsort(verts[:, 0], kind="stable")]
+    xs = vs[:, 0]
     for p, q in zip(a, b, strict=True):
         d = q - p
         L2 = float(d @ d)
         lo, hi = np.minimum(p, q) - tol, np.maximum(p, q) + tol
-        near = verts[((verts >= lo) & (verts <= hi)).all(axis=1)]
+        cand = vs[np.searchsorted(xs, lo[0], "left") : np.searchsorted(xs, hi[0], "right")]
+        near = cand[((cand >= lo) & (cand <= hi)).all(axis=1)]
         t = (near - p) @ d / L2
         off = np.linalg.norm(near - (p + t[:, None] * d), axis=1)
         ts = np.unique(np.concatenate([[0.0, 1.0], t[(off <= tol) & (t > 0) & (t < 1)]]))

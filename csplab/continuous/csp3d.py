@@ -77,9 +77,12 @@ def labels_at(
     outside its bounding box, so each mesh is evaluated only at the points inside its box."""
     items = list(triangles.items()) if isinstance(triangles, dict) else list(triangles)
     lab = np.zeros(len(points), dtype=np.int64)
+    order = np.argsort(points[:, 0], kind="stable")
+    xs = points[order, 0]
     for b, tri in items:
         lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
-        inside = np.flatnonzero(((points >= lo) & (points <= hi)).all(axis=1))
+        cand = order[np.searchsorted(xs, lo[0], "left") : np.searchsorted(xs, hi[0], "right")]
+        inside = cand[((points[cand] >= lo) & (points[cand] <= hi)).all(axis=1)]
         if not inside.size:
             continue
         w = _solid_angles(points[inside], tri) / (4 * np.pi)
@@ -462,6 +465,30 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
                           for c in range(len(signs))}  # fmt: skip
         return lookups[t].get(sig, -1)
 
+    sector_cache: dict[tuple[int, ...], tuple[int, int]] = {}
+
+    def sector_groups(v: int, t: int, f: int, e1: NDArray[np.float64], e2: NDArray[np.float64],
+                      a0: float, a1: float, nrays: int) -> tuple[int, int]:  # fmt: skip
+        """The groups above and below plane ``f`` of the in-plane sector from angle ``a0``
+        to ``a1`` at a vertex of type ``t`` (-1, -1: outside the region)."""
+        if nrays == 1:
+            a1 = a0 + 2 * np.pi
+        if a1 <= a0:
+            a1 += 2 * np.pi
+        mid = 0.5 * (a0 + a1)
+        d = np.cos(mid) * e1 + np.sin(mid) * e2
+        q = xyz[v] + 1e-6 * d
+        if (q < 0).any() or (q > size).any():
+            return -1, -1
+        fams = self.vtypes[t][0]
+        proj = N[fams] @ d
+        sig = [int(np.sign(x)) if abs(x) > 1e-9 else 0 for x in proj]
+        out = []
+        for side in (1, -1):
+            sg = tuple(side if int(fk) == f else sig[j] for j, fk in enumerate(fams))
+            out.append(group_of(t, sg) if 0 not in sg else -1)
+        return out[0], out[1]
+
     tris: dict[int, list[tuple[int, int, int]]] = {}
     for f in range(A.F):
         sel = np.flatnonzero(efam[:, f])
@@ -472,38 +499,29 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
         for k in np.unique(kk).tolist():
             es = sel[kk == k]
             rays: dict[int, list[tuple[float, int, int]]] = {}
-            for e in es.tolist():
-                a, b = int(A.edge_src[e]), int(A.edge_dst[e])
-                d = xyz[b] - xyz[a]
-                ang = float(np.arctan2(d @ e2, d @ e1))
-                rays.setdefault(a, []).append((ang, b, e))
-                rays.setdefault(b, []).append((float(np.arctan2(-d @ e2, -d @ e1)), a, e))
+            src, dst = A.edge_src[es], A.edge_dst[es]
+            dvec = xyz[dst] - xyz[src]
+            ang_f = np.arctan2(dvec @ e2, dvec @ e1).tolist()
+            ang_b = np.arctan2(-dvec @ e2, -dvec @ e1).tolist()
+            line = A.edge_line[es].tolist()
+            for a, b, li, af, ab in zip(src.tolist(), dst.tolist(), line, ang_f, ang_b,
+                                        strict=True):  # fmt: skip
+                rays.setdefault(a, []).append((af, b, 2 * li))
+                rays.setdefault(b, []).append((ab, a, 2 * li + 1))
             sect: dict[int, list[tuple[int, int]]] = {}
             for v, rs in rays.items():
                 rs.sort()
                 t = int(self.vertex_type[v])
-                fams, states, _ = self.vtypes[t]
-                st = states[int(vstate[v])]
+                st = self.vtypes[t][1][int(vstate[v])]
                 out = []
                 for i in range(len(rs)):
-                    a0 = rs[i][0]
-                    a1 = rs[(i + 1) % len(rs)][0] if len(rs) > 1 else a0 + 2 * np.pi
-                    if a1 <= a0:
-                        a1 += 2 * np.pi
-                    mid = 0.5 * (a0 + a1)
-                    d = np.cos(mid) * e1 + np.sin(mid) * e2
-                    q = xyz[v] + 1e-6 * d
-                    if (q < 0).any() or (q > size).any():
-                        out.append((-1, -1))
-                        continue
-                    proj = N[fams] @ d
-                    sig = [int(np.sign(x)) if abs(x) > 1e-9 else 0 for x in proj]
-                    labs = []
-                    for side in (1, -1):
-                        sg = tuple(side if int(fk) == f else sig[j] for j, fk in enumerate(fams))
-                        grp = group_of(t, sg) if 0 not in sg else -1
-                        labs.append(st[grp] if grp >= 0 else -1)
-                    out.append((labs[0], labs[1]))
+                    nxt = rs[(i + 1) % len(rs)]
+                    ck = (t, f, rs[i][2], nxt[2], len(rs))
+                    if ck not in sector_cache:
+                        sector_cache[ck] = sector_groups(v, t, f, e1, e2, rs[i][0], nxt[0],
+                                                         len(rs))  # fmt: skip
+                    gp, gm = sector_cache[ck]
+                    out.append((st[gp] if gp >= 0 else -1, st[gm] if gm >= 0 else -1))
                 sect[v] = out
             pairs = {p for ps in sect.values() for p in ps if p[0] != p[1] and -1 not in p}
             for pair in pairs:
