@@ -96,7 +96,7 @@ def test_cli_late_memory_error_is_one_line(monkeypatch: Any, capsys: Any) -> Non
         return ns
 
     monkeypatch.setattr(parser, "parse_args", parse)
-    monkeypatch.setattr(cli, "build_parser", lambda: parser)
+    monkeypatch.setattr(cli, "build_parser", lambda only=None: parser)
     assert cli.main(["synthesize", "line", "--size", "4x4"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["csplab: error: out of memory (try a smaller --size)"]

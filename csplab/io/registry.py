@@ -50,10 +50,15 @@ from csplab.errors import FormatError, InputError
 from csplab.io.common import NO, Output, read_bytes
 
 if TYPE_CHECKING:
+    from typing import TypeAlias
+
     from csplab.continuous.model import PolygonModel
     from csplab.continuous.polyhedra import PolyhedralModel
     from csplab.example import ExampleModel
     from csplab.io.ruleset import RuleSet
+
+    #: what reading a model file gives
+    Model: TypeAlias = ExampleModel | RuleSet | PolygonModel | PolyhedralModel
 
 __all__ = [
     "FALLBACK",
@@ -275,12 +280,12 @@ class Format:
             )
         return {k: declared[k].check(v, self.name) for k, v in options.items()}
 
-    def read(self, path: str | Path, **options: Any) -> ExampleModel | RuleSet | PolygonModel | PolyhedralModel:
+    def read(self, path: str | Path, **options: Any) -> Model:
         """Read a file of this format."""
         if self.reader is None:
             raise InputError(f"csplab writes {self.name} files but does not read them")
         opts = self.check_options(options)
-        reader = cast("Callable[..., ExampleModel | RuleSet | PolygonModel | PolyhedralModel]", resolve(self.reader))
+        reader = cast("Callable[..., Model]", resolve(self.reader))
         return reader(Path(path), **opts)
 
     def write(self, out: Output | PolygonModel | PolyhedralModel, path: str | Path) -> None:
