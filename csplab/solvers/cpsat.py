@@ -76,6 +76,8 @@ __all__ = ["CpsatSolver"]
 
 _CHUNK = 20_000
 _BULK_CHUNK = 1 << 20  # clauses serialized per kernel call (then the deadline is checked)
+#: bytes per second of the one-call model parse (a cautious start, then measured)
+_PARSE_RATE = [50e6]
 
 
 class _Deadline(Exception):
@@ -202,8 +204,14 @@ class CpsatSolver(Solver):
         buf = _onehot_bytes(enc, pref, deadline) if parse is not None else None
         if parse is not None and buf is not None:
             _check(deadline)
+            # the parse cannot be interrupted: do not start one the time left cannot hold
+            if deadline is not None and time.perf_counter() + buf.size / _PARSE_RATE[0] > deadline:
+                raise _Deadline
+            t = time.perf_counter()
             if not parse(m.proto, buf):
                 raise RuntimeError("CP-SAT could not parse the model csplab serialized")
+            if buf.size > 1 << 20:  # learn this machine's rate from real models
+                _PARSE_RATE[0] = max(1e6, buf.size / max(time.perf_counter() - t, 1e-6))
             _check(deadline)
             return _onehot_reader(enc), "proto-bytes"
         _onehot_elementwise(m, enc, pref, deadline)
