@@ -8,6 +8,7 @@ import pytest
 
 from csplab.continuous.csp3d import ContinuousCSP3, labels_at
 from csplab.continuous.space import Arrangement3, Lattice3, central_cells
+from csplab.errors import InputError
 from csplab.solvers import solve
 
 polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
@@ -171,3 +172,28 @@ def test_cli_synthesizes_a_mesh_example(tmp_path: pytest.TempPathFactory) -> Non
     assert main(["show", str(out), "--out", str(png)]) == 0 and png.exists()
     assert main(["synthesize", str(ex), "--size", "8x8"]) == 2
     assert main(["synthesize", str(ex), "--size", "8x8x5", "--lines", "equal"]) == 2
+
+
+def test_ground_below_the_region() -> None:
+    """A ground (label 1 below z = 0, like Merrell's landscapes) under an example of a slab
+    (1) carrying a box (2): the output stands on it; its solids are closed (the region's
+    bottom closes them) and satisfy Eq. 4.1 inside the region."""
+    from csplab.continuous.check3d import violations3
+
+    E = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [4, 4, 1]), _box(2, [1, 1, 1], [2, 2, 3])])
+    C = ContinuousCSP3(E, (6, 6, 4), boundary={"z-": 1})
+    assert C.problem.meta["boundary"]["z-"] == 1 and C.problem.meta["boundary"]["x-"] == 0
+    for seed in range(2):
+        r = solve(C.problem, "sat", rng=seed)
+        assert r.status == "solved"
+        M = C.model(r.grid)
+        assert all(s.to_trimesh().is_watertight for s in M.solids)
+        assert (C.encode(M) == np.asarray(r.grid).reshape(-1)).all()
+        region = (0.0, 0.0, 0.0, 6.0, 6.0, 4.0)
+        assert len(violations3(E, M, region=region, outside={"z-": 1})) == 0
+        if any(float(np.asarray(s.vertices)[:, 2].min()) == 0 for s in M.solids):
+            assert len(violations3(E, M, region=region)) > 0  # without the ground: wrong
+    with pytest.raises(InputError, match="boundary faces"):
+        ContinuousCSP3(E, (4, 4, 4), boundary={"bottom": 1})
+    with pytest.raises(InputError, match="no neighbourhood of the example fits"):
+        ContinuousCSP3(polyhedra.PolyhedralModel(HOUSE), (4, 4, 4), boundary={"z-": 1})

@@ -26,17 +26,27 @@ def region(args: argparse.Namespace, dim: int = 2) -> tuple[int, ...]:
     return tuple(shp)
 
 
-def boundary_label(args: argparse.Namespace, example: Any) -> int:
-    """``--boundary``: the label outside the region (default 0, empty space)."""
+def boundary_label(args: argparse.Namespace, example: Any) -> Any:
+    """``--boundary``: the label outside the region (default 0, empty space); for a
+    polyhedral example also per face, e.g. ``z-=1`` (a ground below)."""
     b = args.boundary
     if b is None or b in ("auto", "none", "0"):
         return 0
+    if "=" in b and getattr(example, "ndim", 2) == 3:
+        from csplab.grids import parse_boundary
+
+        faces = parse_boundary(b)
+        assert isinstance(faces, dict)
+        for lab in faces.values():
+            if lab not in (0, *example.labels):
+                raise InputError(f"--boundary {b}: label {lab} does not occur in {example.name}")
+        return faces
     try:
         label = int(b)
     except ValueError:
         raise InputError(
             f"--boundary {b}: a continuous model takes one label for outside the region "
-            "(e.g. --boundary 0)"
+            "(e.g. --boundary 0; polyhedral models also face=label pairs such as z-=1)"
         ) from None
     if label not in (0, *example.labels):
         raise InputError(f"--boundary {b}: label {label} does not occur in {example.name}")

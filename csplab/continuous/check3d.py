@@ -35,6 +35,7 @@ Examples
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -47,6 +48,20 @@ from csplab.continuous.space import central_cells
 __all__ = ["violations3"]
 
 ANGLE_TOL = 1e-7
+
+
+class _Joined:
+    """Solids of a model plus the frame of outside labels (no validation: the frame touches
+    the model on the region's faces by construction)."""
+
+    def __init__(self, solids: list[Any], model: Any) -> None:
+        self.solids = solids
+        self.labels = tuple(sorted({int(s.label) for s in solids}))
+        self.bounds = model.bounds if len(model.solids) else (0.0,) * 6
+
+    @property
+    def n_polygons(self) -> int:
+        return sum(len(s.polygons) for s in self.solids)
 
 
 def _normals(model: Any) -> list[tuple[NDArray[np.float64], float, tuple[float, ...]]]:
@@ -172,18 +187,49 @@ def _plane_offsets(models: list[Any], normals: NDArray[np.float64],
     return [np.unique(np.round(np.array(o), 12)) for o in out]
 
 
+def _frame(region: tuple[float, ...], outside: Mapping[str, int]) -> list[dict[str, Any]]:
+    """Boxes of the outside labels around ``region``, in the precedence of
+    :data:`~csplab.continuous.csp3d.FACE_ORDER` (``z`` faces span the corners, then ``x``,
+    then ``y``)."""
+    x0, y0, z0, x1, y1, z1 = region
+    t = max(x1 - x0, y1 - y0, z1 - z0)
+    boxes = {
+        "z-": ((x0 - t, y0 - t, z0 - t), (x1 + t, y1 + t, z0)),
+        "z+": ((x0 - t, y0 - t, z1), (x1 + t, y1 + t, z1 + t)),
+        "x-": ((x0 - t, y0 - t, z0), (x0, y1 + t, z1)),
+        "x+": ((x1, y0 - t, z0), (x1 + t, y1 + t, z1)),
+        "y-": ((x0, y0 - t, z0), (x1, y0, z1)),
+        "y+": ((x0, y1, z0), (x1, y1 + t, z1)),
+    }
+    out = []
+    for face, (lo, hi) in boxes.items():
+        b = int(outside.get(face, 0))
+        if b:
+            v = [[x, y, z] for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])]
+            f = [[0, 2, 3, 1], [4, 5, 7, 6], [0, 1, 5, 4], [2, 6, 7, 3], [1, 3, 7, 5], [0, 4, 6, 2]]
+            out.append({"label": b, "vertices": v, "faces": f})
+    return out
+
+
 def violations3(
     example: Any,
     model: Any,
     *,
     angle_tol: float = ANGLE_TOL,
     region: tuple[float, float, float, float, float, float] | None = None,
+    outside: Mapping[str, int] | None = None,
     dense: int = 8,
 ) -> Violations:
     """Every place where ``model`` breaks Eq. 4.1 w.r.t. ``example`` (see the module
     docstring); ``len() == 0`` means a valid output. ``region`` (``x0, y0, z0, x1, y1,
-    z1``): only points in it are checked (outside is empty space, like the example's)."""
+    z1``): only points in it are checked; outside it is empty space, or the labels
+    ``outside`` gives per face (``{"z-": 1}``: a ground below)."""
     defects: list[Defect] = []
+    if region is not None and outside and any(outside.values()):
+        from csplab.continuous.polyhedra import PolyhedralModel
+
+        frame = PolyhedralModel(_frame(tuple(region), outside), merge_coplanar=False)
+        model = _Joined([*model.solids, *frame.solids], model)
     fams = _families(example, angle_tol)
     for b in model.labels:
         if b not in example.labels:

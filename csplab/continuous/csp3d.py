@@ -32,7 +32,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -42,7 +42,23 @@ from csplab.continuous.space import Arrangement3, Lattice3
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["ContinuousCSP3", "example_signatures3", "labels_at"]
+__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3", "labels_at"]
+
+#: the region's faces; a point outside several takes the label of the first (the ground
+#: ``z-`` wins at the bottom edges)
+FACE_ORDER = ("z-", "z+", "x-", "x+", "y-", "y+")
+
+
+def _boundary_faces(boundary: int | Mapping[str, int]) -> dict[str, int]:
+    """The label outside each face of the region: one label for all, or ``{face: label}``
+    (faces not named: 0, empty space), e.g. ``{"z-": 1}`` for a ground below."""
+    if isinstance(boundary, Mapping):
+        bad = sorted(set(boundary) - set(FACE_ORDER))
+        if bad:
+            raise InputError(f"boundary faces are {', '.join(FACE_ORDER)}, not {', '.join(bad)}")
+        return {f: int(boundary.get(f, 0)) for f in FACE_ORDER}
+    return {f: int(boundary) for f in FACE_ORDER}
+
 
 Labeling = tuple[int, ...]
 
@@ -198,7 +214,7 @@ class ContinuousCSP3:
         *,
         spacing: float | None = None,
         snap: bool = False,
-        boundary: int = 0,
+        boundary: int | Mapping[str, int] = 0,
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
@@ -211,10 +227,13 @@ class ContinuousCSP3:
         self.lattice = Lattice3.of(pts, polys, spacing, snap=snap, where=example.source)
         self.labels: tuple[int, ...] = (0, *example.labels)
         index = {b: i for i, b in enumerate(self.labels)}
-        if boundary not in index:
-            raise InputError(f"boundary label {boundary} does not occur in the example")
-        self.boundary = boundary
-        b0 = index[boundary]
+        faces = _boundary_faces(boundary)
+        for face, lab in faces.items():
+            if lab not in index:
+                raise InputError(
+                    f"boundary {face}={lab}: label {lab} does not occur in the example"
+                )
+        self.boundary = faces
         self.signatures = example_signatures3(example, self.lattice, index)
         sig = np.array(sorted(self.signatures), dtype=np.int64)
         A = self.arrangement = Arrangement3(self.lattice, size)
@@ -223,12 +242,17 @@ class ContinuousCSP3:
         side_fam = [A.axis_family(a) for a in range(3)]
 
         def outside_groups(fams: NDArray[np.int64], sides: int, g: NDArray[np.int64],
-                           ng: int) -> NDArray[np.bool_]:  # fmt: skip
-            out = np.zeros(ng, dtype=bool)
-            for a in range(3):
-                for bit, bad in ((1 << (2 * a), -1), (2 << (2 * a), 1)):
-                    if sides & bit:
-                        out[np.unique(g[signs[:, side_fam[a]] == bad])] = True
+                           ng: int) -> NDArray[np.int64]:  # fmt: skip
+            """Per group: the compact label it must have outside the region, or -1 (inside);
+            a group outside several faces takes the first of ``FACE_ORDER``."""
+            out = np.full(ng, -1, dtype=np.int64)
+            for face in reversed(FACE_ORDER):
+                a, hi = "xyz".index(face[0]), face[1] == "+"
+                bit = (2 if hi else 1) << (2 * a)
+                if sides & bit:
+                    out[np.unique(g[signs[:, side_fam[a]] == (1 if hi else -1)])] = index[
+                        faces[face]
+                    ]
             return out
 
         def states(fams: NDArray[np.int64], sides: int) -> tuple[list[Labeling], Any]:
@@ -237,10 +261,11 @@ class ContinuousCSP3:
             local = sig[:, rep]  # (nsig, ng)
             ok = (sig == local[:, g]).all(axis=1)  # factors through these planes
             out = outside_groups(fams, sides, g, ng)
-            ok &= (local[:, out] == b0).all(axis=1)
+            req = out >= 0
+            ok &= (local[:, req] == out[req]).all(axis=1)
             found = sorted({tuple(int(x) for x in row) for row in local[ok]},
                            key=lambda st: (any(st), st))  # fmt: skip
-            return found, (g, ng)
+            return found, (g, ng, out)
 
         # vertex types
         vside = A.on_side()
@@ -249,13 +274,16 @@ class ContinuousCSP3:
         vtype = vtype.reshape(-1)
         self.vertex_type = vtype
         self.vtypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
+        self.vertex_outside: list[NDArray[np.int64]] = []
         for key in vkeys.tolist():
             fams = np.array([f for f in range(F) if (key >> 6) >> f & 1], dtype=np.int64)
-            st, (g, _) = states(fams, key & 63)
+            st, (g, _, out) = states(fams, key & 63)
             if not st:
                 raise InputError(f"{example.source}: no neighbourhood of the example fits a "
-                                 f"vertex on planes {N[fams].tolist()}")  # fmt: skip
+                                 f"vertex on planes {N[fams].tolist()} with boundary "
+                                 f"{self.boundary}")  # fmt: skip
             self.vtypes.append((fams, st, g))
+            self.vertex_outside.append(out)
         # edge types
         efam = A.edge_families()
         eside = vside[A.edge_src] & vside[A.edge_dst]
@@ -265,7 +293,7 @@ class ContinuousCSP3:
         self.etypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
         for key in ekeys.tolist():
             fams = np.array([f for f in range(F) if (key >> 6) >> f & 1], dtype=np.int64)
-            st, (g, _) = states(fams, key & 63)
+            st, (g, _, _) = states(fams, key & 63)
             self.etypes.append((fams, st, g))
         nst = max(len(t[1]) for t in (*self.vtypes, *self.etypes))
         K = self.K = nst
@@ -333,7 +361,7 @@ class ContinuousCSP3:
             name=getattr(example, "name", "") or "continuous3d",
             meta={"continuous": True, "dim": 3, "size": list(A.size),
                   "spacing": float(self.lattice.spacing), "families": N.tolist(),
-                  "vertices": nv, "edges": ne, "boundary": boundary},
+                  "vertices": nv, "edges": ne, "boundary": dict(self.boundary)},
             positions=pos[order],
         )  # fmt: skip
 
@@ -370,7 +398,6 @@ class ContinuousCSP3:
                 raise InputError(f"label {b} does not occur in the example")
         tris = _triangles(model, self.lattice, 0.0)
         grid = np.full(self.problem.n, -1, dtype=np.int32)
-        bl = index[self.boundary]
         for what, pts, fams_on, types, tlist, var in (
             ("v", A.vertex_xyz(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
             ("e", A.edge_xyz(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
@@ -383,13 +410,16 @@ class ContinuousCSP3:
                 local = [0] * ng
                 for c, b in enumerate(full):
                     local[int(g[c])] = b
-                # outside the region: the boundary label
+                # outside the region: the boundary label of the first face it is outside
                 _, dirs = A.cells
                 for k in range(ng):
                     c = int(np.flatnonzero(g == k)[0])
                     q = pts[i] + 1e-3 * dirs[c]
-                    if (q < 0).any() or (q > size).any():
-                        local[k] = bl
+                    for face in FACE_ORDER:
+                        a = "xyz".index(face[0])
+                        if (q[a] > size[a]) if face[1] == "+" else (q[a] < 0):
+                            local[k] = index[self.boundary[face]]
+                            break
                 lookup = {s: j for j, s in enumerate(st)}
                 grid[var[i]] = lookup.get(tuple(local), -1)
             del what
@@ -521,9 +551,11 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
                         sector_cache[ck] = sector_groups(v, t, f, e1, e2, rs[i][0], nxt[0],
                                                          len(rs))  # fmt: skip
                     gp, gm = sector_cache[ck]
-                    out.append((st[gp] if gp >= 0 else -1, st[gm] if gm >= 0 else -1))
+                    outside = self.vertex_outside[t]  # outside the region: not the output
+                    out.append((st[gp] if gp >= 0 and outside[gp] < 0 else -1,
+                                st[gm] if gm >= 0 and outside[gm] < 0 else -1))  # fmt: skip
                 sect[v] = out
-            pairs = {p for ps in sect.values() for p in ps if p[0] != p[1] and -1 not in p}
+            pairs = {p for ps in sect.values() for p in ps if p[0] != p[1] and max(p) > 0}
             for pair in pairs:
                 rings = _trace(rays, sect, pair)
                 uv = {v: (float(xyz[v] @ e1), float(xyz[v] @ e2)) for r in rings for v in r}
@@ -538,9 +570,9 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
                         if area < 0:
                             ids = [ids[0], ids[2], ids[1]]  # counter-clockwise seen from +n
                         above, below = pair
-                        if below:  # solid below: outward normal +n
+                        if below > 0:  # solid below: outward normal +n
                             tris.setdefault(below, []).append((ids[0], ids[1], ids[2]))
-                        if above:  # solid above: outward normal -n
+                        if above > 0:  # solid above: outward normal -n
                             tris.setdefault(above, []).append((ids[0], ids[2], ids[1]))
     world = self.lattice.to_world(xyz)
     solids = []

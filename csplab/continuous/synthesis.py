@@ -109,7 +109,7 @@ def synthesize3(
     rng: RngLike = None,
     spacing: float | None = None,
     snap: bool = False,
-    boundary: int = 0,
+    boundary: int | dict[str, int] = 0,
     restarts: int = 0,
     check: bool = True,
     **options: Any,
@@ -142,7 +142,7 @@ def synthesize3(
     lo = lat.to_world(np.zeros(3))
     hi = lat.to_world(np.array(csp.arrangement.size, dtype=np.float64))
     v = (
-        violations3(example, model, region=(*lo.tolist(), *hi.tolist()))
+        violations3(example, model, region=(*lo.tolist(), *hi.tolist()), outside=csp.boundary)
         if (check and model is not None)
         else Violations([])
     )
