@@ -473,6 +473,9 @@ def _onehot_bytes(enc: Any, pref: Any, deadline: float | None) -> NDArray[np.uin
     nsup = enc.nclauses - int(enc.stats["alo_clauses"])
     keys = np.array([k_con, k_or, k_one, k_lits], dtype=np.int64)
     size = 0
+    # compile (or load) the kernel even when there is no clause, so that the first small
+    # model pays for it and not a later one under a time limit
+    _clause_records(enc.lits, enc.starts, 0, 0, nsup, keys, parts[0], False)
     for a in range(0, enc.nclauses, _BULK_CHUNK):
         _check(deadline)
         b = min(a + _BULK_CHUNK, enc.nclauses)
