@@ -5,12 +5,14 @@ every one synthesizes with catalog, blocks and sat without violations."""
 from __future__ import annotations
 
 import re
+import warnings
 from importlib import resources
 from pathlib import Path
 
 import pytest
 
 from csplab.continuous.csp3d import ContinuousCSP3
+from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.synthesis import synthesize3
 from csplab.errors import InputError
 from csplab.examples.build_continuous3d import EXAMPLES, write_all
@@ -78,6 +80,12 @@ def test_synthesizes_without_violations(name: str, solver: str) -> None:
     assert s.model is not None
     assert len(s.violations) == 0, s.violations
     assert set(s.model.labels) <= set(E.labels)
+    # the output (built without re-validation) passes every check of a model read from a file
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        V = PolyhedralModel([x.to_json() for x in s.model.solids])
+    assert V.n_polygons == s.model.n_polygons
+    assert V.volume() == pytest.approx(sum(x.volume for x in s.model.solids))
 
 
 def test_terrain_on_a_ground_layer() -> None:

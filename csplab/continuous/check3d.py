@@ -35,19 +35,24 @@ Examples
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab.continuous._geom import point_labels, points_on_segments
 from csplab.continuous.check import Defect, Violations
-from csplab.continuous.csp3d import labels_at
 from csplab.continuous.space import central_cells
 
 __all__ = ["violations3"]
 
 ANGLE_TOL = 1e-7
+# per model (immutable), its polygons' normals and points: computed once per check
+_POLYGON_ARRAYS: weakref.WeakKeyDictionary[Any, tuple[NDArray[np.float64], NDArray[np.float64]]] = (
+    weakref.WeakKeyDictionary()
+)
 
 
 class _Joined:
@@ -64,17 +69,38 @@ class _Joined:
         return sum(len(s.polygons) for s in self.solids)
 
 
+def _polygon_arrays(model: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Unit normal and one point (a triangle's centre) of every polygon of every solid,
+    ``(n, 3)`` each, from the triangles grouped by polygon (cached on the model)."""
+    cached = _POLYGON_ARRAYS.get(model)
+    if cached is not None:
+        return cached
+    solids = [s for s in model.solids if len(s.faces)]
+    if not solids:
+        return np.zeros((0, 3)), np.zeros((0, 3))
+    tris, owners = [], []
+    base = 0
+    for s in solids:
+        tris.append(np.asarray(s.vertices, dtype=np.float64)[np.asarray(s.faces, dtype=np.int64)])
+        owners.append(np.asarray(s.face_polygon, dtype=np.int64) + base)
+        base += len(s.polygons)
+    t = np.concatenate(tris)
+    own = np.concatenate(owners)
+    cr = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    n = np.zeros((base, 3))
+    np.add.at(n, own, cr)
+    c = np.zeros((base, 3))
+    c[own] = t.mean(axis=1)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    _POLYGON_ARRAYS[model] = (n, c)
+    return n, c
+
+
 def _normals(model: Any) -> list[tuple[NDArray[np.float64], float, tuple[float, ...]]]:
     """(unit normal, plane offset, a point) of every polygon of every solid."""
-    out = []
-    for s in model.solids:
-        v = np.asarray(s.vertices, dtype=np.float64)
-        for poly in s.polygons:
-            q = v[list(poly)]
-            n = np.cross(q[1:-1] - q[0], q[2:] - q[0]).sum(axis=0)
-            n /= np.linalg.norm(n)
-            out.append((n, float(n @ q[0]), tuple(q.mean(axis=0))))
-    return out
+    n, c = _polygon_arrays(model)
+    off = (n * c).sum(axis=1)
+    return [(n[i], float(off[i]), tuple(c[i].tolist())) for i in range(len(n))]
 
 
 def _families(example: Any, tol: float) -> NDArray[np.float64]:
@@ -97,6 +123,18 @@ def _samples(model: Any, dense: int) -> NDArray[np.float64]:
     pts = [np.asarray(s.vertices, dtype=np.float64) for s in model.solids]
     verts = np.unique(np.concatenate(pts), axis=0) if pts else np.zeros((0, 3))
     out = [verts]
+    if dense <= 1:
+        if not pts:
+            return verts
+        tri = np.concatenate([np.asarray(s.vertices, dtype=np.float64)[np.asarray(s.faces)]
+                              for s in model.solids])  # fmt: skip
+        out.append(tri.mean(axis=1))
+        # every edge once (by coordinates: solids have their own vertex arrays)
+        ab = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+        key = np.where(_lex_less(ab[:, 0], ab[:, 1])[:, None, None], ab, ab[:, ::-1])
+        edges = np.unique(key.reshape(-1, 6), axis=0).reshape(-1, 2, 3)
+        out.append(_edge_pieces(edges[:, 0], edges[:, 1], verts))
+        return np.concatenate(out)
     for s in model.solids:
         v = np.asarray(s.vertices, dtype=np.float64)
         f = np.asarray(s.faces, dtype=np.int64)
@@ -104,40 +142,43 @@ def _samples(model: Any, dense: int) -> NDArray[np.float64]:
         edges = np.unique(np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]),
                                   axis=1), axis=0)  # fmt: skip
         a, b = v[edges[:, 0]], v[edges[:, 1]]
-        if dense > 1:
-            ts = (np.arange(dense) + 0.5) / dense
-            out.append((a[:, None] + ts[None, :, None] * (b - a)[:, None]).reshape(-1, 3))
-            grid = [(i, j) for i in range(1, dense) for j in range(1, dense - i)]
-            for i, j in grid:
-                u, w = i / dense, j / dense
-                out.append(tri[:, 0] + u * (tri[:, 1] - tri[:, 0]) + w * (tri[:, 2] - tri[:, 0]))
-            out.append(tri.mean(axis=1))
-        else:
-            out.append(tri.mean(axis=1))
-            out.append(_edge_pieces(a, b, verts))
+        ts = (np.arange(dense) + 0.5) / dense
+        out.append((a[:, None] + ts[None, :, None] * (b - a)[:, None]).reshape(-1, 3))
+        grid = [(i, j) for i in range(1, dense) for j in range(1, dense - i)]
+        for i, j in grid:
+            u, w = i / dense, j / dense
+            out.append(tri[:, 0] + u * (tri[:, 1] - tri[:, 0]) + w * (tri[:, 2] - tri[:, 0]))
+        out.append(tri.mean(axis=1))
     return np.concatenate(out)
+
+
+def _lex_less(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.bool_]:
+    """Row-wise lexicographic ``p < q`` of ``(n, 3)`` arrays."""
+    out: NDArray[np.bool_] = (p[:, 0] < q[:, 0]) | ((p[:, 0] == q[:, 0]) & (
+        (p[:, 1] < q[:, 1]) | ((p[:, 1] == q[:, 1]) & (p[:, 2] < q[:, 2]))))  # fmt: skip
+    return out
 
 
 def _edge_pieces(
     a: NDArray[np.float64], b: NDArray[np.float64], verts: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """Midpoints of the pieces of the segments ``a -> b`` between the vertices on them."""
-    out = []
+    if not len(a):
+        return np.zeros((0, 3))
     scale = float(np.ptp(verts, axis=0).max()) if len(verts) else 1.0
     tol = 1e-9 * max(scale, 1.0)
-    vs = verts[np.argsort(verts[:, 0], kind="stable")]
-    xs = vs[:, 0]
-    for p, q in zip(a, b, strict=True):
-        d = q - p
-        L2 = float(d @ d)
-        lo, hi = np.minimum(p, q) - tol, np.maximum(p, q) + tol
-        cand = vs[np.searchsorted(xs, lo[0], "left") : np.searchsorted(xs, hi[0], "right")]
-        near = cand[((cand >= lo) & (cand <= hi)).all(axis=1)]
-        t = (near - p) @ d / L2
-        off = np.linalg.norm(near - (p + t[:, None] * d), axis=1)
-        ts = np.unique(np.concatenate([[0.0, 1.0], t[(off <= tol) & (t > 0) & (t < 1)]]))
-        out.append(p + 0.5 * (ts[1:] + ts[:-1])[:, None] * d)
-    return np.concatenate(out) if out else np.zeros((0, 3))
+    seg, t = points_on_segments(a, b, verts, tol)
+    k = np.concatenate([np.arange(len(a)), np.arange(len(a)), seg])
+    tt = np.concatenate([np.zeros(len(a)), np.ones(len(a)), t])
+    order = np.lexsort((tt, k))
+    k, tt = k[order], tt[order]
+    same = k[1:] == k[:-1]
+    mid = 0.5 * (tt[1:] + tt[:-1])[same]
+    ks = k[1:][same]
+    keep = tt[1:][same] > tt[:-1][same]  # repeated vertices give empty pieces
+    d = b - a
+    out: NDArray[np.float64] = a[ks[keep]] + mid[keep][:, None] * d[ks[keep]]
+    return out
 
 
 def _labelings(
@@ -160,6 +201,8 @@ def _labelings(
     out = np.zeros((len(points), len(dirs)), dtype=np.int64)
     keys, inv = np.unique(through, axis=0, return_inverse=True)
     inv = inv.reshape(-1)
+    jobs = []
+    queries = []
     for k, key in enumerate(keys):
         idx = np.flatnonzero(inv == k)
         fams = np.flatnonzero(key)
@@ -169,8 +212,13 @@ def _labelings(
         else:
             g = np.zeros(len(signs), dtype=np.int64)
         rep = np.array([int(np.flatnonzero(g == j)[0]) for j in range(int(g.max()) + 1)])
-        q = (points[idx][:, None, :] + eps * dirs[rep][None, :, :]).reshape(-1, 3)
-        lab = labels_at(q, tris).reshape(len(idx), len(rep))
+        queries.append((points[idx][:, None, :] + eps * dirs[rep][None, :, :]).reshape(-1, 3))
+        jobs.append((idx, rep, g))
+    lab_all = point_labels(np.concatenate(queries), tris) if queries else np.zeros(0, np.int64)
+    pos = 0
+    for idx, rep, g in jobs:
+        lab = lab_all[pos : pos + len(idx) * len(rep)].reshape(len(idx), len(rep))
+        pos += len(idx) * len(rep)
         out[idx] = lab[:, g]
     return out
 
@@ -178,13 +226,15 @@ def _labelings(
 def _plane_offsets(models: list[Any], normals: NDArray[np.float64],
                    tol: float) -> list[NDArray[np.float64]]:  # fmt: skip
     """Per family, the offsets ``n . x`` of the models' faces of that orientation."""
-    out: list[list[float]] = [[] for _ in normals]
+    out: list[list[NDArray[np.float64]]] = [[] for _ in normals]
     for m in models:
-        for n, c, _ in _normals(m):
-            for f, nf in enumerate(normals):
-                if abs(abs(float(n @ nf)) - 1) <= tol:
-                    out[f].append(c * float(np.sign(n @ nf)))
-    return [np.unique(np.round(np.array(o), 12)) for o in out]
+        n, c = _polygon_arrays(m)
+        off = (n * c).sum(axis=1)
+        dots = n @ normals.T  # (polygons, families)
+        for f in range(len(normals)):
+            hit = np.abs(np.abs(dots[:, f]) - 1) <= tol
+            out[f].append(off[hit] * np.sign(dots[hit, f]))
+    return [np.unique(np.round(np.concatenate(o), 12)) for o in out]
 
 
 def _frame(region: tuple[float, ...], outside: Mapping[str, int]) -> list[dict[str, Any]]:
@@ -235,11 +285,13 @@ def violations3(
         if b not in example.labels:
             defects.append(Defect("label", (math.nan, math.nan),
                                   f"label {b} does not occur in the example"))  # fmt: skip
-    for n, _, c in _normals(model):
-        if not any(abs(abs(float(n @ f)) - 1) <= angle_tol for f in fams):
-            where = tuple(round(x, 6) for x in c)
-            msg = f"a face with normal {np.round(n, 6)} at {where}, an orientation the example"
-            defects.append(Defect("direction", (c[0], c[1]), msg + " does not have"))
+    pn, pc = _polygon_arrays(model)
+    off_family = (np.abs(np.abs(pn @ fams.T) - 1) > angle_tol).all(axis=1)
+    for i in np.flatnonzero(off_family).tolist():
+        n, c = pn[i], pc[i].tolist()
+        where = tuple(round(x, 6) for x in c)
+        msg = f"a face with normal {np.round(n, 6)} at {where}, an orientation the example"
+        defects.append(Defect("direction", (c[0], c[1]), msg + " does not have"))
     if any(d.kind == "direction" for d in defects) or not len(model.solids):
         return Violations(defects)
     # every family plus the axes, so that at least three independent normals exist

@@ -177,19 +177,30 @@ def example_signatures3(example: Any, lattice: Lattice3, index: dict[int, int]) 
     efam = A.edge_families()
     edge_sigs = _local_labels(A, A.edge_xyz(), efam, tris, index)
     sigs |= set(edge_sigs)
-    # faces beside each edge: in each plane through the edge, both half-planes
+    # faces beside each edge: in each plane through the edge, both half-planes; the cells
+    # whose label a face takes depend only on the edge's planes and line (one index map)
     N = A.normals
-    for e, lab in enumerate(edge_sigs):
-        u = A.lines[A.edge_line[e]]
-        for f in np.flatnonzero(efam[e]):
+    L = np.array(edge_sigs, dtype=np.int64).reshape(len(edge_sigs), len(signs))
+    L, which = np.unique(L, axis=0, return_inverse=True)  # few distinct edge labelings
+    which = which.reshape(-1)
+    fmask = efam.astype(np.int64) @ (1 << np.arange(A.F, dtype=np.int64))
+    combo = np.stack([fmask, A.edge_line], axis=1)
+    uniq, inv = np.unique(combo, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    for k, (mask, line) in enumerate(uniq.tolist()):
+        members = np.unique(which[inv == k])
+        fams = [f for f in range(A.F) if mask >> f & 1]
+        u = A.lines[line]
+        for f in fams:
+            others = [x for x in fams if x != f]
             for d in (np.cross(N[f], u), -np.cross(N[f], u)):
                 sd = np.sign(N @ d)
-                others = [k for k in np.flatnonzero(efam[e]) if k != f]
                 sel = np.all(signs[:, others] == sd[others], axis=1) if others else None
-                face: dict[int, int] = {}
+                rep: dict[int, int] = {}
                 for c in np.flatnonzero(sel) if sel is not None else range(len(signs)):
-                    face[int(signs[c, f])] = lab[c]
-                sigs.add(tuple(face[int(signs[c, f])] for c in range(len(signs))))
+                    rep[int(signs[c, f])] = int(c)
+                idx = np.array([rep[int(signs[c, f])] for c in range(len(signs))])
+                sigs |= set(map(tuple, L[members][:, idx].tolist()))
     return sigs
 
 
@@ -291,10 +302,12 @@ class ContinuousCSP3:
         ekeys, etype = np.unique((emask << 6) | eside, return_inverse=True)
         etype = etype.reshape(-1)
         self.etypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
+        self.edge_outside: list[NDArray[np.int64]] = []
         for key in ekeys.tolist():
             fams = np.array([f for f in range(F) if (key >> 6) >> f & 1], dtype=np.int64)
-            st, (g, _, _) = states(fams, key & 63)
+            st, (g, _, out) = states(fams, key & 63)
             self.etypes.append((fams, st, g))
+            self.edge_outside.append(out)
         nst = max(len(t[1]) for t in (*self.vtypes, *self.etypes))
         K = self.K = nst
         nv, ne = A.n_vertices, A.n_edges
@@ -346,15 +359,22 @@ class ContinuousCSP3:
         var[order] = np.arange(nv + ne)
         self.var_vertex, self.var_edge = var[:nv], var[nv:]
         arcs = np.empty((2 * ne, 3), dtype=np.int64)
-        for e in range(ne):
-            a, b, li, et = (
-                int(A.edge_src[e]),
-                int(A.edge_dst[e]),
-                int(A.edge_line[e]),
-                int(etype[e]),
-            )
-            arcs[2 * e] = (var[a], var[nv + e], relation(int(vtype[a]), li, 1, et))
-            arcs[2 * e + 1] = (var[b], var[nv + e], relation(int(vtype[b]), li, -1, et))
+        for end, sgn, k in ((A.edge_src, 1, 0), (A.edge_dst, -1, 1)):
+            nl, nt = len(A.lines), len(self.etypes)
+            key = (vtype[end].astype(np.int64) * nl + A.edge_line) * nt + etype
+            uniq, inv = np.unique(key, return_inverse=True)
+            rid = np.array([relation(int(c // (nl * nt)), int(c // nt % nl), sgn, int(c % nt))
+                            for c in uniq.tolist()], dtype=np.int64)  # fmt: skip
+            arcs[k::2, 0] = var[end]
+            arcs[k::2, 1] = var[nv:]
+            arcs[k::2, 2] = rid[inv.reshape(-1)]
+        # relations numbered by first use along the arcs (edge by edge, as always)
+        _, first = np.unique(arcs[:, 2], return_index=True)
+        order_used = np.unique(arcs[:, 2])[np.argsort(first)]
+        renum = np.full(len(rels), -1, dtype=np.int64)
+        renum[order_used] = np.arange(len(order_used))
+        rels = [rels[i] for i in order_used.tolist()]
+        arcs[:, 2] = renum[arcs[:, 2]]
         self.edge_type = etype
         self.problem = Problem(
             (nv + ne,), dom[order], np.stack(rels), arcs,
@@ -438,15 +458,15 @@ def _plane_basis(n: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.
 
 def _trace(
     rays: dict[int, list[tuple[float, int, int]]],
-    sect: dict[int, list[tuple[int, int]]],
-    pair: tuple[int, int],
+    inside: dict[int, list[bool]],
+    where: dict[tuple[int, int], int],
 ) -> list[list[int]]:
-    """Rings (vertex ids, every vertex kept) around the in-plane region whose sectors carry
-    ``pair``, counter-clockwise; ``rays[v]`` are ``(angle, other vertex, ray id)`` sorted by
-    angle, ``sect[v][i]`` the pair of the sector after ray ``i``."""
-    where = {(v, int(w)): i for v, rs in rays.items() for i, (_, w, _) in enumerate(rs)}
-    starts = [(v, i) for v in rays for i in range(len(rays[v]))
-              if sect[v][i] == pair and sect[v][i - 1] != pair]  # fmt: skip
+    """Rings (vertex ids, every vertex kept) around the in-plane region of the sectors
+    marked ``inside``, counter-clockwise; ``rays[v]`` are ``(angle, other vertex, ray id)``
+    sorted by angle, ``inside[v][i]`` says whether the sector after ray ``i`` belongs,
+    ``where[(v, w)]`` is the position of the ray from ``v`` to ``w`` in ``rays[v]``."""
+    starts = [(v, i) for v, m in inside.items() for i in range(len(m))
+              if m[i] and not m[i - 1]]  # fmt: skip
     used: set[tuple[int, int]] = set()
     rings = []
     for start in starts:
@@ -460,8 +480,9 @@ def _trace(
             ring.append(w)
             j = where[(w, v)]  # the ray at w pointing back to v
             k = j - 1
-            m = len(rays[w])
-            while sect[w][(k - 1) % m] == pair:
+            mw = inside[w]
+            m = len(mw)
+            while mw[(k - 1) % m]:
                 k -= 1
             v, i = w, k % m
         rings.append(ring)
@@ -470,8 +491,7 @@ def _trace(
 
 def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
     """See :meth:`ContinuousCSP3.model`."""
-    import shapely
-
+    from csplab.continuous._geom import triangulate_rings
     from csplab.continuous.polyhedra import PolyhedralModel
 
     A = self.arrangement
@@ -486,6 +506,27 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
     xyz = A.vertex_xyz()
     size = np.array(A.size, dtype=np.float64)
     efam = A.edge_families()
+    # vertices whose labels all agree lie on no face (unless an object reaches the region's
+    # side there, where its solid is closed): their rays are never traced
+    uniform = np.zeros(A.n_vertices, dtype=bool)
+    for t, (_, states, _) in enumerate(self.vtypes):
+        sel = np.flatnonzero(self.vertex_type == t)
+        if sel.size:
+            side = bool((np.asarray(self.vertex_outside[t]) >= 0).any())
+            flat = np.array([len(set(st)) == 1 and (st[0] == 0 or not side) for st in states],
+                            dtype=bool)  # fmt: skip
+            uniform[sel] = flat[vstate[sel]]
+    # likewise edges (an edge in no face's closure can be left out of the rays: the two
+    # sectors it separates are both outside every face)
+    estate = g[self.var_edge]
+    eflat = np.zeros(A.n_edges, dtype=bool)
+    for t, (_, estates, _) in enumerate(self.etypes):
+        sel = np.flatnonzero(self.edge_type == t)
+        if sel.size:
+            side = bool((self.edge_outside[t] >= 0).any())
+            flat = np.array([len(set(st)) == 1 and (st[0] == 0 or not side) for st in estates],
+                            dtype=bool)  # fmt: skip
+            eflat[sel] = flat[estate[sel]]
     lookups: dict[int, dict[tuple[int, ...], int]] = {}
 
     def group_of(t: int, sig: tuple[int, ...]) -> int:
@@ -519,12 +560,20 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
             out.append(group_of(t, sg) if 0 not in sg else -1)
         return out[0], out[1]
 
-    tris: dict[int, list[tuple[int, int, int]]] = {}
+    # the faces: rings of vertex ids with their solid's label, outward
+    rings_out: list[list[int]] = []
+    ring_label: list[int] = []
+    ring_axis: list[int] = []  # the coordinate dropped to project the ring's plane
+    ring_sign: list[int] = []  # the sign of the outward normal along that coordinate
+    ring_group: list[int] = []  # the region (one trace) of each ring
+    groups: list[tuple[int, list[list[int]], int, NDArray[np.float64], NDArray[np.float64]]] = []
+    loose: list[tuple[int, list[list[int]], int, NDArray[np.float64], NDArray[np.float64]]] = []
     for f in range(A.F):
-        sel = np.flatnonzero(efam[:, f])
+        sel = np.flatnonzero(efam[:, f] & ~eflat & ~uniform[A.edge_src] & ~uniform[A.edge_dst])
         if not sel.size:
             continue
         e1, e2 = _plane_basis(N[f])
+        axis = int(np.argmax(np.abs(N[f])))
         kk = s[A.edge_src[sel], f] // A.D
         for k in np.unique(kk).tolist():
             es = sel[kk == k]
@@ -543,6 +592,7 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
                 rs.sort()
                 t = int(self.vertex_type[v])
                 st = self.vtypes[t][1][int(vstate[v])]
+                outside = self.vertex_outside[t]  # outside the region: not the output
                 out = []
                 for i in range(len(rs)):
                     nxt = rs[(i + 1) % len(rs)]
@@ -551,42 +601,186 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
                         sector_cache[ck] = sector_groups(v, t, f, e1, e2, rs[i][0], nxt[0],
                                                          len(rs))  # fmt: skip
                     gp, gm = sector_cache[ck]
-                    outside = self.vertex_outside[t]  # outside the region: not the output
                     out.append((st[gp] if gp >= 0 and outside[gp] < 0 else -1,
                                 st[gm] if gm >= 0 and outside[gm] < 0 else -1))  # fmt: skip
                 sect[v] = out
-            pairs = {p for ps in sect.values() for p in ps if p[0] != p[1] and max(p) > 0}
-            for pair in pairs:
-                rings = _trace(rays, sect, pair)
-                uv = {v: (float(xyz[v] @ e1), float(xyz[v] @ e2)) for r in rings for v in r}
-                key = {(round(x, 7), round(y, 7)): v for v, (x, y) in uv.items()}
-                polys = _rings_to_polygons([[uv[v] for v in r] for r in rings])
-                for poly in polys:
-                    for tri in shapely.constrained_delaunay_triangles(poly).geoms:
-                        c = np.asarray(tri.exterior.coords)[:3]
-                        ids = [key[(round(x, 7), round(y, 7))] for x, y in c]
-                        area = (c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1]) - (
-                            c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0])  # fmt: skip
-                        if area < 0:
-                            ids = [ids[0], ids[2], ids[1]]  # counter-clockwise seen from +n
-                        above, below = pair
-                        if below > 0:  # solid below: outward normal +n
-                            tris.setdefault(below, []).append((ids[0], ids[1], ids[2]))
-                        if above > 0:  # solid above: outward normal -n
-                            tris.setdefault(above, []).append((ids[0], ids[2], ids[1]))
+            labels = {b for ps in sect.values() for p in ps if p[0] != p[1] for b in p if b > 0}
+            where = {(v, w): i for v, rs in rays.items() for i, (_, w, _) in enumerate(rs)}
+            for b in sorted(labels):
+                # the faces of solid b on this plane: b below (outward +n), b above (-n)
+                for below in (True, False):
+                    inside = {v: [(p[1] == b and p[0] != b) if below else
+                                  (p[0] == b and p[1] != b) for p in ps]
+                              for v, ps in sect.items()}  # fmt: skip
+                    if not any(any(m) for m in inside.values()):
+                        continue
+                    rings = _trace(rays, inside, where)
+                    if not below:
+                        rings = [r[::-1] for r in rings]  # counter-clockwise seen from -n
+                    if all(len(set(r)) == len(r) for r in rings):
+                        # checked after the loop: a ring turning the wrong way is a hole
+                        for r in rings:
+                            rings_out.append(r)
+                            ring_label.append(b)
+                            ring_axis.append(axis)
+                            ring_sign.append(int(np.sign(N[f, axis])) * (1 if below else -1))
+                            ring_group.append(len(groups))
+                        groups.append((b, rings, 1 if below else -1, e1, e2))
+                    else:  # rings touching themselves: constrained Delaunay
+                        loose.append((b, [r[::-1] if not below else r for r in rings],
+                                      1 if below else -1, e1, e2))  # fmt: skip
+    holes = _clockwise(XYZ, rings_out, ring_axis, ring_sign)
+    if holes.any():  # regions with holes: constrained Delaunay
+        bad = set(np.asarray(ring_group)[holes].tolist())
+        for gi in sorted(bad):
+            b, rings, sgn, e1, e2 = groups[gi]
+            loose.append((b, [r[::-1] if sgn < 0 else r for r in rings], sgn, e1, e2))
+        keep = [i for i, gi in enumerate(ring_group) if gi not in bad]
+        rings_out = [rings_out[i] for i in keep]
+        ring_label = [ring_label[i] for i in keep]
+        ring_axis = [ring_axis[i] for i in keep]
+    polys, owner, tri_list = _triangulated(XYZ, rings_out, ring_axis, triangulate_rings)
+    labels_of = list(ring_label)
+    for b, rings, sgn, e1, e2 in loose:
+        for tri in _cdt(xyz, rings, e1, e2):
+            polys.append(tri if sgn > 0 else [tri[0], tri[2], tri[1]])
+            tri_list.append(polys[-1])
+            owner.append(len(polys) - 1)
+            labels_of.append(b)
     world = self.lattice.to_world(xyz)
-    solids = []
-    for b in sorted(tris):
-        T = np.array(tris[b], dtype=np.int64)
-        for comp in _components(T):
-            used, inv = np.unique(comp, return_inverse=True)
-            solids.append({"label": self.labels[b], "vertices": world[used].tolist(),
-                           "faces": inv.reshape(-1, 3).tolist()})  # fmt: skip
-    return PolyhedralModel(
+    solids = _solids(polys, owner, tri_list, labels_of, world, self.labels)
+    return PolyhedralModel.trusted(
         solids, name=name or f"{getattr(self.example, 'name', '') or 'model'}-synth",
         meta={"size": list(A.size), "spacing": float(self.lattice.spacing)},
-        merge_coplanar=True,
     )  # fmt: skip
+
+
+def _projected(
+    XYZ: NDArray[np.int64], rings: list[list[int]], axes: list[int]
+) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """The rings' vertex ids one after another, their start offsets, their integer 2D
+    coordinates (the ring's plane projected along ``axes``, the other two coordinates in
+    cyclic order) and twice their signed areas there."""
+    flat = np.concatenate([np.asarray(r, dtype=np.int64) for r in rings])
+    lens = np.array([len(r) for r in rings], dtype=np.int64)
+    start = np.concatenate([[0], np.cumsum(lens)])
+    ax = np.repeat(np.asarray(axes, dtype=np.int64), lens)
+    keep = np.array([[1, 2], [2, 0], [0, 1]], dtype=np.int64)[ax]
+    xy = np.take_along_axis(XYZ[flat], keep, axis=1)
+    nxt = np.roll(np.arange(len(flat)), -1)
+    nxt[start[1:] - 1] = start[:-1]
+    cr = xy[:, 0] * xy[nxt, 1] - xy[:, 1] * xy[nxt, 0]
+    return flat, start, xy, np.add.reduceat(cr, start[:-1])
+
+
+def _clockwise(
+    XYZ: NDArray[np.int64], rings: list[list[int]], axes: list[int], signs: list[int]
+) -> NDArray[np.bool_]:
+    """Rings turning clockwise seen from their outward side (holes), exactly."""
+    if not rings:
+        return np.zeros(0, dtype=bool)
+    area = _projected(XYZ, rings, axes)[3]
+    out: NDArray[np.bool_] = area * np.asarray(signs, dtype=np.int64) < 0
+    return out
+
+
+def _triangulated(
+    XYZ: NDArray[np.int64], rings: list[list[int]], axes: list[int], earclip: Any
+) -> tuple[list[list[int]], list[int], list[list[int]]]:
+    """Polygons (the rings), each triangle's polygon, and the triangles (vertex ids,
+    counter-clockwise like their ring): ear clipping on the integer coordinates with the
+    ring's plane projected along ``axes``."""
+    if not rings:
+        return [], [], []
+    flat, start, xy, area = _projected(XYZ, rings, axes)
+    lens = np.diff(start)
+    # orient every ring counter-clockwise in its projection (reverse the triangles after)
+    flip = area < 0
+    order = np.arange(len(flat))
+    for r in np.flatnonzero(flip).tolist():
+        order[start[r] : start[r + 1]] = order[start[r] : start[r + 1]][::-1]
+    tri, ok = earclip(xy[order], start)
+    if not ok.all():  # pragma: no cover - simple counter-clockwise lattice rings
+        bad = int(np.flatnonzero(~ok)[0])
+        raise RuntimeError(f"ear clipping failed on output ring {bad}")
+    ids = flat[order][tri]
+    rtri = np.repeat(np.arange(len(rings)), lens - 2)
+    ids[flip[rtri]] = ids[flip[rtri]][:, ::-1]
+    return [list(r) for r in rings], rtri.tolist(), ids.tolist()
+
+
+def _cdt(
+    xyz: NDArray[np.float64], rings: list[list[int]], e1: NDArray[np.float64],
+    e2: NDArray[np.float64],
+) -> list[list[int]]:  # fmt: skip
+    """Constrained Delaunay triangles (vertex ids, counter-clockwise in ``e1, e2``) of the
+    region bounded by ``rings`` (counter-clockwise shells, clockwise holes)."""
+    import shapely
+
+    uv = {v: (float(xyz[v] @ e1), float(xyz[v] @ e2)) for r in rings for v in r}
+    key = {(round(x, 7), round(y, 7)): v for v, (x, y) in uv.items()}
+    out = []
+    for poly in _rings_to_polygons([[uv[v] for v in r] for r in rings]):
+        for tri in shapely.constrained_delaunay_triangles(poly).geoms:
+            c = np.asarray(tri.exterior.coords)[:3]
+            ids = [key[(round(x, 7), round(y, 7))] for x, y in c]
+            area = (c[1, 0] - c[0, 0]) * (c[2, 1] - c[0, 1]) - (
+                c[1, 1] - c[0, 1]) * (c[2, 0] - c[0, 0])  # fmt: skip
+            out.append(ids if area > 0 else [ids[0], ids[2], ids[1]])
+    return out
+
+
+def _solids(
+    polys: list[list[int]], owner: list[int], tris: list[list[int]], labels: list[int],
+    world: NDArray[np.float64], names: Sequence[int],
+) -> list[Any]:  # fmt: skip
+    """Polygons of one label split into closed surfaces (connected through shared edges),
+    each a :class:`~csplab.continuous.polyhedra.Solid` with its own vertex numbering."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from csplab.continuous.polyhedra import Solid
+
+    if not polys:
+        return []
+    lens = np.array([len(p) for p in polys], dtype=np.int64)
+    flat = np.concatenate([np.asarray(p, dtype=np.int64) for p in polys])
+    start = np.concatenate([[0], np.cumsum(lens)])
+    pid = np.repeat(np.arange(len(polys)), lens)
+    nxt = np.roll(np.arange(len(flat)), -1)
+    nxt[start[1:] - 1] = start[:-1]
+    lab = np.asarray(labels, dtype=np.int64)
+    a, b = flat, flat[nxt]
+    key = np.stack([lab[pid], np.minimum(a, b), np.maximum(a, b)], axis=1)
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    n = len(polys)
+    graph = coo_matrix((np.ones(len(pid)), (pid, n + inv)), shape=(n + int(inv.max()) + 1,) * 2)
+    _, comp = connected_components(graph, directed=False)
+    comp = comp[:n]
+    T = np.asarray(tris, dtype=np.int64).reshape(-1, 3)
+    own = np.asarray(owner, dtype=np.int64)
+    out = []
+    by_comp = np.argsort(comp, kind="stable")
+    bounds = np.flatnonzero(np.diff(comp[by_comp])) + 1
+    tri_order = np.argsort(comp[own], kind="stable")
+    tri_bounds = np.searchsorted(comp[own][tri_order], np.unique(comp))
+    tri_bounds = np.append(tri_bounds, len(own))
+    for ci, members in enumerate(np.split(by_comp, bounds)):
+        ts = tri_order[tri_bounds[ci] : tri_bounds[ci + 1]]
+        verts = np.unique(np.concatenate([flat[start[j] : start[j + 1]] for j in members]))
+        local = {int(v): i for i, v in enumerate(verts.tolist())}
+        pmap = np.full(n, -1, dtype=np.int64)
+        pmap[members] = np.arange(len(members))
+        faces = np.searchsorted(verts, T[ts])
+        out.append(Solid(
+            label=int(names[int(lab[members[0]])]),
+            vertices=world[verts],
+            faces=np.ascontiguousarray(faces, dtype=np.int64),
+            polygons=tuple(tuple(local[v] for v in polys[j]) for j in members.tolist()),
+            face_polygon=pmap[own[ts]],
+        ))  # fmt: skip
+    return out
 
 
 def _rings_to_polygons(rings: list[list[tuple[float, float]]]) -> list[Any]:
@@ -608,27 +802,3 @@ def _rings_to_polygons(rings: list[list[tuple[float, float]]]) -> list[Any]:
             raise AssertionError("a hole outside every shell")
         owned[min(inside, key=lambda i: sp[i].area)].append(h)
     return [SP(s, hs) for s, hs in zip(shells, owned, strict=True)]
-
-
-def _components(T: NDArray[np.int64]) -> list[NDArray[np.int64]]:
-    """Triangles split into groups connected through shared edges."""
-    parent = list(range(len(T)))
-
-    def find(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
-
-    first: dict[tuple[int, int], int] = {}
-    for i, t in enumerate(T.tolist()):
-        for a, b in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0])):
-            key = (min(a, b), max(a, b))
-            if key in first:
-                parent[find(i)] = find(first[key])
-            else:
-                first[key] = i
-    groups: dict[int, list[int]] = {}
-    for i in range(len(T)):
-        groups.setdefault(find(i), []).append(i)
-    return [T[idx] for idx in groups.values()]

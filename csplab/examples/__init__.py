@@ -59,12 +59,15 @@ def example_names() -> list[str]:
 
 
 def example_info() -> list[tuple[str, str]]:
-    """``(name, description)`` of every built-in example, grids then polygon models
-    (continuous model synthesis, :mod:`csplab.examples.continuous`)."""
+    """``(name, description)`` of every built-in example: grids, then polygon models and
+    polyhedral models (continuous model synthesis, :mod:`csplab.examples.continuous`,
+    :mod:`csplab.examples.continuous3d`)."""
     from csplab.examples.continuous import CONTINUOUS_EXAMPLES
+    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES
 
     grids = [(k, v[1]) for k, v in EXAMPLES.items()]
-    return grids + [(k, f"polygons: {v[1]}") for k, v in CONTINUOUS_EXAMPLES.items()]
+    polys = [(k, f"polygons: {v[1]}") for k, v in CONTINUOUS_EXAMPLES.items()]
+    return grids + polys + [(k, f"polyhedra: {v[1]}") for k, v in POLYHEDRAL_EXAMPLES.items()]
 
 
 def load_example(name: str) -> ExampleModel:

@@ -107,6 +107,7 @@ example 'line'
     """
     from csplab.examples import ALIASES, EXAMPLES, load_example
     from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
+    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
 
     p = Path(spec)
     if p.exists():
@@ -124,11 +125,18 @@ example 'line'
                 f"model options apply to model files only, not to the built-in example {text!r}"
             )
         return load_polygon_example(text)
+    if text in POLYHEDRAL_EXAMPLES:
+        if options:
+            raise InputError(
+                f"model options apply to model files only, not to the built-in example {text!r}"
+            )
+        return load_polyhedral_example(text)
     if p.suffix or "/" in text or "\\" in text:
         raise FormatError("no such file", path=text)
     raise InputError(
         f"{text!r} is neither a model file nor a built-in example "
-        f"({', '.join([*EXAMPLES, *CONTINUOUS_EXAMPLES])}); see `csplab info`"
+        f"({', '.join([*EXAMPLES, *CONTINUOUS_EXAMPLES, *POLYHEDRAL_EXAMPLES])}); "
+        "see `csplab info`"
     )
 
 
