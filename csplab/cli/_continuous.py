@@ -7,6 +7,8 @@ import json
 import sys
 from typing import Any
 
+import numpy as np
+
 from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 from csplab.grids import parse_shape
@@ -98,6 +100,14 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     settings["restarts"] = restarts
     common = dict(solver=args.solver, rng=args.seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts)  # fmt: skip
+    cons = user_constraints(args, example)
+    if cons is not None and dim == 2:
+        raise InputError("--constraints: polygon models (2D) take no user constraints yet")
+    if cons is not None:
+        common["constraints"] = cons
+        settings["constraints"] = ", ".join(cons_summary(cons))
+        if not cls.complete or cons.connected:
+            common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
     if dim == 2:
         settings["lines"] = args.lines
         s = run2(example, size, lines=args.lines, **common, **opts)
@@ -178,6 +188,16 @@ def check(args: argparse.Namespace, example: Any) -> int:
         if not isinstance(out, PolyhedralModel):
             raise InputError(f"{args.grid} is not a polyhedral model (the example {args.model} is)")
         v3 = violations3(example, out)
+        cons = user_constraints(args, example)
+        if cons is not None:
+            from csplab.continuous.check import Violations
+            from csplab.continuous.space import Lattice3
+            from csplab.continuous.user3d import user_violations3
+
+            lat = _example_lattice(example, Lattice3)
+            origin = [float(x) for x in lat.origin]
+            extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
+            v3 = Violations([*v3, *extra])
         if args.json:
             print(json.dumps({"violations": len(v3), **v3.counts(), "solids": len(out.solids)}))
         else:
@@ -197,3 +217,39 @@ def check(args: argparse.Namespace, example: Any) -> int:
         if len(v):
             print(v.describe(args.limit))
     return 0 if len(v) == 0 else 1
+
+
+def user_constraints(args: argparse.Namespace, example: Any) -> Any:
+    """The ``--constraints`` files merged (:mod:`csplab.continuous.user3d`), or ``None``."""
+    if not getattr(args, "constraints", None):
+        return None
+    from csplab.continuous.user3d import read_user_constraints
+
+    names = {str(v): int(k) for k, v in (example.meta.get("label_names") or {}).items()}
+    out = None
+    for path in args.constraints:
+        c = read_user_constraints(path, names)
+        out = c if out is None else out.merged(c)
+    return out
+
+
+def cons_summary(c: Any) -> list[str]:
+    """One phrase per kind of user constraint."""
+    out = []
+    if c.dimensional:
+        out.append("dimensional " + " ".join(f"{b}:{list(n)}" for b, n in c.dimensional))
+    if c.allowed:
+        out.append(f"large-scale {len(c.allowed)} label(s) in voxels {list(c.voxel)}")
+    if c.connected:
+        out.append(f"connected {list(c.connected)}")
+    return out
+
+
+def _example_lattice(example: Any, lattice: Any) -> Any:
+    """The plane lattice of a polyhedral example (origin = the output region's corner)."""
+    pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
+    polys, base = [], 0
+    for s in example.solids:
+        polys += [[base + int(i) for i in p] for p in s.polygons]
+        base += len(s.vertices)
+    return lattice.of(pts, polys, where=example.source)

@@ -35,6 +35,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="GRID",
         help=f"grid file to check ({exts}: label ids kept; .vox: colour b + 1 = label b)",
     )
+    p.add_argument(
+        "--constraints",
+        action="append",
+        metavar="FILE",
+        help='a constraints file {"constraints": [...]} (repeatable); polyhedral models take '
+        "dimensional, large-scale and connected (thesis Sec. 4.6)",
+    )
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 
@@ -47,6 +54,8 @@ def run(args: argparse.Namespace) -> int:
         from csplab.cli import _continuous
 
         return _continuous.check(args, model)
+    if args.constraints:
+        raise InputError("--constraints: grid models take no constraints file yet")
     grid = load_grid(args.grid, model.ndim, model)
     problem = problem_from_args(args, model, shape=tuple(grid.shape))
     unassigned = int((grid < 0).sum())

@@ -106,6 +106,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="also write a failed or timed-out run's partial grid (unassigned cells -1; "
         f"{', '.join(output_extensions(partial=True))})",
     )
+    p.add_argument(
+        "--constraints",
+        action="append",
+        metavar="FILE",
+        help='a constraints file {"constraints": [...]} (repeatable); polyhedral models take '
+        "dimensional, large-scale and connected (thesis Sec. 4.6)",
+    )
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
 
 

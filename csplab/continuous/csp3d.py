@@ -216,6 +216,11 @@ class ContinuousCSP3:
         Compact label index -> model label (0: empty space).
     signatures : set
         The example's neighbourhoods (full labelings of the central cells).
+    constraints : UserConstraints3 or None
+        User constraints (thesis Sec. 4.6, :mod:`csplab.continuous.user3d`): the
+        dimensional and large-scale ones restrict the problem's domains (every solver
+        enforces them); connectivity is checked on the output by
+        :func:`~csplab.continuous.synthesis.synthesize3`.
     """
 
     def __init__(
@@ -226,6 +231,7 @@ class ContinuousCSP3:
         spacing: float | None = None,
         snap: bool = False,
         boundary: int | Mapping[str, int] = 0,
+        constraints: Any = None,
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
@@ -384,6 +390,14 @@ class ContinuousCSP3:
                   "vertices": nv, "edges": ne, "boundary": dict(self.boundary)},
             positions=pos[order],
         )  # fmt: skip
+        #: the user constraints of Sec. 4.6 (:mod:`csplab.continuous.user3d`), if any
+        self.constraints = constraints
+        if constraints:
+            from csplab.continuous.user3d import allowed_states
+
+            keep = allowed_states(self, constraints)
+            self.problem = self.problem.restrict(keep, key="user constraints (Sec. 4.6)")
+            self.problem.meta["constraints"] = constraints.source
 
     def model(self, grid: ArrayLike, *, name: str = "") -> Any:
         """The output solids of a solution: on every plane the regions between two

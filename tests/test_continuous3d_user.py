@@ -1,0 +1,134 @@
+"""User-defined constraints of continuous model synthesis in 3D (thesis Sec. 4.6):
+dimensional and large-scale constraints restrict the CSP (every solver honours them),
+connectivity is exact with sat (a cut loop) and retried otherwise; the checker
+(user_violations3) catches each planted breach."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from csplab.continuous.synthesis import synthesize3
+from csplab.continuous.user3d import parse_user_constraints, read_user_constraints, user_violations3
+from csplab.errors import InputError
+
+polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
+pytest.importorskip("trimesh")
+pytest.importorskip("pysat")
+
+
+def _box(label: int, lo: list[int], hi: list[int]) -> dict[str, object]:
+    x0, y0, z0 = lo
+    x1, y1, z1 = hi
+    v = [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
+         [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]]  # fmt: skip
+    f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]]
+    return {"label": label, "vertices": v, "faces": f}
+
+
+E = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 2])], name="box")
+ORIGIN = [0.0, 0.0, 0.0]
+
+
+def _c(*items: dict[str, object]) -> object:
+    return parse_user_constraints({"constraints": list(items)}, source="c.json")
+
+
+@pytest.mark.parametrize("solver", ["catalog", "sat", "blocks"])
+def test_dimensional_objects_are_one_spacing_thick(solver: str) -> None:
+    c = _c({"type": "dimensional", "labels": [1], "normals": ["z"]})
+    s = synthesize3(E, (6, 6, 4), solver=solver, rng=3, restarts=5, constraints=c)
+    assert s.ok and s.model is not None and len(s.violations) == 0
+    assert s.model.solids, "an empty output would say nothing"
+    for sol in s.model.solids:  # spacing 2 (the box's side): every solid 2 high
+        z = sol.vertices[:, 2]
+        assert z.max() - z.min() == pytest.approx(2.0)
+
+
+def test_dimensional_breach_is_found() -> None:
+    c = _c({"type": "dimensional", "labels": [1], "normals": ["z"]})
+    tall = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 4])])
+    d = user_violations3(tall, c, origin=ORIGIN, spacing=2.0)
+    assert [x.kind for x in d] == ["dimensional"] and "spans 2" in d[0].detail
+    assert not user_violations3(E, c, origin=ORIGIN, spacing=2.0)
+
+
+@pytest.mark.parametrize("solver", ["catalog", "sat"])
+def test_large_scale_keeps_labels_in_their_voxels(solver: str) -> None:
+    c = _c({"type": "large-scale", "voxel": [3, 3, 4], "allowed": {"1": [[0, 0, 0], [1, 1, 0]]}})
+    s = synthesize3(E, (6, 6, 4), solver=solver, rng=1, restarts=5, constraints=c)
+    assert s.ok and s.model is not None and len(s.violations) == 0
+    for sol in s.model.solids:  # voxels of 3 spacings = 6 units: [0, 6) or [6, 12) squared
+        lo, hi = sol.vertices.min(axis=0), sol.vertices.max(axis=0)
+        assert (hi[:2] <= 6 + 1e-9).all() or (lo[:2] >= 6 - 1e-9).all()
+    planted = polyhedra.PolyhedralModel([_box(1, [6, 0, 0], [8, 2, 2])])
+    d = user_violations3(planted, c, origin=ORIGIN, spacing=2.0)
+    assert [x.kind for x in d] == ["large-scale"]
+
+
+def test_connected_exact_with_sat_and_the_breach_is_found() -> None:
+    c = _c({"type": "connected", "labels": [1]})
+    s = synthesize3(E, (6, 6, 3), solver="sat", rng=2, constraints=c)
+    assert s.result.status == "solved" and s.model is not None and len(s.violations) == 0
+    assert s.result.stats["rounds"] >= 1
+    two = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 2]), _box(1, [4, 4, 0], [6, 6, 2])])
+    d = user_violations3(two, c, origin=ORIGIN, spacing=2.0)
+    assert [x.kind for x in d] == ["connected"] and "2 separate groups" in d[0].detail
+    touching = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 2]),
+                                          _box(1, [2, 2, 0], [4, 4, 2])])  # fmt: skip
+    assert not user_violations3(touching, c, origin=ORIGIN, spacing=2.0)
+
+
+def test_incomplete_solvers_never_report_solved_with_a_broken_constraint() -> None:
+    c = _c({"type": "connected", "labels": [1]})
+    for seed in range(3):
+        s = synthesize3(E, (8, 8, 3), solver="catalog", rng=seed, restarts=2, constraints=c)
+        broken = user_violations3(s.model, c, origin=ORIGIN, spacing=2.0) if s.model else []
+        assert (s.result.status == "solved") == (s.model is not None and not broken)
+        if broken:
+            assert s.result.status == "failed" and "connected" in s.result.stats["broken"]
+
+
+@pytest.mark.parametrize(
+    ("entry", "msg"),
+    [
+        ({"type": "count", "labels": [1]}, "does not apply to polyhedral models"),
+        ({"type": "dimensional", "labels": [0]}, "not an object label"),
+        ({"type": "dimensional", "labels": [1], "normals": [[0, 0, 0]]}, "normal"),
+        ({"type": "large-scale", "voxel": 0, "allowed": {"1": []}}, "voxel"),
+        ({"type": "connected"}, "labels"),
+    ],
+)
+def test_bad_entries_are_one_line(entry: dict[str, object], msg: str) -> None:
+    with pytest.raises(InputError, match=rf"c\.json: constraint 0: .*{msg}"):
+        _c(entry)
+
+
+def test_unknown_normal_and_label_name_the_file(tmp_path: Path) -> None:
+    f = tmp_path / "c.json"
+    f.write_text(json.dumps({"constraints": [{"type": "dimensional", "labels": [1],
+                                              "normals": [[1, 1, 0]]}]}))  # fmt: skip
+    with pytest.raises(InputError, match="not a plane family"):
+        synthesize3(E, (4, 4, 2), constraints=read_user_constraints(f))
+    f.write_text("{")
+    with pytest.raises(InputError, match=r"c\.json: line 1: not JSON"):
+        read_user_constraints(f)
+
+
+def test_cli_synthesize_and_check_with_constraints(tmp_path: Path) -> None:
+    f = tmp_path / "c.json"
+    f.write_text(json.dumps({"constraints": [{"type": "dimensional", "labels": [1],
+                                              "normals": ["z"]}]}))  # fmt: skip
+    out = tmp_path / "out.obj"
+    cmd = [sys.executable, "-m", "csplab", "synthesize", "houses", "--size", "8x8x6",
+           "--seed", "1", "--constraints", str(f), "--out", str(out)]  # fmt: skip
+    r = subprocess.run(cmd, capture_output=True, text=True, check=False)
+    assert r.returncode == 0, r.stderr
+    assert "constraints=dimensional 1:[0, 0, 1]" in r.stdout
+    chk = [sys.executable, "-m", "csplab", "check", "houses", str(out), "--constraints", str(f)]
+    r = subprocess.run(chk, capture_output=True, text=True, check=False)
+    assert r.returncode == 0 and r.stdout.startswith("0 violations"), r.stdout + r.stderr
