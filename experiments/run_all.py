@@ -64,6 +64,17 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
         {"examples": ["castle"], "order": "scanline", "boundary": "auto", "sizes": "6:14:2"},
     ),
     "sampling_bias": ("sampling_bias", {}),
+    "table1_continuous": ("table1_continuous", {}),
+    "table1_continuous_solvers": (
+        "table1_continuous",
+        {
+            "solvers": ["catalog", "blocks", "sat"],
+            "sizes_3d": dict.fromkeys(
+                ["skyscrapers", "terrain", "fractals", "arches", "houses", "pentagons"], "20x20x8"
+            ),
+            "seeds": 2,
+        },
+    ),
 }
 
 

@@ -31,7 +31,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 from numpy.typing import NDArray
 
 __all__ = ["point_labels", "points_on_segments", "triangulate_rings"]
@@ -87,7 +87,7 @@ def _bucket(
     return counts, items
 
 
-@njit(cache=True)
+@njit(cache=True, parallel=True)
 def _first_hits(
     q: NDArray[np.float64],
     tri: NDArray[np.float64],
@@ -107,7 +107,7 @@ def _first_hits(
     P = q.shape[0]
     out = np.zeros(P, dtype=np.int64)
     doubt = np.zeros(P, dtype=np.bool_)
-    for p in range(P):
+    for p in prange(P):
         px, py, pz = q[p, 0], q[p, 1], q[p, 2]
         i = int((px - x0) / h)
         j = int((py - y0) / h)

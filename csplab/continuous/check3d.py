@@ -319,8 +319,13 @@ def violations3(
         m_pts = m_pts[((m_pts >= r[:3] - t) & (m_pts <= r[3:] + t)).all(axis=1)]
     seen: set[tuple[int, ...]] = set()
     m_planes = _plane_offsets([model], N, angle_tol)
-    m_lab = _labelings(m_pts, cells, M_tris, m_planes, N, eps).tolist()
-    for p, lab in zip(m_pts, m_lab, strict=True):
+    m_arr = _labelings(m_pts, cells, M_tris, m_planes, N, eps)
+    # each distinct neighbourhood once, at its first point (in the points' order)
+    rows = np.ascontiguousarray(m_arr.astype(np.int32))
+    _, first = np.unique(rows.view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))),
+                         return_index=True)  # fmt: skip
+    for i in np.sort(first).tolist():
+        p, lab = m_pts[i], m_arr[i].tolist()
         key = tuple(lab)
         if key in allowed or key in seen:
             continue

@@ -265,6 +265,17 @@ class PolyhedralModel:
         d["solids"] = [s.to_json() for s in self.solids]
         return d
 
+    def hash(self) -> str:
+        """A short content hash (labels, vertices, polygons): equal models, equal hashes
+        (what the experiment harness keys trials by)."""
+        import hashlib
+
+        h = hashlib.sha256(b"polyhedra")
+        for s in self.solids:
+            h.update(str((s.label, s.vertices.shape, s.polygons)).encode())
+            h.update(np.ascontiguousarray(s.vertices, dtype=np.float64).tobytes())
+        return h.hexdigest()[:16]
+
     def __len__(self) -> int:
         return len(self.solids)
 

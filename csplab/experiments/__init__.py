@@ -13,6 +13,7 @@ Python entry point.
 ``table3_1``              k, output size and times per example and solver (Table 3.1)
 ``catalog_gap``           Alg. 3.1 choices outside the exact catalog C*
 ``sampling_bias``         label / 2×2-pattern frequencies vs exact uniform sampling
+``table1_continuous``     continuous 3D: Table 1 of the 2008 paper (polygons, time)
 ========================  ============================================================
 
 Examples
@@ -58,6 +59,7 @@ EXPERIMENTS: dict[str, str] = {
     "table3_1": "csplab.experiments.table3_1:Table31",
     "catalog_gap": "csplab.experiments.catalog_gap:CatalogGap",
     "sampling_bias": "csplab.experiments.sampling_bias:SamplingBias",
+    "table1_continuous": "csplab.experiments.table1_continuous:Table1Continuous",
 }
 ALIASES: dict[str, str] = {"fig3_10": "blocksize", "table3.1": "table3_1", "fig3.8": "fig3_8"}
 

@@ -165,7 +165,7 @@ def resolve(path: str) -> Callable[..., dict[str, Any]]:
     return f
 
 
-def execute(trial: Trial, example: ExampleModel) -> dict[str, Any]:
+def execute(trial: Trial, example: Any) -> dict[str, Any]:
     """Run one trial; returns ``{"status", "time_s", "stats", "host"}``.
 
     The problem is built outside the timed part; ``time_s`` is what the measure function
@@ -176,7 +176,9 @@ def execute(trial: Trial, example: ExampleModel) -> dict[str, Any]:
         from csplab.errors import InputError
 
         raise InputError(f"example {trial.example!r} does not match the trial's example hash")
-    problem = problem_for(trial, example)
+    # a grid example's problem is built here, untimed; other models (polyhedral examples of
+    # continuous synthesis) are the measure function's to build and time
+    problem = problem_for(trial, example) if isinstance(example, ExampleModel) else None
     t0 = time.perf_counter()
     out = resolve(trial.measure)(trial, example, problem)
     out.setdefault("time_s", time.perf_counter() - t0)

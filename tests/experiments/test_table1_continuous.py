@@ -1,0 +1,31 @@
+"""The table1_continuous experiment (2008 paper Table 1) on the quick configuration: every
+trial solves with 0 violations, the table carries the paper's row beside csplab's, and the
+previews are written."""
+
+import pytest
+
+from csplab.examples.continuous3d import load_polyhedral_example
+from csplab.experiments import run
+from csplab.experiments.table1_continuous import PAPER_TABLE1
+
+pytest.importorskip("trimesh")
+
+
+def test_quick_table_has_paper_rows_and_clean_outputs(tmp_path):
+    s, rep = run(
+        "table1_continuous", quick=True, seeds=2, store=tmp_path / "r.sqlite", out=tmp_path,
+        jobs=1, progress=False,
+    )  # fmt: skip
+    assert not s.errors and s.ran == 2 * 2
+    rows = {r["example"]: r for r in rep.tables["Table 1"]}
+    assert set(rows) == {"houses", "fractals"}
+    for name, r in rows.items():
+        assert r["solved"] == "2/2" and r["violations"] == 0
+        assert (r["paper in"], r["paper out"]) == PAPER_TABLE1[name][:2]
+        assert r["csplab in"] == load_polyhedral_example(name).n_polygons
+        assert r["out polygons (median)"] > 0 and r["target"] == "misses"  # 8x8x6 is small
+        assert r["time (s)"] >= r["solve (s)"]
+        assert (tmp_path / f"table1_continuous_{name}.png").exists()
+    # the same sweep again runs nothing new
+    assert run("table1_continuous", quick=True, seeds=2, store=tmp_path / "r.sqlite",
+               out=tmp_path, jobs=1, progress=False)[0].skipped == 4  # fmt: skip
