@@ -196,7 +196,8 @@ class Problem:
                 raise InputError(f"arc endpoints must be cells 0..{n - 1}")
             if a[:, 2].min() < 0 or a[:, 2].max() >= rel.shape[0]:
                 raise InputError(f"arc relation ids must be 0..{rel.shape[0] - 1}")
-        base = dom.copy() if base_domains is None else np.array(base_domains, dtype=bool)
+        # without unary restrictions the base domains are the domains: one (read-only) array
+        base = dom if base_domains is None else np.array(base_domains, dtype=bool)
         if base.shape == (*self.shape, K):
             base = base.reshape(n, K)
         # fold self-arcs into the domains
@@ -205,7 +206,8 @@ class Problem:
             for c, r in a[selfarc][:, [0, 2]]:
                 diag = np.diagonal(rel[r]).copy()
                 dom[c] &= diag
-                base[c] &= diag
+                if base is not dom:
+                    base[c] &= diag
         w = np.ones(K) if weights is None else np.array(weights, dtype=np.float64).reshape(-1)
         if w.shape != (K,) or not np.all(np.isfinite(w)) or np.any(w < 0):
             raise InputError(f"weights must be {K} finite non-negative numbers")

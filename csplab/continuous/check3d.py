@@ -195,9 +195,13 @@ def _labelings(
     scale = max(1.0, float(np.abs(points).max()) if len(points) else 1.0)
     through = np.zeros((len(points), len(normals)), dtype=bool)
     for f, offs in enumerate(planes):
-        if len(offs):
+        if len(offs):  # the nearest offset (sorted), without a points x offsets matrix
             d = points @ normals[f]
-            through[:, f] = (np.abs(d[:, None] - offs[None, :]) <= 1e-9 * scale).any(axis=1)
+            o = np.sort(offs)
+            k = np.clip(np.searchsorted(o, d), 1, len(o) - 1) if len(o) > 1 else np.zeros(
+                len(d), dtype=np.int64)  # fmt: skip
+            near = np.minimum(np.abs(d - o[k]), np.abs(d - o[np.maximum(k - 1, 0)]))
+            through[:, f] = near <= 1e-9 * scale
     out = np.zeros((len(points), len(dirs)), dtype=np.int64)
     keys, inv = np.unique(through, axis=0, return_inverse=True)
     inv = inv.reshape(-1)

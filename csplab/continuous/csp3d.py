@@ -382,8 +382,9 @@ class ContinuousCSP3:
         rels = [rels[i] for i in order_used.tolist()]
         arcs[:, 2] = renum[arcs[:, 2]]
         self.edge_type = etype
+        dom = dom[order]  # (the unordered copy is freed before the problem copies it)
         self.problem = Problem(
-            (nv + ne,), dom[order], np.stack(rels), arcs,
+            (nv + ne,), dom, np.stack(rels), arcs,
             name=getattr(example, "name", "") or "continuous3d",
             meta={"continuous": True, "dim": 3, "size": list(A.size),
                   "spacing": float(self.lattice.spacing), "families": N.tolist(),
