@@ -3,7 +3,7 @@ Table 1 of the 2008 paper.
 
 For each built-in example (:mod:`csplab.examples.continuous3d`) it prints the paper's Table 1
 row (input polygons, output polygons, minutes) next to csplab's: the input polygons
-(``n_polygons``), and for the region sizes searched upwards (10x10x6, 20x20x8, 30x30x10, ...
+(``n_polygons``), and for the region sizes searched upwards (10x10x6, 14x14x6, 20x20x8, ...
 plane spacings) until the output has at least the paper's number of polygons or a run takes
 longer than ``--cap`` seconds, the output polygons and solids and the time of each phase of
 :func:`~csplab.continuous.synthesis.synthesize3` with ``catalog`` (restarts allowed):
@@ -46,7 +46,15 @@ PAPER_TABLE1: dict[str, tuple[int, int, float]] = {
     "houses": (39, 1908, 1.3),
     "pentagons": (33, 2004, 1.1),
 }
-SIZES = [(10, 10, 6), (20, 20, 8), (30, 30, 10), (40, 40, 12), (60, 60, 14), (80, 80, 16)]
+SIZES = [
+    (10, 10, 6),
+    (14, 14, 6),
+    (20, 20, 8),
+    (30, 30, 10),
+    (40, 40, 12),
+    (60, 60, 14),
+    (80, 80, 16),
+]
 MEMORY_SIZE = (40, 40, 20)
 MEMORY_TARGET_GB = 2.0
 RESTARTS = 10
