@@ -286,13 +286,16 @@ class PolyhedralModel:
     # ------------------------------------------------------------------ validation
     def _check_overlaps(self) -> None:
         n = len(self.solids)
-        pairs = [
-            (i, j)
-            for i in range(n)
-            for j in range(i + 1, n)
-            if self.solids[i].label != self.solids[j].label
-            and _boxes_meet(self.solids[i], self.solids[j])
-        ]
+        if n < 2:
+            return
+        lo = np.array([s.vertices.min(axis=0) for s in self.solids])
+        hi = np.array([s.vertices.max(axis=0) for s in self.solids])
+        lab = np.array([s.label for s in self.solids])
+        pairs = []
+        for i in range(n - 1):  # bounding boxes sharing interior points, different labels
+            j = np.arange(i + 1, n)
+            meet = (lo[i] < hi[j]).all(axis=1) & (lo[j] < hi[i]).all(axis=1) & (lab[j] != lab[i])
+            pairs += [(i, int(k)) for k in j[meet]]
         if not pairs:
             return
         cache: dict[int, Any] = {}
@@ -409,47 +412,60 @@ def _merge_vertices(
     return new_v, out
 
 
-def _newell(pts: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Twice the vector area of a polygon (normal direction by the right-hand rule)."""
-    nxt = np.roll(pts, -1, axis=0)
-    return np.asarray(np.cross(pts, nxt).sum(axis=0), dtype=np.float64)
-
-
 def _triangulate(
     v: NDArray[np.float64], polys: list[tuple[int, ...]], where: str, scale: float
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    tris: list[NDArray[np.int64]] = []
-    owner: list[NDArray[np.int64]] = []
+    """Triangles of the polygons (earcut in each polygon's plane) and each one's polygon;
+    normals and orientations in bulk."""
     for j, p in enumerate(polys):
         if len(set(p)) < 3:
             raise InputError(f"{where}: face {j} has zero area (fewer than 3 distinct vertices)")
-        pts = v[list(p)]
-        normal = _newell(pts)
-        area = 0.5 * float(np.linalg.norm(normal))
-        if area <= _AREA_TOL * scale**2:
-            raise InputError(f"{where}: face {j} has zero area")
-        if len(p) == 3:
-            t = np.asarray([p], dtype=np.int64)
-        else:
-            nz = normal / np.linalg.norm(normal)
-            ax = np.eye(3)[int(np.argmin(np.abs(nz)))]
-            e1 = np.cross(nz, ax)
-            e1 /= np.linalg.norm(e1)
-            e2 = np.cross(nz, e1)
-            flat = np.column_stack([(pts - pts[0]) @ e1, (pts - pts[0]) @ e2])
-            ring = np.asarray([len(p)], dtype=np.uint32)
-            idx = np.asarray(_earcut().triangulate_float64(flat, ring), dtype=np.int64)
-            if len(idx) != 3 * (len(p) - 2):
-                raise InputError(f"{where}: face {j} cannot be triangulated (not a simple polygon)")
-            loc = idx.reshape(-1, 3)
-            # earcut's winding in the (e1, e2) plane may be either: match the face's normal
-            a, b, c = pts[loc[:, 0]], pts[loc[:, 1]], pts[loc[:, 2]]
-            flip = np.cross(b - a, c - a) @ normal < 0
-            loc[flip] = loc[flip][:, ::-1]
-            t = np.asarray(p, dtype=np.int64)[loc]
-        tris.append(t)
-        owner.append(np.full(len(t), j, dtype=np.int64))
-    return np.concatenate(tris), np.concatenate(owner)
+    lens = np.fromiter((len(p) for p in polys), dtype=np.int64, count=len(polys))
+    flat = np.fromiter((i for p in polys for i in p), dtype=np.int64, count=int(lens.sum()))
+    start = np.concatenate([[0], np.cumsum(lens)])
+    nxt = np.arange(len(flat)) + 1
+    nxt[start[1:] - 1] = start[:-1]
+    a, b = v[flat], v[flat[nxt]]
+    normals = np.add.reduceat(np.cross(a, b), start[:-1], axis=0)  # Newell: 2x vector area
+    area = 0.5 * np.linalg.norm(normals, axis=1)
+    bad = np.flatnonzero(area <= _AREA_TOL * scale**2)
+    if bad.size:
+        raise InputError(f"{where}: face {int(bad[0])} has zero area")
+    tris: list[NDArray[np.int64]] = []
+    owner: list[NDArray[np.int64]] = []
+    tri3 = np.flatnonzero(lens == 3)
+    if tri3.size:
+        idx = start[tri3][:, None] + np.arange(3)[None, :]
+        tris.append(flat[idx])
+        owner.append(tri3)
+    unit = normals / (2 * area)[:, None]
+    for j in np.flatnonzero(lens > 3).tolist():
+        p = flat[start[j] : start[j + 1]]
+        pts = v[p]
+        x, y, z = unit[j].tolist()
+        # a basis of the face's plane (plain arithmetic: np.cross is slow on one vector)
+        k = min(range(3), key=lambda i: abs((x, y, z)[i]))
+        e1 = [(0.0, z, -y), (-z, 0.0, x), (y, -x, 0.0)][k]
+        n1 = math.sqrt(e1[0] ** 2 + e1[1] ** 2 + e1[2] ** 2)
+        a1 = (e1[0] / n1, e1[1] / n1, e1[2] / n1)
+        a2 = (y * a1[2] - z * a1[1], z * a1[0] - x * a1[2], x * a1[1] - y * a1[0])
+        rel = pts - pts[0]
+        flat2 = np.column_stack([rel @ np.array(a1), rel @ np.array(a2)])
+        ring = np.asarray([len(p)], dtype=np.uint32)
+        loc = np.asarray(_earcut().triangulate_float64(flat2, ring), dtype=np.int64)
+        if len(loc) != 3 * (len(p) - 2):
+            raise InputError(f"{where}: face {j} cannot be triangulated (not a simple polygon)")
+        tris.append(p[loc.reshape(-1, 3)])
+        owner.append(np.full(len(p) - 2, j, dtype=np.int64))
+    T = np.concatenate(tris)
+    own = np.concatenate(owner)
+    order = np.argsort(own, kind="stable")
+    T, own = T[order], own[order]
+    # earcut's winding in the (e1, e2) plane may be either: match each face's normal
+    ta, tb, tc = v[T[:, 0]], v[T[:, 1]], v[T[:, 2]]
+    flip = (np.cross(tb - ta, tc - ta) * normals[own]).sum(axis=1) < 0
+    T[flip] = T[flip][:, ::-1]
+    return T, own
 
 
 def _check_edges(faces: NDArray[np.int64], owner: NDArray[np.int64], where: str) -> None:
