@@ -293,9 +293,9 @@ class PolyhedralModel:
         lab = np.array([s.label for s in self.solids])
         pairs = []
         for i in range(n - 1):  # bounding boxes sharing interior points, different labels
-            j = np.arange(i + 1, n)
-            meet = (lo[i] < hi[j]).all(axis=1) & (lo[j] < hi[i]).all(axis=1) & (lab[j] != lab[i])
-            pairs += [(i, int(k)) for k in j[meet]]
+            js = np.arange(i + 1, n)
+            meet = (lo[i] < hi[js]).all(axis=1) & (lo[js] < hi[i]).all(axis=1) & (lab[js] != lab[i])
+            pairs += [(i, int(k)) for k in js[meet]]
         if not pairs:
             return
         cache: dict[int, Any] = {}
@@ -440,8 +440,8 @@ def _triangulate(
         owner.append(tri3)
     unit = normals / (2 * area)[:, None]
     for j in np.flatnonzero(lens > 3).tolist():
-        p = flat[start[j] : start[j + 1]]
-        pts = v[p]
+        ids = flat[start[j] : start[j + 1]]
+        pts = v[ids]
         x, y, z = unit[j].tolist()
         # a basis of the face's plane (plain arithmetic: np.cross is slow on one vector)
         k = min(range(3), key=lambda i: abs((x, y, z)[i]))
@@ -451,12 +451,12 @@ def _triangulate(
         a2 = (y * a1[2] - z * a1[1], z * a1[0] - x * a1[2], x * a1[1] - y * a1[0])
         rel = pts - pts[0]
         flat2 = np.column_stack([rel @ np.array(a1), rel @ np.array(a2)])
-        ring = np.asarray([len(p)], dtype=np.uint32)
+        ring = np.asarray([len(ids)], dtype=np.uint32)
         loc = np.asarray(_earcut().triangulate_float64(flat2, ring), dtype=np.int64)
-        if len(loc) != 3 * (len(p) - 2):
+        if len(loc) != 3 * (len(ids) - 2):
             raise InputError(f"{where}: face {j} cannot be triangulated (not a simple polygon)")
-        tris.append(p[loc.reshape(-1, 3)])
-        owner.append(np.full(len(p) - 2, j, dtype=np.int64))
+        tris.append(ids[loc.reshape(-1, 3)])
+        owner.append(np.full(len(ids) - 2, j, dtype=np.int64))
     T = np.concatenate(tris)
     own = np.concatenate(owner)
     order = np.argsort(own, kind="stable")
