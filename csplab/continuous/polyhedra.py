@@ -121,6 +121,11 @@ class Solid:
         tm = _trimesh()
         return tm.Trimesh(vertices=self.vertices, faces=self.faces, process=False)
 
+    def to_manifold(self, where: str = "solid") -> Any:
+        """The solid as a ``manifold3d.Manifold`` (for Boolean operations and volumes);
+        ``where`` names it in the error when manifold3d rejects it."""
+        return _as_manifold(self, where)
+
     def to_json(self) -> dict[str, Any]:
         """``{"label", "vertices", "faces"}`` (faces: the polygons) and the extra keys."""
         d: dict[str, Any] = dict(self.extra)

@@ -338,8 +338,6 @@ def _large_scale(model: Any, c: UserConstraints3, o: NDArray[np.float64], s: flo
     intersection volume above 1e-9 of the voxel)."""
     import manifold3d as man
 
-    from csplab.continuous.polyhedra import _as_manifold
-
     assert c.voxel is not None
     size = np.asarray(c.voxel, dtype=np.float64) * s
     out: list[Defect] = []
@@ -356,7 +354,7 @@ def _large_scale(model: Any, c: UserConstraints3, o: NDArray[np.float64], s: flo
                         if (x, y, z) in cells:
                             continue
                         if m is None:
-                            m = _as_manifold(sol, f"solid {i}")
+                            m = sol.to_manifold(f"solid {i}")
                         box = man.Manifold.cube(size.tolist()).translate(
                             (o + np.array([x, y, z]) * size).tolist()
                         )
