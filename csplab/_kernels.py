@@ -106,11 +106,17 @@ class Heap(NamedTuple):
     pos: NDArray[np.int64]  #: position of each cell in ``heap`` (-1: popped)
     key: NDArray[np.float64]  #: entropy + tie-breaking noise of each cell
     noise: NDArray[np.float64]  #: ``(n,)`` tie-breaking numbers in [0, 1)
+    #: ``(n,)`` sum of the weights and of ``w log w`` over ``D(v)``, kept up to date by
+    #: the propagation for weighted entropy keys (fast-wfc's memoised entropy: each removed
+    #: label is subtracted once); empty arrays: recomputed from the domain
+    sw: NDArray[np.float64] = np.zeros(0, dtype=np.float64)
+    swl: NDArray[np.float64] = np.zeros(0, dtype=np.float64)
 
     @staticmethod
     def empty() -> Heap:
         z = np.zeros(0, dtype=np.int64)
-        return Heap(z, z, np.zeros(0, dtype=np.float64), np.zeros(0, dtype=np.float64))
+        f = np.zeros(0, dtype=np.float64)
+        return Heap(z, z, f, f, f, f)
 
 
 class Run(NamedTuple):
@@ -366,7 +372,7 @@ def propagate(
     return _propagate(
         ac.dom, ac.prev, arcs.full, arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup, arcs.supall,
         ac.queue, ac.inq, start, nstart, ac.stats, hp.heap, hp.pos, hp.key, hsize, hp.noise,
-        arcs.weights, arcs.wlogw, weighted,
+        arcs.weights, arcs.wlogw, weighted, hp.sw, hp.swl,
     )  # fmt: skip
 
 
@@ -393,6 +399,8 @@ def _propagate(
     weights: np.ndarray,
     wlogw: np.ndarray,
     weighted: bool,
+    sw: np.ndarray,
+    swl: np.ndarray,
 ) -> int:
     """:func:`propagate` with flat arguments (Alg. 3.1 calls it per step with its own arrays).
 
@@ -498,6 +506,8 @@ def _propagate(
                     continue
             changed = False
             empty = True
+            inheap = hsize > 0 and hpos[v] >= 0 and hpos[v] < hsize
+            memo = inheap and weighted and sw.shape[0] > 0
             for w in range(W):
                 old = dom[v, w]
                 new = old & acc[w]
@@ -505,14 +515,24 @@ def _propagate(
                     stats[1] += popcount64(old ^ new)
                     dom[v, w] = new
                     changed = True
+                    if memo:
+                        x = old & ~new
+                        while x:
+                            a = w * 64 + ctz64(x)
+                            x &= x - np.uint64(1)
+                            sw[v] -= weights[a]
+                            swl[v] -= wlogw[a]
                 if new:
                     empty = False
             if changed:
                 if empty:
                     wiped = v
                     break
-                if hsize > 0 and hpos[v] >= 0 and hpos[v] < hsize:
-                    k = entropy_of(dom, v, weights, wlogw, weighted) + 1e-6 * noise[v]
+                if inheap:
+                    if memo and sw[v] > 1e-12:
+                        k = np.log(sw[v]) - swl[v] / sw[v] + 1e-6 * noise[v]
+                    else:
+                        k = entropy_of(dom, v, weights, wlogw, weighted) + 1e-6 * noise[v]
                     heap_update(heap, hpos, hkey, hsize, v, k)
                 if not inq[v]:
                     inq[v] = True
@@ -600,7 +620,7 @@ def alg31(
     sup, supall, weights, wlogw = arcs.sup, arcs.supall, arcs.weights, arcs.wlogw
     order, ustream, grid, state = run.order, run.ustream, run.grid, run.state
     trace_cell, trace_label = run.trace_cell, run.trace_label
-    heap, hpos, hkey, noise = hp.heap, hp.pos, hp.key, hp.noise
+    heap, hpos, hkey, noise, sw, swl = hp.heap, hp.pos, hp.key, hp.noise, hp.sw, hp.swl
     n = dom.shape[0]
     start = np.empty(1, dtype=np.int64)
     steps_here = 0
@@ -636,7 +656,7 @@ def alg31(
             wiped = _propagate(
                 dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
                 heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw,
-                key_weighted,
+                key_weighted, sw, swl,
             )  # fmt: skip
             if wiped >= 0:
                 state[2] = wiped

@@ -114,6 +114,11 @@ class _Compiled:
         self.supall = pack(both.any(axis=1))  # (2R, W): union of supports of all labels
         self.full = pack(np.ones((1, K), dtype=bool))[0]
         self.n, self.K, self.W = n, K, W
+        #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
+        #: wiped): every solve of the problem starts from it, so it is computed once
+        self.initial: tuple[Any, Any, Any, bool, int] | None = None
+        #: per weighting, the entropies (and weight sums) of that catalog
+        self.entropies: dict[bool, tuple[Any, Any, Any]] = {}
         w = np.asarray(problem.weights, dtype=np.float64)
         self.weights = np.ascontiguousarray(w)
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -171,7 +176,16 @@ class Propagator:
         self.ok = bool(np.all(self.bits.any(axis=1))) if n else True
         self.wiped: int = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
         if propagate_initial and self.ok:
-            self.propagate(None)
+            init = self.c.initial if domains is None else None
+            if init is not None:  # the problem's own fixpoint, computed once per problem
+                self.bits, self.prev = init[0].copy(), init[1].copy()
+                self.stats = init[2].copy()
+                self.ok, self.wiped = init[3], init[4]
+            else:
+                self.propagate(None)
+                if domains is None:
+                    self.c.initial = (self.bits.copy(), self.prev.copy(), self.stats.copy(),
+                                      self.ok, self.wiped)  # fmt: skip
 
     # --------------------------------------------------------------- core
     def propagate(self, changed: ArrayLike | None = None) -> bool:

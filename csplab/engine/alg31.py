@@ -95,9 +95,16 @@ def run_alg31(
     heap: kern.Heap | None = None
     key_weighted = weighted and order == "min-entropy"  # min-domain (MRV): label counts
     if order in _HEAP_ORDERS:
+        pristine = engine is None and eng.c.initial is not None
+        cached = eng.c.entropies.get(key_weighted) if pristine else None
+        if cached is None:
+            cached = _entropies(eng, key_weighted)
+            if pristine:
+                eng.c.entropies[key_weighted] = cached
+        ent, sw, swl = cached[0], cached[1].copy(), cached[2].copy()
         heap = kern.Heap(
             heap=np.arange(n, dtype=np.int64), pos=np.zeros(n, dtype=np.int64),
-            key=_entropies(eng, key_weighted) + 1e-6 * noise, noise=noise,
+            key=ent + 1e-6 * noise, noise=noise, sw=sw, swl=swl,
         )  # fmt: skip
         kern.heap_build(heap.heap, heap.pos, heap.key, n)
     run = kern.Run(
@@ -159,11 +166,14 @@ def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:
     raise InputError(f"order must be one of {', '.join(ORDERS)}, not {order!r}")
 
 
-def _entropies(eng: Propagator, weighted: bool) -> np.ndarray:
+def _entropies(eng: Propagator, weighted: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Entropy of every cell's catalog, and (weighted) the sums of weights and of
+    ``w log w`` the propagation keeps up to date (empty arrays when not weighted)."""
     C = eng.catalog()
     if not weighted:
         cnt = C.sum(axis=1)
-        return np.asarray(np.log(np.maximum(cnt, 1)), dtype=np.float64)
+        none = np.zeros(0, dtype=np.float64)
+        return np.asarray(np.log(np.maximum(cnt, 1)), dtype=np.float64), none, none
     w = eng.c.weights
     s = C @ w
     sl = C @ eng.c.wlogw
@@ -171,7 +181,8 @@ def _entropies(eng: Propagator, weighted: bool) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         h = np.where(s > 0, np.log(np.where(s > 0, s, 1.0)) - sl / np.where(s > 0, s, 1.0),
                      np.log(np.maximum(cnt, 1)))  # fmt: skip
-    return np.asarray(h, dtype=np.float64)
+    return (np.asarray(h, dtype=np.float64), np.ascontiguousarray(s, dtype=np.float64),
+            np.ascontiguousarray(sl, dtype=np.float64))  # fmt: skip
 
 
 def check_order(
