@@ -450,20 +450,38 @@ class Problem:
         ``cells`` (a speed-up for many small blocks; the result is the same).
         """
         idx = np.asarray(cells, dtype=np.int64).ravel()
-        lab = self._flat_grid(grid)
-        local = np.full(self.n, -1, dtype=np.int64)
-        local[idx] = np.arange(idx.size)
+        g = np.asarray(grid)
+        if g.shape != self.shape and g.shape != (self.n,):
+            raise InputError(f"grid has shape {g.shape}, the problem has shape {self.shape}")
+        if not (np.issubdtype(g.dtype, np.integer) or g.size == 0):
+            raise InputError(f"grid must hold integer labels, got dtype {g.dtype}")
+        flat = g.reshape(-1)  # a view: nothing of the whole grid's size is built per block
         a = self.arcs if arc_ids is None else self.arcs[np.asarray(arc_ids, dtype=np.int64)]
-        ls, ld = local[a[:, 0]], local[a[:, 1]]
+        if arc_ids is None:
+            local = np.full(self.n, -1, dtype=np.int64)
+            local[idx] = np.arange(idx.size)
+            ls, ld = local[a[:, 0]], local[a[:, 1]]
+        else:  # the position in ``cells`` of each arc end, by search (O(arcs log cells))
+            o = np.argsort(idx, kind="stable")
+            srt = idx[o]
+
+            def where(x: NDArray[np.int64]) -> NDArray[np.int64]:
+                p = np.minimum(np.searchsorted(srt, x), max(srt.size - 1, 0))
+                hit = srt[p] == x if srt.size else np.zeros(x.size, dtype=bool)
+                return np.where(hit, o[p] if srt.size else -1, -1)
+
+            ls, ld = where(a[:, 0]), where(a[:, 1])
+        lab_s = flat[a[:, 0]].astype(np.int64)
+        lab_d = flat[a[:, 1]].astype(np.int64)
         inside = (ls >= 0) & (ld >= 0)
         dom = self.domains[idx].copy()
         # outside src (labelled) -> inside dst
-        m = (ls < 0) & (ld >= 0) & (lab[a[:, 0]] >= 0)
+        m = (ls < 0) & (ld >= 0) & (lab_s >= 0)
         if m.any():
-            np.logical_and.at(dom, ld[m], self.relations[a[m, 2], lab[a[m, 0]], :])
-        m = (ls >= 0) & (ld < 0) & (lab[a[:, 1]] >= 0)
+            np.logical_and.at(dom, ld[m], self.relations[a[m, 2], lab_s[m], :])
+        m = (ls >= 0) & (ld < 0) & (lab_d >= 0)
         if m.any():
-            np.logical_and.at(dom, ls[m], self.relations[a[m, 2], :, lab[a[m, 1]]])
+            np.logical_and.at(dom, ls[m], self.relations[a[m, 2], :, lab_d[m]])
         arcs = np.stack([ls[inside], ld[inside], a[inside, 2]], axis=1)
         shp = (idx.size,) if shape is None else tuple(shape)
         return Problem(
