@@ -36,17 +36,8 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-# Merrell & Manocha, "Continuous Model Synthesis", SIGGRAPH Asia 2008, Table 1 ("Complexity
-# of the input and output models and computation time for various results"): input
-# polygons, output polygons, time in minutes.
-PAPER_TABLE1: dict[str, tuple[int, int, float]] = {
-    "skyscrapers": (27, 9542, 1.8),
-    "terrain": (22, 922, 0.5),
-    "fractals": (8, 5743, 0.2),
-    "arches": (20, 1002, 0.5),
-    "houses": (39, 1908, 1.3),
-    "pentagons": (33, 2004, 1.1),
-}
+from csplab.experiments.table1_continuous import PAPER_TABLE1
+
 SIZES = [
     (10, 10, 6),
     (14, 14, 6),

@@ -10,21 +10,13 @@ from csplab.continuous.csp3d import ContinuousCSP3, labels_at
 from csplab.continuous.space import Arrangement3, Lattice3, central_cells
 from csplab.errors import InputError
 from csplab.solvers import solve
+from tests._meshes import box as _box
 
 polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
 pytest.importorskip("trimesh")
 
 TET = {"label": 1, "vertices": [[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]],
        "faces": [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]}  # fmt: skip
-
-
-def _box(label: int, lo: list[int], hi: list[int]) -> dict[str, object]:
-    x0, y0, z0 = lo
-    x1, y1, z1 = hi
-    v = [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
-         [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]]  # fmt: skip
-    f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]]
-    return {"label": label, "vertices": v, "faces": f}
 
 
 def _scaled(d: dict[str, object], t: int, off: int) -> dict[str, object]:

@@ -15,19 +15,11 @@ import pytest
 from csplab.continuous.synthesis import synthesize3
 from csplab.continuous.user3d import parse_user_constraints, read_user_constraints, user_violations3
 from csplab.errors import InputError
+from tests._meshes import box as _box
 
 polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
 pytest.importorskip("trimesh")
 pytest.importorskip("pysat")
-
-
-def _box(label: int, lo: list[int], hi: list[int]) -> dict[str, object]:
-    x0, y0, z0 = lo
-    x1, y1, z1 = hi
-    v = [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
-         [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]]  # fmt: skip
-    f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]]
-    return {"label": label, "vertices": v, "faces": f}
 
 
 E = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 2])], name="box")

@@ -7,8 +7,6 @@ import json
 import sys
 from typing import Any
 
-import numpy as np
-
 from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 from csplab.grids import parse_shape
@@ -194,7 +192,7 @@ def check(args: argparse.Namespace, example: Any) -> int:
             from csplab.continuous.space import Lattice3
             from csplab.continuous.user3d import user_violations3
 
-            lat = _example_lattice(example, Lattice3)
+            lat = Lattice3.of_model(example)
             origin = [float(x) for x in lat.origin]
             extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
             v3 = Violations([*v3, *extra])
@@ -243,13 +241,3 @@ def cons_summary(c: Any) -> list[str]:
     if c.connected:
         out.append(f"connected {list(c.connected)}")
     return out
-
-
-def _example_lattice(example: Any, lattice: Any) -> Any:
-    """The plane lattice of a polyhedral example (origin = the output region's corner)."""
-    pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
-    polys, base = [], 0
-    for s in example.solids:
-        polys += [[base + int(i) for i in p] for p in s.polygons]
-        base += len(s.vertices)
-    return lattice.of(pts, polys, where=example.source)

@@ -6,6 +6,7 @@ import argparse
 import json
 
 from csplab.cli.common import (
+    add_constraints_arg,
     add_problem_args,
     load_grid,
     load_model,
@@ -35,13 +36,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         metavar="GRID",
         help=f"grid file to check ({exts}: label ids kept; .vox: colour b + 1 = label b)",
     )
-    p.add_argument(
-        "--constraints",
-        action="append",
-        metavar="FILE",
-        help='a constraints file {"constraints": [...]} (repeatable); polyhedral models take '
-        "dimensional, large-scale and connected (thesis Sec. 4.6)",
-    )
+    add_constraints_arg(p)
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 

@@ -28,6 +28,7 @@ from csplab.problem import Problem
 __all__ = [
     "COMPILING",
     "Model",
+    "add_constraints_arg",
     "add_problem_args",
     "check_output_dir",
     "check_output_path",
@@ -286,6 +287,17 @@ def _vox_labels(p: Path, model: Model | None) -> NDArray[np.int64]:
     if empty is not None and empty >= 0:
         g[g < 0] = empty
     return g
+
+
+def add_constraints_arg(p: argparse.ArgumentParser) -> None:
+    """``--constraints FILE`` (repeatable), for the commands that take constraints."""
+    p.add_argument(
+        "--constraints",
+        action="append",
+        metavar="FILE",
+        help='a constraints file {"constraints": [...]} (repeatable); polyhedral models take '
+        "dimensional, large-scale and connected (thesis Sec. 4.6)",
+    )
 
 
 def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) -> None:

@@ -8,6 +8,7 @@ import sys
 from typing import Any
 
 from csplab.cli.common import (
+    add_constraints_arg,
     add_problem_args,
     check_output_path,
     key_values,
@@ -106,13 +107,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="also write a failed or timed-out run's partial grid (unassigned cells -1; "
         f"{', '.join(output_extensions(partial=True))})",
     )
-    p.add_argument(
-        "--constraints",
-        action="append",
-        metavar="FILE",
-        help='a constraints file {"constraints": [...]} (repeatable); polyhedral models take '
-        "dimensional, large-scale and connected (thesis Sec. 4.6)",
-    )
+    add_constraints_arg(p)
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
 
 

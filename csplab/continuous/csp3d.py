@@ -235,13 +235,8 @@ class ContinuousCSP3:
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
-        pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
-        polys, base = [], 0
-        for s in example.solids:
-            polys += [[base + int(i) for i in p] for p in s.polygons]
-            base += len(s.vertices)
         self.example = example
-        self.lattice = Lattice3.of(pts, polys, spacing, snap=snap, where=example.source)
+        self.lattice = Lattice3.of_model(example, spacing, snap=snap)
         self.labels: tuple[int, ...] = (0, *example.labels)
         index = {b: i for i, b in enumerate(self.labels)}
         faces = _boundary_faces(boundary)

@@ -150,6 +150,20 @@ class Lattice3:
             )
         return cls(origin, s, tuple(sorted(normals)), off if snap else 0.0)  # type: ignore[arg-type]
 
+    @classmethod
+    def of_model(
+        cls, example: Any, spacing: float | None = None, *, snap: bool = False
+    ) -> Lattice3:
+        """:meth:`of` the vertices and polygons of a polyhedral model (its ``source`` named
+        in errors)."""
+        pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
+        polys: list[list[int]] = []
+        base = 0
+        for s in example.solids:
+            polys += [[base + int(i) for i in p] for p in s.polygons]
+            base += len(s.vertices)
+        return cls.of(pts, polys, spacing, snap=snap, where=example.source)
+
     def to_lattice(self, xyz: NDArray[np.float64]) -> NDArray[np.float64]:
         """World coordinates -> lattice coordinates (floats)."""
         o = np.array([float(v) for v in self.origin])
