@@ -127,10 +127,11 @@ def _options(items: list[str] | None) -> dict[str, Any] | None:
 def _list() -> int:
     from csplab.experiments import EXPERIMENTS, get_experiment
 
+    width = max(map(len, EXPERIMENTS)) + 1
     for name in EXPERIMENTS:
         exp = get_experiment(name)
-        print(f"{name:<14} {exp.title}")
-        print(f"{'':<14} {exp.description}")
+        print(f"{name:<{width}} {exp.title}")
+        print(f"{'':<{width}} {exp.description}")
     return 0
 
 
