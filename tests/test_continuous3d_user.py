@@ -73,6 +73,10 @@ def test_connected_exact_with_sat_and_the_breach_is_found() -> None:
     touching = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 2]),
                                           _box(1, [2, 2, 0], [4, 4, 2])])  # fmt: skip
     assert not user_violations3(touching, c, origin=ORIGIN, spacing=2.0)
+    none = user_violations3(polyhedra.PolyhedralModel([]), c, origin=ORIGIN, spacing=2.0)
+    assert [x.kind for x in none] == ["connected"] and "0 separate groups" in none[0].detail
+    labels = [x.label for x in s.model.solids]
+    assert labels.count(1) == 1  # exactly one group of label 1
 
 
 def test_incomplete_solvers_never_report_solved_with_a_broken_constraint() -> None:

@@ -114,6 +114,7 @@ def synthesize3(
     restarts: int = 0,
     check: bool = True,
     constraints: Any = None,
+    progress: bool = False,
     **options: Any,
 ) -> Synthesis:
     """Continuous model synthesis in 3D of a polyhedral ``example`` in an ``A x B x C``
@@ -124,7 +125,7 @@ def synthesize3(
     ones restrict the CSP, and while the output breaks one (a connectivity constraint) the
     synthesis runs again with a fresh derived seed, at most ``restarts`` times (for every
     solver); an output that still breaks one is ``failed`` (its ``stats["broken"]`` says
-    which), never ``solved``.
+    which), never ``solved``. ``progress`` shows the exact connectivity search's rounds.
 
     Examples
     --------
@@ -159,7 +160,8 @@ def synthesize3(
         run_seed = seed if attempts == 1 else int(gen.integers(2**63))
         if constraints and constraints.connected and solver.split(":")[0] == "sat":
             result = connected_sat(csp, constraints.connected, solver, rng=run_seed,
-                                   time_limit=options.get("time_limit"))  # fmt: skip
+                                   time_limit=options.get("time_limit"),
+                                   progress=progress)  # fmt: skip
         else:
             result = solve(csp.problem, solver, rng=run_seed, restarts=restarts, **options)
         t2 = time.perf_counter()
@@ -196,22 +198,29 @@ def _touches(states: list[tuple[int, ...]], outside: NDArray[np.int64], b: int) 
 
 def connected_sat(
     csp: Any, labels: Sequence[int], solver: str = "sat", *, rng: RngLike = None,
-    time_limit: float | None = None,
+    time_limit: float | None = None, progress: bool = False,
 ) -> Result:  # fmt: skip
     """Exact connectivity (thesis Sec. 4.6.2) with the SAT oracle: a lazy cut loop.
 
-    The objects of a label ``b`` are connected exactly when the arrangement vertices whose
-    state touches ``b`` (inside the region), joined by the edges whose state touches ``b``,
-    form one component. Solve; while the output has several components, add for each
-    component ``C`` but the largest ``L`` the cut "if some vertex of ``C`` and a vertex of
-    ``L`` touch ``b``, some edge leaving ``C`` does" (sound: every path from ``C`` to ``L``
-    leaves ``C`` by such an edge), and solve again. The answer is ``solved`` with a connected
-    output, ``unsat`` (no connected output exists) or ``timeout``.
+    The objects of a label ``b`` form one connected group exactly when the arrangement
+    vertices whose state touches ``b`` (inside the region), joined by the edges whose state
+    touches ``b``, form one component (so some vertex touches ``b``: one clause). Solve;
+    while the output has several components, add for every ordered pair of components
+    ``(C, D)`` the cut "if some vertex of ``C`` and some vertex of ``D`` touch ``b``, some
+    edge leaving ``C`` does" (sound: every path from ``C`` to ``D`` leaves ``C`` by such an
+    edge; "some vertex of C touches b" is one new variable implied by each of their
+    states), and solve again. The answer is ``solved`` with a connected output, ``unsat``
+    (no connected output exists) or ``timeout``. The solver tends to remove objects rather
+    than join them, so outputs are connected but often small. ``progress`` shows the rounds
+    on stderr once they take over 2 s.
     """
+    import itertools
+
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
     from csplab.engine.sat import SatOracle, preferred_labels
+    from csplab.progress import progress_bar
     from csplab.rng import make_rng
 
     gen, seed = make_rng(rng)
@@ -237,25 +246,22 @@ def connected_sat(
                 te[t][_touches(st, csp.edge_outside[t], bi)] = True
             touch_v.append(tv)
             touch_e.append(te)
-        aux: dict[tuple[int, int], int] = {}
-
-        def active(li: int, v: int) -> int:
-            """A variable implied by every state of vertex ``v`` touching label ``li``."""
-            key = (li, v)
-            if key not in aux:
-                y = aux[key] = o.new_var()
-                t = int(csp.vertex_type[v])
-                cell = int(csp.var_vertex[v])
-                for s in np.flatnonzero(touch_v[li][t]).tolist():
-                    if P.domains[cell, s]:
-                        o.add_clause([-o.literal(cell, s), y])
-            return aux[key]
-
         if not o.enc.ok:
             status = "unsat"
         else:  # random decision phases, as the sat solver's default (diverse outputs)
             o.set_phases(preferred_labels(o.enc.catalog, None, gen))
-        while o.enc.ok:
+            # one group means at least one object: some vertex touches each label
+            for li in range(len(labels)):
+                some_b = []
+                for t, mask in enumerate(touch_v[li]):
+                    for v in np.flatnonzero(csp.vertex_type == t).tolist():
+                        cell = int(csp.var_vertex[v])
+                        for s in np.flatnonzero(mask & P.domains[cell, : len(mask)]).tolist():
+                            some_b.append(o.literal(cell, s))
+                o.add_clause(some_b)
+        rounds = progress_bar(itertools.count(), total=None, desc="connectivity cuts",
+                              enabled=progress, unit="round")  # fmt: skip
+        for _ in rounds if o.enc.ok else ():
             if deadline is not None and time.perf_counter() > deadline:
                 break
             r = o.solve(deadline=deadline)
@@ -285,30 +291,38 @@ def connected_sat(
                 if len(labs) <= 1:
                     continue
                 big = int(labs[np.argmax(counts)])
-                z = int(idx[comp[idx] == big][0])
-                for c in labs.tolist():
-                    if c == big:
-                        continue
-                    inC = comp == c
-                    inC[~av] = False
-                    leave = np.flatnonzero(inC[src] != inC[dst])
-                    # "some vertex of C touches b" (implied by each of their states)
-                    yc = o.new_var()
-                    for a in np.flatnonzero(inC).tolist():
+
+                def some(vs: NDArray[np.int64], li: int = li) -> int:
+                    """A variable implied by every state touching b at the vertices vs."""
+                    y = o.new_var()
+                    for a in vs.tolist():
                         t = int(csp.vertex_type[a])
                         cell = int(csp.var_vertex[a])
                         for s in np.flatnonzero(touch_v[li][t]).tolist():
                             if P.domains[cell, s]:
-                                o.add_clause([-o.literal(cell, s), yc])
-                    clause = [-yc, -active(li, z)]
-                    for e in leave.tolist():
+                                o.add_clause([-o.literal(cell, s), y])
+                    return y
+
+                # one "touches b somewhere in it" variable per component; for every pair
+                # (C, D): some vertex of C and some vertex of D touch b -> an edge leaves C
+                ys, exits = {}, {}
+                for c in labs.tolist():
+                    inC = (comp == c) & av
+                    ys[c] = some(np.flatnonzero(inC))
+                    lits = []
+                    for e in np.flatnonzero(inC[src] != inC[dst]).tolist():
                         cell = int(csp.var_edge[e])
                         t = int(csp.edge_type[e])
                         for s in np.flatnonzero(touch_e[li][t]).tolist():
                             if P.domains[cell, s]:
-                                clause.append(o.literal(cell, s))
-                    o.add_clause(clause)
-                    cuts += 1
+                                lits.append(o.literal(cell, s))
+                    exits[c] = lits
+                del big
+                for c in labs.tolist():
+                    for d in labs.tolist():
+                        if c != d:
+                            o.add_clause([-ys[c], -ys[d], *exits[c]])
+                            cuts += 1
             stats["cuts"] += cuts
             if cuts == 0:
                 status = "sat"

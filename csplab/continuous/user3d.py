@@ -15,8 +15,10 @@ Three kinds, read from the constraints file shared with the grid constraints
     free; empty space always is). A state is removed when one of its sectors lies in a
     voxel where its label is not allowed: a domain restriction, **exact for every solver**.
 ``{"type": "connected", "labels": [1]}``
-    Sec. 4.6.2: all objects of these labels form one connected whole (closures meeting at
-    least at a point; no label: nothing to connect). The thesis grows objects from a seed;
+    Sec. 4.6.2: the objects of each of these labels form exactly one connected group
+    (closures meeting at least at a point; an output without the label breaks it: there is
+    no group, like the thesis' single seed grown into a road network). The thesis grows
+    objects from a seed;
     csplab **checks** the output and, for every solver, runs again with a fresh derived seed
     while the output is disconnected (``restarts``), and never reports ``solved`` for a
     disconnected output: it is enforced by retrying, not encoded.
@@ -309,10 +311,10 @@ def user_violations3(
         out += _large_scale(model, c, o, s)
     for b in c.connected:
         groups = _touching_groups([sol for sol in model.solids if sol.label == b])
-        if groups > 1:
+        if groups != 1:
             out.append(Defect("connected", (float("nan"), float("nan")),
                               f"the objects of label {b} form {groups} separate groups "
-                              "(one is required)"))  # fmt: skip
+                              "(exactly one is required)"))  # fmt: skip
     return out
 
 
