@@ -104,6 +104,8 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     if cons is not None:
         common["constraints"] = cons
         settings["constraints"] = ", ".join(cons_summary(cons))
+        if cons.connected and cls.name == "sat":
+            common["progress"] = True  # the cut loop's rounds, once it takes over 2 s
         if not cls.complete or cons.connected:
             common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
     if dim == 2:
