@@ -467,34 +467,34 @@ def _plane_basis(n: NDArray[np.int64]) -> tuple[NDArray[np.float64], NDArray[np.
 
 
 def _trace(
-    rays: dict[int, list[tuple[float, int, int]]],
-    inside: dict[int, list[bool]],
-    where: dict[tuple[int, int], int],
+    inside: list[bool],
+    starts: list[int],
+    rw: list[int],
+    rev: list[int],
+    gs: list[int],
+    gz: list[int],
 ) -> list[list[int]]:
     """Rings (vertex ids, every vertex kept) around the in-plane region of the sectors
-    marked ``inside``, counter-clockwise; ``rays[v]`` are ``(angle, other vertex, ray id)``
-    sorted by angle, ``inside[v][i]`` says whether the sector after ray ``i`` belongs,
-    ``where[(v, w)]`` is the position of the ray from ``v`` to ``w`` in ``rays[v]``."""
-    starts = [(v, i) for v, m in inside.items() for i in range(len(m))
-              if m[i] and not m[i - 1]]  # fmt: skip
-    used: set[tuple[int, int]] = set()
+    marked ``inside``, counter-clockwise. Rays are sorted by vertex, then angle; ray ``j``
+    goes to vertex ``rw[j]``, ``rev[j]`` is the same edge seen from there, ``gs[j]`` and
+    ``gz[j]`` the first ray and the number of rays of its vertex; ``inside[j]`` says whether
+    the sector after ray ``j`` belongs, ``starts`` are the rays after which a region begins."""
+    used = [False] * len(inside)
     rings = []
-    for start in starts:
-        if start in used:
+    for j0 in starts:
+        if used[j0]:
             continue
         ring: list[int] = []
-        v, i = start
-        while (v, i) not in used:
-            used.add((v, i))
-            w = rays[v][i][1]
-            ring.append(w)
-            j = where[(w, v)]  # the ray at w pointing back to v
-            k = j - 1
-            mw = inside[w]
-            m = len(mw)
-            while mw[(k - 1) % m]:
+        j = j0
+        while not used[j]:
+            used[j] = True
+            ring.append(rw[j])
+            jr = rev[j]  # the ray at the next vertex pointing back
+            g, m = gs[jr], gz[jr]
+            k = jr - g - 1
+            while inside[g + (k - 1) % m]:
                 k -= 1
-            v, i = w, k % m
+            j = g + k % m
         rings.append(ring)
     return rings
 
@@ -547,6 +547,14 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
         return lookups[t].get(sig, -1)
 
     sector_cache: dict[tuple[int, ...], tuple[int, int]] = {}
+    tables: dict[int, NDArray[np.int64]] = {}
+
+    def state_table(t: int) -> NDArray[np.int64]:
+        """The states of vertex type ``t`` as an array (state, group) -> label."""
+        if t not in tables:
+            tables[t] = np.array(self.vtypes[t][1], dtype=np.int64).reshape(
+                len(self.vtypes[t][1]), -1)  # fmt: skip
+        return tables[t]
 
     def sector_groups(v: int, t: int, f: int, e1: NDArray[np.float64], e2: NDArray[np.float64],
                       a0: float, a1: float, nrays: int) -> tuple[int, int]:  # fmt: skip
@@ -587,45 +595,67 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
         kk = s[A.edge_src[sel], f] // A.D
         for k in np.unique(kk).tolist():
             es = sel[kk == k]
-            rays: dict[int, list[tuple[float, int, int]]] = {}
             src, dst = A.edge_src[es], A.edge_dst[es]
             dvec = xyz[dst] - xyz[src]
-            ang_f = np.arctan2(dvec @ e2, dvec @ e1).tolist()
-            ang_b = np.arctan2(-dvec @ e2, -dvec @ e1).tolist()
-            line = A.edge_line[es].tolist()
-            for a, b, li, af, ab in zip(src.tolist(), dst.tolist(), line, ang_f, ang_b,
-                                        strict=True):  # fmt: skip
-                rays.setdefault(a, []).append((af, b, 2 * li))
-                rays.setdefault(b, []).append((ab, a, 2 * li + 1))
-            sect: dict[int, list[tuple[int, int]]] = {}
-            for v, rs in rays.items():
-                rs.sort()
-                t = int(self.vertex_type[v])
-                st = self.vtypes[t][1][int(vstate[v])]
-                outside = self.vertex_outside[t]  # outside the region: not the output
-                out = []
-                for i in range(len(rs)):
-                    nxt = rs[(i + 1) % len(rs)]
-                    ck = (t, f, rs[i][2], nxt[2], len(rs))
-                    if ck not in sector_cache:
-                        sector_cache[ck] = sector_groups(v, t, f, e1, e2, rs[i][0], nxt[0],
-                                                         len(rs))  # fmt: skip
-                    gp, gm = sector_cache[ck]
-                    out.append((st[gp] if gp >= 0 and outside[gp] < 0 else -1,
-                                st[gm] if gm >= 0 and outside[gm] < 0 else -1))  # fmt: skip
-                sect[v] = out
-            labels = {b for ps in sect.values() for p in ps if p[0] != p[1] for b in p if b > 0}
-            where = {(v, w): i for v, rs in rays.items() for i, (_, w, _) in enumerate(rs)}
+            ne = len(es)
+            # every ray (an edge seen from one end), sorted by vertex, then angle
+            rv = np.concatenate([src, dst])
+            rw = np.concatenate([dst, src])
+            ra = np.concatenate([np.arctan2(dvec @ e2, dvec @ e1),
+                                 np.arctan2(-dvec @ e2, -dvec @ e1)])  # fmt: skip
+            li = A.edge_line[es]
+            rid = np.concatenate([2 * li, 2 * li + 1])
+            o = np.lexsort((ra, rv))
+            rv, rw, ra, rid = rv[o], rw[o], ra[o], rid[o]
+            back = np.empty(2 * ne, dtype=np.int64)
+            back[o] = np.arange(2 * ne)
+            rev = back[(o + ne) % (2 * ne)]  # the same edge seen from its other end
+            first = np.flatnonzero(np.r_[True, rv[1:] != rv[:-1]])
+            sizes = np.diff(np.r_[first, 2 * ne])
+            gs = np.repeat(first, sizes)
+            gz = np.repeat(sizes, sizes)
+            j = np.arange(2 * ne)
+            nxt = np.where(j + 1 < gs + gz, j + 1, gs)
+            prv = np.where(j > gs, j - 1, gs + gz - 1)
+            tt = self.vertex_type[rv]
+            # the groups above and below the plane in each sector (after each ray)
+            nl2 = 2 * len(A.lines) + 1
+            key = ((tt.astype(np.int64) * nl2 + rid) * nl2 + rid[nxt]) * nl2 + gz
+            uk, first_k, inv_k = np.unique(key, return_index=True, return_inverse=True)
+            gpm = np.empty((len(uk), 2), dtype=np.int64)
+            for u, c in enumerate(uk.tolist()):
+                t, r0, r1, nr = c // nl2**3, c // nl2**2 % nl2, c // nl2 % nl2, c % nl2
+                ck = (t, f, r0, r1, nr)
+                if ck not in sector_cache:
+                    jj = int(first_k[u])
+                    sector_cache[ck] = sector_groups(int(rv[jj]), t, f, e1, e2, float(ra[jj]),
+                                                     float(ra[nxt[jj]]), nr)  # fmt: skip
+                gpm[u] = sector_cache[ck]
+            gpm = gpm[inv_k.reshape(-1)]
+            lab_a = np.full(2 * ne, -1, dtype=np.int64)  # the label above the plane
+            lab_b = np.full(2 * ne, -1, dtype=np.int64)  # and below it
+            for t in np.unique(tt).tolist():
+                m = tt == t
+                S, outside = state_table(t), np.asarray(self.vertex_outside[t])
+                rows = vstate[rv[m]]
+                for col, out_arr in ((0, lab_a), (1, lab_b)):
+                    g = gpm[m, col]
+                    gc = np.maximum(g, 0)
+                    ok = (g >= 0) & (outside[gc] < 0)
+                    out_arr[m] = np.where(ok, S[rows, gc], -1)
+            diff = lab_a != lab_b
+            labels = set(np.unique(np.concatenate([lab_a[diff], lab_b[diff]])).tolist()) - {-1, 0}
+            arrays = (rw.tolist(), rev.tolist(), gs.tolist(), gz.tolist())
             for b in sorted(labels):
                 # the faces of solid b on this plane: b below (outward +n), b above (-n)
-                for below in (True, False):
-                    inside = {v: [(p[1] == b and p[0] != b) if below else
-                                  (p[0] == b and p[1] != b) for p in ps]
-                              for v, ps in sect.items()}  # fmt: skip
-                    if not any(any(m) for m in inside.values()):
+                for is_below in (True, False):
+                    mask = ((lab_b == b) & (lab_a != b)) if is_below else (
+                        (lab_a == b) & (lab_b != b))  # fmt: skip
+                    if not mask.any():
                         continue
-                    rings = _trace(rays, inside, where)
-                    if not below:
+                    starts = np.flatnonzero(mask & ~mask[prv]).tolist()
+                    rings = _trace(mask.tolist(), starts, *arrays)
+                    if not is_below:
                         rings = [r[::-1] for r in rings]  # counter-clockwise seen from -n
                     if all(len(set(r)) == len(r) for r in rings):
                         # checked after the loop: a ring turning the wrong way is a hole
@@ -633,12 +663,12 @@ def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
                             rings_out.append(r)
                             ring_label.append(b)
                             ring_axis.append(axis)
-                            ring_sign.append(int(np.sign(N[f, axis])) * (1 if below else -1))
+                            ring_sign.append(int(np.sign(N[f, axis])) * (1 if is_below else -1))
                             ring_group.append(len(groups))
-                        groups.append((b, rings, 1 if below else -1, e1, e2))
+                        groups.append((b, rings, 1 if is_below else -1, e1, e2))
                     else:  # rings touching themselves: constrained Delaunay
-                        loose.append((b, [r[::-1] if not below else r for r in rings],
-                                      1 if below else -1, e1, e2))  # fmt: skip
+                        loose.append((b, [r[::-1] if not is_below else r for r in rings],
+                                      1 if is_below else -1, e1, e2))  # fmt: skip
     holes = _clockwise(XYZ, rings_out, ring_axis, ring_sign)
     if holes.any():  # regions with holes: constrained Delaunay
         bad = set(np.asarray(ring_group)[holes].tolist())
