@@ -121,7 +121,7 @@ def _samples(model: Any, dense: int) -> NDArray[np.float64]:
     """Points where ``model``'s neighbourhoods are taken: vertices, edge pieces, triangles
     (``dense`` > 1: that many points along each edge and a grid on each triangle)."""
     pts = [np.asarray(s.vertices, dtype=np.float64) for s in model.solids]
-    verts = np.unique(np.concatenate(pts), axis=0) if pts else np.zeros((0, 3))
+    verts = _unique_rows(np.concatenate(pts) + 0.0) if pts else np.zeros((0, 3))
     out = [verts]
     if dense <= 1:
         if not pts:
@@ -132,7 +132,7 @@ def _samples(model: Any, dense: int) -> NDArray[np.float64]:
         # every edge once (by coordinates: solids have their own vertex arrays)
         ab = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
         key = np.where(_lex_less(ab[:, 0], ab[:, 1])[:, None, None], ab, ab[:, ::-1])
-        edges = np.unique(key.reshape(-1, 6), axis=0).reshape(-1, 2, 3)
+        edges = _unique_rows(key.reshape(-1, 6) + 0.0).reshape(-1, 2, 3)
         out.append(_edge_pieces(edges[:, 0], edges[:, 1], verts))
         return np.concatenate(out)
     for s in model.solids:
@@ -150,6 +150,15 @@ def _samples(model: Any, dense: int) -> NDArray[np.float64]:
             out.append(tri[:, 0] + u * (tri[:, 1] - tri[:, 0]) + w * (tri[:, 2] - tri[:, 0]))
         out.append(tri.mean(axis=1))
     return np.concatenate(out)
+
+
+def _unique_rows(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The distinct rows of a float array (``-0.0`` given as ``0.0``), in some order."""
+    a = np.ascontiguousarray(a)
+    v = a.view(np.dtype((np.void, a.dtype.itemsize * a.shape[1]))).reshape(-1)
+    _, idx = np.unique(v, return_index=True)
+    out: NDArray[np.float64] = a[np.sort(idx)]
+    return out
 
 
 def _lex_less(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -203,7 +212,9 @@ def _labelings(
             near = np.minimum(np.abs(d - o[k]), np.abs(d - o[np.maximum(k - 1, 0)]))
             through[:, f] = near <= 1e-9 * scale
     out = np.zeros((len(points), len(dirs)), dtype=np.int64)
-    keys, inv = np.unique(through, axis=0, return_inverse=True)
+    code = through.astype(np.int64) @ (1 << np.arange(through.shape[1], dtype=np.int64))
+    ucode, inv = np.unique(code, return_inverse=True)
+    keys = (ucode[:, None] >> np.arange(through.shape[1])) & 1 > 0
     inv = inv.reshape(-1)
     jobs = []
     queries = []
