@@ -34,6 +34,7 @@ COMMANDS: dict[str, str] = {
     "reduction": "csplab.cli.reduction",
     "count": "csplab.cli.count",
     "experiment": "csplab.cli.experiment",
+    "baseline": "csplab.cli.baseline",
 }
 
 

@@ -14,6 +14,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from csplab import __version__
+    from csplab.baselines import BASELINES
     from csplab.examples import example_info
     from csplab.io.registry import FORMATS
     from csplab.solvers import available_solvers
@@ -29,6 +30,7 @@ def run(args: argparse.Namespace) -> int:
                     "solvers": solvers,
                     "examples": dict(examples),
                     "formats": formats,
+                    "baselines": {b.name: b.summary for b in BASELINES.values()},
                 }
             )
         )
@@ -57,4 +59,9 @@ def run(args: argparse.Namespace) -> int:
         print(f"  {f.name:<13} {rw:<10} {' '.join(f.extensions):<15} {f.description}")
         for o in f.options:
             print(f"  {'':<13} {o.usage}: {o.help}")
+    print("baselines (csplab baseline NAME MODEL --size ...):")
+    for b in BASELINES.values():
+        print(f"  {b.name:<10} {b.summary}")
+        for bo in b.options:
+            print(f"  {'':<10} --{bo.name}={bo.default!r}: {bo.help}")
     return 0

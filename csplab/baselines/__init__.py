@@ -1,0 +1,90 @@
+"""Baselines the seeds compare model synthesis against, runnable on the same inputs.
+
+Each baseline declares itself once in :data:`BASELINES` (name, summary, options, function);
+``csplab baseline NAME MODEL --size ... --out FILE`` and ``csplab info`` are derived from
+the declaration. A grid baseline returns an ordinary label grid, so ``csplab check`` counts
+the adjacency constraints it breaks (model synthesis breaks none by construction).
+
+To add one: write ``csplab/baselines/NAME.py`` with a function ``f(example, size, *, rng,
+**options) -> grid``, add a :class:`Baseline` entry to :data:`BASELINES` with its options,
+and a test under ``tests/baselines/``.
+
+Examples
+--------
+>>> from csplab.examples import load_example
+>>> g = run_baseline("texture", load_example("fig3_10"), (8, 8), rng=0, window=3)
+>>> g.shape
+(8, 8)
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from numpy.typing import NDArray
+
+from csplab.errors import InputError
+
+__all__ = ["BASELINES", "Baseline", "BaselineOption", "run_baseline"]
+
+
+@dataclass(frozen=True)
+class BaselineOption:
+    """One option of a baseline: its name (``--name`` on the command line), type, default
+    and help."""
+
+    name: str
+    type: type
+    default: Any
+    help: str
+
+
+@dataclass(frozen=True)
+class Baseline:
+    """A declared baseline: ``function`` is ``"module:function"``."""
+
+    name: str
+    summary: str
+    function: str
+    options: tuple[BaselineOption, ...] = ()
+    gives: str = "grid"
+
+    def resolve(self) -> Callable[..., NDArray[Any]]:
+        mod, _, fn = self.function.partition(":")
+        f: Callable[..., NDArray[Any]] = getattr(importlib.import_module(mod), fn)
+        return f
+
+
+#: every baseline, declared once
+BASELINES: dict[str, Baseline] = {
+    "texture": Baseline(
+        "texture",
+        "Efros & Leung 1999 non-parametric texture synthesis of label grids (2D and 3D): "
+        "causal neighbourhood, a label drawn among the matches within (1 + eps) of the best",
+        "csplab.baselines.texture:efros_leung",
+        (
+            BaselineOption("window", int, 5, "odd neighbourhood width in cells"),
+            BaselineOption("eps", float, 0.1, "candidates within (1 + eps) of the best match"),
+        ),
+    ),
+}
+
+
+def run_baseline(
+    name: str, example: Any, size: Sequence[int], *, rng: Any = None, **options: Any
+) -> NDArray[Any]:
+    """Run the baseline ``name`` on ``example`` at ``size`` with its ``options``."""
+    b = BASELINES.get(name)
+    if b is None:
+        raise InputError(f"unknown baseline {name!r}; baselines: {', '.join(BASELINES)}")
+    known = {o.name for o in b.options}
+    bad = set(options) - known
+    if bad:
+        raise InputError(
+            f"baseline {name!r} has no option(s) {', '.join(sorted(bad))}; "
+            f"it has {', '.join(sorted(known)) or 'none'}"
+        )
+    return b.resolve()(example, size, rng=rng, **options)
