@@ -41,6 +41,7 @@ EXTRAS: dict[str, str] = {
     "manifold3d": "mesh",
     "scipy": "mesh",
     "mapbox_earcut": "mesh",
+    "maxflow": "baselines",
 }
 
 

@@ -65,6 +65,7 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
     ),
     "sampling_bias": ("sampling_bias", {}),
     "table1_continuous": ("table1_continuous", {}),
+    "baselines": ("baselines", {}),
     "table1_continuous_solvers": (
         "table1_continuous",
         {

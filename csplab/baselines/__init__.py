@@ -62,11 +62,15 @@ class Baseline:
 BASELINES: dict[str, Baseline] = {
     "texture": Baseline(
         "texture",
-        "Efros & Leung 1999 non-parametric texture synthesis of label grids (2D and 3D): "
-        "causal neighbourhood, a label drawn among the matches within (1 + eps) of the best",
-        "csplab.baselines.texture:efros_leung",
+        "texture synthesis of label grids (2D and 3D): Efros & Leung 1999 non-parametric "
+        "sampling (a label drawn among the causal-neighbourhood matches within (1 + eps) of "
+        "the best) or Kwatra et al. 2003 graph-cut patches (minimum-cut seams, PyMaxflow)",
+        "csplab.baselines.texture:texture",
         (
-            BaselineOption("window", int, 5, "odd neighbourhood width in cells"),
+            BaselineOption("method", str, "efros-leung", "efros-leung or graphcut"),
+            BaselineOption("window", int, 5, "efros-leung: odd neighbourhood width in cells"),
+            BaselineOption("patch", int, 8, "graphcut: patch width in cells"),
+            BaselineOption("overlap", int, 3, "graphcut: overlap of neighbouring patches"),
             BaselineOption("eps", float, 0.1, "candidates within (1 + eps) of the best match"),
         ),
     ),

@@ -1,4 +1,5 @@
-"""Non-parametric texture synthesis of label grids (Efros & Leung 1999), 2D and 3D.
+"""Texture synthesis of label grids, 2D and 3D: non-parametric sampling (Efros & Leung 1999)
+and graph-cut patches (Kwatra et al. 2003).
 
 The baseline the thesis compares model synthesis with (Sec. 2.3, 5.1, Fig. 5.1): the output
 grows cell by cell in scanline order; each new cell looks at its *causal* neighbourhood (the
@@ -29,7 +30,7 @@ from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.rng import RngLike, make_rng
 
-__all__ = ["efros_leung"]
+__all__ = ["METHODS", "efros_leung", "graphcut", "texture"]
 
 
 def _offsets(ndim: int, window: int) -> NDArray[np.int64]:
@@ -100,3 +101,125 @@ def efros_leung(
         cand = np.flatnonzero(dist <= best * (1.0 + eps))
         out[cell] = ex_lab[int(cand[gen.integers(len(cand))])]
     return out.astype(np.int32)
+
+
+def graphcut(
+    example: ExampleModel,
+    size: Sequence[int],
+    *,
+    patch: int = 8,
+    overlap: int = 3,
+    eps: float = 0.1,
+    rng: RngLike = None,
+) -> NDArray[np.int32]:
+    """Graph-cut patch synthesis of a label grid (Kwatra et al. 2003, 2D and 3D).
+
+    Patches of the example (``patch`` cells per axis, clipped to the example) are placed in
+    scan order, ``patch - overlap`` apart; each copies the example block whose labels
+    disagree least with the cells already written under it (one of those within
+    ``(1 + eps)`` of the best, uniformly), and the seam between old and new cells is a
+    minimum cut (PyMaxflow) where cutting between neighbours ``s, t`` costs
+    ``[old(s) != new(s)] + [old(t) != new(t)]``: written cells on the footprint's border keep
+    their label, unwritten ones take the patch's.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> g = graphcut(load_example("fig3_10"), (14, 14), patch=4, overlap=2, rng=0)
+    >>> g.shape, int(g.min()) >= 0
+    ((14, 14), True)
+    """
+    from csplab.deps import require
+
+    maxflow = require("maxflow", "baselines", "the graph-cut texture baseline")
+    shape = tuple(int(s) for s in size)
+    E = np.asarray(example.labels, dtype=np.int64)
+    d = E.ndim
+    if len(shape) != d or any(s < 1 for s in shape):
+        raise InputError(f"size {shape} must have {d} positive axes like the example")
+    if patch < 2 or not 0 <= overlap < patch:
+        raise InputError(f"need patch >= 2 and 0 <= overlap < patch, not {patch}, {overlap}")
+    if not eps >= 0:
+        raise InputError(f"eps must be >= 0, not {eps}")
+    gen, _ = make_rng(rng)
+    P = np.minimum(patch, np.array(E.shape))
+    step = np.maximum(P - overlap, 1)
+    out = np.full(shape, -1, dtype=np.int64)
+    # every example block of size P (its corner)
+    corners = np.array(list(np.ndindex(*(np.array(E.shape) - P + 1))), dtype=np.int64)
+    starts = [np.arange(0, s, st) for s, st in zip(shape, step, strict=True)]
+    for corner in itertools.product(*starts):
+        lo = np.array(corner)
+        hi = np.minimum(lo + P, shape)
+        ext = hi - lo
+        win = tuple(slice(a, b) for a, b in zip(lo, hi, strict=True))
+        old = out[win]
+        filled = old >= 0
+        # candidate blocks: mismatches over the written cells
+        costs = np.empty(len(corners))
+        for i, c in enumerate(corners):
+            blk = E[tuple(slice(a, a + e) for a, e in zip(c, ext, strict=True))]
+            costs[i] = np.count_nonzero((blk != old) & filled)
+        best = costs.min()
+        cand = np.flatnonzero(costs <= best * (1.0 + eps))
+        c = corners[int(cand[gen.integers(len(cand))])]
+        new = E[tuple(slice(a, a + e) for a, e in zip(c, ext, strict=True))]
+        if not filled.any():
+            out[win] = new
+            continue
+        # the seam: a minimum cut between keeping the old labels and taking the new ones
+        g = maxflow.Graph[float]()
+        nodes = g.add_grid_nodes(old.shape)
+        diff = (old != new).astype(np.float64)
+        for axis in range(d):
+            w = np.zeros(old.shape)
+            a = [slice(None)] * d
+            b = [slice(None)] * d
+            a[axis], b[axis] = slice(0, -1), slice(1, None)
+            w[tuple(a)] = diff[tuple(a)] + diff[tuple(b)] + 1e-6
+            struct = np.zeros((3,) * d)
+            idx = [1] * d
+            idx[axis] = 2
+            struct[tuple(idx)] = 1
+            g.add_grid_edges(nodes, weights=w, structure=struct, symmetric=True)
+        big = 1e9
+        border = np.zeros(old.shape, dtype=bool)  # written cells next to written outside
+        for axis in range(d):
+            for side, at in ((0, lo[axis] - 1), (-1, hi[axis])):
+                if 0 <= at < shape[axis]:
+                    sl = [slice(a, b) for a, b in zip(lo, hi, strict=True)]
+                    sl[axis] = slice(at, at + 1)
+                    outside = (out[tuple(sl)] >= 0).reshape(
+                        [1 if k == axis else ext[k] for k in range(d)])  # fmt: skip
+                    face = [slice(None)] * d
+                    face[axis] = slice(side, side + 1) if side == 0 else slice(-1, None)
+                    border[tuple(face)] |= outside & filled[tuple(face)]
+        g.add_grid_tedges(nodes, np.where(border, big, 0.0), np.where(~filled, big, 0.0))
+        g.maxflow()
+        take_new = g.get_grid_segments(nodes)  # sink side: the new patch
+        out[win] = np.where(take_new, new, old)
+    return out.astype(np.int32)
+
+
+#: the texture synthesis methods of :func:`texture`
+METHODS = ("efros-leung", "graphcut")
+
+
+def texture(
+    example: ExampleModel,
+    size: Sequence[int],
+    *,
+    method: str = "efros-leung",
+    window: int = 5,
+    patch: int = 8,
+    overlap: int = 3,
+    eps: float = 0.1,
+    rng: RngLike = None,
+) -> NDArray[np.int32]:
+    """Texture synthesis of a label grid: :func:`efros_leung` (``window``) or
+    :func:`graphcut` (``patch``, ``overlap``); ``eps`` for both."""
+    if method == "efros-leung":
+        return efros_leung(example, size, window=window, eps=eps, rng=rng)
+    if method == "graphcut":
+        return graphcut(example, size, patch=patch, overlap=overlap, eps=eps, rng=rng)
+    raise InputError(f"texture method must be one of {', '.join(METHODS)}, not {method!r}")

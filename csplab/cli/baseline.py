@@ -14,7 +14,7 @@ HELP = "run a baseline the seeds compare against (texture synthesis ...) on an e
 DESCRIPTION = (
     "Run a baseline method on an example grid and write its output grid; `csplab check "
     "MODEL OUT` then counts the adjacency constraints it breaks. Baselines: "
-    "texture (Efros & Leung 1999)."
+    "texture (Efros & Leung 1999 sampling or Kwatra et al. 2003 graph-cut patches)."
 )
 
 

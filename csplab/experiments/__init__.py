@@ -14,6 +14,7 @@ Python entry point.
 ``catalog_gap``           Alg. 3.1 choices outside the exact catalog C*
 ``sampling_bias``         label / 2×2-pattern frequencies vs exact uniform sampling
 ``table1_continuous``     continuous 3D: Table 1 of the 2008 paper (polygons, time)
+``baselines``             model synthesis against texture synthesis (Fig. 5.1/5.2)
 ========================  ============================================================
 
 Examples
@@ -60,6 +61,7 @@ EXPERIMENTS: dict[str, str] = {
     "catalog_gap": "csplab.experiments.catalog_gap:CatalogGap",
     "sampling_bias": "csplab.experiments.sampling_bias:SamplingBias",
     "table1_continuous": "csplab.experiments.table1_continuous:Table1Continuous",
+    "baselines": "csplab.experiments.baselines:Baselines",
 }
 ALIASES: dict[str, str] = {"fig3_10": "blocksize", "table3.1": "table3_1", "fig3.8": "fig3_8"}
 

@@ -65,3 +65,30 @@ def test_cli_baseline_then_check(tmp_path) -> None:
     chk = subprocess.run([sys.executable, "-m", "csplab", "check", "castle", str(out)],
                          capture_output=True, text=True, check=False)  # fmt: skip
     assert chk.stdout.startswith(f"{n} violations"), chk.stdout
+
+
+@pytest.mark.parametrize("name", ["fig3_10", "castle"])
+def test_graphcut_patches(name: str) -> None:
+    """Graph-cut patch synthesis (Kwatra et al. 2003): every cell written, labels of the
+    example, reproducible by seed, violations counted by the same checker."""
+    pytest.importorskip("maxflow")
+    from csplab.baselines.texture import graphcut
+
+    E = load_example(name)
+    size = (20, 20) if E.ndim == 2 else (16, 16, 6)
+    a = run_baseline("texture", E, size, rng=3, method="graphcut", patch=4, overlap=2)
+    assert a.shape == size and int(a.min()) >= 0
+    assert set(np.unique(a).tolist()) <= set(np.unique(E.labels).tolist())
+    assert np.array_equal(a, graphcut(E, size, patch=4, overlap=2, rng=3))
+    assert len(Problem.from_example(E, size).violations(a)) >= 0
+    with pytest.raises(InputError, match="overlap"):
+        graphcut(E, size, patch=4, overlap=4)
+
+
+def test_graphcut_seams_follow_the_cheapest_cut() -> None:
+    """A copy of the example placed over itself needs no seam: on an example that tiles
+    (a checkerboard) every patch matches exactly and the output breaks nothing."""
+    pytest.importorskip("maxflow")
+    E = load_example("fig3_1b")  # checkerboard
+    g = run_baseline("texture", E, (12, 12), rng=1, method="graphcut", patch=2, overlap=1)
+    assert len(Problem.from_example(E, (12, 12)).violations(g)) == 0
