@@ -42,6 +42,7 @@ EXTRAS: dict[str, str] = {
     "scipy": "mesh",
     "mapbox_earcut": "mesh",
     "maxflow": "baselines",
+    "skimage": "baselines",
 }
 
 

@@ -24,8 +24,6 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from numpy.typing import NDArray
-
 from csplab.errors import InputError
 
 __all__ = ["BASELINES", "Baseline", "BaselineOption", "run_baseline"]
@@ -52,9 +50,9 @@ class Baseline:
     options: tuple[BaselineOption, ...] = ()
     gives: str = "grid"
 
-    def resolve(self) -> Callable[..., NDArray[Any]]:
+    def resolve(self) -> Callable[..., Any]:
         mod, _, fn = self.function.partition(":")
-        f: Callable[..., NDArray[Any]] = getattr(importlib.import_module(mod), fn)
+        f: Callable[..., Any] = getattr(importlib.import_module(mod), fn)
         return f
 
 
@@ -74,13 +72,26 @@ BASELINES: dict[str, Baseline] = {
             BaselineOption("eps", float, 0.1, "candidates within (1 + eps) of the best match"),
         ),
     ),
+    "geometry": Baseline(
+        "geometry",
+        "Lagae et al. 2004 geometry synthesis: a signed distance field of the example's "
+        "closed mesh, best-first block matching in a search tree of block pyramids, the "
+        "zero level set as a closed mesh (marching cubes)",
+        "csplab.baselines.geometry:geometry",
+        (
+            BaselineOption("resolution", int, 24, "field samples along the example's longest side"),
+            BaselineOption("block", int, 8, "block side in samples (a power of 2)"),
+        ),
+        gives="mesh",
+    ),
 }
 
 
 def run_baseline(
     name: str, example: Any, size: Sequence[int], *, rng: Any = None, **options: Any
-) -> NDArray[Any]:
-    """Run the baseline ``name`` on ``example`` at ``size`` with its ``options``."""
+) -> Any:
+    """Run the baseline ``name`` on ``example`` at ``size`` with its ``options``: a label
+    grid (``gives="grid"``) or a ``trimesh.Trimesh`` (``gives="mesh"``)."""
     b = BASELINES.get(name)
     if b is None:
         raise InputError(f"unknown baseline {name!r}; baselines: {', '.join(BASELINES)}")
