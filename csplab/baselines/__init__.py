@@ -84,6 +84,19 @@ BASELINES: dict[str, Baseline] = {
         ),
         gives="mesh",
     ),
+    "retarget": Baseline(
+        "retarget",
+        "Wu et al. 3D model retargeting with offset statistics: voxels, dominant offsets of "
+        "matched surface features, expansion moves over translated copies (PyMaxflow), a "
+        "closed mesh; --offsets all is the conventional MRF of every translation",
+        "csplab.baselines.retarget:retarget",
+        (
+            BaselineOption("resolution", int, 24, "voxels along the example's longest side"),
+            BaselineOption("offsets", str, "sparse", "sparse (principal offsets) or all"),
+            BaselineOption("regular", int, 2, "offsets all: translations this many voxels apart"),
+        ),
+        gives="mesh",
+    ),
 }
 
 

@@ -15,7 +15,8 @@ DESCRIPTION = (
     "Run a baseline method on an example grid and write its output grid; `csplab check "
     "MODEL OUT` then counts the adjacency constraints it breaks. Baselines: "
     "texture (Efros & Leung 1999 sampling or Kwatra et al. 2003 graph-cut patches) on "
-    "example grids; geometry (Lagae et al. 2004) on closed meshes, writing a mesh."
+    "example grids; geometry (Lagae et al. 2004) and retarget (Wu et al.) on closed meshes, "
+    "writing a mesh."
 )
 
 
@@ -117,13 +118,18 @@ def _mesh(args: argparse.Namespace, b: object, example: object) -> int:
         os.replace(tmp, out)
     info = {"baseline": args.name, "size": list(size), "seed": seed, "time_s": dt,
             "faces": len(mesh.faces), "watertight": bool(mesh.is_watertight),
-            "volume": float(mesh.volume), "out": args.out}  # fmt: skip
+            "volume": float(mesh.volume), "out": args.out,
+            **mesh.metadata.get("retarget", {})}  # fmt: skip
     if args.json:
         print(json.dumps(info))
     else:
         print(f"{args.name}: {'x'.join(map(str, size))} samples in {dt:.2f} s, seed {seed}; "
               f"{len(mesh.faces)} triangles, closed {info['watertight']}, volume "
               f"{info['volume']:.4g}")  # fmt: skip
+        if "nodes" in info:
+            print(f"  graph: {info['nodes']} nodes, {info['labels']} labels, optimized in "
+                  f"{info['time_s']:.3f} s; principal offsets {info['principal']} voxels "
+                  f"({info['dominant']} dominant)")  # fmt: skip
         if args.out:
             print(f"  wrote {args.out}")
     return 0
