@@ -52,8 +52,6 @@ __all__ = [
 def signed_distance(model: Any, resolution: int = 32) -> NDArray[np.float64]:
     """The signed distance field of a polyhedral model's solids (voxel units, negative
     inside) on a grid with ``resolution`` samples along the longest side of its bounds."""
-    from csplab.continuous._geom import point_labels
-
     ndi = require("scipy.ndimage", "mesh", "the geometry baseline")
     if resolution < 4:
         raise InputError(f"resolution must be >= 4, not {resolution}")
@@ -63,8 +61,7 @@ def signed_distance(model: Any, resolution: int = 32) -> NDArray[np.float64]:
     shape = tuple(int(np.ceil((hi[a] - lo[a]) / h)) + 1 for a in range(3))
     axes = [lo[a] + h * (np.arange(shape[a]) + 0.5 * 1e-3) for a in range(3)]
     pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    tris = [(s.label, s.vertices[s.faces]) for s in model.solids]
-    inside = (point_labels(pts, tris) > 0).reshape(shape)
+    inside = (model.labels_at(pts) > 0).reshape(shape)
     out: NDArray[np.float64] = ndi.distance_transform_edt(~inside) - ndi.distance_transform_edt(
         inside
     )

@@ -48,8 +48,6 @@ __all__ = ["OUTSIDE", "dominant_offsets", "retarget", "retarget_labels", "voxeli
 def voxelize(model: Any, resolution: int = 24) -> NDArray[np.bool_]:
     """Occupancy of the voxels (centres inside a solid), ``resolution`` along the longest
     side of the model's bounds."""
-    from csplab.continuous._geom import point_labels
-
     if resolution < 4:
         raise InputError(f"resolution must be >= 4, not {resolution}")
     b = np.array(model.bounds, dtype=np.float64)
@@ -58,8 +56,7 @@ def voxelize(model: Any, resolution: int = 24) -> NDArray[np.bool_]:
     shape = tuple(max(1, round((hi[a] - lo[a]) / h)) for a in range(3))
     axes = [lo[a] + h * (np.arange(shape[a]) + 0.5) + 1e-7 for a in range(3)]
     pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    tris = [(s.label, s.vertices[s.faces]) for s in model.solids]
-    out: NDArray[np.bool_] = (point_labels(pts, tris) > 0).reshape(shape)
+    out: NDArray[np.bool_] = (model.labels_at(pts) > 0).reshape(shape)
     return out
 
 

@@ -253,6 +253,15 @@ class PolyhedralModel:
                 total += sum(s.volume for s in group)
         return total
 
+    def labels_at(self, points: Any) -> NDArray[np.int64]:
+        """The label of the solid containing each point ``(P, 3)`` (0: empty space; points
+        on a face are ambiguous), by compiled ray casting
+        (:func:`csplab.continuous._geom.point_labels`)."""
+        from csplab.continuous._geom import point_labels
+
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        return point_labels(pts, [(s.label, s.vertices[s.faces]) for s in self.solids])
+
     def to_trimesh(self, label: int | None = None) -> Any:
         """The solids of ``label`` (all when ``None``) as one ``trimesh.Trimesh``
         (concatenated, not united); :meth:`Solid.to_trimesh` gives one solid."""

@@ -34,6 +34,7 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "fig3_6a": ("fig3_6a_pairs.grid", "E_F, Fig. 3.6(a): 2s in pairs; fallible, detected late"),
     "fig3_16": ("fig3_16_pairs.grid", "E_I, Fig. 3.16: fig3_6a + labels >= 10; infallible"),
     "fig3_10": ("fig3_10_rectangle.grid", "Fig. 3.10(a): a rectangle; small blocks grow it thin"),
+    "loops": ("loops.grid", "csplab's own: closed loops of connecting path pieces (Fig. 5.1)"),
     "pillar": ("pillar.grid", "3D, 2007 paper Fig. 2: base, shaft, capital; no levitation"),
     "city": ("city3d.grid", "3D, csplab's own: a city block, K=119; Alg. 3.1 never failed"),
     "castle": ("castle3d.grid", "3D, csplab's own: castle walls, towers, K=63; fails often"),

@@ -6,7 +6,8 @@ model) and every texture method of :mod:`csplab.baselines.texture` make an outpu
 same size; each output is measured by the same checker (``Problem.violations``: the arcs it
 breaks, 0 for model synthesis by construction), by the distance of its pattern statistics to
 the example's (total variation between the frequencies of the distinct 2-wide sub-blocks:
-0 when the output uses only the example's patterns in the same proportions), and by time.
+0 when the output uses only the example's patterns in the same proportions), by time, and
+on path examples (``loops``) by the number of dead ends (thesis Fig. 5.1).
 The report's figure shows one output per method side by side for each example (a middle
 slice of 3D outputs).
 
@@ -36,7 +37,7 @@ from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
 from csplab.grids import parse_shape
 
-__all__ = ["Baselines", "measure_baseline", "pattern_distance"]
+__all__ = ["Baselines", "dead_ends", "measure_baseline", "pattern_distance"]
 
 METHODS = ("model-synthesis", "texture:efros-leung", "texture:graphcut")
 
@@ -67,6 +68,40 @@ def pattern_distance(grid: ArrayLike, example: ArrayLike) -> float:
     return float(0.5 * sum(abs(p.get(k, 0.0) - q.get(k, 0.0)) for k in p.keys() | q.keys()))
 
 
+#: where each piece of a path example connects (label name -> unit offsets), ``loops``
+_CONNECTS = {
+    "path_x": ((-1, 0), (1, 0)), "path_y": ((0, -1), (0, 1)),
+    "corner_+x+y": ((1, 0), (0, 1)), "corner_-x+y": ((-1, 0), (0, 1)),
+    "corner_+x-y": ((1, 0), (0, -1)), "corner_-x-y": ((-1, 0), (0, -1)),
+}  # fmt: skip
+
+
+def dead_ends(grid: ArrayLike, names: tuple[str, ...] | None) -> int | None:
+    """Connections of path pieces that their neighbour does not return (thesis Fig. 5.1's
+    dead ends; connections leaving the grid are not counted), for examples whose label
+    names say where pieces connect; ``None`` for other examples.
+
+    Examples
+    --------
+    >>> names = ("empty", "path_x", "path_y", "corner_+x+y", "corner_-x+y")
+    >>> dead_ends([[0, 0], [1, 0], [0, 0]], names)      # a lone x piece: both ends open
+    2
+    """
+    if not names or not any(n in _CONNECTS for n in names):
+        return None
+    g = np.asarray(grid)
+    conn = {i: _CONNECTS.get(n, ()) for i, n in enumerate(names)}
+    count = 0
+    for (x, y), b in np.ndenumerate(g):
+        for dx, dy in conn.get(int(b), ()):
+            u, v = x + dx, y + dy
+            if not (0 <= u < g.shape[0] and 0 <= v < g.shape[1]):
+                continue
+            if (-dx, -dy) not in conn.get(int(g[u, v]), ()):
+                count += 1
+    return count
+
+
 def _make(trial: Trial, example: ExampleModel) -> NDArray[np.int32]:
     from csplab.baselines import run_baseline
     from csplab.problem import Problem
@@ -77,8 +112,9 @@ def _make(trial: Trial, example: ExampleModel) -> NDArray[np.int32]:
         r = solve(P, "blocks", rng=trial.seed, block=int(trial.params.get("block", 10)))
         return np.asarray(r.grid, dtype=np.int32)
     method = trial.solver.split(":", 1)[1]
-    return run_baseline("texture", example, trial.size, rng=trial.seed, method=method,
-                        **trial.params.get("options", {}).get(method, {}))  # fmt: skip
+    g = run_baseline("texture", example, trial.size, rng=trial.seed, method=method,
+                     **trial.params.get("options", {}).get(method, {}))  # fmt: skip
+    return np.asarray(g, dtype=np.int32)
 
 
 def measure_baseline(trial: Trial, example: ExampleModel, problem: Any) -> dict[str, Any]:
@@ -94,6 +130,7 @@ def measure_baseline(trial: Trial, example: ExampleModel, problem: Any) -> dict[
         "arcs": len(problem.arcs),
         "broken_fraction": broken / max(1, len(problem.arcs)),
         "pattern_tv": pattern_distance(g, np.asarray(example.labels)),
+        "dead_ends": dead_ends(g, example.names) if g.ndim == 2 else None,
     }
     return {"status": "solved", "time_s": dt, "stats": stats}
 
@@ -106,7 +143,7 @@ class Baselines(Experiment):
         "Efros-Leung and graph-cut texture synthesis on the same examples"
     )
     defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["fig3_10", "fig3_6a", "line", "castle", "city"],
+        "examples": ["loops", "fig3_10", "fig3_6a", "line", "castle", "city"],
         "size": "40x40",
         "size3d": "24x24x8",
         "seeds": 3,
@@ -115,7 +152,7 @@ class Baselines(Experiment):
         "options": {"efros-leung": {"window": 5}, "graphcut": {"patch": 6, "overlap": 2}},
     }
     quick: ClassVar[dict[str, Any]] = {
-        "examples": ["fig3_10", "castle"],
+        "examples": ["loops", "castle"],
         "size": "12x12",
         "size3d": "8x8x4",
         "seeds": 1,
@@ -150,6 +187,8 @@ class Baselines(Experiment):
                                        f"{max(s['violations'] for s in st)}",
                 "of arcs": st[0]["arcs"],
                 "pattern TV (median)": median_iqr([s["pattern_tv"] for s in st])[0],
+                "dead ends (median)": (median_iqr([s["dead_ends"] for s in st])[0]
+                                       if st[0].get("dead_ends") is not None else "–"),
                 "time s (median)": median_iqr([r["time_s"] for r in rs])[0],
             })  # fmt: skip
         rep.tables["methods"] = table
@@ -157,7 +196,8 @@ class Baselines(Experiment):
             "Broken arcs: adjacency constraints the output breaks (Problem.violations, the "
             "checker of every solver); model synthesis (blocks) breaks none by construction. "
             "Pattern TV: total variation distance between the output's and the example's "
-            "2-wide sub-block frequencies. Dead-end counts (thesis Fig. 5.1) are not measured."
+            "2-wide sub-block frequencies. Dead ends (thesis Fig. 5.1): connections of path "
+            "pieces that the neighbour does not return, on the path example `loops`."
         )
         if self.draw_figures and rows:
             rep.figures += self._figure(config, out)
