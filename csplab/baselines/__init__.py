@@ -81,6 +81,7 @@ BASELINES: dict[str, Baseline] = {
         (
             BaselineOption("resolution", int, 24, "field samples along the example's longest side"),
             BaselineOption("block", int, 8, "block side in samples (a power of 2)"),
+            BaselineOption("levels", int, 1, "1: single resolution; more: multiresolution"),
         ),
         gives="mesh",
     ),

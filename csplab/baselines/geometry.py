@@ -10,9 +10,11 @@ search: a priority queue of nodes by their distance to the query's pyramid at th
 (mean squared difference, Eq. 1); since a finer level is never closer (Eq. 2), the first leaf
 popped is the best block. :func:`match_speedup` times it against a linear search.
 
-Synthesis (single resolution, Sec. 5.1): the target field starts as random source samples;
-blocks are placed in scan order half a block apart (7/8 of each block already synthesized in
-3D), and the best-matching source block is copied into each. The surface is the zero level
+Synthesis (Sec. 5.1): the target field starts as random source samples; blocks are placed
+in scan order half a block apart (7/8 of each block already synthesized in 3D), and the
+best-matching source block is copied into each; with ``levels > 1`` (Sec. 5.2) the passes
+run from the source subsampled ``2^(levels-1)`` times to the full field, each seeded with
+the previous result. The surface is the zero level
 set (scikit-image marching cubes, the field padded with outside so that the mesh is closed).
 
 Examples
@@ -189,22 +191,10 @@ def match_speedup(
     }
 
 
-def geometry_synthesis(
-    model: Any,
-    size: Sequence[int],
-    *,
-    resolution: int = 24,
-    block: int = 8,
-    rng: RngLike = None,
-) -> NDArray[np.float64]:
-    """A synthesized signed distance field of ``size`` samples (single resolution)."""
-    shape = tuple(int(s) for s in size)
-    if len(shape) != 3 or any(s < block for s in shape):
-        raise InputError(f"size {shape} must be three sides of at least block={block}")
-    gen, _ = make_rng(rng)
-    f = signed_distance(model, resolution)
+def _pass(f: NDArray[np.float64], target: NDArray[np.float64], block: int) -> NDArray[np.float64]:
+    """One single-resolution synthesis pass over ``target`` with source field ``f``."""
+    shape = target.shape
     tree = SearchTree.build(f, block)
-    target = gen.choice(f.reshape(-1), size=shape)
     step = block // 2
     starts = [list(range(0, s - block + 1, step)) or [0] for s in shape]
     for a in range(3):  # the last block flush with the far side
@@ -215,6 +205,56 @@ def geometry_synthesis(
         bi, _ = tree.best(target[win])
         src = tree.corners[bi]
         target[win] = f[tuple(slice(x, x + block) for x in src)]
+    return target
+
+
+def _down(f: NDArray[np.float64], k: int) -> NDArray[np.float64]:
+    """``f`` averaged over ``k``-sided cubes (the sides cut to multiples of ``k``)."""
+    n = [s // k for s in f.shape]
+    g = f[: n[0] * k, : n[1] * k, : n[2] * k].reshape(n[0], k, n[1], k, n[2], k)
+    out: NDArray[np.float64] = g.mean(axis=(1, 3, 5))
+    return out
+
+
+def geometry_synthesis(
+    model: Any,
+    size: Sequence[int],
+    *,
+    resolution: int = 24,
+    block: int = 8,
+    levels: int = 1,
+    rng: RngLike = None,
+) -> NDArray[np.float64]:
+    """A synthesized signed distance field of ``size`` samples: single resolution
+    (``levels=1``, Sec. 5.1) or multiresolution (Sec. 5.2: the first pass on the source
+    subsampled ``2^(levels-1)`` times, each next pass on the previous result upsampled, the
+    block size in samples the same at every level, so coarse passes place large features)."""
+    shape = tuple(int(s) for s in size)
+    if len(shape) != 3 or any(s < block for s in shape):
+        raise InputError(f"size {shape} must be three sides of at least block={block}")
+    if levels < 1:
+        raise InputError(f"levels must be >= 1, not {levels}")
+    gen, _ = make_rng(rng)
+    f = signed_distance(model, resolution)
+    target: NDArray[np.float64] | None = None
+    for lvl in range(levels - 1, -1, -1):
+        k = 2**lvl
+        src = _down(f, k) if k > 1 else f
+        tshape = tuple(max(block, s // k) for s in shape)
+        if any(s < block for s in src.shape):
+            continue  # too coarse for a block: start at a finer level
+        if target is None:
+            t = gen.choice(src.reshape(-1), size=tshape)
+        else:  # the previous (coarser) result, upsampled by repetition
+            up = np.repeat(np.repeat(np.repeat(target, 2, 0), 2, 1), 2, 2)
+            t = np.empty(tshape)
+            sl = tuple(slice(0, min(a, b)) for a, b in zip(tshape, up.shape, strict=True))
+            t[...] = gen.choice(src.reshape(-1), size=tshape)
+            t[sl] = up[sl]
+        target = _pass(src, t, block)
+    assert target is not None
+    if target.shape != shape:  # the finest level has the requested size
+        target = _pass(f, np.resize(target, shape), block)
     return np.asarray(target, dtype=np.float64)
 
 
@@ -236,6 +276,7 @@ def geometry(
     *,
     resolution: int = 24,
     block: int = 8,
+    levels: int = 1,
     rng: RngLike = None,
 ) -> Any:
     """:func:`geometry_synthesis` then :func:`surface`: a closed ``trimesh.Trimesh`` in the
@@ -244,7 +285,8 @@ def geometry(
 
     if not isinstance(model, PolyhedralModel):
         raise InputError("the geometry baseline takes a polyhedral model (a closed mesh)")
-    sdf = geometry_synthesis(model, size, resolution=resolution, block=block, rng=rng)
+    sdf = geometry_synthesis(model, size, resolution=resolution, block=block, levels=levels,
+                             rng=rng)  # fmt: skip
     mesh = surface(sdf)
     b = np.array(model.bounds, dtype=np.float64)
     h = float((b[3:] - b[:3]).max()) / (resolution - 1)

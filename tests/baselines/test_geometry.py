@@ -61,3 +61,13 @@ def test_synthesized_mesh_is_closed(tmp_path) -> None:
     r = subprocess.run(cmd, capture_output=True, text=True, check=False)
     assert r.returncode == 0 and "closed True" in r.stdout, r.stdout + r.stderr
     assert out.exists()
+
+
+def test_multiresolution_is_closed_and_seeded_by_the_coarse_pass() -> None:
+    E = load_polyhedral_example("terrain")
+    one = geometry(E, (16, 16, 8), resolution=16, block=4, levels=1, rng=3)
+    two = geometry(E, (16, 16, 8), resolution=16, block=4, levels=2, rng=3)
+    assert one.is_watertight and two.is_watertight
+    assert not np.array_equal(one.vertices.shape, ()) and two.volume > 0
+    with pytest.raises(InputError, match="levels"):
+        geometry(E, (16, 16, 8), resolution=16, block=4, levels=0)
