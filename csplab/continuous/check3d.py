@@ -96,16 +96,9 @@ def _polygon_arrays(model: Any) -> tuple[NDArray[np.float64], NDArray[np.float64
     return n, c
 
 
-def _normals(model: Any) -> list[tuple[NDArray[np.float64], float, tuple[float, ...]]]:
-    """(unit normal, plane offset, a point) of every polygon of every solid."""
-    n, c = _polygon_arrays(model)
-    off = (n * c).sum(axis=1)
-    return [(n[i], float(off[i]), tuple(c[i].tolist())) for i in range(len(n))]
-
-
 def _families(example: Any, tol: float) -> NDArray[np.float64]:
     fams: list[NDArray[np.float64]] = []
-    for n, _, _ in _normals(example):
+    for n in _polygon_arrays(example)[0]:
         if not any(abs(abs(float(n @ f)) - 1) <= tol for f in fams):
             first = next(x for x in n if abs(x) > 1e-12)
             fams.append(n if first > 0 else -n)

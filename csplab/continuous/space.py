@@ -51,7 +51,7 @@ from numpy.typing import NDArray
 from csplab.continuous.arrangement import gcd_fractions, rational
 from csplab.errors import InputError
 
-__all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells"]
+__all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells", "primitive3"]
 
 #: most plane families (the central arrangement has O(F^2) cells and a neighbourhood is a
 #: label per cell)
@@ -61,7 +61,9 @@ _SNAP_TOL = 1e-6
 _AXES = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
 
 
-def _primitive3(v: Sequence[int]) -> tuple[int, int, int]:
+def primitive3(v: Sequence[int]) -> tuple[int, int, int]:
+    """An integer vector divided by its gcd, its first non-zero component positive (one
+    representative per plane family)."""
     a, b, c = (int(x) for x in v)
     g = math.gcd(math.gcd(a, b), c)
     a, b, c = a // g, b // g, c // g
@@ -142,7 +144,7 @@ class Lattice3:
                 int(((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()),
             )
             if n != (0, 0, 0):
-                normals.add(_primitive3(n))
+                normals.add(primitive3(n))
         if len(normals | set(_AXES)) > MAX_FAMILIES3:
             raise InputError(
                 f"{where}: {len(normals)} face orientations; at most {MAX_FAMILIES3} planes "
@@ -344,7 +346,7 @@ class Arrangement3:
             u0 = np.cross(N[f], N[g])
             if not u0.any():
                 continue
-            u = _primitive3(u0.tolist())
+            u = primitive3(u0.tolist())
             li = lines.setdefault(u, len(lines))
             idx = np.flatnonzero(on[:, f] & on[:, g])
             if idx.size < 2:

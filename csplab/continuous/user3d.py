@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.continuous.check import Defect
+from csplab.continuous.space import primitive3
 from csplab.errors import InputError
 
 __all__ = [
@@ -95,16 +96,6 @@ class UserConstraints3:
             tuple(dict.fromkeys(self.connected + other.connected)),
             self.source,
         )
-
-
-def _primitive(v: Sequence[int]) -> tuple[int, int, int]:
-    import math
-
-    a, b, c = (int(x) for x in v)
-    g = math.gcd(math.gcd(a, b), c)
-    a, b, c = a // g, b // g, c // g
-    first = next(x for x in (a, b, c) if x != 0)
-    return (-a, -b, -c) if first < 0 else (a, b, c)
 
 
 def _labels(raw: Any, where: str, names: Mapping[str, int]) -> list[int]:
@@ -159,7 +150,7 @@ def parse_user_constraints(
                 elif (isinstance(n, list) and len(n) == 3
                       and all(isinstance(x, int) and not isinstance(x, bool) for x in n)
                       and any(n)):  # fmt: skip
-                    vec = _primitive(n)
+                    vec = primitive3(n)
                 else:
                     raise InputError(f"{where}: normal {n!r} is not x, y, z or [a, b, c] integers")
                 dim += [(b, vec) for b in labs]
@@ -227,12 +218,10 @@ def allowed_states(csp: Any, c: UserConstraints3) -> NDArray[np.bool_]:
             )
         dim.append((index[b], fam_of[n]))
     dom = np.array(csp.problem.domains, dtype=bool, copy=True)
-    nv = A.n_vertices
     kinds = (
         (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_xyz()),
         (csp.edge_type, csp.etypes, csp.var_edge, A.edge_xyz()),
     )
-    del nv
     # large-scale: per label, a boolean voxel grid
     grids: list[tuple[int, NDArray[np.bool_]]] = []
     if c.allowed and c.voxel is not None:
@@ -286,12 +275,10 @@ def user_violations3(
     *,
     origin: Sequence[float],
     spacing: float,
-    normals: Sequence[Sequence[int]] | None = None,
 ) -> list[Defect]:
     """The user constraints ``model`` breaks, from its solids alone (see the module
     docstring); ``origin`` and ``spacing`` place the plane lattice and the voxels (the
     region's corner and the plane spacing)."""
-    del normals
     out: list[Defect] = []
     o = np.asarray(origin, dtype=np.float64)
     s = float(spacing)
