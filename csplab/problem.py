@@ -457,20 +457,18 @@ class Problem:
             raise InputError(f"grid must hold integer labels, got dtype {g.dtype}")
         flat = g.reshape(-1)  # a view: nothing of the whole grid's size is built per block
         a = self.arcs if arc_ids is None else self.arcs[np.asarray(arc_ids, dtype=np.int64)]
-        if arc_ids is None:
-            local = np.full(self.n, -1, dtype=np.int64)
-            local[idx] = np.arange(idx.size)
-            ls, ld = local[a[:, 0]], local[a[:, 1]]
-        else:  # the position in ``cells`` of each arc end, by search (O(arcs log cells))
-            o = np.argsort(idx, kind="stable")
-            srt = idx[o]
+        # the position in ``cells`` of each arc end, by search: nothing of the whole grid's
+        # size is built, so many small blocks cost what their arcs cost
+        o = np.argsort(idx, kind="stable")
+        srt = idx[o]
 
-            def where(x: NDArray[np.int64]) -> NDArray[np.int64]:
-                p = np.minimum(np.searchsorted(srt, x), max(srt.size - 1, 0))
-                hit = srt[p] == x if srt.size else np.zeros(x.size, dtype=bool)
-                return np.where(hit, o[p] if srt.size else -1, -1)
+        def where(x: NDArray[np.int64]) -> NDArray[np.int64]:
+            if not srt.size:
+                return np.full(x.size, -1, dtype=np.int64)
+            p = np.minimum(np.searchsorted(srt, x), srt.size - 1)
+            return np.where(srt[p] == x, o[p], -1)
 
-            ls, ld = where(a[:, 0]), where(a[:, 1])
+        ls, ld = where(a[:, 0]), where(a[:, 1])
         lab_s = flat[a[:, 0]].astype(np.int64)
         lab_d = flat[a[:, 1]].astype(np.int64)
         inside = (ls >= 0) & (ld >= 0)
