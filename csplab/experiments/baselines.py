@@ -28,78 +28,18 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 import numpy as np
-from numpy.lib.stride_tricks import sliding_window_view
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import NDArray
 
 from csplab.example import ExampleModel
 from csplab.experiments.base import Experiment, Report, new_figure, save_figure
+from csplab.experiments.measures import dead_ends, pattern_distance
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
 from csplab.grids import parse_shape
 
-__all__ = ["Baselines", "dead_ends", "measure_baseline", "pattern_distance"]
+__all__ = ["Baselines", "measure_baseline"]
 
 METHODS = ("model-synthesis", "texture:efros-leung", "texture:graphcut")
-
-
-def _patterns(grid: ArrayLike) -> dict[bytes, float]:
-    """Frequencies of the distinct 2-wide sub-blocks."""
-    g = np.asarray(grid, dtype=np.int64)
-    w = tuple(min(2, s) for s in g.shape)
-    win = np.ascontiguousarray(sliding_window_view(g, w).reshape(-1, int(np.prod(w))))
-    keys, counts = np.unique(win.view(np.dtype((np.void, 8 * win.shape[1]))).reshape(-1),
-                             return_counts=True)  # fmt: skip
-    total = float(counts.sum())
-    return {bytes(k): float(c) / total for k, c in zip(keys, counts, strict=True)}
-
-
-def pattern_distance(grid: ArrayLike, example: ArrayLike) -> float:
-    """Total variation distance between the 2-wide sub-block frequencies of ``grid`` and
-    ``example`` (0: same patterns, same proportions; 1: no pattern in common).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> e = np.array([[0, 1], [1, 0]])
-    >>> pattern_distance(np.tile(e, (3, 3)), e) > 0, pattern_distance(e, e)
-    (True, 0.0)
-    """
-    p, q = _patterns(grid), _patterns(example)
-    return float(0.5 * sum(abs(p.get(k, 0.0) - q.get(k, 0.0)) for k in p.keys() | q.keys()))
-
-
-#: where each piece of a path example connects (label name -> unit offsets), ``loops``
-_CONNECTS = {
-    "path_x": ((-1, 0), (1, 0)), "path_y": ((0, -1), (0, 1)),
-    "corner_+x+y": ((1, 0), (0, 1)), "corner_-x+y": ((-1, 0), (0, 1)),
-    "corner_+x-y": ((1, 0), (0, -1)), "corner_-x-y": ((-1, 0), (0, -1)),
-}  # fmt: skip
-
-
-def dead_ends(grid: ArrayLike, names: tuple[str, ...] | None) -> int | None:
-    """Connections of path pieces that their neighbour does not return (thesis Fig. 5.1's
-    dead ends; connections leaving the grid are not counted), for examples whose label
-    names say where pieces connect; ``None`` for other examples.
-
-    Examples
-    --------
-    >>> names = ("empty", "path_x", "path_y", "corner_+x+y", "corner_-x+y")
-    >>> dead_ends([[0, 0], [1, 0], [0, 0]], names)      # a lone x piece: both ends open
-    2
-    """
-    if not names or not any(n in _CONNECTS for n in names):
-        return None
-    g = np.asarray(grid)
-    conn = {i: _CONNECTS.get(n, ()) for i, n in enumerate(names)}
-    count = 0
-    for (x, y), b in np.ndenumerate(g):
-        for dx, dy in conn.get(int(b), ()):
-            u, v = x + dx, y + dy
-            if not (0 <= u < g.shape[0] and 0 <= v < g.shape[1]):
-                continue
-            if (-dx, -dy) not in conn.get(int(g[u, v]), ()):
-                count += 1
-    return count
 
 
 def _make(trial: Trial, example: ExampleModel) -> NDArray[np.int32]:

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from csplab.experiments import run
-from csplab.experiments.baselines import pattern_distance
+from csplab.experiments.measures import pattern_distance
 
 pytest.importorskip("maxflow")
 
