@@ -46,6 +46,7 @@ __all__ = [
     "geometry",
     "geometry_synthesis",
     "match_speedup",
+    "occupancy",
     "signed_distance",
     "surface",
 ]
@@ -61,12 +62,17 @@ def signed_distance(model: Any, resolution: int = 32) -> NDArray[np.float64]:
     lo, hi = b[:3], b[3:]
     h = float((hi - lo).max()) / (resolution - 1)
     shape = tuple(int(np.ceil((hi[a] - lo[a]) / h)) + 1 for a in range(3))
-    axes = [lo[a] + h * (np.arange(shape[a]) + 0.5 * 1e-3) for a in range(3)]
-    pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    inside = (model.labels_at(pts) > 0).reshape(shape)
+    inside = occupancy(model, [lo[a] + h * (np.arange(shape[a]) + 0.5e-3) for a in range(3)])
     out: NDArray[np.float64] = ndi.distance_transform_edt(~inside) - ndi.distance_transform_edt(
         inside
     )
+    return out
+
+
+def occupancy(model: Any, axes: Sequence[NDArray[np.float64]]) -> NDArray[np.bool_]:
+    """Whether each point of the grid ``axes[0] x axes[1] x axes[2]`` is inside a solid."""
+    pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    out: NDArray[np.bool_] = (model.labels_at(pts) > 0).reshape([len(x) for x in axes])
     return out
 
 

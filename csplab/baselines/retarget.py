@@ -54,10 +54,9 @@ def voxelize(model: Any, resolution: int = 24) -> NDArray[np.bool_]:
     lo, hi = b[:3], b[3:]
     h = float((hi - lo).max()) / resolution
     shape = tuple(max(1, round((hi[a] - lo[a]) / h)) for a in range(3))
-    axes = [lo[a] + h * (np.arange(shape[a]) + 0.5) + 1e-7 for a in range(3)]
-    pts = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    out: NDArray[np.bool_] = (model.labels_at(pts) > 0).reshape(shape)
-    return out
+    from csplab.baselines.geometry import occupancy
+
+    return occupancy(model, [lo[a] + h * (np.arange(shape[a]) + 0.5) + 1e-7 for a in range(3)])
 
 
 def dominant_offsets(
@@ -149,9 +148,9 @@ def retarget_labels(
         if st > 0:
             need = np.maximum(0, idx[..., a] - (int(n_in[a]) - 1))
             start[..., a] = np.minimum(-(-need // st) * st, ranges[a][-1])
-    key = {tuple(t): i for i, t in enumerate(labels.tolist())}
-    cur = np.vectorize(lambda x, y, z: key[(x, y, z)])(start[..., 0], start[..., 1], start[..., 2])
-    cur = np.asarray(cur, dtype=np.int64)
+    # the label of those shifts: its position in the product of the ranges (C order)
+    step_no = [start[..., a] // max(int(steps[a]), 1) for a in range(3)]
+    cur = np.ravel_multi_index(step_no, [len(r) for r in ranges]).astype(np.int64)
     ii, jj, kk = idx[..., 0], idx[..., 1], idx[..., 2]
     c = np.array([max(1, int(x)) for x in cell])
     coarse = tuple(int(-(-shape[a] // c[a])) for a in range(3))
