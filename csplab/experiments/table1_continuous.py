@@ -125,12 +125,11 @@ class Table1Continuous(Experiment):
             E = load_polyhedral_example(name)
             models[E.hash()] = E
             size = parse_shape(config["sizes_3d"].get(name, "20x20x8"))
-            for solver in config["solvers"]:
-                params = {
-                    "restarts": int(config["restarts"]),
-                    "boundary": config["boundary"].get(name),
-                    "options": dict(config["options"]),
-                }
+            for entry in config["solvers"]:
+                # the solver spec and its options (validated, time limit, @options, NAME.key)
+                solver, params = self.solver_params(config, entry)
+                params.update(restarts=int(config["restarts"]),
+                              boundary=config["boundary"].get(name))  # fmt: skip
                 for seed in self.seeds(config):
                     trials.append(Trial(self.name, name, E.hash(), size, solver, params,
                                         seed=seed, boundary=_boundary_text(params["boundary"]),
