@@ -41,9 +41,13 @@ hint); ``"none"`` keeps CP-SAT's defaults. The seed is passed as ``random_seed``
 
 Time limit: the model is built in chunks that check the deadline (the one-hot model is
 checked again after its single parse, about half a second at 40×40×10), and CP-SAT gets
-the time that is left; but CP-SAT loads a table model without looking at its limit (nor
-at ``StopSearch``): on a 30×30×8 box town (4 labels) the call ended 1.7–2.1 s after a
-0.3 s limit. The one-hot model stays within the limit.
+the time that is left. CP-SAT's own set-up in ``Solve`` (validating and loading the
+model, before its search) does not look at the limit (nor at ``StopSearch``): on a
+30×30×8 box town (4 labels) it takes 0.95 s for the 37.5 MB one-hot model and 1.8 s for
+the 1.86M allowed pairs of the table model, whatever the limit. So csplab estimates it
+(model size over a rate learned from this machine's runs, :data:`_SETUP_RATE`) and
+returns ``timeout`` at once when the time left cannot hold it (``stats["setup_estimate_s"]``)
+instead of overrunning the limit by seconds.
 
 Examples
 --------
@@ -80,6 +84,46 @@ _BULK_CHUNK = 1 << 20  # clauses serialized per kernel call (then the deadline i
 _PARSE_RATE = [50e6]
 
 
+#: CP-SAT's set-up before its search (model units per second; units: serialized bytes for
+#: the one-hot model, allowed pairs for the table model). Starts from the rates measured on
+#: 30x30x8 (39 MB/s and 1.0M pairs/s) made 1.5x cautious, then follows this machine's runs.
+_SETUP_RATE = {"onehot": 26e6, "table": 0.67e6}
+_SETUP_MIN_UNITS = {"onehot": 1 << 20, "table": 50_000}  # smaller runs teach nothing
+
+
+def _learn_setup(model: str, units: int, solve_s: float, searched: bool, solved: bool) -> None:
+    """Update :data:`_SETUP_RATE` from a finished ``Solve``.
+
+    A call stopped before any search measured the set-up itself; a solved call bounds it
+    from above (set-up took at most the whole call), so the rate can only rise from it.
+    """
+    if units < _SETUP_MIN_UNITS[model] or solve_s <= 0:
+        return
+    rate = units / solve_s
+    if not searched and not solved:
+        _SETUP_RATE[model] = rate
+    elif solved and rate > _SETUP_RATE[model]:
+        _SETUP_RATE[model] = rate
+
+
+class _SetupOverrun(Exception):
+    """CP-SAT's set-up (estimated) would end after the deadline."""
+
+    def __init__(self, estimate: float) -> None:
+        super().__init__(estimate)
+        self.estimate = estimate
+
+
+def _check_setup(model: str, units: int, deadline: float | None, before: float = 0.0) -> None:
+    """Raise :class:`_SetupOverrun` when ``before`` seconds of work and then CP-SAT's set-up
+    for ``units`` cannot end by ``deadline``."""
+    if deadline is None:
+        return
+    est = units / _SETUP_RATE[model]
+    if time.perf_counter() + before + est > deadline:
+        raise _SetupOverrun(est)
+
+
 class _Deadline(Exception):
     pass
 
@@ -100,8 +144,9 @@ class CpsatSolver(Solver):
     notes = (
         '`model="onehot"` (Booleans + the support clauses, default) or `"table"` '
         "(`AddAllowedAssignments` per arc); presolve off by default (it expands the tables); "
-        "diverse outputs from random solution hints; `num_workers`, `time_limit` (CP-SAT "
-        "loads a table model without looking at the limit: 1.7-2.1 s over it on 30x30x8)"
+        "diverse outputs from random solution hints; `num_workers`, `time_limit` (CP-SAT's "
+        "set-up ignores it, so csplab estimates the set-up and stops before a run that "
+        "cannot fit)"
     )
     options = (
         Option("model", str, "onehot", "one Boolean per label and the support clauses, or "
@@ -146,9 +191,14 @@ class CpsatSolver(Solver):
         t_load = time.perf_counter()
         try:
             if model == "onehot":
-                read, stats["loader"] = self._onehot(m, enc, pref, deadline)
+                read, stats["loader"], units = self._onehot(m, enc, pref, deadline)
             else:
-                read, stats["loader"] = self._table(m, enc, pref, deadline)
+                read, stats["loader"], units = self._table(m, enc, pref, deadline)
+            _check_setup(model, units, deadline)
+        except _SetupOverrun as e:
+            stats["setup_estimate_s"] = e.estimate
+            stats["build_s"] = time.perf_counter() - t0
+            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
         except _Deadline:
             stats["load_s"] = time.perf_counter() - t_load
             stats["build_s"] = time.perf_counter() - t0
@@ -181,6 +231,10 @@ class CpsatSolver(Solver):
         stats["solver_status"] = s.StatusName(code)
         stats["conflicts"] = int(s.NumConflicts())
         stats["decisions"] = int(s.NumBranches())
+        solved = code in (cp_model.OPTIMAL, cp_model.FEASIBLE)
+        searched = stats["conflicts"] > 0 or stats["decisions"] > 0
+        if num_workers == 1:  # several workers set up several copies
+            _learn_setup(model, units, stats["solve_s"], searched, solved)
         if code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
             values = np.asarray(list(s.response_proto.solution), dtype=np.int64)
             out = read(values).reshape(problem.shape)
@@ -191,39 +245,45 @@ class CpsatSolver(Solver):
         return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
 
     @staticmethod
-    def _onehot(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str]:
+    def _onehot(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str, int]:
         """Booleans x[v, b] (proto index = SAT variable - 1) and the support clauses.
 
         The model is serialized in bulk (:func:`_onehot_bytes`) and parsed into
         ``m``'s proto in one call; without the parser (:func:`_proto_parser`), or for a
         model over 2 GB, it is built element by element (:func:`_onehot_elementwise`).
-        Returns the function from solution values to the grid and the loader's name
-        (``"proto-bytes"`` or ``"proto-api"``).
+        Returns the function from solution values to the grid, the loader's name
+        (``"proto-bytes"`` or ``"proto-api"``) and the model's size in bytes (0 when built
+        element by element) for :func:`_check_setup`.
         """
         parse = _proto_parser()
         buf = _onehot_bytes(enc, pref, deadline) if parse is not None else None
         if parse is not None and buf is not None:
             _check(deadline)
-            # the parse cannot be interrupted: do not start one the time left cannot hold
-            if deadline is not None and time.perf_counter() + buf.size / _PARSE_RATE[0] > deadline:
-                raise _Deadline
+            # neither the parse nor CP-SAT's set-up can be interrupted: do not start a parse
+            # the time left cannot hold with the set-up after it
+            _check_setup("onehot", buf.size, deadline, before=buf.size / _PARSE_RATE[0])
             t = time.perf_counter()
             if not parse(m.proto, buf):
                 raise RuntimeError("CP-SAT could not parse the model csplab serialized")
             if buf.size > 1 << 20:  # learn this machine's rate from real models
                 _PARSE_RATE[0] = max(1e6, buf.size / max(time.perf_counter() - t, 1e-6))
             _check(deadline)
-            return _onehot_reader(enc), "proto-bytes"
+            return _onehot_reader(enc), "proto-bytes", int(buf.size)
         _onehot_elementwise(m, enc, pref, deadline)
-        return _onehot_reader(enc), "proto-api"
+        return _onehot_reader(enc), "proto-api", 0
 
     @staticmethod
-    def _table(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str]:
-        """One integer variable per cell and ``AddAllowedAssignments`` per arc."""
+    def _table(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str, int]:
+        """One integer variable per cell and ``AddAllowedAssignments`` per arc (returns the
+        reader, the loader's name and the number of allowed pairs)."""
         cp_model = require("ortools.sat.python.cp_model", "cpsat", "solver 'cpsat'")
 
         P = enc.problem
         C = enc.catalog
+        real = P.arcs[:, 0] != P.arcs[:, 1]
+        pairs = P.relations.reshape(P.R, -1).sum(axis=1)
+        units = int(pairs[P.arcs[real, 2]].sum())
+        _check_setup("table", units, deadline)  # before spending the build on it
         X = []
         for v in range(P.n):
             labels = np.flatnonzero(C[v]).tolist()
@@ -231,7 +291,7 @@ class CpsatSolver(Solver):
             if v % _CHUNK == 0:
                 _check(deadline)
         tuples = [np.argwhere(P.relations[r]).tolist() for r in range(P.R)]
-        arcs = P.arcs[P.arcs[:, 0] != P.arcs[:, 1]].tolist()
+        arcs = P.arcs[real].tolist()
         for i, (a, b, r) in enumerate(arcs):
             m.AddAllowedAssignments([X[a], X[b]], tuples[r])
             if i % _CHUNK == 0:
@@ -243,7 +303,7 @@ class CpsatSolver(Solver):
         def read(values: np.ndarray) -> np.ndarray:
             return np.asarray(values[: P.n], dtype=np.int32)
 
-        return read, "proto-api"
+        return read, "proto-api", units
 
 
 def _onehot_elementwise(m: Any, enc: Any, pref: Any, deadline: float | None) -> None:

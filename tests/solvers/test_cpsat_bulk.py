@@ -36,7 +36,7 @@ def _models(P: Problem, hint: bool, seed: int = 0) -> tuple[str, str]:
     assert enc.ok
     pref = preferred_labels(enc.catalog, None, np.random.default_rng(seed)) if hint else None
     a = cp_model.CpModel()
-    _read, loader = cpsat.CpsatSolver._onehot(a, enc, pref, None)
+    _read, loader, _size = cpsat.CpsatSolver._onehot(a, enc, pref, None)
     assert loader == "proto-bytes"
     b = cp_model.CpModel()
     cpsat._onehot_elementwise(b, enc, pref, None)
@@ -139,3 +139,34 @@ def test_time_limit_is_respected() -> None:
     wall = time.perf_counter() - t0
     assert r.status in ("timeout", "solved")
     assert wall < limit + 1.0, wall
+
+
+@pytest.mark.parametrize("model", ["onehot", "table"])
+def test_a_setup_the_time_left_cannot_hold_is_not_started(model, monkeypatch) -> None:
+    # CP-SAT's set-up ignores its time limit: with a (pretend) slow machine csplab returns
+    # at once, saying what it estimated, rather than overrunning the limit
+    P = Problem.from_example(load_example("castle"), (8, 8, 4), boundary="auto")
+    monkeypatch.setitem(cpsat._SETUP_RATE, model, 1.0)  # one unit per second
+    t0 = time.perf_counter()
+    r = solve(P, "cpsat", rng=0, time_limit=5.0, model=model)
+    assert time.perf_counter() - t0 < 2.0
+    assert r.status == "timeout" and r.stats["setup_estimate_s"] > 5.0
+    assert "solve_s" not in r.stats  # Solve was never called
+    # without a limit the same run solves, and the rate is learned from it
+    r = solve(P, "cpsat", rng=0, model=model)
+    assert r.status == "solved" and len(P.violations(r.grid)) == 0
+
+
+def test_setup_rate_learning() -> None:
+    rate = dict(cpsat._SETUP_RATE)
+    try:
+        cpsat._learn_setup("onehot", 10 << 20, 0.5, searched=False, solved=False)
+        assert cpsat._SETUP_RATE["onehot"] == pytest.approx((10 << 20) / 0.5)  # measured
+        cpsat._learn_setup("onehot", 10 << 20, 2.0, searched=True, solved=True)
+        assert cpsat._SETUP_RATE["onehot"] == pytest.approx((10 << 20) / 0.5)  # bound: no fall
+        cpsat._learn_setup("onehot", 10 << 20, 0.1, searched=True, solved=True)
+        assert cpsat._SETUP_RATE["onehot"] == pytest.approx((10 << 20) / 0.1)  # bound: rise
+        cpsat._learn_setup("onehot", 1000, 1e-6, searched=False, solved=False)
+        assert cpsat._SETUP_RATE["onehot"] == pytest.approx((10 << 20) / 0.1)  # too small
+    finally:
+        cpsat._SETUP_RATE.update(rate)
