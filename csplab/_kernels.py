@@ -1082,3 +1082,137 @@ def direct_clauses(
                                 lits[2 * nc + 1] = -vid[u, c]
                             nc += 1
     return nc
+
+
+# ----------------------------------------------------------------------------- global constraints
+
+
+@njit(cache=True)
+def mac_restrict(arcs: Arcs, ac: AcState, se: Search, cells: np.ndarray, masks: np.ndarray) -> int:
+    """Intersect the domains of ``cells`` with ``masks`` (packed, ``(len(cells), W)``) inside a
+    MAC search, saving the old domains on the trail, and propagate; the wiped cell or -1.
+
+    What a global-constraint propagator (:mod:`csplab.constraints`) removes between two
+    decisions: undone with the current decision when it is rejected (state slot ``NEED``
+    set to 0) or backtracked.
+    """
+    dom = ac.dom
+    W = dom.shape[1]
+    state = se.state
+    changed = np.zeros(cells.shape[0], dtype=np.bool_)
+    for i in range(cells.shape[0]):
+        v = cells[i]
+        diff = False
+        for w in range(W):
+            if dom[v, w] & ~masks[i, w]:
+                diff = True
+                break
+        if not diff:
+            continue
+        _save(dom, v, se.stamp, state, se.tcell, se.tbits)
+        empty = True
+        for w in range(W):
+            dom[v, w] &= masks[i, w]
+            if dom[v, w]:
+                empty = False
+        if empty:
+            return int(v)
+        changed[i] = True
+    for i in range(cells.shape[0]):
+        if changed[i]:
+            wiped = _propagate_trail(
+                dom, arcs.full, arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup, arcs.supall,
+                ac.queue, ac.inq, cells[i], se.stamp, state, se.tcell, se.tbits, se.counters,
+            )  # fmt: skip
+            if wiped >= 0:
+                return wiped
+    return -1
+
+
+@njit(cache=True)
+def components(n: int, eu: np.ndarray, ev: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """Connected components of the ``active`` vertices over edges ``(eu[i], ev[i])`` (union
+    find); component ids are the smallest vertex of each component, -1 for inactive ones."""
+    parent = np.arange(n)
+    for i in range(eu.shape[0]):
+        a = eu[i]
+        b = ev[i]
+        if not (active[a] and active[b]):
+            continue
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        while parent[b] != b:
+            parent[b] = parent[parent[b]]
+            b = parent[b]
+        if a != b:
+            if a < b:
+                parent[b] = a
+            else:
+                parent[a] = b
+    out = np.full(n, -1, dtype=np.int64)
+    for v in range(n):
+        if active[v]:
+            r = v
+            while parent[r] != r:
+                r = parent[r]
+            out[v] = r
+    return out
+
+
+@njit(cache=True)
+def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: int) -> np.ndarray:
+    """The vertices whose removal separates two ``must`` vertices (the graph ``ptr``/``nbr``,
+    CSR, holds only the vertices that may take part; ``root`` is a must vertex).
+
+    Tarjan's low points over an iterative depth-first search from ``root``: a vertex ``u``
+    other than the root separates when a child ``c`` has ``low[c] >= disc[u]`` and the
+    subtree of ``c`` holds a must vertex (the root, a must vertex, is on the other side).
+    Vertices not reached from the root get -1 in slot 1 of the result: ``out[:, 0]`` is
+    "separating", ``out[:, 1]`` is "reached".
+    """
+    n = ptr.shape[0] - 1
+    disc = np.full(n, -1, dtype=np.int64)
+    low = np.zeros(n, dtype=np.int64)
+    below = np.zeros(n, dtype=np.int64)  # must vertices in the DFS subtree
+    parent = np.full(n, -1, dtype=np.int64)
+    it = np.zeros(n, dtype=np.int64)
+    stack = np.empty(n, dtype=np.int64)
+    out = np.zeros((n, 2), dtype=np.bool_)
+    t = 0
+    sp = 0
+    stack[0] = root
+    sp = 1
+    disc[root] = 0
+    low[root] = 0
+    it[root] = ptr[root]
+    below[root] = 1 if must[root] else 0
+    t = 1
+    while sp > 0:
+        u = stack[sp - 1]
+        if it[u] < ptr[u + 1]:
+            w = nbr[it[u]]
+            it[u] += 1
+            if disc[w] < 0:
+                disc[w] = t
+                low[w] = t
+                t += 1
+                parent[w] = u
+                it[w] = ptr[w]
+                below[w] = 1 if must[w] else 0
+                stack[sp] = w
+                sp += 1
+            elif w != parent[u] and disc[w] < low[u]:
+                low[u] = disc[w]
+        else:
+            sp -= 1
+            p = parent[u]
+            if p >= 0:
+                if low[u] < low[p]:
+                    low[p] = low[u]
+                below[p] += below[u]
+                if p != root and low[u] >= disc[p] and below[u] > 0:
+                    out[p, 0] = True
+    for v in range(n):
+        out[v, 1] = disc[v] >= 0
+    return out

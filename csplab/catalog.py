@@ -234,6 +234,49 @@ class Propagator:
             return False
         return self.propagate([cell])
 
+    def narrow(self, allowed: ArrayLike) -> bool:
+        """Intersect every domain with ``allowed`` (bool ``(n, K)``) and propagate from the
+        cells that changed; ``False`` on wipe-out."""
+        if not self.ok:
+            return False
+        new = self.bits & pack(np.asarray(allowed, dtype=bool))
+        changed = np.flatnonzero((new != self.bits).any(axis=1))
+        if not changed.size:
+            return True
+        self.bits[changed] = new[changed]
+        empty = changed[~new[changed].any(axis=1)]
+        if empty.size:
+            self.ok = False
+            self.wiped = int(empty[0])
+            return False
+        return self.propagate(changed)
+
+    def constrain(self, search: Search | None = None) -> int:
+        """Prune the catalog with the problem's global constraints
+        (:func:`csplab.constraints.propagate_all`) and arc consistency until neither removes
+        more. Inside a MAC ``search`` the removals go on its trail (undone with the current
+        decision). Returns -2 when a constraint propagator refutes the catalog, the wiped
+        cell when arc consistency does, -1 when the catalog survives."""
+        from csplab.constraints import propagate_all
+
+        for _ in range(1000):
+            cur = self.catalog()
+            d = propagate_all(self.problem, cur)
+            if d is None:
+                return -2
+            changed = np.flatnonzero((d != cur).any(axis=1))
+            if not changed.size:
+                return -1
+            if search is None:
+                if not self.narrow(d):
+                    return self.wiped
+                continue
+            cells = np.ascontiguousarray(changed, dtype=np.int64)
+            wiped = kern.mac_restrict(self.c.arcs, self._ac(), search, cells, pack(d[changed]))
+            if wiped >= 0:
+                return int(wiped)
+        return -1
+
     # --------------------------------------------------------------- kernels
     def _ac(self) -> kern.AcState:
         """The mutable state as one kernel argument (built per call: arrays may be replaced)."""

@@ -41,6 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 from csplab.errors import InputError, MemoryLimitError
 
 if TYPE_CHECKING:
+    from csplab.constraints import Constraint
     from csplab.example import ExampleModel
 
 __all__ = [
@@ -87,19 +88,23 @@ class Unary:
 
 @dataclass(frozen=True)
 class Violations:
-    """What :meth:`Problem.violations` found: violated arcs and out-of-domain cells.
+    """What :meth:`Problem.violations` found: violated arcs, out-of-domain cells and broken
+    global constraints.
 
     ``arcs`` are indices into ``problem.arcs``; ``cells`` are flat cell indices whose label is
-    unassigned (negative), out of range or not in the cell's domain. ``len()`` is the total.
+    unassigned (negative), out of range or not in the cell's domain; ``constraints`` holds
+    one line per broken constraint of ``problem.constraints`` (checked on complete grids).
+    ``len()`` is the total.
     """
 
     arcs: NDArray[np.int64]
     cells: NDArray[np.int64]
     problem: Problem = field(repr=False, compare=False)
     grid: NDArray[np.int64] = field(repr=False, compare=False)
+    constraints: tuple[str, ...] = ()
 
     def __len__(self) -> int:
-        return int(self.arcs.size + self.cells.size)
+        return int(self.arcs.size + self.cells.size + len(self.constraints))
 
     def __bool__(self) -> bool:
         return len(self) > 0
@@ -108,6 +113,9 @@ class Violations:
         """Human-readable list of the first ``limit`` violations."""
         P, lab = self.problem, self.grid
         lines = [f"{self.arcs.size} violated arcs, {self.cells.size} cells outside their domain"]
+        if self.constraints:
+            lines[0] += f", {len(self.constraints)} broken constraints"
+            lines += [f"  {c}" for c in self.constraints]
         for c in self.cells[:limit]:
             b = int(lab[c])
             why = "unassigned" if b < 0 else ("out of range" if b >= P.K else "not allowed")
@@ -151,6 +159,9 @@ class Problem:
         Where each cell is, for problems whose cells are not a grid (continuous model
         synthesis: arrangement vertices and edges, in line spacings). ``blocks`` cuts such
         a problem into boxes of these coordinates; grid problems leave it ``None``.
+    constraints : sequence of Constraint, optional
+        Global constraints beside the arcs (:mod:`csplab.constraints`: count, connected,
+        mirror/rotate, separation, max-run), checked by :meth:`violations`.
 
     Notes
     -----
@@ -174,6 +185,7 @@ class Problem:
         name: str = "",
         meta: Mapping[str, Any] | None = None,
         positions: ArrayLike | None = None,
+        constraints: Sequence[Constraint] = (),
     ) -> None:
         self.shape: tuple[int, ...] = tuple(int(s) for s in shape)
         if not self.shape or any(s < 1 for s in self.shape):
@@ -238,6 +250,9 @@ class Problem:
         self.base_domains: NDArray[np.bool_] = base
         self.name = name
         self.meta: dict[str, Any] = dict(meta or {})
+        self.constraints: tuple[Constraint, ...] = tuple(constraints)
+        for c in self.constraints:
+            c.validate(self)
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -263,7 +278,8 @@ class Problem:
         nm = f"{self.name!r}, " if self.name else ""
         return (
             f"Problem({nm}shape={self.shape}, K={self.K}, relations={self.R}, "
-            f"arcs={len(self.arcs)}, unary={len(self.unary)})"
+            f"arcs={len(self.arcs)}, unary={len(self.unary)}"
+            + (f", constraints={len(self.constraints)})" if self.constraints else ")")
         )
 
     # ------------------------------------------------------------------ naming helpers
@@ -312,11 +328,15 @@ class Problem:
         bad_cell = ~inr | ~self.domains[np.arange(self.n), safe]
         s, d, r = self.arcs[:, 0], self.arcs[:, 1], self.arcs[:, 2]
         ok = inr[s] & inr[d] & self.relations[r, safe[s], safe[d]]
+        broken: list[str] = []
+        if self.constraints and inr.all():
+            broken = [m for c in self.constraints if (m := c.check(self, lab)) is not None]
         return Violations(
             arcs=np.flatnonzero(~ok).astype(np.int64),
             cells=np.flatnonzero(bad_cell).astype(np.int64),
             problem=self,
             grid=lab,
+            constraints=tuple(broken),
         )
 
     def is_solution(self, grid: ArrayLike) -> bool:
@@ -385,10 +405,24 @@ class Problem:
             shape=self.shape, domains=self.domains, relations=self.relations, arcs=self.arcs,
             weights=self.weights, names=self.names, relation_names=self.relation_names,
             unary=self.unary, base_domains=self.base_domains, name=self.name, meta=self.meta,
-            positions=self.positions,
+            positions=self.positions, constraints=self.constraints,
         )  # fmt: skip
         args.update(changes)
         return Problem(**args)
+
+    def with_constraints(self, extra: Sequence[Constraint]) -> Problem:
+        """A copy with more global constraints (:mod:`csplab.constraints`)."""
+        return self._replace(constraints=(*self.constraints, *extra))
+
+    def without_constraints(self) -> Problem:
+        """A copy without global constraints (what the arcs and domains alone say)."""
+        return self._replace(constraints=())
+
+    def require_no_constraints(self, what: str) -> None:
+        """One :class:`InputError` line when ``what`` cannot take global constraints."""
+        if self.constraints:
+            kinds = ", ".join(sorted({c.kind for c in self.constraints}))
+            raise InputError(f"{what} does not handle global constraints ({kinds}); drop them")
 
     def with_unary(self, extra: Sequence[Unary]) -> Problem:
         """A copy with more unary restrictions (each remembered, for explanations)."""

@@ -49,8 +49,6 @@ def run(args: argparse.Namespace) -> int:
         from csplab.cli import _continuous
 
         return _continuous.check(args, model)
-    if args.constraints:
-        raise InputError("--constraints: grid models take no constraints file yet")
     grid = load_grid(args.grid, model.ndim, model)
     problem = problem_from_args(args, model, shape=tuple(grid.shape))
     unassigned = int((grid < 0).sum())
@@ -62,6 +60,7 @@ def run(args: argparse.Namespace) -> int:
                     "violations": len(v),
                     "arcs": int(v.arcs.size),
                     "cells": int(v.cells.size),
+                    "constraints": list(v.constraints),
                     "unassigned": unassigned,
                     "shape": list(problem.shape),
                 }

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -295,8 +296,9 @@ def add_constraints_arg(p: argparse.ArgumentParser) -> None:
         "--constraints",
         action="append",
         metavar="FILE",
-        help='a constraints file {"constraints": [...]} (repeatable); polyhedral models take '
-        "dimensional, large-scale and connected (thesis Sec. 4.6)",
+        help='a constraints file {"constraints": [...]} (repeatable); grid models take count, '
+        "connected, mirror, rotate, separation and max-run (csplab.constraints); polyhedral "
+        "models take dimensional, large-scale and connected (thesis Sec. 4.6)",
     )
 
 
@@ -353,11 +355,24 @@ def problem_from_args(
         if shape is None and model.shape is None:
             raise InputError(f"{model.name or args.model} gives no output size: use --size")
         # no --boundary: a tileset keeps the file's own boundary conditions
-        return model.problem(shape, periodic=args.periodic, boundary=boundary or "auto")
-    if shape is None:
-        if getattr(args, "_size_required", False):
-            raise InputError("--size is required for an example model (e.g. --size 40x40x10)")
-        shape = model.shape
-    return Problem.from_example(
-        model, shape, periodic=bool(args.periodic), boundary=boundary or "none"
-    )
+        P = model.problem(shape, periodic=args.periodic, boundary=boundary or "auto")
+    else:
+        if shape is None:
+            if getattr(args, "_size_required", False):
+                raise InputError("--size is required for an example model (e.g. --size 40x40x10)")
+            shape = model.shape
+        P = Problem.from_example(
+            model, shape, periodic=bool(args.periodic), boundary=boundary or "none"
+        )
+    return with_constraint_files(P, getattr(args, "constraints", None))
+
+
+def with_constraint_files(problem: Problem, paths: Sequence[str] | None) -> Problem:
+    """``problem`` with the constraints of every ``--constraints FILE``
+    (:func:`csplab.constraints.read_constraints`)."""
+    if not paths:
+        return problem
+    from csplab.constraints import read_constraints
+
+    extra = [c for p in paths for c in read_constraints(p, problem)]
+    return problem.with_constraints(extra)

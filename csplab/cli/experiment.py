@@ -52,6 +52,11 @@ _COMMON: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {
          "help": "extra solver option (repeatable; JSON values); SOLVER. limits it to one solver"},
     ),
     "time_limit": (("--time-limit",), {"type": float, "help": "seconds per trial"}),
+    "constraints": (
+        ("--constraints",),
+        {"action": "append", "metavar": "FILE", "help": "a constraints file (repeatable): "
+         "global constraints added to every trial's problem (csplab.constraints)"},
+    ),
 }  # fmt: skip
 
 

@@ -91,11 +91,24 @@ def run_alg31(
             "unsat", grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
             stats=stats, trace=np.zeros((0, 2), dtype=np.int64),
         )  # fmt: skip
+    cons = bool(problem.constraints)
+    if cons:  # global constraints: prune the root catalog (sound: no solution is lost)
+        stats.update(constraint_prunings=0, constraint_conflicts=0)
+        got = eng.constrain()
+        if got != -1:
+            stats.update(assigned=0, revisions=int(eng.stats[0]), removals=int(eng.stats[1]))
+            stats["fail_cell"] = list(problem.coords(got)) if got >= 0 else None
+            stats["proof"] = "global-constraint propagation before any choice"
+            return Result(
+                "unsat", grid.reshape(problem.shape), "catalog",
+                time_s=time.perf_counter() - t0, stats=stats,
+                trace=np.zeros((0, 2), dtype=np.int64),
+            )  # fmt: skip
     weighted = choice == "weighted"
     heap: kern.Heap | None = None
     key_weighted = weighted and order == "min-entropy"  # min-domain (MRV): label counts
     if order in _HEAP_ORDERS:
-        pristine = engine is None and eng.c.initial is not None
+        pristine = engine is None and eng.c.initial is not None and not cons
         cached = eng.c.entropies.get(key_weighted) if pristine else None
         if cached is None:
             cached = _entropies(eng, key_weighted)
@@ -115,9 +128,20 @@ def run_alg31(
     )  # fmt: skip
     deadline = None if time_limit is None else t0 + float(time_limit)
     status: Status
+    broken: str | None = None
     while True:
+        steps = 1 if cons else _CHUNK if deadline is not None else None
         code = eng.alg31(run, heap, weighted=weighted, key_weighted=key_weighted,
-                         max_steps=_CHUNK if deadline is not None else None)  # fmt: skip
+                         max_steps=steps)  # fmt: skip
+        if cons and code in (kern.Code.PAUSED, kern.Code.SOLVED):
+            # after each assignment the constraints prune (Alg. 3.1 never undoes a choice)
+            got = eng.constrain()
+            if got != -1:
+                stats["constraint_conflicts"] += 1
+                broken = "a global constraint's propagator emptied a domain"
+                if got >= 0:
+                    run.state[2] = got
+                code = kern.Code.FAILED
         if code is kern.Code.SOLVED:
             status = "solved"
             break
@@ -130,7 +154,10 @@ def run_alg31(
     steps = run.steps
     stats.update(assigned=steps, revisions=int(eng.stats[0]), removals=int(eng.stats[1]))
     if status == "failed":
-        stats["fail_cell"] = list(problem.coords(run.fail_cell))
+        fc = run.fail_cell
+        stats["fail_cell"] = list(problem.coords(fc)) if fc >= 0 else None
+        if broken is not None:
+            stats["broken"] = [broken]
     trace = np.stack([run.trace_cell[:steps], run.trace_label[:steps]], axis=1)
     return Result(
         status, grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,

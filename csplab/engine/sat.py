@@ -39,6 +39,7 @@ from numba import njit
 from numpy.typing import NDArray
 
 from csplab.cnf import DeadlineExceeded, Encoding, amo_clauses, encode
+from csplab.constraints import ClauseContext, constraint_clauses
 from csplab.deps import require
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -262,6 +263,7 @@ class SatOracle:
             self.timed_out = True
             self.enc = encode(Problem((1,), [[True]], [[[True]]], []))  # a trivial stand-in
         self.top = self.enc.nvars
+        self.cons: ClauseContext | None = None
         self.stats: dict[str, Any] = dict(self.enc.stats)
         self.stats.update(backend=self.backend, refinements=0, sat_calls=0, solve_s=0.0)
         self.grid: NDArray[np.int32] | None = None
@@ -285,9 +287,15 @@ class SatOracle:
             self.solver.add_clause([])  # the empty clause: arc consistency wiped out
         elif not self.timed_out:
             self._load(self.enc.lits, self.enc.starts, deadline)
+        # global constraints (csplab.constraints): their clauses, and cuts in solve()
+        if problem.constraints and self.enc.ok and not self.timed_out:
+            self.cons = constraint_clauses(problem, self.enc.literal, self.top)
+            self.stats["constraint_clauses"] = len(self.cons.clauses)
+            self.stats["cuts"] = 0
+            self._flush()
         self.stats["load_s"] = time.perf_counter() - t0
-        self.stats["vars"] = self.enc.nvars
-        self.stats["clauses"] = self.enc.nclauses
+        self.stats["vars"] = self.top
+        self.stats["clauses"] = self.enc.nclauses + len(self.cons.clauses if self.cons else ())
 
     # ------------------------------------------------------------------ building
     def _load(
@@ -310,6 +318,23 @@ class SatOracle:
                 st = (starts[a : b + 1] - lo).tolist()
                 self.solver.append_formula([sub[i:j] for i, j in itertools.pairwise(st)])
 
+    def _flush(self) -> None:
+        """Load the constraint clauses not loaded yet."""
+        ctx = self.cons
+        if ctx is None:
+            return
+        done = getattr(self, "_cons_done", 0)
+        new = ctx.clauses[done:]
+        self._cons_done = len(ctx.clauses)
+        self.top = max(self.top, ctx.top)
+        if not new:
+            return
+        lengths = np.array([len(c) for c in new], dtype=np.int64)
+        if (lengths == 0).any():
+            self.solver.add_clause([])
+            return
+        self.add_clauses(np.fromiter(itertools.chain.from_iterable(new), np.int32), lengths)
+
     def add_clause(self, clause: Sequence[int]) -> None:
         """Add one clause (Python ints)."""
         if not self.timed_out:
@@ -324,6 +349,8 @@ class SatOracle:
     def new_var(self) -> int:
         """A fresh variable (e.g. a selector for assumptions)."""
         self.top += 1
+        if self.cons is not None:
+            self.cons.top = self.top
         return self.top
 
     def add_amo(self, cells: NDArray[np.int64]) -> None:
@@ -336,6 +363,8 @@ class SatOracle:
         has = self.enc.var > 0
         enc = "seqcounter"
         lits, lens, self.top = amo_clauses(self.enc.var, has, enc, self.top, cells=cells)
+        if self.cons is not None:
+            self.cons.top = self.top
         if lens.size:
             self.add_clauses(lits, lens)
 
@@ -380,6 +409,19 @@ class SatOracle:
             val[pos] = 1
             ids = np.flatnonzero(val[1 : self.enc.nx + 1]) + 1
             self.solver.set_phases((ids * val[ids]).tolist())
+
+    def _prefer(self, lits: Sequence[int]) -> None:
+        """Decision phases for some literals (later calls override earlier ones)."""
+        if not lits or self.timed_out:
+            return
+        arr = np.asarray(lits, dtype=np.int32)
+        if self._fast is not None:
+            _feed_literals(self._fast[1], self._ptr, arr)
+        else:
+            try:
+                self.solver.set_phases(arr.tolist())
+            except (NotImplementedError, AttributeError):
+                pass
 
     def _raw(self, assumptions: list[int], deadline: float | None) -> bool | None:
         S = self.solver
@@ -445,6 +487,14 @@ class SatOracle:
                     return "unsat"
                 grid, multi = self.enc.decode(self._model_truth())
                 if multi.size == 0:
+                    if self.cons is not None:
+                        self.cons.top = max(self.cons.top, self.top)
+                        k = self.cons.cuts(grid)
+                        if k:  # a connectivity breach: cut it off and solve again
+                            self.stats["cuts"] += k
+                            self._flush()
+                            self._prefer(self.cons.hints)
+                            continue
                     self.grid = grid
                     return "sat"
                 self.stats["refinements"] += 1

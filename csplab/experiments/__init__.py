@@ -62,6 +62,7 @@ EXPERIMENTS: dict[str, str] = {
     "sampling_bias": "csplab.experiments.sampling_bias:SamplingBias",
     "table1_continuous": "csplab.experiments.table1_continuous:Table1Continuous",
     "baselines": "csplab.experiments.baselines:Baselines",
+    "constraints": "csplab.experiments.constraints:ConstraintsExperiment",
 }
 ALIASES: dict[str, str] = {"fig3_10": "blocksize", "table3.1": "table3_1", "fig3.8": "fig3_8"}
 

@@ -30,7 +30,8 @@ import numpy as np
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.experiments.trial import Trial
+from csplab.experiments.trial import Trial, parse_boundary
+from csplab.problem import Problem
 
 __all__ = [
     "Experiment",
@@ -441,8 +442,11 @@ class Experiment:
     ) -> list[Trial]:
         """One trial per configured solver entry and seed for ``example`` at ``size``."""
         out: list[Trial] = []
+        cons = self.constraint_entries(config, example, size)
         for entry in config["solvers"]:
             solver, params = self.solver_params(config, entry)
+            if cons:
+                params["constraints"] = cons
             for seed in self.seeds(config):
                 out.append(
                     Trial(
@@ -452,14 +456,49 @@ class Experiment:
                 )  # fmt: skip
         return out
 
+    def constraint_entries(
+        self, config: dict[str, Any], example: ExampleModel, size: tuple[int, ...]
+    ) -> list[dict[str, Any]]:
+        """The global constraints of the trials of ``example`` at ``size``: the entries of
+        every ``--constraints FILE`` (checked against the problem here, so a bad file is one
+        line before anything runs)."""
+        paths = config.get("constraints") or []
+        if not paths:
+            return []
+        from csplab.constraints import parse_constraints
+        from csplab.io._json import load_json
+
+        entries: list[dict[str, Any]] = []
+        for path in paths:
+            try:
+                text = Path(path).read_text(encoding="utf-8")
+            except OSError as e:
+                raise InputError(f"--constraints {path}: {e.strerror or e}") from None
+            doc = load_json(text, path=path)
+            items = doc.get("constraints") if isinstance(doc, dict) else doc
+            if not isinstance(items, list):
+                raise InputError(f'{path}: a constraints file is {{"constraints": [ ... ]}}')
+            entries += items
+        boundary = parse_boundary(config.get("boundary", "none"))
+        P = Problem.from_example(example, size, periodic=bool(config.get("periodic")),
+                                 boundary=boundary)  # fmt: skip
+        parse_constraints(entries, P, ", ".join(map(str, paths)))
+        return entries
+
     def solver_params(self, config: dict[str, Any], entry: str) -> tuple[str, dict[str, Any]]:
-        """``(solver spec, params)`` for a solver entry: params hold the ``options`` and,
-        for entries with ``@`` options, the entry as ``label``."""
+        """``(solver spec, params)`` for a solver entry: params hold the ``options``, the
+        ``restarts`` of :func:`csplab.solvers.solve` (``catalog@restarts=20``) and, for
+        entries with ``@`` options, the entry as ``label``."""
         spec, extra = split_solver(entry)
         opts = self.solver_options(config, spec)
+        restarts = extra.pop("restarts", None)  # solve(..., restarts=N), not a solver option
         opts.update(extra)
         params: dict[str, Any] = {"options": opts}
-        if extra:
+        if restarts is not None:
+            if isinstance(restarts, bool) or not isinstance(restarts, int) or restarts < 0:
+                raise InputError(f"solver entry {entry!r}: restarts must be an integer >= 0")
+            params["restarts"] = restarts
+        if extra or restarts is not None:
             params["label"] = entry
         return spec, params
 

@@ -59,6 +59,7 @@ class Fig38(Experiment):
         "periodic": False,
         "options": {},
         "time_limit": None,
+        "constraints": None,
     }
     quick: ClassVar[dict[str, Any]] = {
         "examples": ["castle", "line"],

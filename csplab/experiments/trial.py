@@ -67,8 +67,9 @@ class Trial:
     solver : str
         Solver spec (``"catalog"``, ``"blocks"``, ``"sat:cadical195"`` ...).
     params : dict
-        JSON-serialisable parameters: ``options`` (solver options) and anything the
-        measure function reads.
+        JSON-serialisable parameters: ``options`` (solver options), ``constraints``
+        (entries of a constraints file, :mod:`csplab.constraints`, added to the problem)
+        and anything the measure function reads.
     seed : int
     boundary : str
         ``"auto"``, ``"none"`` or ``"face=label,..."``.
@@ -132,7 +133,8 @@ def parse_boundary(text: str) -> Any:
 
 def problem_for(trial: Trial, example: ExampleModel) -> Problem:
     """The trial's problem, built once per process and kept in a small cache."""
-    key = (trial.example_hash, trial.size, trial.boundary, trial.periodic)
+    cons = trial.params.get("constraints")
+    key = (trial.example_hash, trial.size, trial.boundary, trial.periodic, _canon(cons))
     with TRIAL_LOCK:
         P = _PROBLEMS.get(key)
         if P is not None:
@@ -141,6 +143,10 @@ def problem_for(trial: Trial, example: ExampleModel) -> Problem:
     P = Problem.from_example(
         example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
     )
+    if cons:  # global constraints: entries of a constraints file (csplab.constraints)
+        from csplab.constraints import parse_constraints
+
+        P = P.with_constraints(parse_constraints(cons, P, f"trial {trial.key}"))
     with TRIAL_LOCK:
         _PROBLEMS[key] = P
         while len(_PROBLEMS) > 6:
@@ -213,7 +219,8 @@ def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict
     a digest of the output grid."""
     from csplab.solvers import solve
 
-    r = solve(problem, trial.solver, rng=trial.seed, **trial.options)
+    restarts = int(trial.params.get("restarts", 0))
+    r = solve(problem, trial.solver, rng=trial.seed, restarts=restarts, **trial.options)
     stats = kept_stats(r.stats)
     stats["grid"] = grid_digest(r.grid)
     return {"status": r.status, "time_s": float(r.time_s), "stats": stats}

@@ -25,9 +25,14 @@ their turned forms do not exist and those adjacencies are not expanded). Weights
 rows); csplab's points up, so ``up`` is ``+y`` and pictures look the same.
 
 Supported constraints: ``border`` (``tile``/``tiles``, ``sides``, ``excludeSides``,
-``ban``) and ``fixedTile`` (``tile``/``tiles`` at ``point``). Every other constraint
-(``path``, ``edgedPath``, ``count``, ...) is reported as a warning and is NOT enforced;
-``strict=True`` makes it an error.
+``ban``) and ``fixedTile`` (``tile``/``tiles`` at ``point``) become domain restrictions;
+``path`` (``tiles``, ``endPoints``), ``edgedPath`` (``exits``, ``endPoints``), ``count``
+(``tiles``, ``comparison``, ``count``), ``mirrorX``/``mirrorY``, ``maxConsecutive``
+(``tiles``, ``maxCount``, ``axes``) and ``separation`` (``tiles``, ``minDistance``) become
+global constraints (:mod:`csplab.constraints`), which csplab's exact solvers enforce
+exactly (DeBroglie enforces them heuristically while backtracking). Every other
+constraint is reported as a warning and is NOT enforced; ``strict=True`` makes it an
+error.
 
 Examples
 --------
@@ -51,6 +56,7 @@ from csplab.io._json import load_json
 from csplab.io.common import KIND, NO, LoaderWarnings, json_like, read_bytes
 from csplab.io.ruleset import DomainOp, RuleSet
 from csplab.io.symmetry import Group, square_group
+from csplab.problem import AXIS_NAMES
 
 __all__ = ["parse_debroglie", "read_debroglie", "sniff"]
 
@@ -172,7 +178,7 @@ def parse_debroglie(
                 unsupported(f"tiles[{i}].{key} is not supported by csplab and is ignored")
     names = [str(v) for v in order]
     shape = _shape(d, ndim, path)
-    boundary_ops, constraint_ops = _constraints(d, order, K, ndim, path, unsupported)
+    boundary_ops, constraint_ops, global_ops = _constraints(d, order, K, ndim, path, unsupported)
     meta: dict[str, Any] = {
         "format": "debroglie",
         "source": str(path),
@@ -189,6 +195,7 @@ def parse_debroglie(
         periodic=bool(d.get("periodic", False)),
         boundary_ops=boundary_ops,
         constraint_ops=constraint_ops,
+        constraints=global_ops,
         symmetry=(G, perm),
         meta=meta,
     )
@@ -325,9 +332,10 @@ def _close(img: list[dict[int, int]], S: Group, path: object) -> None:
 
 def _constraints(
     d: dict[str, Any], order: dict[Any, int], K: int, ndim: int, path: object, unsupported: Any
-) -> tuple[list[DomainOp], list[DomainOp]]:
+) -> tuple[list[DomainOp], list[DomainOp], list[dict[str, Any]]]:
     bops: list[DomainOp] = []
     cops: list[DomainOp] = []
+    gops: list[dict[str, Any]] = []
     cons = d.get("constraints", []) or []
     if not isinstance(cons, list):
         raise FormatError("'constraints' must be a list", path=path)
@@ -398,12 +406,100 @@ def _constraints(
                     "force", lab, region=region, flip=flip, kind="fixed", key=f"fixedTile {pt}"
                 )
             )
+        elif typ in _GLOBAL:
+            spec = _global(c, typ, i, ndim, path, unsupported)
+            if spec is not None:
+                gops.append(spec)
         else:
             unsupported(
                 f"constraints[{i}] type {typ!r} is not supported by csplab and is NOT "
                 "enforced: outputs may violate it"
             )
-    return bops, cops
+    return bops, cops, gops
+
+
+_GLOBAL = ("path", "edgedPath", "count", "mirrorX", "mirrorY", "maxConsecutive", "separation")
+_EXIT = {  # DeBroglie exit direction -> csplab face (DeBroglie's y points down)
+    "x-": "x-", "x+": "x+", "y-": "y+", "y+": "y-", "z-": "z-", "z+": "z+",
+    "xmin": "x-", "xmax": "x+", "ymin": "y+", "ymax": "y-", "zmin": "z-", "zmax": "z+",
+    "left": "x-", "right": "x+", "up": "y+", "down": "y-", "above": "z+", "below": "z-",
+}  # fmt: skip
+
+
+def _global(
+    c: dict[str, Any], typ: str, i: int, ndim: int, path: object, unsupported: Any
+) -> dict[str, Any] | None:
+    """A DeBroglie constraint as an entry of csplab's constraints file
+    (:mod:`csplab.constraints`; labels by name, ``y`` counted from the top as DeBroglie
+    counts it: csplab's ``-1 - y``)."""
+    where = f"constraints[{i}] ({typ})"
+
+    def tiles(key: str = "tiles") -> list[str]:
+        v = c.get(key, c.get("tile"))
+        if v is None:
+            raise FormatError(f"{where} needs {key!r}", path=path)
+        return [str(t) for t in _tile_list(v, where, path)]
+
+    def integer(key: str) -> int:
+        v = c.get(key)
+        if isinstance(v, bool) or not isinstance(v, int) or v < 0:
+            raise FormatError(f"{where}.{key} must be an integer >= 0, got {v!r}", path=path)
+        return v
+
+    if typ in ("path", "edgedPath"):
+        spec: dict[str, Any] = {"type": "connected"}
+        if typ == "edgedPath":
+            exits = c.get("exits")
+            if not isinstance(exits, dict) or not exits:
+                raise FormatError(f"{where} needs 'exits': {{tile: [directions]}}", path=path)
+            ports: dict[str, list[str]] = {}
+            for t, dirs in exits.items():
+                out = []
+                for dname in dirs if isinstance(dirs, list) else [dirs]:
+                    f = _EXIT.get(str(dname).strip().lower())
+                    if f is None or AXIS_NAMES.index(f[0]) >= ndim:
+                        raise FormatError(
+                            f"{where}: unknown exit {dname!r} of tile {t!r}", path=path
+                        )
+                    out.append(f)
+                ports[str(t)] = out
+            spec["labels"] = list(ports)
+            spec["ports"] = ports
+        else:
+            spec["labels"] = tiles()
+        pts = c.get("endPoints") or []
+        cells = []
+        for p in pts if isinstance(pts, list) else []:
+            if not isinstance(p, dict):
+                raise FormatError(f"{where}.endPoints must hold {{x, y[, z]}} objects", path=path)
+            xyz = [p.get(a, 0) for a in "xyz"[:ndim]]
+            if any(isinstance(v, bool) or not isinstance(v, int) or v < 0 for v in xyz):
+                raise FormatError(
+                    f"{where}.endPoints: coordinates must be integers >= 0", path=path
+                )
+            xyz[1] = -1 - xyz[1]  # DeBroglie's y points down
+            cells.append(xyz)
+        if cells:
+            spec["cells"] = cells
+        if c.get("endPointTiles"):
+            unsupported(f"{where}: endPointTiles is not supported and NOT applied")
+        return spec
+    if typ == "count":
+        cmp = str(c.get("comparison", "atMost")).lower()
+        n = integer("count")
+        bounds = {"atmost": (0, n), "atleast": (n, None), "exactly": (n, n)}.get(cmp)
+        if bounds is None:
+            raise FormatError(f"{where}.comparison must be atMost, atLeast or exactly", path=path)
+        return {"type": "count", "labels": tiles(), "min": bounds[0], "max": bounds[1]}
+    if typ in ("mirrorX", "mirrorY"):
+        return {"type": "mirror", "axis": typ[-1].lower()}
+    if typ == "maxConsecutive":
+        spec = {"type": "max-run", "labels": tiles(), "n": integer("maxCount")}
+        if c.get("axes") is not None:
+            axes = c["axes"] if isinstance(c["axes"], list) else [c["axes"]]
+            spec["axes"] = [str(a).lower()[:1] for a in axes]
+        return spec
+    return {"type": "separation", "labels": tiles(), "distance": integer("minDistance")}
 
 
 def _from_sample(d: dict[str, Any], mtype: str, src: Any, path: object, strict: bool) -> RuleSet:

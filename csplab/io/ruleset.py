@@ -124,6 +124,9 @@ class RuleSet:
     boundary_ops, constraint_ops : sequence of DomainOp
         Boundary conditions (dropped by ``boundary="none"``) and other restrictions (always
         applied).
+    constraints : sequence of mapping
+        Global constraints the file states, as entries of csplab's constraints file
+        (:mod:`csplab.constraints`), added to every problem built (for its size).
     images : uint8 array ``(K, h, w, 4)``, optional
         One RGBA picture per label, rows top to bottom as in an image file.
     colors : uint8 array ``(K, 3)``, optional
@@ -152,6 +155,7 @@ class RuleSet:
         periodic: bool | Sequence[bool] = False,
         boundary_ops: Sequence[DomainOp] = (),
         constraint_ops: Sequence[DomainOp] = (),
+        constraints: Sequence[Mapping[str, Any]] = (),
         images: ArrayLike | None = None,
         colors: ArrayLike | None = None,
         empty: int | None = None,
@@ -188,6 +192,7 @@ class RuleSet:
                 raise InputError(f"unknown face {op.face!r}")
         self.boundary_ops: tuple[DomainOp, ...] = tuple(boundary_ops)
         self.constraint_ops: tuple[DomainOp, ...] = tuple(constraint_ops)
+        self.constraints: tuple[Mapping[str, Any], ...] = tuple(constraints)
         self.images: NDArray[np.uint8] | None = None
         if images is not None:
             im = np.asarray(images, dtype=np.uint8)
@@ -342,6 +347,12 @@ class RuleSet:
         unary = self._unaries(ops, shp)
         if unary:
             P = P.with_unary(unary)
+        if self.constraints:
+            from csplab.constraints import parse_constraints
+
+            P = P.with_constraints(
+                parse_constraints(list(self.constraints), P, self.meta.get("source") or self.name)
+            )
         return P
 
     def _unaries(self, ops: Sequence[DomainOp], shp: tuple[int, ...]) -> list[Unary]:

@@ -173,6 +173,7 @@ def available_solvers() -> list[dict[str, Any]]:
             "name": name,
             "description": cls.description,
             "complete": cls.complete,
+            "constraints": cls.constraints,
             "requires": list(cls.requires),
             "extra": cls.extra,
             "installed": not missing,
@@ -208,7 +209,10 @@ def option_values(option: str) -> list[str]:
 
 def markdown_table() -> str:
     """The README solver table, from the declarations (``python -m csplab.solvers``)."""
-    rows = ["| name | algorithm | complete | options | notes |", "|---|---|---|---|---|"]
+    rows = [
+        "| name | algorithm | complete | global constraints | options | notes |",
+        "|---|---|---|---|---|---|",
+    ]
     for name in solver_names():
         cls = solver_class(name)
         spec = f"`{name}[:backend]`" if cls.backends is not None else f"`{name}`"
@@ -216,8 +220,8 @@ def markdown_table() -> str:
             f"`{o.name}`" + (f" ({'/'.join(o.values)})" if o.values else "") for o in cls.options
         )
         rows.append(
-            f"| {spec} | {cls.description} | {'yes' if cls.complete else 'no'} | {opts} | "
-            f"{cls.notes} |"
+            f"| {spec} | {cls.description} | {'yes' if cls.complete else 'no'} | "
+            f"{cls.constraints} | {opts} | {cls.notes} |"
         )
     return "\n".join(rows)
 
@@ -282,6 +286,12 @@ def solve(
         attempt += 1
         if res.status not in STATUSES:
             raise CsplabError(f"solver {solver!r} returned unknown status {res.status!r}")
+        if res.status == "solved" and problem.constraints and cls.constraints == "checked":
+            # a solver that only checks global constraints: a breach is a failed run
+            broken = problem.violations(res.grid).constraints
+            if broken:
+                res.status = "failed"
+                res.stats["broken"] = list(broken)
         if res.status != "failed" or cls.complete or attempt > restarts:
             break
         if limit is not None:

@@ -102,6 +102,7 @@ Examples
 from __future__ import annotations
 
 import inspect
+import itertools
 import json
 import subprocess
 import sys
@@ -117,9 +118,10 @@ from numba import njit
 from numpy.typing import NDArray
 
 from csplab.cnf import DeadlineExceeded, Encoding, encode
+from csplab.constraints import ClauseContext, constraint_clauses
 from csplab.deps import require
 from csplab.engine.sat import preferred_labels
-from csplab.errors import CsplabError
+from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result, Status
 from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
@@ -231,20 +233,29 @@ def _constraints(lits: NDArray[np.int32], starts: NDArray[np.int64], a: int, b: 
     return _text(tok, line)
 
 
-def _heuristics(atoms: NDArray[np.int64]) -> bytes:
-    """``#heuristic a. [1, sign]`` for each atom (aspif ``7 1 a 1 0 0``)."""
+def _heuristics(atoms: NDArray[np.int64], sign: int = 1) -> bytes:
+    """``#heuristic a. [sign, sign]`` for each atom (aspif ``7 1 a sign 0 0``)."""
     m = atoms.size
     tok = np.zeros((m, 6), dtype=np.int64)
-    tok[:, 0], tok[:, 1], tok[:, 2], tok[:, 3] = 7, 1, atoms, 1
+    tok[:, 0], tok[:, 1], tok[:, 2], tok[:, 3] = 7, 1, atoms, sign
     return _text(tok.ravel(), np.full(m, 6, dtype=np.int64))
 
 
-def ground_program(enc: Encoding, prefer: NDArray[np.int64] | None = None) -> Iterator[bytes]:
+def ground_program(
+    enc: Encoding,
+    prefer: NDArray[np.int64] | None = None,
+    ctx: ClauseContext | None = None,
+    reach: tuple[bytes, NDArray[np.int64]] | None = None,
+) -> Iterator[bytes]:
     """The ground ASP program of an encoding, in aspif, as a stream of pieces.
 
     Atom ``i`` is CNF variable ``i`` of ``enc`` (``(cell, label)`` of the catalog, numbered
     cell by cell); constant cells have no atoms. ``prefer`` (one label per cell, -1 for
-    none) adds domain-heuristic sign preferences.
+    none) adds domain-heuristic sign preferences. ``ctx`` adds the clauses of the
+    problem's global constraints (:mod:`csplab.constraints`): their auxiliary variables
+    become free choice atoms and every clause an integrity constraint, so answer sets are
+    exactly the models of the clauses; ``reach`` (:func:`reach_rules`) adds the
+    reachability rules of connectivity constraints.
 
     Examples
     --------
@@ -275,11 +286,94 @@ def ground_program(enc: Encoding, prefer: NDArray[np.int64] | None = None) -> It
         yield _cell_rules(first[a : a + _CELL_CHUNK], k[a : a + _CELL_CHUNK])
     for a in range(0, enc.nclauses, _CLAUSE_CHUNK):
         yield _constraints(enc.lits, enc.starts, a, min(a + _CLAUSE_CHUNK, enc.nclauses))
+    if reach is not None:
+        yield reach[0]
+    if ctx is not None and (ctx.clauses or reach is not None):
+        aux = np.arange(enc.nvars + 1, ctx.top + 1, dtype=np.int64)
+        if reach is not None:
+            aux = aux[~np.isin(aux, reach[1])]  # reach atoms are defined by rules
+        if aux.size:
+            yield _cell_rules(aux, np.ones(aux.size, dtype=np.int64))  # {a}. (and :- 2 {a}.)
+        lits = np.fromiter(itertools.chain.from_iterable(ctx.clauses), np.int32)
+        lens = np.array([len(c) for c in ctx.clauses], dtype=np.int64)
+        starts = np.zeros(lens.size + 1, dtype=np.int64)
+        np.cumsum(lens, out=starts[1:])
+        for a in range(0, lens.size, _CLAUSE_CHUNK):
+            yield _constraints(lits, starts, a, min(a + _CLAUSE_CHUNK, lens.size))
     if prefer is not None:
         c = cells[prefer[cells] >= 0]
         atoms = enc.var[c, prefer[c]].astype(np.int64)
         yield _heuristics(atoms[atoms > 0])
+    if ctx is not None and ctx.hints:  # after a cut: try the stray cells without the set
+        yield _heuristics(-np.asarray(ctx.hints, dtype=np.int64), sign=-1)
     yield b"0\n"
+
+
+def reach_rules(ctx: ClauseContext) -> tuple[bytes, NDArray[np.int64]]:
+    """Connectivity the ASP way, for every :class:`~csplab.constraints.Connected` of the
+    problem: a chosen root ``r(c)`` (at most one, on a cell of the set), reachability
+    ``h(v) :- h(u), link(u, v)`` along the axis neighbours (through open ports for
+    ``edgedPath``) and ``:- y(c), not h(c)``. Stable models make ``h`` the least fixpoint,
+    so the answer sets are exactly the connected grids: no cut loop. Returns the aspif
+    lines and the ``h`` atoms (defined by rules, not choices)."""
+    from csplab.constraints import Connected, grid_edges, label_mask
+
+    P = ctx.problem
+    lines: list[str] = []
+    defined: list[int] = []
+    for con in P.constraints:
+        if not isinstance(con, Connected):
+            continue
+        S = label_mask(con.labels, P.K)
+        y = [ctx.in_set(c, S) for c in range(P.n)]
+        h = np.zeros(P.n, dtype=np.int64)
+        roots = []
+        for c in range(P.n):
+            if y[c] is False:
+                continue
+            h[c] = ctx.new_var()
+            defined.append(int(h[c]))
+            r = ctx.new_var()
+            roots.append(r)
+            if y[c] is not True:
+                ctx.clauses.append([-r, int(y[c])])  # a root is in the set
+            lines.append(f"1 0 1 {h[c]} 0 1 {r}")  # h(c) :- r(c).
+            if y[c] is True:
+                lines.append(f"1 0 0 0 1 -{h[c]}")  # :- not h(c).
+            else:
+                lines.append(f"1 0 0 0 2 {int(y[c])} -{h[c]}")  # :- y(c), not h(c).
+        if len(roots) > 1:  # :- 2 {r(c)}.
+            lines.append(f"1 0 0 1 2 {len(roots)} " + " ".join(f"{r} 1" for r in roots))
+        lo, hi, ax = grid_edges(P)
+        ports = None if con.ports is None else np.asarray(con.ports, dtype=bool)
+        for u, v, a in zip(lo.tolist(), hi.tolist(), ax.tolist(), strict=True):
+            if not (h[u] and h[v]):
+                continue
+            if ports is None:
+                p, q = y[u], y[v]
+            else:
+                p = ctx.in_set(u, S & ports[:, 2 * a + 1])
+                q = ctx.in_set(v, S & ports[:, 2 * a])
+            if p is False or q is False:
+                continue
+            body = [int(x) for x in (p, q) if x is not True]
+            for src, dst in ((u, v), (v, u)):
+                lits = [int(h[src]), *body]
+                lines.append(f"1 0 1 {h[dst]} 0 {len(lits)} " + " ".join(map(str, lits)))
+    text = ("\n".join(lines) + "\n").encode() if lines else b""
+    return text, np.asarray(defined, dtype=np.int64)
+
+
+def _grid_of(enc: Encoding, report: dict[str, Any]) -> NDArray[np.int32]:
+    """The grid of an answer set read as ``atoms`` (atom i+1 is ``(cells[i], labels[i])``)."""
+    grid = enc.const.copy()
+    cells, labels = np.nonzero(enc.var > 0)
+    idx = np.asarray(report["atoms"], dtype=np.int64) - 1
+    if idx.size != np.count_nonzero(enc.const < 0):
+        raise CsplabError(f"clingo's model has {idx.size} labels for the "
+                          f"{np.count_nonzero(enc.const < 0)} open cells")  # fmt: skip
+    grid[cells[idx]] = labels[idx]
+    return grid
 
 
 def facts(problem: Problem, catalog: NDArray[np.bool_], supports: str, encoding: str) -> str:
@@ -493,6 +587,7 @@ class AspSolver(Solver):
     """Complete: answer-set programming with clingo (choice rule + support constraints)."""
 
     name = "asp"
+    constraints = "exact"
     complete = True
     requires = ("clingo",)
     extra = "asp"
@@ -549,6 +644,10 @@ class AspSolver(Solver):
         if enc.nx == 0:  # arc consistency left one label per cell: that is the solution
             stats["ground_s"] = stats["encode_s"]
             stats["solve_s"] = 0.0
+            broken = problem.violations(enc.const).constraints
+            if broken:
+                stats["proof"] = f"the only labelling arc consistency leaves breaks {broken[0]}"
+                return done("unsat")
             return done("solved", enc.const.reshape(problem.shape))
         if deadline is not None and time.perf_counter() > deadline:
             return done("timeout")
@@ -561,8 +660,17 @@ class AspSolver(Solver):
             prefer = preferred_labels(enc.catalog, None, rng)
             args.append("--heuristic=Domain")
         pieces: Iterator[bytes]
+        ctx = None
+        reach = None
+        if problem.constraints:  # global constraints: choice atoms and integrity constraints
+            if grounding != "csplab":
+                raise InputError("solver 'asp': global constraints need grounding='csplab'")
+            ctx = constraint_clauses(problem, enc.literal, enc.nvars)
+            reach = reach_rules(ctx)
+            stats["constraint_clauses"] = len(ctx.clauses)
+            stats["cuts"] = 0
         if grounding == "csplab":
-            pieces = ground_program(enc, prefer)
+            pieces = ground_program(enc, prefer, ctx, reach)
             read = "atoms"
         else:
             text = facts(problem, enc.catalog, supports, encoding)
@@ -576,6 +684,16 @@ class AspSolver(Solver):
             read = "shown"
         t_write = time.time()
         report, written = _run_child(args, pieces, read=read, nx=enc.nx, deadline=deadline)
+        while ctx is not None and report is not None and report.get("status") == "SAT":
+            k = ctx.cuts(_grid_of(enc, report))  # connectivity: cut the answer off, run again
+            if not k:
+                break
+            stats["cuts"] += k
+            stats["sat_calls"] = stats.get("sat_calls", 1) + 1
+            if "--heuristic=Domain" not in args:
+                args = [*args, "--heuristic=Domain"]
+            report, written = _run_child(args, ground_program(enc, prefer, ctx, reach), read=read,
+                                         nx=enc.nx, deadline=deadline)  # fmt: skip
         stats["solver_stats"] = sub = {
             "clingo": str(clingo.__version__),
             "seed": cseed,
@@ -600,15 +718,10 @@ class AspSolver(Solver):
         if report.get("messages"):
             sub["messages"] = report["messages"]
         if report["status"] == "SAT":
-            grid = enc.const.copy()
             if read == "atoms":
-                cells, labels = np.nonzero(enc.var > 0)  # atom i+1 <-> (cells[i], labels[i])
-                idx = np.asarray(report["atoms"], dtype=np.int64) - 1
-                if idx.size != np.count_nonzero(enc.const < 0):
-                    raise CsplabError(f"clingo's model has {idx.size} labels for the "
-                                      f"{np.count_nonzero(enc.const < 0)} open cells")  # fmt: skip
-                grid[cells[idx]] = labels[idx]
+                grid = _grid_of(enc, report)
             else:
+                grid = enc.const.copy()
                 pairs = np.asarray(report["pairs"], dtype=np.int64).reshape(-1, 2)
                 grid[pairs[:, 0]] = pairs[:, 1]
             return done("solved", grid.reshape(problem.shape))

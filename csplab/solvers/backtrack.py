@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+from csplab import _kernels as kern
 from csplab.catalog import Code, Propagator, Search
 from csplab.problem import Problem
 from csplab.result import Result, Status
@@ -40,6 +41,27 @@ from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Option, Solver, order_
 __all__ = ["BacktrackSolver", "luby"]
 
 _CHUNK_NODES = 2000
+
+
+def _constrain(eng: Propagator, search: Search, code: Code, stats: dict[str, Any]) -> Code:
+    """After a decision (``PAUSED``) or at a full assignment (``SOLVED``): prune with the
+    problem's global constraints; a refutation rejects the decision (the search tries the
+    cell's next label on resumption) or, at the root, proves unsatisfiability."""
+    before = int(search.state[kern.TLEN])
+    got = eng.constrain(search)
+    if got == -1:
+        if int(search.state[kern.TLEN]) != before:
+            stats["constraint_prunings"] += 1
+        if code is Code.SOLVED and eng.catalog().sum(axis=1).max() > 1:
+            return Code.PAUSED  # the pruning left choices: search on
+        return code
+    stats["constraint_conflicts"] += 1
+    if int(search.state[kern.LEVEL]) == 0:
+        return Code.EXHAUSTED
+    search.state[kern.NEED] = 0  # reject the current label of the last decision
+    search.state[kern.FAILS] += 1
+    search.state[kern.FAILS_RUN] += 1
+    return Code.PAUSED
 
 
 def luby(i: int) -> int:
@@ -67,6 +89,7 @@ class BacktrackSolver(Solver):
 
     name = "backtrack"
     complete = True
+    constraints = "propagated"
     description = "depth-first search maintaining arc consistency (MAC), compiled, with a trail"
     notes = (
         '`order="min-domain"` or `"scanline"` (= Alg. 3.1 + chronological backtracking); '
@@ -100,6 +123,14 @@ class BacktrackSolver(Solver):
             stats["fail_cell"] = list(problem.coords(eng.wiped))
             return Result("unsat", grid, "backtrack", time_s=time.perf_counter() - t0,
                           stats=stats)  # fmt: skip
+        cons = bool(problem.constraints)
+        if cons:  # global constraints: prune the root, then after every decision
+            stats.update(constraint_prunings=0, constraint_conflicts=0)
+            if eng.constrain() != -1:
+                stats.update(nodes=0, conflicts=0, restarts=0)
+                stats["proof"] = "global-constraint propagation before any decision"
+                return Result("unsat", grid, "backtrack", time_s=time.perf_counter() - t0,
+                              stats=stats)  # fmt: skip
         search = Search.new(n, eng.c.W, seed=int(rng.integers(0, 2**63 - 1)))
         restarts = 0
         cutoff = int(restart) * luby(1) if restart else 0
@@ -112,7 +143,10 @@ class BacktrackSolver(Solver):
                     status, stats["limit"] = "timeout", "nodes"
                     break
             code = eng.mac_search(search, scan=order == "scanline", weighted=choice == "weighted",
-                                  max_nodes=budget, restart_fails=cutoff)  # fmt: skip
+                                  max_nodes=1 if cons else budget,
+                                  restart_fails=cutoff)  # fmt: skip
+            if cons and code in (Code.PAUSED, Code.SOLVED):
+                code = _constrain(eng, search, code, stats)
             if code is Code.SOLVED:
                 status = "solved"
                 break

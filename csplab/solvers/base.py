@@ -20,6 +20,11 @@ options       :class:`Option` declarations (use :func:`order_option`,
 backends      a callable listing the ``name:backend`` values, or ``None``
 alg31         runs Alg. 3.1 and takes its ``order``/``choice`` vocabulary (the
               experiments pass their ``--order``/``--choice`` to these solvers)
+constraints   what it does with global constraints (:mod:`csplab.constraints`):
+              ``exact`` (encoded: a solution honours them, unsat is a proof),
+              ``propagated`` (pruned during the search, checked at the end) or
+              ``checked`` (a finished grid that breaks one becomes ``failed``, which
+              restarts retry); no solver returns ``solved`` with one broken
 bench         option variants ``benchmarks/bench_solvers.py`` times
 ============  ==================================================================
 
@@ -47,7 +52,7 @@ import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import NDArray
@@ -198,6 +203,11 @@ STATS: dict[str, str] = {
     "fail_cell": "coordinates of the cell whose domain emptied",
     "proof": "why the status is unsat (a wipe-out before any choice, a refutation by ...)",
     "violations": "violated constraints of the returned grid (0 when solved)",
+    "broken": "global constraints the grid of a failed run breaks (csplab.constraints)",
+    "constraint_clauses": "clauses of the global constraints (csplab.constraints)",
+    "cuts": "connectivity cuts added lazily (csplab.constraints.Connected)",
+    "constraint_prunings": "search steps where a global-constraint propagator removed labels",
+    "constraint_conflicts": "decisions refuted by a global-constraint propagator",
     "final_violations": "violations of the final grid (modify in blocks)",
     "blocks_tried": "blocks attempted (Alg. 3.4)",
     "blocks_accepted": "blocks whose new labels were kept (Alg. 3.4)",
@@ -291,6 +301,7 @@ class Solver(ABC):
     backends: ClassVar[Callable[[], list[str]] | None] = None
     bench: ClassVar[tuple[dict[str, Any], ...]] = ({},)
     alg31: ClassVar[bool] = False
+    constraints: ClassVar[Literal["exact", "propagated", "checked"]] = "checked"
 
     @classmethod
     def option(cls, name: str) -> Option | None:

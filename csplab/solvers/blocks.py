@@ -212,6 +212,9 @@ def run_blocks(
         ``solved`` (always consistent) or ``timeout``.
     """
     t0 = time.perf_counter()
+    # global constraints are checked on the result (solve() reports a breach as failed):
+    # the blocks see only the arcs, as their subproblems do
+    problem = problem.without_constraints()
     if retries < 0 or sweeps < 1:
         raise InputError("retries must be >= 0 and sweeps >= 1")
     if workers < 0:

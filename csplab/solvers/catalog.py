@@ -29,6 +29,7 @@ class CatalogSolver(Solver):
     """Alg. 3.1: assign every cell from the arc-consistent catalog (incomplete)."""
 
     name = "catalog"
+    constraints = "propagated"
     alg31 = True
     complete = False
     description = "Merrell Alg. 3.1 with the catalog of Alg. 3.2/3.3 (arc consistency)"

@@ -70,8 +70,10 @@ from numba import njit
 from numpy.typing import NDArray
 
 from csplab.cnf import DeadlineExceeded, encode
+from csplab.constraints import ClauseContext
 from csplab.deps import require
 from csplab.engine.sat import preferred_labels
+from csplab.errors import InputError
 from csplab.problem import Problem
 from csplab.result import Result
 from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
@@ -137,6 +139,7 @@ class CpsatSolver(Solver):
     """Complete: OR-Tools CP-SAT (one-hot Boolean or table model)."""
 
     name = "cpsat"
+    constraints = "exact"
     complete = True
     requires = ("ortools",)
     extra = "cpsat"
@@ -187,6 +190,8 @@ class CpsatSolver(Solver):
             stats["fail_cell"] = list(problem.coords(enc.wiped))
             return Result("unsat", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
         pref = preferred_labels(enc.catalog, None, rng) if diversity == "hint" else None
+        if problem.constraints and model != "onehot":
+            raise InputError("solver 'cpsat': global constraints need model='onehot'")
         m = cp_model.CpModel()
         t_load = time.perf_counter()
         try:
@@ -203,6 +208,14 @@ class CpsatSolver(Solver):
             stats["load_s"] = time.perf_counter() - t_load
             stats["build_s"] = time.perf_counter() - t0
             return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+        ctx = None
+        if problem.constraints:  # global constraints: clauses and linear counts, cuts below
+            ctx = _LinearContext(problem, enc.literal, enc.nvars)
+            for c in problem.constraints:
+                c.clauses(ctx)
+            ctx.emit(m)
+            stats["constraint_clauses"] = len(ctx.clauses)
+            stats["cuts"] = 0
         t1 = time.perf_counter()
         stats["load_s"] = t1 - t_load
         stats["build_s"] = t1 - t0
@@ -227,6 +240,20 @@ class CpsatSolver(Solver):
                               stats=stats)  # fmt: skip
             prm.max_time_in_seconds = left
         code = s.Solve(m)
+        while ctx is not None and code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+            values = np.asarray(list(s.response_proto.solution), dtype=np.int64)
+            k = ctx.cuts(read(values))  # connectivity: cut the solution off, solve again
+            if not k:
+                break
+            stats["cuts"] += k
+            ctx.emit(m)
+            if deadline is not None:
+                left = deadline - time.perf_counter()
+                if left <= 0:
+                    code = cp_model.UNKNOWN
+                    break
+                prm.max_time_in_seconds = left
+            code = s.Solve(m)
         stats["solve_s"] = time.perf_counter() - t1
         stats["solver_status"] = s.StatusName(code)
         stats["conflicts"] = int(s.NumConflicts())
@@ -304,6 +331,44 @@ class CpsatSolver(Solver):
             return np.asarray(values[: P.n], dtype=np.int32)
 
         return read, "proto-api", units
+
+
+class _LinearContext(ClauseContext):
+    """Constraint clauses for CP-SAT: literals are the one-hot Booleans (SAT variable ``v``
+    is proto variable ``v - 1``), counts become linear constraints."""
+
+    def __init__(self, problem: Problem, lit: Any, top: int) -> None:
+        super().__init__(problem, lit, top)
+        self.linear: list[tuple[list[int], int, int]] = []
+        self._done = (0, 0)
+
+    def card(self, lits: Any, lo: int, hi: int | None) -> None:
+        fixed = sum(1 for x in lits if x is True)
+        free = [int(x) for x in lits if x is not True and x is not False]
+        if any(x < 0 for x in free):  # not produced by csplab's constraints; stay general
+            super().card(lits, lo, hi)
+            return
+        up = len(free) if hi is None else hi - fixed
+        low = max(lo - fixed, 0)
+        if low > min(up, len(free)):
+            self.add([])  # infeasible: an empty clause
+            return
+        self.linear.append((free, low, up))
+
+    def emit(self, m: Any) -> None:
+        """Add what is new since the last call to the model ``m``."""
+        proto = m.proto
+        while len(proto.variables) < self.top:
+            proto.variables.add().domain.extend([0, 1])
+        nc, nl = self._done
+        for c in self.clauses[nc:]:  # SAT literal l: proto literal l - 1 (l > 0) or l
+            proto.constraints.add().bool_or.literals.extend([x - 1 if x > 0 else x for x in c])
+        for free, lo, up in self.linear[nl:]:
+            lin = proto.constraints.add().linear
+            lin.vars.extend([x - 1 for x in free])
+            lin.coeffs.extend([1] * len(free))
+            lin.domain.extend([lo, up])
+        self._done = (len(self.clauses), len(self.linear))
 
 
 def _onehot_elementwise(m: Any, enc: Any, pref: Any, deadline: float | None) -> None:

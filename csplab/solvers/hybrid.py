@@ -58,6 +58,7 @@ class HybridSolver(Solver):
     """Complete: Alg. 3.1, with SAT-guided repair of the first bad choice after a failure."""
 
     name = "hybrid"
+    constraints = "propagated"
     alg31 = True
     complete = True
     requires = ("pysat",)

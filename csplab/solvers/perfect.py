@@ -48,6 +48,7 @@ class PerfectSolver(Solver):
     """Complete: Alg. 3.1 drawing every label from C* (SAT-checked)."""
 
     name = "perfect"
+    constraints = "exact"
     alg31 = True
     complete = True
     requires = ("pysat",)

@@ -51,6 +51,7 @@ class SatSolver(Solver):
     """Complete: CNF encoding + a pysat backend."""
 
     name = "sat"
+    constraints = "exact"
     complete = True
     requires = ("pysat",)
     extra = "sat"

@@ -12,7 +12,7 @@ from ._helpers import DATA, anchor, installed_solvers
 
 
 def load_tiny(**kw):
-    with pytest.warns(UserWarning, match="'path' is not supported"):
+    with pytest.warns(UserWarning, match="no tile pictures"):
         return read_debroglie(DATA / "tiny_debroglie.json", **kw)
 
 
@@ -37,13 +37,14 @@ def test_tiny_constraints():
     rs = load_tiny()
     P = rs.problem()
     assert P.shape == (8, 6)
-    r = csplab.solve(P, "catalog", rng=2)
+    assert [c.kind for c in P.constraints] == ["connected"]  # the path constraint
+    r = csplab.solve(P, "catalog", rng=2, restarts=20)
     assert r.ok
     g = r.grid
     assert (g[0] == 0).all() and (g[-1] == 0).all()  # border xmin, xmax: grass
     assert rs.names[g[3, 5]] == "ew"  # fixedTile at DeBroglie (3, 0) = top row
-    with pytest.raises(FormatError, match="'path' is not supported"):
-        read_debroglie(DATA / "tiny_debroglie.json", strict=True)
+    assert not P.violations(g)  # one road network
+    assert read_debroglie(DATA / "tiny_debroglie.json", strict=True).constraints
 
 
 def test_comments_inside_strings_are_kept():
@@ -92,12 +93,11 @@ def test_overlapping_config_uses_the_sample(tmp_path):
 
 def test_shared_edged_path_file():
     p = anchor("DeBroglie/edged_path_constraint.json")
-    with pytest.warns(UserWarning, match="edgedPath"):
+    with pytest.warns(UserWarning, match="no tile pictures"):
         rs = read_model(p)
     assert rs.K == 16 and rs.shape == (10, 10) and rs.closure_violations() == []
-    assert any("edgedPath" in w and "NOT enforced" in w for w in rs.warnings)
-    with pytest.raises(FormatError, match="edgedPath"):
-        read_debroglie(p, strict=True)
+    assert not any("edgedPath" in w for w in rs.warnings)  # now a constraint, no warning
+    assert [c["type"] for c in rs.constraints] == ["connected"]
 
 
 @pytest.mark.parametrize("solver", installed_solvers())
@@ -105,7 +105,7 @@ def test_shared_edged_path_every_solver_30x30(solver):
     p = anchor("DeBroglie/edged_path_constraint.json")
     with pytest.warns(UserWarning):
         rs = read_model(p)
-    P = rs.problem((30, 30))
+    P = rs.problem((30, 30)).without_constraints()  # the rules; the path: test_constraints
     r = csplab.solve(P, solver, rng=1)
     assert r.ok and P.is_solution(r.grid)
     assert (r.grid[0] == rs.names.index("1")).all()  # the border constraint
