@@ -116,7 +116,7 @@ def test_warnings_are_one_line_each(capsys, tmp_path):
     assert code == 0
     lines = [ln for ln in err.splitlines() if ln]
     assert lines and all(ln.startswith("csplab: warning:") for ln in lines)
-    assert any("'path' is not supported" in ln for ln in lines)
+    assert any("no tile pictures" in ln for ln in lines)
 
 
 SHARED = [

@@ -466,7 +466,6 @@ class Experiment:
         if not paths:
             return []
         from csplab.constraints import parse_constraints
-        from csplab.io._json import load_json
 
         entries: list[dict[str, Any]] = []
         for path in paths:
@@ -474,7 +473,12 @@ class Experiment:
                 text = Path(path).read_text(encoding="utf-8")
             except OSError as e:
                 raise InputError(f"--constraints {path}: {e.strerror or e}") from None
-            doc = load_json(text, path=path)
+            try:
+                doc = json.loads(text)
+            except json.JSONDecodeError as e:
+                raise InputError(
+                    f"--constraints {path}, line {e.lineno}: not JSON: {e.msg}"
+                ) from None
             items = doc.get("constraints") if isinstance(doc, dict) else doc
             if not isinstance(items, list):
                 raise InputError(f'{path}: a constraints file is {{"constraints": [ ... ]}}')

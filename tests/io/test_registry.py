@@ -151,7 +151,7 @@ def test_options_are_checked_and_converted():
 
 
 def test_load_model_warns_and_never_prints(capsys):
-    with pytest.warns(UserWarning, match="'path' is not supported"):
+    with pytest.warns(UserWarning, match="no tile pictures"):
         rs = load_model(DATA / "tiny_debroglie.json")
     assert rs.warnings and capsys.readouterr() == ("", "")
     assert load_model("line").name == "line"
