@@ -442,6 +442,7 @@ def count_solutions(
         raise InputError(f"time_limit must be a positive number of seconds, not {time_limit!r}")
     _, seed = make_rng(rng)
     seed = seed or 0
+    problem.require_no_constraints("counting")
     t0 = time.perf_counter()
     deadline = None if time_limit is None else t0 + time_limit
     if method in ("auto", "transfer"):

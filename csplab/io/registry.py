@@ -506,8 +506,10 @@ FORMATS: dict[str, Format] = {
             files='with `"adjacencies"` (comments allowed)',
             details="tiles with `rotateCw`/`reflectX`… and frequencies, `symmetry`, "
             "`left/right`, `up/down`, `above/below` adjacencies closed under the group, "
-            "`border` and `fixedTile` constraints; every other constraint (`path`, "
-            "`edgedPath`, …) is a one-line warning, never dropped silently; `overlapping` "
+            "`border` and `fixedTile` constraints; `path`, `edgedPath`, `count`, "
+            "`mirrorX`/`mirrorY`, `maxConsecutive` and `separation` become global "
+            "constraints (`csplab.constraints`); any other constraint is a one-line warning, "
+            "never dropped silently; `overlapping` "
             "configs use their PNG sample; tile pictures (Tiled `.tsx`) are not read, and a "
             "warning says so",
             example="csplab synthesize DeBroglie/edged_path_constraint.json --size 30x30 "
