@@ -238,7 +238,8 @@ def from_example(
     if T.shape[0] < len(shp):
         pad = np.zeros((len(shp) - T.shape[0], example.K, example.K), dtype=bool)
         T = np.concatenate([T, pad])
-    meta: dict[str, Any] = {"example": example.name, "example_hash": example.hash()}
+    meta: dict[str, Any] = {"example": example.name, "example_hash": example.hash(),
+                            "model": example}  # fmt: skip
     if rule is not None:
         meta["boundary_rule"] = rule
     return grid(

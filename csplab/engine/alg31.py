@@ -14,7 +14,9 @@ unassigned cell of least Shannon entropy (weighted when ``choice="weighted"``) w
 random tie-breaking, as WaveFunctionCollapse does; ``min-domain`` the unassigned cell with
 the fewest labels left (WaveFunctionCollapse's ``MRV`` heuristic; same tie-breaking), whatever
 the choice. Choices (:data:`CHOICES`): ``uniform``
-over the catalog (thesis) or ``weighted`` by the problem's label weights.
+over the catalog (thesis), ``weighted`` by the problem's label weights, or ``resemblance``
+(2007 paper Eq. 2–6: by how many example windows the partial model still matches,
+:mod:`csplab.engine.resemblance`).
 
 Examples
 --------
@@ -52,7 +54,7 @@ __all__ = [
 
 ORDERS = ("scanline", "random", "min-entropy", "min-domain", "scan:AXES")
 _HEAP_ORDERS = ("min-entropy", "min-domain")
-CHOICES = ("uniform", "weighted")
+CHOICES = ("uniform", "weighted", "resemblance")
 _CHUNK = 4096
 
 
@@ -64,8 +66,14 @@ def run_alg31(
     choice: str = "uniform",
     time_limit: float | None = None,
     engine: Propagator | None = None,
+    window: int = 1,
+    context: tuple[Any, Any, tuple[int, ...]] | None = None,
 ) -> Result:
     """Run Alg. 3.1 once on ``problem`` with randomness from ``rng``.
+
+    ``choice="resemblance"`` draws labels by resemblance to the example model the problem
+    was built from (2007 paper Eq. 2–6, :mod:`csplab.engine.resemblance`; windows of
+    ``2 * window + 1`` cells; ``context`` gives the labels around a block).
 
     ``engine`` may supply an already propagated :class:`~csplab.catalog.Propagator` for the
     problem (it is consumed). Random numbers are drawn in this order: the cell permutation
@@ -75,6 +83,8 @@ def run_alg31(
     scan = scan_order(problem.shape, order)
     if choice not in CHOICES:
         raise InputError(f"choice must be one of {', '.join(CHOICES)}, not {choice!r}")
+    if choice == "resemblance":
+        return _resemblance(problem, rng, order, scan, window, context, time_limit)
     t0 = time.perf_counter()
     n = problem.n
     perm = rng.permutation(n).astype(np.int64) if order == "random" else scan
@@ -163,6 +173,28 @@ def run_alg31(
         status, grid.reshape(problem.shape), "catalog", time_s=time.perf_counter() - t0,
         stats=stats, trace=trace,
     )  # fmt: skip
+
+
+def _resemblance(
+    problem: Problem, rng: np.random.Generator, order: str, scan: Any, window: int,
+    context: Any, time_limit: float | None,
+) -> Result:  # fmt: skip
+    from csplab.engine.resemblance import run_resemblance
+    from csplab.example import ExampleModel
+
+    example = problem.meta.get("model")
+    if not isinstance(example, ExampleModel):
+        raise InputError(
+            "choice='resemblance' needs a problem built from an example model "
+            "(Problem.from_example); tilesets have no example to resemble"
+        )
+    if order in _HEAP_ORDERS:
+        raise InputError("choice='resemblance' takes the scan orders and random, not " + order)
+    perm = rng.permutation(problem.n).astype(np.int64) if order == "random" else scan
+    r = run_resemblance(problem, example, rng, order=perm, window=window, context=context,
+                        time_limit=time_limit)  # fmt: skip
+    r.stats["order"] = order
+    return r
 
 
 def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:

@@ -66,6 +66,7 @@ __all__ = [
     "CHOICE",
     "STATS",
     "TIME_LIMIT",
+    "WINDOW",
     "Call",
     "Option",
     "Solver",
@@ -171,8 +172,14 @@ def order_option(
 
 CHOICE = Option(
     "choice", str, "uniform",
-    "label choice: uniform over the candidates (thesis) or weighted by label frequencies",
+    "label choice: uniform over the candidates (thesis), weighted by label frequencies, or "
+    "resemblance to the example (2007 paper Eq. 2-6)",
     values=CHOICES,
+)  # fmt: skip
+
+WINDOW = Option(
+    "window", int, 1, "choice=resemblance: windows of 2w+1 cells per axis (2007 paper Eq. 2)",
+    minimum=0,
 )  # fmt: skip
 
 
@@ -209,6 +216,12 @@ STATS: dict[str, str] = {
     "constraint_prunings": "search steps where a global-constraint propagator removed labels",
     "constraint_conflicts": "decisions refuted by a global-constraint propagator",
     "final_violations": "violations of the final grid (modify in blocks)",
+    "energy": "soft-constraint energy E(M) of the returned grid (csplab.soft)",
+    "energies": "energy after each sweep, the first entry before any (modify in blocks)",
+    "metropolis_rejected": "consistent blocks rejected by the Metropolis test",
+    "temperature": "Metropolis temperature at the first sweep",
+    "cooling": "factor applied to the temperature after each sweep",
+    "window": "resemblance window half-width (2007 paper Eq. 2)",
     "blocks_tried": "blocks attempted (Alg. 3.4)",
     "blocks_accepted": "blocks whose new labels were kept (Alg. 3.4)",
     "acceptance_rate": "blocks_accepted / blocks_tried",

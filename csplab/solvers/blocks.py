@@ -40,6 +40,7 @@ Examples
 from __future__ import annotations
 
 import itertools
+import math
 import time
 from collections.abc import Sequence
 from typing import Any
@@ -52,7 +53,16 @@ from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Option, Solver, order_option
+from csplab.soft import Energy
+from csplab.solvers.base import (
+    CHOICE,
+    TIME_LIMIT,
+    WINDOW,
+    Call,
+    Option,
+    Solver,
+    order_option,
+)
 
 __all__ = ["BlocksSolver", "block_starts", "trivial_solution"]
 
@@ -188,6 +198,10 @@ def run_blocks(
     time_limit: float | None = None,
     workers: int = 0,
     scheduler: str | None = None,
+    window: int = 1,
+    energy: Energy | None = None,
+    temperature: float = 1.0,
+    cooling: float = 1.0,
 ) -> Result:
     """Alg. 3.4 (see the module docstring).
 
@@ -205,6 +219,12 @@ def run_blocks(
     scheduler : str, optional
         ``"local"`` (a Dask ``LocalCluster`` of ``workers`` processes) or the address of a
         Dask scheduler; ``None``: a local process pool.
+    window : int
+        ``choice="resemblance"``: windows of ``2 * window + 1`` cells (2007 paper Eq. 2).
+    energy, temperature, cooling
+        Soft constraints (2007 paper Sec. 4.2, :mod:`csplab.soft`): a consistent new block
+        is kept with probability ``min(1, exp(-(E(M') - E(M)) / T))``; ``T`` starts at
+        ``temperature`` and is multiplied by ``cooling`` after each sweep.
 
     Returns
     -------
@@ -250,7 +270,12 @@ def run_blocks(
             for q in itertools.product(*starts)
         ]
     deadline = None if time_limit is None else t0 + float(time_limit)
+    soft = _Soft(energy, float(temperature), float(cooling), grid) if energy is not None else None
     if workers >= 1:
+        if choice == "resemblance" or soft is not None:
+            raise InputError(
+                "choice='resemblance' and energy= run in the thesis' sweep (workers=0)"
+            )
         status, tried, accepted, retry_count, revisions = _run_waves(
             problem, grid, boxes, counts, None if m == (0,) else m, rng,
             retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
@@ -260,6 +285,7 @@ def run_blocks(
         status, tried, accepted, retry_count, revisions = _run_sweep(
             problem, grid, boxes, None if m == (0,) else m, rng,
             retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
+            window=window, soft=soft,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -278,12 +304,49 @@ def run_blocks(
     }
     if scheduler is not None:
         stats["scheduler"] = scheduler
+    if soft is not None:
+        stats.update(energy=soft.E, energies=soft.trace, metropolis_rejected=soft.rejected,
+                     temperature=soft.T0, cooling=soft.cooling)  # fmt: skip
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
 
 
 _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries, revisions
+
+
+class _Soft:
+    """Metropolis acceptance of consistent blocks under an energy (2007 paper Sec. 4.2)."""
+
+    def __init__(self, energy: Energy, temperature: float, cooling: float, grid: Any) -> None:
+        if not temperature > 0 or not 0 < cooling <= 1:
+            raise InputError("temperature must be > 0 and cooling in (0, 1]")
+        self.energy, self.T0, self.T, self.cooling = energy, temperature, temperature, cooling
+        self.shape: tuple[int, ...] = ()
+        self.E = float("nan")
+        self.trace: list[float] = []
+        self.rejected = 0
+        self._grid = grid
+
+    def start(self, shape: tuple[int, ...]) -> None:
+        self.shape = shape
+        self.E = self.energy(self._grid.reshape(shape))
+        self.trace = [self.E]
+
+    def accept(self, grid: Any, cells: Any, labels: Any, rng: np.random.Generator) -> bool:
+        new = grid.copy()
+        new[cells] = labels
+        E2 = self.energy(new.reshape(self.shape))
+        dE = E2 - self.E
+        if dE <= 0 or rng.random() < math.exp(-dE / self.T):
+            self.E = E2
+            return True
+        self.rejected += 1
+        return False
+
+    def end_sweep(self) -> None:
+        self.trace.append(self.E)
+        self.T *= self.cooling
 
 
 def _run_sweep(
@@ -298,6 +361,8 @@ def _run_sweep(
     order: str,
     choice: str,
     deadline: float | None,
+    window: int = 1,
+    soft: _Soft | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
     ``grid`` (flat) in place."""
@@ -305,6 +370,8 @@ def _run_sweep(
     tried = accepted = retry_count = 0
     revisions = 0
     status: Status = "solved"
+    if soft is not None:
+        soft.start(problem.shape)
     for _sweep in range(sweeps):
         for cells in boxes:
             if deadline is not None and time.perf_counter() > deadline:
@@ -317,11 +384,15 @@ def _run_sweep(
             tried += 1
             for attempt in range(retries + 1):
                 left = None if deadline is None else max(0.0, deadline - time.perf_counter())
-                r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left)
+                ctx = (grid, cells, problem.shape) if choice == "resemblance" else None
+                r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left,
+                              window=window, context=ctx)  # fmt: skip
                 revisions += int(r.stats.get("revisions", 0))
                 if r.status == "solved":
-                    grid[cells] = r.grid.reshape(-1)
-                    accepted += 1
+                    new = r.grid.reshape(-1)
+                    if soft is None or soft.accept(grid, cells, new, rng):
+                        grid[cells] = new
+                        accepted += 1
                     break
                 if r.status == "timeout":
                     status = "timeout"
@@ -330,6 +401,8 @@ def _run_sweep(
                     retry_count += 1
             if status == "timeout":
                 break
+        if soft is not None:
+            soft.end_sweep()
         if status == "timeout":
             break
     return status, tried, accepted, retry_count, revisions
@@ -530,6 +603,22 @@ def _scheduler_arg(value: Any) -> str:
     return v
 
 
+def _energy_arg(value: Any) -> Energy:
+    if not isinstance(value, Energy):
+        raise InputError(f"must be a csplab.soft.Energy, not {type(value).__name__}")
+    return value
+
+
+def _positive(value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = math.nan
+    if isinstance(value, bool) or not v > 0 or not math.isfinite(v):
+        raise InputError(f"must be a positive number, not {value!r}")
+    return v
+
+
 class BlocksSolver(Solver):
     """Alg. 3.4: modify a consistent model in overlapping blocks (never inconsistent)."""
 
@@ -559,6 +648,14 @@ class BlocksSolver(Solver):
         Option("scheduler", str, None,
                "with workers: local (a Dask LocalCluster of N processes) or a Dask scheduler "
                "address; default a local process pool", nullable=True, convert=_scheduler_arg),
+        WINDOW,
+        Option("energy", object, None, "soft constraints: a csplab.soft.Energy; consistent "
+               "blocks are kept with Metropolis probability (2007 paper Sec. 4.2)",
+               nullable=True, convert=_energy_arg),
+        Option("temperature", float, 1.0, "Metropolis temperature T at the first sweep",
+               convert=_positive),
+        Option("cooling", float, 1.0, "T is multiplied by this after each sweep (0 < c <= 1)",
+               convert=_positive),
     )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:

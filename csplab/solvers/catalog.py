@@ -20,7 +20,7 @@ from __future__ import annotations
 from csplab.engine.alg31 import run_alg31
 from csplab.problem import Problem
 from csplab.result import Result
-from csplab.solvers.base import CHOICE, TIME_LIMIT, Call, Solver, order_option
+from csplab.solvers.base import CHOICE, TIME_LIMIT, WINDOW, Call, Solver, order_option
 
 __all__ = ["CatalogSolver"]
 
@@ -38,7 +38,7 @@ class CatalogSolver(Solver):
         "`scan:AXES`; label choice `uniform` (thesis) or `weighted`; `failed` = gave up, "
         "`unsat` only when arc consistency wipes out before any choice"
     )
-    options = (order_option(), CHOICE, TIME_LIMIT)
+    options = (order_option(), CHOICE, WINDOW, TIME_LIMIT)
 
     def run(self, problem: Problem, call: Call) -> Result:
         return run_alg31(problem, call.rng, **call.options)
