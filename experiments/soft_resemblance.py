@@ -86,8 +86,10 @@ def soft(seeds: int) -> list[str]:
                     traces.append([en(res.grid)])
             tr = np.mean(np.array(traces, dtype=float), axis=0)
             what = ", ".join(f"{x:.0f}" for x in tr) if metro else f"(final) {tr[-1]:.0f}"
-            rows.append(f"| {name} | {en.terms[0].__class__.__name__} | {'yes' if metro else 'no'}"
-                        f" | {what} | {np.mean(rej) if rej else 0:.0f} | {np.mean(ts):.2f} |")  # fmt: skip
+            term = en.terms[0].__class__.__name__
+            rej_s = f"{np.mean(rej) if rej else 0:.0f}"
+            yes = "yes" if metro else "no"
+            rows.append(f"| {name} | {term} | {yes} | {what} | {rej_s} | {np.mean(ts):.2f} |")
             print(rows[-1], flush=True)
     return rows
 
