@@ -219,8 +219,23 @@ class ExampleModel:
             return np.array(self.weights, dtype=np.float64)
         return self.counts().astype(np.float64)
 
+    @property
+    def topology(self) -> str:
+        """The grid the example lives on (:mod:`csplab.topology`; ``meta["topology"]``,
+        default ``"square"``)."""
+        return str(self.meta.get("topology", "square"))
+
     def transitions(self) -> NDArray[np.bool_]:
-        """Transition matrices ``T[d, b, c]`` of Eq. 3.2, shape ``(ndim, K, K)``."""
+        """Transition matrices ``T[d, b, c]`` of Eq. 3.2, shape ``(ndim, K, K)``.
+
+        Only for examples on square grids (and cylinders, affine grids): a hexagonal or
+        triangular example has other relations (:meth:`csplab.topology.Topology.learn`),
+        and a tool that reads axis transitions refuses it with one line."""
+        if self.topology.startswith(("hex", "tri")):
+            raise InputError(
+                f"{self.name or 'the example'} is on a {self.topology} grid: this tool works "
+                "on square grids (synthesis takes it: Problem.from_example, csplab synthesize)"
+            )
         return pair_transitions(self.labels, self.K)
 
     def file_labels(self, grid: ArrayLike | None = None) -> NDArray[np.int64]:

@@ -120,6 +120,7 @@ def grid(
     name: str = "",
     meta: Mapping[str, Any] | None = None,
     labels: ArrayLike | None = None,
+    topology: str | None = None,
 ) -> Problem:
     """A grid problem from per-axis transition matrices ``T[d, b, c]``.
 
@@ -127,22 +128,36 @@ def grid(
     ``periodic`` (all axes or one flag per axis) the last cell also wraps to the first.
     ``fixed``, ``boundary`` and ``mask`` restrict domains as in
     :func:`from_example` (which supplies ``T`` from an example model). ``labels`` (bool
-    ``(K,)``) limits the base domains of every cell to the labels in use.
+    ``(K,)``) limits the base domains of every cell to the labels in use. ``topology``
+    (:mod:`csplab.topology`: ``hex:odd-r``, ``tri``, ``cylinder`` ...) changes the
+    neighbours: ``T`` then has one matrix per relation of the topology; a cylinder's
+    ``theta`` axis (``y``) is periodic.
     """
+    from csplab.topology import Topology
+
+    topo = Topology.parse(topology)
     shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
     T = np.asarray(transitions, dtype=bool)
     ndim = len(shp)
-    if T.ndim != 3 or T.shape[0] != ndim or T.shape[1] != T.shape[2]:
+    R = len(topo.relation_names(ndim))
+    if T.ndim != 3 or T.shape[0] != R or T.shape[1] != T.shape[2]:
         raise InputError(
-            f"transitions must have shape ({ndim}, K, K) for a {ndim}-D grid, got {T.shape}"
+            f"transitions must have shape ({R}, K, K) for a {ndim}-D {topo.name} grid, "
+            f"got {T.shape}"
         )
     K = T.shape[1]
     per = _as_flag_tuple(periodic, ndim, "periodic")
+    if topo.variant == "cylinder":
+        if ndim < 2:
+            raise InputError("a cylinder grid needs the axes r and theta")
+        per = (per[0], True, *per[2:])
+    if not topo.square and any(per):
+        raise InputError(f"a {topo.name} grid cannot be periodic")
     n = math.prod(shp)
     check_memory(shp, K)  # one line with the estimate before allocating
     idx = np.arange(n, dtype=np.int64).reshape(shp)
-    parts = []
-    for d in range(ndim):
+    parts = [] if topo.square else [topo.arcs(shp)]
+    for d in range(ndim if topo.square else 0):
         a = np.moveaxis(idx, d, 0)
         if shp[d] > 1:
             src, dst = a[:-1].ravel(), a[1:].ravel()
@@ -163,6 +178,8 @@ def grid(
         dom[u.cells] &= u.allowed
     m = dict(meta or {})
     m.setdefault("periodic", per)
+    if topo.name != "square":
+        m["topology"] = topo.name
     if boundary is not None:
         m.setdefault("boundary", dict(boundary))
     return Problem(
@@ -172,7 +189,7 @@ def grid(
         arcs,
         weights=weights,
         names=names,
-        relation_names=tuple(f"T_{AXIS_NAMES[d]}" for d in range(ndim)),
+        relation_names=topo.relation_names(ndim),
         unary=unary,
         base_domains=base,
         name=name,
@@ -188,8 +205,12 @@ def from_example(
     fixed: ArrayLike | Mapping[Sequence[int], int] | None = None,
     boundary: Mapping[str, int] | Literal["auto", "none"] | None = None,
     mask: ArrayLike | None = None,
+    topology: str | None = None,
 ) -> Problem:
     """The model-synthesis problem for example ``E`` and output size ``shape``.
+
+    ``topology`` (:mod:`csplab.topology`) reads the example and builds the output on that
+    grid (default: the example's own, ``example.meta["topology"]``, else square).
 
     Parameters
     ----------
@@ -234,10 +255,22 @@ def from_example(
             boundary = None
         else:
             raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
-    T = example.transitions()
-    if T.shape[0] < len(shp):
-        pad = np.zeros((len(shp) - T.shape[0], example.K, example.K), dtype=bool)
-        T = np.concatenate([T, pad])
+    from csplab.example import pair_transitions
+    from csplab.topology import Topology
+
+    topo = Topology.parse(topology or example.meta.get("topology"))
+    if topo.square:
+        # an explicit square topology reads any example along its axes
+        T = pair_transitions(example.labels, example.K) if topology else example.transitions()
+        if T.shape[0] < len(shp):
+            pad = np.zeros((len(shp) - T.shape[0], example.K, example.K), dtype=bool)
+            T = np.concatenate([T, pad])
+    else:
+        if example.ndim != len(shp):
+            raise InputError(
+                f"a {example.ndim}-D {topo.name} example needs a {example.ndim}-D size"
+            )
+        T = topo.learn(example.labels, example.K)
     meta: dict[str, Any] = {"example": example.name, "example_hash": example.hash(),
                             "model": example}  # fmt: skip
     if rule is not None:
@@ -254,6 +287,7 @@ def from_example(
         name=example.name,
         meta=meta,
         labels=example.counts() > 0,
+        topology=topo.name,
     )
 
 

@@ -285,6 +285,30 @@ def render_tiles(grid: ArrayLike, tiles: ArrayLike, *, scale: int = 1) -> Image.
     return Image.fromarray(np.ascontiguousarray(img), "RGB")
 
 
+def _render_polygons(
+    g: NDArray[np.int64], K: int, colors: NDArray[np.uint8] | None, topology: str,
+    scale: int | None,
+) -> Image.Image:  # fmt: skip
+    """One filled polygon per cell of a 2D grid on a :mod:`csplab.topology` grid."""
+    from PIL import ImageDraw
+
+    from csplab.topology import Topology
+
+    polys = Topology.parse(topology).polygons((int(g.shape[0]), int(g.shape[1])))
+    allp = np.concatenate(polys)
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    s = float(scale or max(3, min(24, 640 / max(float((hi - lo).max()), 1.0))))
+    W, H = (int(np.ceil(v)) + 3 for v in (hi - lo) * s)
+    img = Image.new("RGB", (W, H), (255, 255, 255))
+    draw = ImageDraw.Draw(img)
+    cols = palette(K) if colors is None else colors
+    for lab, pts in zip(g.reshape(-1).tolist(), polys, strict=True):
+        c = (40, 40, 40) if lab < 0 else tuple(int(v) for v in cols[min(lab, K - 1)])
+        xy = [(1 + (px - lo[0]) * s, H - 2 - (py - lo[1]) * s) for px, py in pts]
+        draw.polygon(xy, fill=c, outline=(90, 90, 90))
+    return img
+
+
 def render(
     grid: ArrayLike,
     *,
@@ -295,8 +319,12 @@ def render(
     tiles: ArrayLike | None = None,
     objects: Sequence[str] | None = None,
     legend: bool = False,
+    topology: str | None = None,
 ) -> Image.Image:
     """A PIL image of a label grid (1D/2D: cells; 3D: isometric voxels; 4D: the ``w = 0`` slice).
+
+    ``topology`` (:mod:`csplab.topology`) draws 2D hexagonal and triangular grids as
+    hexagons and triangles, a cylinder as an annulus and an affine grid as parallelograms.
 
     Parameters
     ----------
@@ -353,7 +381,9 @@ def render(
         s = scale or max(1, min(8, 640 // max(max(g.shape) * max(t.shape[1:3]), 1)))
         return render_tiles(g, t, scale=s)
     skip = None
-    if g.ndim == 2:
+    if g.ndim == 2 and topology not in (None, "square"):
+        img = _render_polygons(g, K, cols, topology, scale)
+    elif g.ndim == 2:
         s = scale or max(2, min(24, 640 // max(g.shape)))
         img = _render_2d(g, K, s, cols)
     else:
@@ -380,6 +410,7 @@ def render_png_bytes(
     names: Sequence[str] | None = None,
     model: Any = None,
     periodic: bool | None = None,
+    topology: str | None = None,
 ) -> bytes:
     """PNG bytes of :func:`render` (or of ``model.render(grid)`` when the model, e.g. a
     :class:`~csplab.io.ruleset.RuleSet`, draws its own tiles)."""
@@ -391,6 +422,6 @@ def render_png_bytes(
         objects = model_objects(model) if model is not None else None
         if objects is None and names is not None:
             objects = label_objects(len(names), names=names)
-        img = render(grid, K=K, objects=objects)
+        img = render(grid, K=K, objects=objects, topology=topology)
     img.save(buf, format="PNG")
     return buf.getvalue()

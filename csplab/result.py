@@ -107,7 +107,9 @@ class Result:
         names = self.problem.names if self.problem is not None else None
         model = self.problem.meta.get("model") if self.problem is not None else None
         per = self.problem.meta.get("periodic", False) if self.problem is not None else False
-        return render_png_bytes(self.grid, names=names, model=model, periodic=bool(np.all(per)))
+        topo = self.problem.meta.get("topology") if self.problem is not None else None
+        return render_png_bytes(self.grid, names=names, model=model, periodic=bool(np.all(per)),
+                                topology=topo)  # fmt: skip
 
 
 @dataclass

@@ -328,6 +328,14 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
         help="wrap around on every axis (default: off, or the tileset file's setting)",
     )
     p.add_argument(
+        "--grid",
+        dest="topology",
+        metavar="TOPOLOGY",
+        help="the grid of an example model (thesis Sec. 3.5.1): square, hex:odd-r, "
+        "hex:even-r, hex:odd-q, hex:even-q, tri, cylinder (theta = y, periodic) or "
+        "affine:A,B,C,D (default: the example's own, else square)",
+    )
+    p.add_argument(
         "--model-option",
         action="append",
         default=[],
@@ -352,6 +360,8 @@ def problem_from_args(
         shape = parse_shape(args.size, what="--size")
     boundary = parse_boundary(args.boundary)
     if isinstance(model, RuleSet):
+        if getattr(args, "topology", None):
+            raise InputError("--grid applies to example models; a tileset states its own grid")
         if shape is None and model.shape is None:
             raise InputError(f"{model.name or args.model} gives no output size: use --size")
         # no --boundary: a tileset keeps the file's own boundary conditions
@@ -361,9 +371,15 @@ def problem_from_args(
             if getattr(args, "_size_required", False):
                 raise InputError("--size is required for an example model (e.g. --size 40x40x10)")
             shape = model.shape
+        topology = getattr(args, "topology", None)
+        if topology:
+            from csplab.topology import Topology
+
+            topology = Topology.parse(topology).name  # one line for a bad name
         P = Problem.from_example(
-            model, shape, periodic=bool(args.periodic), boundary=boundary or "none"
-        )
+            model, shape, periodic=bool(args.periodic), boundary=boundary or "none",
+            topology=topology,
+        )  # fmt: skip
     return with_constraint_files(P, getattr(args, "constraints", None))
 
 

@@ -195,9 +195,11 @@ def run(args: argparse.Namespace) -> int:
     wrote = None
     if out_format is not None and (result.ok or args.out_partial):
         per = problem.meta.get("periodic", False)
+        topo = problem.meta.get("topology")
         write_labels(
-            result.grid, args.out, name=example.name, model=example, periodic=bool(all(per))
-        )
+            result.grid, args.out, name=example.name, model=example, periodic=bool(all(per)),
+            meta={"topology": topo} if topo else None,
+        )  # fmt: skip
         wrote = args.out
     if args.json:
         d = result.to_dict()

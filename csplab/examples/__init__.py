@@ -39,6 +39,8 @@ EXAMPLES: dict[str, tuple[str, str]] = {
     "city": ("city3d.grid", "3D, csplab's own: a city block, K=119; Alg. 3.1 never failed"),
     "castle": ("castle3d.grid", "3D, csplab's own: castle walls, towers, K=63; fails often"),
     "canal": ("canal3d.grid", "3D, csplab's own: canal town, bridges, K=80; fails seldom"),
+    "hexriver": ("hexriver.grid", "hexagonal (hex:odd-r), csplab's own: a river with banks"),
+    "trifan": ("trifan.grid", "triangular (tri), csplab's own: rosettes of six triangles"),
 }
 ALIASES: dict[str, str] = {
     "E0": "fig3_1a",

@@ -283,6 +283,8 @@ class Output:
         meta = dict(meta or {})
         if isinstance(model, ExampleModel) and "label_ids" in model.meta:
             meta.setdefault("label_ids", model.meta["label_ids"])  # write the file's ids
+        if isinstance(model, ExampleModel) and "topology" in model.meta:
+            meta.setdefault("topology", model.meta["topology"])  # hex, tri ... (pictures, .grid)
         colors = empty = None
         pieces: dict[int, str] = {}
         if isinstance(model, RuleSet):

@@ -5,6 +5,7 @@ Layout::
     # csplab grid v1            optional magic line; any line starting with # is a comment
     shape: 4x3x2                optional header lines "key: value" before the data:
     labels: empty ground wall   names of labels 0, 1, 2, ... (then names may be used as tokens)
+    topology: hex:odd-r         the grid (csplab.topology; default square)
     weights: 5 1 1              optional per-label weights
     0 0 0 0                     data: a 2D slice is drawn as a picture, one line per row,
     0 2 2 0                     the top line is the highest y, tokens run along x
@@ -31,10 +32,11 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from csplab.errors import FormatError
+from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.grids import parse_shape
 from csplab.io.common import KIND, NO, SURE, Output, read_text, text_lines
@@ -51,7 +53,7 @@ __all__ = [
 ]
 
 MAGIC = "# csplab grid v1"
-_HEADER = re.compile(r"^\s*(shape|labels|weights|name)\s*:(.*)$", re.IGNORECASE)
+_HEADER = re.compile(r"^\s*(shape|labels|weights|name|topology)\s*:(.*)$", re.IGNORECASE)
 _SEP4 = re.compile(r"^\s*-{3,}\s*$")
 
 
@@ -198,14 +200,17 @@ def parse_grid(text: str, *, path: object = "<string>", name: str = "") -> Examp
             f"label {int(labels.max())} has no name ({len(names)} names given)", path=path
         )
     nm = header["name"][0] if "name" in header else name
+    meta: dict[str, Any] = {"format": "grid", "source": str(path)}
+    if "topology" in header:  # thesis Sec. 3.5.1 grids: hex:odd-r, tri, cylinder, ...
+        from csplab.topology import Topology
+
+        txt, ln = header["topology"]
+        try:
+            meta["topology"] = Topology.parse(txt).name
+        except InputError as e:
+            raise FormatError(str(e), path=path, line=ln) from None
     try:
-        return ExampleModel(
-            labels,
-            names=names,
-            weights=weights,
-            name=nm,
-            meta={"format": "grid", "source": str(path)},
-        )
+        return ExampleModel(labels, names=names, weights=weights, name=nm, meta=meta)
     except ValueError as e:
         raise FormatError(str(e), path=path) from None
 
@@ -244,6 +249,8 @@ def format_grid(example: ExampleModel, comments: str = "") -> str:
     if example.name:
         out.append(f"name: {example.name}")
     out.append(f"shape: {'x'.join(map(str, lab.shape))}")
+    if example.meta.get("topology", "square") != "square":
+        out.append(f"topology: {example.meta['topology']}")
     if example.names is not None:
         out.append("labels: " + " ".join(example.names))
     if example.weights is not None:

@@ -37,4 +37,7 @@ def write_output(out: Output, path: Path) -> None:
 
     K = len(out.names) if out.names is not None else None
     objects = model_objects(out.model) if out.model is not None else None
-    render(out.grid, K=K, colors=out.colors, objects=objects).save(path, format="PNG")
+    topology = out.meta.get("topology")
+    render(out.grid, K=K, colors=out.colors, objects=objects, topology=topology).save(
+        path, format="PNG"
+    )
