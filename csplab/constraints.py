@@ -315,6 +315,11 @@ class Constraint(ABC):
     def check(self, problem: Problem, lab: NDArray[np.int64]) -> str | None:
         """What a complete grid (flat labels, all in range) breaks, or ``None``."""
 
+    def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
+        """How far a complete grid is from satisfying the constraint (0 when it does): a
+        count of cells or pairs, the energy modify in blocks repairs with."""
+        return 0.0 if self.check(problem, lab) is None else 1.0
+
     @abstractmethod
     def propagate(self, problem: Problem, dom: NDArray[np.bool_]) -> bool:
         """Remove from ``dom`` (in place) labels no solution can have; ``False`` when none
@@ -376,6 +381,10 @@ class Count(Constraint):
                 f"outside [{self.min}, {'n' if self.max is None else self.max}]"
             )
         return None
+
+    def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
+        k = int(np.isin(lab[self.cells(problem)], list(self.labels)).sum())
+        return float(max(0, self.min - k) + (0 if self.max is None else max(0, k - self.max)))
 
     def propagate(self, problem: Problem, dom: NDArray[np.bool_]) -> bool:
         S = label_mask(self.labels, problem.K)
@@ -450,6 +459,13 @@ class Connected(Constraint):
             safe = np.clip(lab, 0, problem.K - 1)
             on &= P[safe[lo], 2 * ax + 1] & P[safe[hi], 2 * ax]
         return kern.components(problem.n, lo[on], hi[on], act)
+
+    def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
+        """Cells of the set outside its largest component, plus ``n`` per missing given cell."""
+        comp = self.components(problem, lab)
+        miss = sum(1 for c in self.cells if comp[c] < 0)
+        ids, sizes = np.unique(comp[comp >= 0], return_counts=True)
+        return float(problem.n * miss + (sizes.sum() - sizes.max() if ids.size else 0))
 
     def check(self, problem: Problem, lab: NDArray[np.int64]) -> str | None:
         comp = self.components(problem, lab)
@@ -613,6 +629,10 @@ class Symmetric(Constraint):
             )
         return None
 
+    def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
+        m = np.asarray(self.label_map)
+        return float((lab[self.perm(problem)] != m[np.clip(lab, 0, problem.K - 1)]).sum())
+
     def propagate(self, problem: Problem, dom: NDArray[np.bool_]) -> bool:
         perm = self.perm(problem)
         m = np.asarray(self.label_map)
@@ -749,6 +769,11 @@ class Separation(Constraint):
             )
         return None
 
+    def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
+        act = np.flatnonzero(np.isin(lab, list(self.labels)))
+        _, dst = self._pairs(problem, act)
+        return float(np.isin(lab[dst], list(self.labels)).sum() / 2)
+
     def propagate(self, problem: Problem, dom: NDArray[np.bool_]) -> bool:
         S = label_mask(self.labels, problem.K)
         must = np.flatnonzero((dom & S).any(axis=1) & ~(dom & ~S).any(axis=1))
@@ -811,6 +836,15 @@ class MaxRun(Constraint):
         for i in range(L - 2, -1, -1):
             right[i] = np.where(a[i + 1], right[i + 1] + 1, 0)
         return np.moveaxis(left, 0, axis), np.moveaxis(right, 0, axis)
+
+    def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
+        act = np.isin(lab, list(self.labels)).reshape(problem.shape)
+        total = 0.0
+        for ax in self._axes(problem):
+            left, right = self._runs(act, ax)
+            run = np.where(act, left + 1 + right, 0)
+            total += float(np.maximum(run - self.n, 0).sum())  # each cell of a long run
+        return total
 
     def check(self, problem: Problem, lab: NDArray[np.int64]) -> str | None:
         act = np.isin(lab, list(self.labels)).reshape(problem.shape)

@@ -37,7 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import InputError
 
-__all__ = ["Energy", "HeightField", "Histogram", "Region", "Term"]
+__all__ = ["Breaches", "Energy", "HeightField", "Histogram", "Region", "Term"]
 
 
 class Term:
@@ -114,6 +114,22 @@ class HeightField(Term):
         z = np.arange(1, g.shape[2] + 1)
         h = np.where(solid, z, 0).max(axis=2)
         return float(self.weight * np.abs(h - np.asarray(self.heights)).sum())
+
+
+@dataclass(frozen=True, eq=False)
+class Breaches(Term):
+    """The global constraints of a problem as an energy: the sum of their
+    :meth:`~csplab.constraints.Constraint.excess` (0 when every one holds); modify in
+    blocks minimises it to repair a model that breaks them."""
+
+    problem: Any
+    weight: float = 1.0
+
+    def __call__(self, grid: NDArray[np.integer[Any]]) -> float:
+        lab = np.asarray(grid, dtype=np.int64).reshape(-1)
+        return float(
+            self.weight * sum(c.excess(self.problem, lab) for c in self.problem.constraints)
+        )
 
 
 @dataclass(frozen=True, eq=False)

@@ -220,7 +220,7 @@ def test_incomplete_solvers_retry_or_report(tmp_path):
             if r.status == "solved":
                 assert not Q.violations(r.grid)
             elif solver == "blocks":
-                assert r.stats["broken"]  # checked: the breach is named
+                assert r.stats["broken"] and r.stats["breaches"] > 0  # the breach is named
 
 
 def _run(capsys, *args):
@@ -318,3 +318,16 @@ def test_shared_edged_path_is_honoured(solver):
         for s in range(5)
     )
     assert broken >= 3
+
+
+def test_blocks_repairs_a_model_that_breaks_the_constraints():
+    E = csplab.load_example("loops")
+    P = Problem.from_example(E, (16, 16))
+    paths = [b for b in range(E.K) if E.names[b] != "empty"]
+    Q = P.with_constraints([Connected(paths), Count(paths, min=20, max=60)])
+    r = csplab.solve(Q, "blocks", rng=1, block=6, sweeps=3)
+    assert r.status == "solved" and not Q.violations(r.grid)
+    assert r.stats["energies"][0] > 0 and r.stats["breaches"] == 0  # started broken
+    for con, grid in [(Count([1], min=3), np.zeros((4, 4), dtype=np.int64))]:
+        R = Problem.from_example(E, (4, 4)).with_constraints([con])
+        assert con.excess(R, grid.reshape(-1)) == 3

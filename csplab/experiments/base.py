@@ -79,24 +79,29 @@ def size_for(example: ExampleModel, s: int, nz: int) -> tuple[int, ...]:
     layer thick) for an example."""
     if example.ndim == 1:
         return (s,)
+    if not isinstance(example, ExampleModel):  # a tileset: its axes
+        return (s, s) if example.ndim == 2 else (s, s, nz)
     if example.ndim == 2 or (example.ndim == 3 and example.shape[2] == 1):
         return (s, s) if example.ndim == 2 else (s, s, 1)
     return (s, s, nz, *example.shape[3:])
 
 
-def load_examples(specs: Sequence[str]) -> list[tuple[str, ExampleModel]]:
-    """Built-in names or model files -> ``(spec, ExampleModel)``; bad input raises one line."""
+def load_examples(specs: Sequence[str], tilesets: bool = False) -> list[tuple[str, Any]]:
+    """Built-in names or model files -> ``(spec, model)``: example models, and tilesets
+    (:class:`~csplab.io.ruleset.RuleSet`) for experiments that take them; bad input raises
+    one line."""
     from csplab.io import load_model
+    from csplab.io.ruleset import RuleSet
 
     if not specs:
         raise InputError("no example model given")
-    out: list[tuple[str, ExampleModel]] = []
+    out: list[tuple[str, Any]] = []
     for s in specs:
         m = load_model(s)
-        if not isinstance(m, ExampleModel):
+        if not isinstance(m, ExampleModel) and not (tilesets and isinstance(m, RuleSet)):
             raise InputError(
-                f"{s}: experiments take example models (grids); {type(m).__name__} "
-                "tilesets are not supported by the experiment harness yet"
+                f"{s}: this experiment takes example models (grids), not "
+                f"{type(m).__name__} files (fig3_8 and constraints also take tilesets)"
             )
         out.append((s, m))
     return out
@@ -144,9 +149,12 @@ def outside_legend(target: Any, **kwargs: Any) -> Any:
 
 def background_labels(example: ExampleModel) -> list[int]:
     """Labels that count as 'nothing built': the empty space and ground labels of
-    ``boundary="auto"``, else the most frequent label."""
+    ``boundary="auto"``, else the most frequent label (tilesets:
+    :meth:`~csplab.io.ruleset.RuleSet.background`)."""
     from csplab.grids import auto_boundary
 
+    if not isinstance(example, ExampleModel):
+        return list(example.background())
     try:
         return sorted(set(auto_boundary(example).values()))
     except InputError:
@@ -357,8 +365,9 @@ def setting_of(row: dict[str, Any]) -> str:
 
 
 def check_boundary(example: ExampleModel, boundary: str, spec: str) -> None:
-    """Fail early (one line) when ``boundary="auto"`` cannot label this example."""
-    if boundary == "auto":
+    """Fail early (one line) when ``boundary="auto"`` cannot label this example (a tileset
+    brings its own boundary conditions)."""
+    if boundary == "auto" and isinstance(example, ExampleModel):
         from csplab.grids import auto_boundary
 
         try:
@@ -382,6 +391,7 @@ class Experiment:
     defaults: ClassVar[dict[str, Any]] = {}
     quick: ClassVar[dict[str, Any]] = {}
     uses: ClassVar[frozenset[str]] = frozenset()
+    tilesets: ClassVar[bool] = False  # whether examples may be tilesets (RuleSet files)
     draw_figures: bool = True  # draw figures in :meth:`report` (tests switch them off)
 
     def add_arguments(self, p: argparse.ArgumentParser) -> None:
@@ -428,7 +438,7 @@ class Experiment:
     ) -> tuple[list[tuple[str, ExampleModel]], dict[str, ExampleModel]]:
         """The configured examples as ``(spec, model)`` pairs, each checked against the
         boundary, and the same models by content hash (what :meth:`build` returns)."""
-        loaded = load_examples(config["examples"])
+        loaded = load_examples(config["examples"], tilesets=self.tilesets)
         for spec, E in loaded:
             check_boundary(E, config["boundary"], spec)
         return loaded, {E.hash(): E for _, E in loaded}

@@ -1,16 +1,20 @@
 """Experiment ``constraints``: success rate and time of each solver with global constraints.
 
-For each example, the constraints are *one connected structure*: every cell that is not
-background (:func:`~csplab.experiments.base.background_labels`: the empty space and ground
-of ``boundary="auto"``, else the most frequent label) belongs to one connected component
+Examples may be tilesets: the default is the WFC pipes tileset and the DeBroglie road
+tileset of the test data (run from the repository's root), the built-in path example
+``loops`` and the 3D ``city``. For each, the constraints are *one connected structure*:
+every cell that is not background (:func:`~csplab.experiments.base.background_labels`: the
+empty space and ground of ``boundary="auto"``, else the most frequent label; a tileset's
+empty or border label) belongs to one connected component
 (:class:`~csplab.constraints.Connected`), and *a bounded amount of it*: between ``lo`` and
 ``hi`` of the cells are non-background (:class:`~csplab.constraints.Count`, default 5% and
-30%). ``--constraints FILE`` replaces them by the file's. Each solver runs once per seed
+30%); a tileset's own constraints (the road tileset's path) hold as well. ``--constraints
+FILE`` replaces the generated ones by the file's. Each solver runs once per seed
 (``catalog@restarts=20`` retries, as WaveFunctionCollapse does); a trial succeeds when the
 solver returns a grid that :meth:`~csplab.problem.Problem.violations` accepts, so the
-exact solvers (``sat``) show what the constraints cost and the others how often they get
-there. The report is :class:`~csplab.experiments.fig3_8.Fig38`'s: rate with 95% Wilson
-intervals and median time per size, and a figure.
+exact solvers show what the constraints cost and the others how often they get there. The
+report is :class:`~csplab.experiments.fig3_8.Fig38`'s: rate with 95% Wilson intervals and
+median time per size, and a figure.
 
 Examples
 --------
@@ -45,10 +49,22 @@ class ConstraintsExperiment(Fig38):
     )
     defaults: ClassVar[dict[str, Any]] = {
         **Fig38.defaults,
-        "examples": ["loops", "fig3_10", "city"],
+        "examples": [
+            "tests/io/data/pipes.xml",
+            "tests/io/data/tiny_debroglie.json",
+            "loops",
+            "city",
+        ],
         "sizes": "8,12,16",
         "nz": 6,
-        "solvers": ["sat", "cpsat", "asp", "backtrack", "catalog@restarts=20"],
+        "solvers": [
+            "sat",
+            "cpsat",
+            "asp",
+            "backtrack",
+            "catalog@restarts=20",
+            "blocks@sweeps=4,restarts=3",
+        ],
         "seeds": 4,
         "order": "scanline",
         "boundary": "auto",

@@ -68,6 +68,7 @@ class Fig38(Experiment):
         "seeds": 3,
     }
     uses: ClassVar[frozenset[str]] = frozenset(defaults)
+    tilesets: ClassVar[bool] = True
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument("--nz", type=int, help="nz for 3D examples (default 10)")

@@ -140,9 +140,13 @@ def problem_for(trial: Trial, example: ExampleModel) -> Problem:
         if P is not None:
             _PROBLEMS.move_to_end(key)
             return P
-    P = Problem.from_example(
-        example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
-    )
+    if isinstance(example, ExampleModel):
+        P = Problem.from_example(
+            example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
+        )
+    else:  # a tileset (RuleSet): "auto" is the file's own boundary conditions
+        P = example.problem(trial.size, periodic=trial.periodic or None,
+                            boundary=parse_boundary(trial.boundary) or "none")  # fmt: skip
     if cons:  # global constraints: entries of a constraints file (csplab.constraints)
         from csplab.constraints import parse_constraints
 
@@ -184,7 +188,10 @@ def execute(trial: Trial, example: Any) -> dict[str, Any]:
         raise InputError(f"example {trial.example!r} does not match the trial's example hash")
     # a grid example's problem is built here, untimed; other models (polyhedral examples of
     # continuous synthesis) are the measure function's to build and time
-    problem = problem_for(trial, example) if isinstance(example, ExampleModel) else None
+    from csplab.io.ruleset import RuleSet
+
+    grid_like = isinstance(example, ExampleModel | RuleSet)
+    problem = problem_for(trial, example) if grid_like else None
     t0 = time.perf_counter()
     out = resolve(trial.measure)(trial, example, problem)
     out.setdefault("time_s", time.perf_counter() - t0)

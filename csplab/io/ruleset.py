@@ -223,6 +223,36 @@ class RuleSet:
         self.meta.setdefault("warnings", [])
 
     # ------------------------------------------------------------------ basics
+    def hash(self) -> str:
+        """A stable content hash (relations, names, weights, size, periodicity, the file's
+        restrictions and constraints) for result stores, like :meth:`ExampleModel.hash`."""
+        import hashlib
+        import json
+
+        h = hashlib.sha256()
+        h.update(str((self.relations.shape, self.shape, self.periodic)).encode())
+        h.update(np.packbits(self.relations).tobytes())
+        h.update("\0".join(self.names).encode())
+        h.update(self.weights.tobytes())
+        for op in (*self.boundary_ops, *self.constraint_ops):
+            h.update(str((op.op, op.face, op.region, tuple(op.flip), op.kind)).encode())
+            h.update(np.packbits(op.labels).tobytes())
+        h.update(json.dumps(list(self.constraints), sort_keys=True, default=str).encode())
+        return h.hexdigest()[:16]
+
+    def background(self) -> list[int]:
+        """Labels that count as 'nothing built': the file's empty label, else the labels its
+        boundary conditions force on every face, else labels named ``empty ...``, else 0."""
+        if self.empty is not None:
+            return [self.empty]
+        forced = [op.labels for op in self.boundary_ops if op.op == "force"]
+        if forced:
+            common = np.logical_and.reduce(forced)
+            if common.any():
+                return np.flatnonzero(common).tolist()
+        named = [b for b, nm in enumerate(self.names) if nm.split(" ")[0].lower() == "empty"]
+        return named or [0]
+
     @property
     def K(self) -> int:
         """Number of labels."""

@@ -217,6 +217,7 @@ STATS: dict[str, str] = {
     "constraint_conflicts": "decisions refuted by a global-constraint propagator",
     "final_violations": "violations of the final grid (modify in blocks)",
     "energy": "soft-constraint energy E(M) of the returned grid (csplab.soft)",
+    "breaches": "excess of the global constraints in the returned grid (0: all hold; blocks)",
     "energies": "energy after each sweep, the first entry before any (modify in blocks)",
     "metropolis_rejected": "consistent blocks rejected by the Metropolis test",
     "temperature": "Metropolis temperature at the first sweep",

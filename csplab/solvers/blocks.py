@@ -53,7 +53,7 @@ from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result, Status
-from csplab.soft import Energy
+from csplab.soft import Breaches, Energy
 from csplab.solvers.base import (
     CHOICE,
     TIME_LIMIT,
@@ -232,8 +232,15 @@ def run_blocks(
         ``solved`` (always consistent) or ``timeout``.
     """
     t0 = time.perf_counter()
-    # global constraints are checked on the result (solve() reports a breach as failed):
-    # the blocks see only the arcs, as their subproblems do
+    # global constraints: the blocks see only the arcs (as their subproblems do); a block
+    # that breaks the constraints more than the model did is rejected (their excess is an
+    # energy at zero temperature), so the sweeps repair the model; solve() checks the end
+    repair = None
+    if problem.constraints:
+        repair = Breaches(problem, weight=1e6 if energy is not None else 1.0)
+        energy = Energy([*(energy.terms if energy is not None else ()), repair])
+        if repair.weight == 1.0:
+            temperature, cooling = 1e-9, 1.0
     problem = problem.without_constraints()
     if retries < 0 or sweeps < 1:
         raise InputError("retries must be >= 0 and sweeps >= 1")
@@ -307,6 +314,8 @@ def run_blocks(
     if soft is not None:
         stats.update(energy=soft.E, energies=soft.trace, metropolis_rejected=soft.rejected,
                      temperature=soft.T0, cooling=soft.cooling)  # fmt: skip
+    if repair is not None:
+        stats["breaches"] = repair(out)
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
@@ -628,7 +637,9 @@ class BlocksSolver(Solver):
     description = "Merrell Alg. 3.4, modify in overlapping blocks"
     notes = (
         "starts from a trivial solution (empty space, or ground under empty space) or `init=`; "
-        "`block=10`, `retries=20`; the output is always consistent"
+        "`block=10`, `retries=20`; the output is always consistent; global constraints: a "
+        "block that breaks them more is rejected, so `sweeps` repair the model (`failed` "
+        "if one is still broken); soft constraints by Metropolis (`energy=`)"
     )
     options = (
         Option("block", object, 10, "block size per axis (an int or one per axis, e.g. 10x10x4)",
