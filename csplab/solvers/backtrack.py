@@ -147,6 +147,9 @@ class BacktrackSolver(Solver):
                                   restart_fails=cutoff)  # fmt: skip
             if cons and code in (Code.PAUSED, Code.SOLVED):
                 code = _constrain(eng, search, code, stats)
+                # refutations by a constraint count towards the Luby restarts too
+                if code is Code.PAUSED and cutoff and int(search.state[kern.FAILS_RUN]) >= cutoff:
+                    code = Code.RESTART
             if code is Code.SOLVED:
                 status = "solved"
                 break
