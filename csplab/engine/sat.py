@@ -264,6 +264,7 @@ class SatOracle:
             self.enc = encode(Problem((1,), [[True]], [[[True]]], []))  # a trivial stand-in
         self.top = self.enc.nvars
         self.cons: ClauseContext | None = None
+        self._prop: Any = None
         self.stats: dict[str, Any] = dict(self.enc.stats)
         self.stats.update(backend=self.backend, refinements=0, sat_calls=0, solve_s=0.0)
         self.grid: NDArray[np.int32] | None = None
@@ -292,6 +293,10 @@ class SatOracle:
             self.cons = constraint_clauses(problem, self.enc.literal, self.top)
             self.stats["constraint_clauses"] = len(self.cons.clauses)
             self.stats["cuts"] = 0
+            if self.backend == "cadical195":  # connectivity inside the search (IPASIR-UP)
+                from csplab.engine.connectivity import attach
+
+                self._prop = attach(self.solver, problem, self.cons)
             self._flush()
         self.stats["load_s"] = time.perf_counter() - t0
         self.stats["vars"] = self.top
@@ -517,6 +522,12 @@ class SatOracle:
             return False
         self.add_clause((-var[free, g[free]]).tolist())
         return True
+
+    def constraint_stats(self) -> dict[str, Any]:
+        """Figures of the global constraints' connectivity propagator (if attached)."""
+        if self._prop is None:
+            return {}
+        return {"connectivity_propagations": int(self._prop.propagated)}
 
     def solver_stats(self) -> dict[str, Any]:
         try:

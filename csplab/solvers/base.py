@@ -213,6 +213,7 @@ STATS: dict[str, str] = {
     "broken": "global constraints the grid of a failed run breaks (csplab.constraints)",
     "constraint_clauses": "clauses of the global constraints (csplab.constraints)",
     "cuts": "connectivity cuts added lazily (csplab.constraints.Connected)",
+    "connectivity_propagations": "cells excluded by the SAT search's connectivity propagator",
     "constraint_prunings": "search steps where a global-constraint propagator removed labels",
     "constraint_conflicts": "decisions refuted by a global-constraint propagator",
     "final_violations": "violations of the final grid (modify in blocks)",

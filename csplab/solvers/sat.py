@@ -114,6 +114,7 @@ class SatSolver(Solver):
                     o.set_phases(preferred_labels(o.enc.catalog, w, rng))
                 status = o.solve(deadline=deadline)
                 stats.update(o.solver_stats())
+                stats.update(o.constraint_stats())
                 if status == "sat" and o.grid is not None:
                     grid = o.grid
                 if status == "unsat":
