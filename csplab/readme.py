@@ -8,7 +8,7 @@ Examples
 --------
 >>> from csplab.readme import render
 >>> render("solvers").splitlines()[0]
-'| name | algorithm | complete | options | notes |'
+'| name | algorithm | complete | global constraints | options | notes |'
 """
 
 from __future__ import annotations

@@ -22,8 +22,8 @@ Examples
 --------
 >>> import numpy as np
 >>> E = Energy([Histogram({1: 0.5}), Region(np.eye(3, dtype=bool), [1])])
->>> E(np.array([[1, 0, 0], [0, 0, 0], [0, 0, 0]]))
-5.5
+>>> E(np.array([[1, 0, 0], [0, 0, 0], [0, 0, 0]]))      # (8 + 3.5) / 2 + 2 cells
+7.75
 """
 
 from __future__ import annotations

@@ -331,3 +331,12 @@ def test_blocks_repairs_a_model_that_breaks_the_constraints():
     for con, grid in [(Count([1], min=3), np.zeros((4, 4), dtype=np.int64))]:
         R = Problem.from_example(E, (4, 4)).with_constraints([con])
         assert con.excess(R, grid.reshape(-1)) == 3
+
+
+def test_constraints_file_given_as_a_model_says_so(capsys):
+    f = Path(__file__).parent / "constraints" / "pipes_network.json"
+    code, _, err = _run(capsys, "synthesize", f, "--size", "5x5")
+    assert code == 2 and "this is a constraints file" in err and "--constraints" in err
+    code, _, err = _run(capsys, "synthesize", DATA / "pipes.xml", "--size", "12x12",
+                        "--solver", "sat", "--constraints", f, "--seed", "2")  # fmt: skip
+    assert code == 0, err

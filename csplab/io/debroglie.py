@@ -95,6 +95,12 @@ def parse_debroglie(
     d = load_json(text, path=path, comments=True)
     if not isinstance(d, dict):
         raise FormatError("a DeBroglie config is a JSON object", path=path)
+    if set(d) == {"constraints"}:
+        raise FormatError(
+            "this is a constraints file (csplab.constraints), not a model: give it with "
+            "--constraints",
+            path=path,
+        )
     warn = LoaderWarnings(path)
 
     def unsupported(msg: str) -> None:

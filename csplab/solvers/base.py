@@ -36,7 +36,7 @@ Examples
 >>> from csplab.solvers import solver_class
 >>> cls = solver_class("catalog")
 >>> [o.name for o in cls.options]
-['order', 'choice', 'time_limit']
+['order', 'choice', 'window', 'time_limit']
 >>> cls.validate({"order": "scan:yx"})["choice"]
 'uniform'
 >>> cls.validate({"order": "zigzag"})
