@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import itertools
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import csplab
 from csplab import ExampleModel, Problem, load_example
-from csplab.errors import InputError
+from csplab.errors import FormatError, InputError
 from csplab.io.gridtext import format_grid, parse_grid
 from csplab.render import render
 from csplab.topology import Topology
@@ -131,3 +132,46 @@ def test_cli(tmp_path, capsys):
     assert code == 0 and png.stat().st_size > 0, err
     code, _, err = _run(capsys, "synthesize", "loops", "--size", "8x8", "--grid", "pentagon")
     assert code == 2 and "unknown grid 'pentagon'" in err and len(err.strip().splitlines()) == 1
+
+
+def test_tiled_maps_and_debroglie_hex_configs(tmp_path):
+    from csplab.io import load_model
+    from csplab.io.tiled import parse_tmx
+
+    data = Path(__file__).parent / "io" / "data"
+    E = load_model(data / "hexmap.tmx")
+    # 6 rows, odd ones shifted in the file: after the flip (y up) the even rows are
+    assert E.topology == "hex:even-r" and E.shape == (8, 6) and E.K == 3
+    assert E.names == ("gid 1", "gid 2", "gid 3")
+    P = Problem.from_example(E, (12, 9))
+    r = csplab.solve(P, "sat", rng=1)
+    assert r.ok and P.is_solution(r.grid)
+    # the map's own river is consistent with what the map teaches
+    assert Problem.from_example(E, E.shape).is_solution(E.labels)
+    rs = load_model(data / "tiled" / "hex_debroglie.json")
+    assert rs.topology == "hex:even-r" and rs.ndim == 2 and rs.shape == (16, 12)
+    assert np.array_equal(rs.relations, Topology.parse(E.topology).learn(E.labels, E.K))
+    Q = rs.problem()
+    assert Q.meta["topology"] == "hex:even-r"
+    r = csplab.solve(Q, "catalog", rng=2, restarts=10)
+    assert r.ok and Q.is_solution(r.grid)
+    assert rs.render(r.grid).width > 0
+    # base64 + zlib, columns offset, and the errors
+    import base64
+    import zlib
+
+    ids = np.array([1, 2, 2, 1, 1, 2], dtype="<u4").tobytes()
+    b64 = base64.b64encode(zlib.compress(ids)).decode()
+    text = (f'<map orientation="hexagonal" staggeraxis="x" staggerindex="odd" width="3" '
+            f'height="2"><layer><data encoding="base64" compression="zlib">{b64}</data>'
+            '</layer></map>')  # fmt: skip
+    M = parse_tmx(text, path="m.tmx")
+    assert M.topology == "hex:even-q" and M.labels.tolist() == [[0, 0], [0, 1], [1, 1]]
+    for bad, what in [
+        ('<map orientation="isometric" width="1" height="1"/>', "not supported"),
+        ('<map width="2" height="1"><layer><data encoding="csv">1</data></layer></map>',
+         "1 tiles for a 2x1 layer"),
+        ("<set/>", "root <map>"),
+    ]:  # fmt: skip
+        with pytest.raises(FormatError, match=what):
+            parse_tmx(bad, path="m.tmx")

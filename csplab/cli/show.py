@@ -111,8 +111,11 @@ def run(args: argparse.Namespace) -> int:
             colors = model.meta.get("colors")
             empty = args.empty if args.empty is not None else model.meta.get("empty")
             img = render(model.labels, K=model.K, scale=args.scale, empty=empty, colors=colors,
-                         objects=model_objects(model), legend=args.legend)  # fmt: skip
+                         objects=model_objects(model), legend=args.legend,
+                         topology=model.meta.get("topology"))  # fmt: skip
             what = f"{'x'.join(map(str, model.shape))} grid {model.name}"
+            if model.meta.get("topology"):
+                what += f" ({model.meta['topology']})"
     if partial is not None and (unassigned := int((partial < 0).sum())):
         what += f", {unassigned} unassigned cells (drawn dark in 2D, left out in 3D)"
     img.save(out, format="PNG")

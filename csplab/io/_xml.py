@@ -36,6 +36,7 @@ class Node:
     attrib: dict[str, str]
     line: int
     children: list[Node] = field(default_factory=list)
+    text: str = ""  #: the character data directly inside the element
 
     def find(self, tag: str) -> Node | None:
         """First child with this tag (case-insensitive)."""
@@ -77,8 +78,13 @@ def parse_xml(text: str | bytes, *, path: object = "<string>") -> Node:
     def end(tag: str) -> None:
         stack.pop()
 
+    def chars(data: str) -> None:
+        if stack:
+            stack[-1].text += data
+
     parser.StartElementHandler = start
     parser.EndElementHandler = end
+    parser.CharacterDataHandler = chars
     parser.StartDoctypeDeclHandler = lambda *a: refuse("DOCTYPE declarations")
     parser.EntityDeclHandler = lambda *a: refuse("entity declarations")
     parser.ExternalEntityRefHandler = lambda *a: refuse("external entities")  # type: ignore[assignment]

@@ -508,15 +508,48 @@ def _global(
     return {"type": "separation", "labels": tiles(), "distance": integer("minDistance")}
 
 
-def _from_sample(d: dict[str, Any], mtype: str, src: Any, path: object, strict: bool) -> RuleSet:
-    if not isinstance(src, str) or not src.lower().endswith((".png", ".bmp", ".gif")):
+def _from_tiled(d: dict[str, Any], mtype: str, f: Path, path: object) -> RuleSet:
+    """An adjacent model learnt from a Tiled map sample (orthogonal or hexagonal, as
+    DeBroglie reads them): the pairs of tiles the map shows along each relation of its
+    grid (:mod:`csplab.io.tiled`, :mod:`csplab.topology`)."""
+    from csplab.io.tiled import read_tmx
+    from csplab.topology import Topology
+
+    if mtype != "adjacent":
         raise FormatError(
-            f"a {mtype} model without adjacencies needs a PNG sample in 'src', got {src!r}",
+            f"a {mtype} model of a Tiled map is not supported (adjacent is)", path=path
+        )
+    E = read_tmx(f)
+    topo = Topology.parse(E.topology)
+    T = topo.learn(E.labels, E.K) if not topo.square else E.transitions()
+    shape = None
+    w, h = d.get("width"), d.get("height")
+    if isinstance(w, int) and isinstance(h, int) and w > 0 and h > 0:
+        shape = (w, h)
+    rs = RuleSet(
+        T, names=E.names, weights=E.counts().astype(float), name=Path(str(path)).stem,
+        shape=shape, periodic=bool(d.get("periodic", False)), topology=topo.name,
+        meta={"format": "debroglie", "source": str(path), "sample": str(f)},
+    )  # fmt: skip
+    for i, c in enumerate(d.get("constraints", []) or []):
+        typ = c.get("type") if isinstance(c, dict) else c
+        rs.warnings.append(f"constraints[{i}] type {typ!r} is not supported for sample models "
+                           "and NOT enforced")  # fmt: skip
+    return rs
+
+
+def _from_sample(d: dict[str, Any], mtype: str, src: Any, path: object, strict: bool) -> RuleSet:
+    if not isinstance(src, str) or not src.lower().endswith((".png", ".bmp", ".gif", ".tmx")):
+        raise FormatError(
+            f"a {mtype} model without adjacencies needs a PNG or Tiled (.tmx) sample in "
+            f"'src', got {src!r}",
             path=path,
         )
     f = Path(str(path)).parent / src
     if not f.is_file():
         raise FormatError(f"sample {src!r} not found next to the config", path=path)
+    if src.lower().endswith(".tmx"):
+        return _from_tiled(d, mtype, f, path)
     from csplab.io.overlap import OverlapModel
 
     model = d.get("model", {}) or {}

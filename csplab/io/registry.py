@@ -33,7 +33,7 @@ Examples
 >>> get_format("zip")
 Traceback (most recent call last):
 ...
-csplab.errors.InputError: unknown model format 'zip'; use merrell, grid, npy, wfc, \
+csplab.errors.InputError: unknown model format 'zip'; use merrell, grid, tiled, npy, wfc, \
 overlapping, wfc-samples, poms, debroglie, markovjunior, png, vox, obj, polygons, svg, \
 polygon-png, mesh-obj, off, stl or mesh-png
 """
@@ -370,6 +370,21 @@ FORMATS: dict[str, Format] = {
             "`weights:` headers (`csplab/io/gridtext.py`)",
             example="csplab synthesize line --size 12x6 --seed 2 --out line.grid "
             "&& csplab show line.grid",
+        ),
+        Format(
+            name="tiled",
+            extensions=(".tmx",),
+            gives="ExampleModel",
+            description="Tiled map",
+            reader="csplab.io.tiled:read_tmx",
+            sniffer="csplab.io.tiled:sniff",
+            files="with root `<map>`",
+            details="the first tile layer (csv or base64, zlib/gzip) as an example; "
+            '`orientation="hexagonal"` maps give hexagonal examples (`staggeraxis`, '
+            "`staggerindex` -> `hex:odd-r` ...), as DeBroglie reads them; DeBroglie configs "
+            "with a `.tmx` sample learn an adjacent model on its grid",
+            example="csplab synthesize tests/io/data/hexmap.tmx --size 20x16 --seed 1 "
+            "--out hex.png",
         ),
         Format(
             name="npy",

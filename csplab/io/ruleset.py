@@ -142,6 +142,9 @@ class RuleSet:
         :meth:`closure_violations`).
     meta : mapping
         Provenance: ``format``, ``source``, ``warnings`` and format-specific data.
+    topology : str, optional
+        The grid (:mod:`csplab.topology`, e.g. ``hex:odd-r``); ``relations`` then hold one
+        matrix per relation of that grid (default: square, one per axis).
     """
 
     def __init__(
@@ -163,8 +166,19 @@ class RuleSet:
         voxel_palette: ArrayLike | None = None,
         symmetry: tuple[Group, NDArray[np.int64]] | None = None,
         meta: Mapping[str, Any] | None = None,
+        topology: str | None = None,
     ) -> None:
+        from csplab.topology import Topology
+
+        topo = Topology.parse(topology)
+        self.topology = topo.name
         T = np.array(relations, dtype=bool)
+        self._ndim = int(T.shape[0]) if T.ndim == 3 else 0
+        if not topo.square:  # one matrix per relation of the grid (csplab.topology)
+            self._ndim = len(shape) if shape is not None else 2
+            want = len(topo.relation_names(self._ndim))
+            if T.ndim != 3 or T.shape[0] != want:
+                raise InputError(f"a {topo.name} rule set needs {want} relations")
         if T.ndim != 3 or T.shape[1] != T.shape[2] or not 1 <= T.shape[0] <= 4 or T.shape[1] < 1:
             raise InputError(f"relations must have shape (ndim, K, K), got {T.shape}")
         T.setflags(write=False)
@@ -260,7 +274,7 @@ class RuleSet:
 
     @property
     def ndim(self) -> int:
-        return int(self.relations.shape[0])
+        return self._ndim
 
     @property
     def warnings(self) -> list[str]:
@@ -365,6 +379,7 @@ class RuleSet:
         P = Problem.grid(
             shp,
             self.relations,
+            topology=self.topology,
             periodic=per_t,
             fixed=fixed,
             boundary=mapping,
@@ -452,6 +467,9 @@ class RuleSet:
         from csplab.render import render
 
         g = np.asarray(grid)
+        if self.topology != "square" and g.ndim == 2:
+            return render(g, K=self.K, colors=self.label_colors(), scale=scale,
+                          topology=self.topology)  # fmt: skip
         if self.images is not None and g.ndim == 2:
             return render(g, tiles=self.images, scale=scale)
         if self.voxels is not None and g.ndim == 3 and g.size * self.voxels[0].size <= 2_000_000:
