@@ -241,7 +241,7 @@ def run_blocks(
         energy = Energy([*(energy.terms if energy is not None else ()), repair])
         if repair.weight == 1.0:
             temperature, cooling = 1e-9, 1.0
-    problem = problem.without_constraints()
+        problem = problem.without_constraints()
     if retries < 0 or sweeps < 1:
         raise InputError("retries must be >= 0 and sweeps >= 1")
     if workers < 0:
