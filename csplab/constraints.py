@@ -1078,7 +1078,7 @@ def constraints_json(problem: Problem) -> dict[str, Any]:
 def solver_note(kind: str) -> str:
     """What a solver's ``constraints`` declaration means, for tables."""
     return {
-        "exact": "encoded exactly (CNF, cardinality networks, lazy connectivity cuts)",
-        "propagated": "pruned during search, checked at the end",
-        "checked": "checked at the end: a breach is reported as failed (retried by restarts)",
+        "exact": "encoded: every output honours them, unsat is a proof",
+        "propagated": "pruned during the search and checked at the end",
+        "checked": "checked at the end; a breach is a failed run, retried by --restarts",
     }[kind]

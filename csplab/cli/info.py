@@ -15,6 +15,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from csplab import __version__
     from csplab.baselines import BASELINES
+    from csplab.constraints import solver_note
     from csplab.examples import example_info
     from csplab.io.registry import FORMATS
     from csplab.solvers import available_solvers
@@ -45,6 +46,9 @@ def run(args: argparse.Namespace) -> int:
         )
         kind = "complete" if s.get("complete") else "incomplete"
         print(f"  {s['name']:<10} {kind:<10} {mark:<12} {s.get('description', s.get('error', ''))}")
+        if s.get("constraints"):
+            how = f"{s['constraints']} ({solver_note(s['constraints'])})"
+            print(f"  {'':<10} global constraints: {how}")
         if s.get("backends"):
             print(f"  {'':<10} backends: {', '.join(s['backends'])}")
         for o in s.get("options", []):
