@@ -76,6 +76,7 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
             "seeds": 2,
         },
     ),
+    "constraints": ("constraints", {}),
 }
 
 
