@@ -173,6 +173,7 @@ class Propagator:
         self._queue = np.zeros(max(n, 1), dtype=np.int64)
         self._inq = np.zeros(max(n, 1), dtype=np.bool_)
         self.stats = np.zeros(2, dtype=np.int64)  # pops, removals
+        self.refuted_by: str | None = None  # the global constraint :meth:`constrain` broke
         self.ok = bool(np.all(self.bits.any(axis=1))) if n else True
         self.wiped: int = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
         if propagate_initial and self.ok:
@@ -255,14 +256,17 @@ class Propagator:
         """Prune the catalog with the problem's global constraints
         (:func:`csplab.constraints.propagate_all`) and arc consistency until neither removes
         more. Inside a MAC ``search`` the removals go on its trail (undone with the current
-        decision). Returns -2 when a constraint propagator refutes the catalog, the wiped
-        cell when arc consistency does, -1 when the catalog survives."""
+        decision). Returns -2 when a constraint propagator refutes the catalog (its
+        description in ``refuted_by``), the wiped cell when arc consistency does, -1 when
+        the catalog survives."""
         from csplab.constraints import propagate_all
 
         for _ in range(1000):
             cur = self.catalog()
-            d = propagate_all(self.problem, cur)
+            why: list[str] = []
+            d = propagate_all(self.problem, cur, why)
             if d is None:
+                self.refuted_by = why[0] if why else None
                 return -2
             changed = np.flatnonzero((d != cur).any(axis=1))
             if not changed.size:

@@ -285,14 +285,19 @@ def constraint_clauses(problem: Problem, lit: Callable[[int, int], Lit], top: in
     return ctx
 
 
-def propagate_all(problem: Problem, dom: NDArray[np.bool_]) -> NDArray[np.bool_] | None:
+def propagate_all(
+    problem: Problem, dom: NDArray[np.bool_], why: list[str] | None = None
+) -> NDArray[np.bool_] | None:
     """The domains ``dom`` (bool ``(n, K)``, not changed) pruned by every constraint's
-    propagator until none prunes more; ``None`` when one proves that no completion exists."""
+    propagator until none prunes more; ``None`` when one proves that no completion exists
+    (then ``why``, if given, receives that constraint's description)."""
     d = np.array(dom, dtype=bool)
     for _ in range(100):
         before = d.copy()
         for c in problem.constraints:
             if not c.propagate(problem, d) or not d.any(axis=1).all():
+                if why is not None:
+                    why.append(c.describe(problem))
                 return None
         if np.array_equal(d, before):
             break

@@ -221,6 +221,12 @@ def run(args: argparse.Namespace) -> int:
         keys = [k for k in result.stats if k not in ("order", "choice")]
         if keys:
             print("  " + ", ".join(f"{k}={result.stats[k]}" for k in keys))
+        if result.status == "failed" and problem.constraints:
+            from csplab.solvers import solver_class
+
+            if solver_class(result.solver.partition(":")[0]).constraints != "exact":
+                print("  hint: with global constraints, --solver backtrack, sat or asp search "
+                      "with them (catalog and blocks retry with --restarts)")  # fmt: skip
         if wrote:
             unset = int((result.grid < 0).sum())
             print(f"  wrote {wrote}" + (f" (partial: {unset} cells unassigned)" if unset else ""))

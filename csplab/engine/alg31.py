@@ -148,7 +148,11 @@ def run_alg31(
             got = eng.constrain()
             if got != -1:
                 stats["constraint_conflicts"] += 1
-                broken = "a global constraint's propagator emptied a domain"
+                broken = (
+                    f"{eng.refuted_by}: no completion is left"
+                    if got == -2 and eng.refuted_by
+                    else "arc consistency after a global constraint's pruning emptied a domain"
+                )
                 if got >= 0:
                     run.state[2] = got
                 code = kern.Code.FAILED
