@@ -119,20 +119,33 @@ def _set_name(problem: Problem, labels: Sequence[int]) -> str:
     return "{" + ", ".join(names) + "}"
 
 
-def _need_grid(problem: Problem, what: str) -> None:
+def _need_grid(problem: Problem, what: str, square: bool = False) -> None:
+    """One line when ``what`` cannot live on ``problem``: cells at positions, or (for the
+    kinds that use axis geometry: offsets, runs, mirror images, faces) a hexagonal or
+    triangular grid."""
     if problem.positions is not None:
         raise InputError(f"{what} needs a grid problem (this one has cells at positions)")
+    topo = str(problem.meta.get("topology", "square"))
+    if square and topo.startswith(("hex", "tri")):
+        raise InputError(f"{what} needs a square grid (this one is {topo})")
 
 
 def grid_edges(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
     """The axis neighbours of a grid problem as ``(lo, hi, axis)``: ``hi`` is ``lo``'s ``+1``
     neighbour along ``axis`` (periodic axes wrap), taken from the problem's arcs (so only
-    neighbours the problem relates are neighbours); each pair once."""
+    neighbours the problem relates are neighbours); each pair once. On a hexagonal or
+    triangular grid (:mod:`csplab.topology`) every arc joins neighbours: ``axis`` is then
+    its relation."""
     cached = problem.__dict__.get("_grid_edges")
     if cached is not None:
         return cached  # type: ignore[no-any-return]
     a = problem.arcs
     a = a[a[:, 0] != a[:, 1]]
+    if str(problem.meta.get("topology", "square")).startswith(("hex", "tri")):
+        trip = np.unique(a, axis=0) if a.size else np.zeros((0, 3), np.int64)
+        out = tuple(np.ascontiguousarray(trip[:, i], dtype=np.int64) for i in range(3))
+        problem.__dict__["_grid_edges"] = out
+        return out  # type: ignore[return-value]
     shp = np.array(problem.shape, dtype=np.int64)
     cs = np.stack(np.unravel_index(a[:, 0], problem.shape), axis=1)
     cd = np.stack(np.unravel_index(a[:, 1], problem.shape), axis=1)
@@ -445,7 +458,7 @@ class Connected(Constraint):
 
     def validate(self, problem: Problem) -> None:
         _check_labels(self.labels, problem)
-        _need_grid(problem, "a connected constraint")
+        _need_grid(problem, "a connected constraint", square=self.ports is not None)
         if any(not 0 <= c < problem.n for c in self.cells):
             raise InputError("connected: cells must be inside the grid")
         if self.ports is not None and np.shape(self.ports) != (problem.K, 2 * problem.ndim):
@@ -608,7 +621,7 @@ class Symmetric(Constraint):
         return np.asarray(np.ravel_multi_index(tuple(q.T), problem.shape), dtype=np.int64)
 
     def validate(self, problem: Problem) -> None:
-        _need_grid(problem, f"a {self.name} constraint")
+        _need_grid(problem, f"a {self.name} constraint", square=True)
         M = np.asarray(self.matrix)
         if M.shape != (problem.ndim, problem.ndim):
             raise InputError(f"{self.name}: the grid has {problem.ndim} axes")
@@ -742,7 +755,7 @@ class Separation(Constraint):
 
     def validate(self, problem: Problem) -> None:
         _check_labels(self.labels, problem)
-        _need_grid(problem, "a separation constraint")
+        _need_grid(problem, "a separation constraint", square=True)
         if self.distance < 1:
             raise InputError(f"separation distance must be at least 1, not {self.distance}")
 
@@ -823,7 +836,7 @@ class MaxRun(Constraint):
 
     def validate(self, problem: Problem) -> None:
         _check_labels(self.labels, problem)
-        _need_grid(problem, "a max-run constraint")
+        _need_grid(problem, "a max-run constraint", square=True)
         if self.n < 0:
             raise InputError(f"max-run n must be at least 0, not {self.n}")
         if any(not 0 <= a < problem.ndim for a in self._axes(problem)):

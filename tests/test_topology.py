@@ -175,3 +175,19 @@ def test_tiled_maps_and_debroglie_hex_configs(tmp_path):
     ]:  # fmt: skip
         with pytest.raises(FormatError, match=what):
             parse_tmx(bad, path="m.tmx")
+
+
+def test_connectivity_uses_the_grid_s_own_neighbours():
+    from csplab.constraints import Connected, MaxRun, grid_edges
+
+    P = Problem.from_example(load_example("hexriver"), (6, 5))
+    lo = grid_edges(P)[0]
+    assert len(lo) == len(P.arcs)  # every hexagonal neighbour pair, diagonal ones too
+    # two cells that touch only through a hex diagonal (odd-r: row 1 is shifted right, so
+    # (0, 1) touches (1, 2)) connect
+    g = np.zeros((6, 5), dtype=np.int32)
+    g[0, 1] = g[1, 2] = 2
+    Q = P.with_constraints([Connected([2])])
+    assert Q.constraints[0].check(Q, g.reshape(-1).astype(np.int64)) is None
+    with pytest.raises(InputError, match="needs a square grid"):
+        P.with_constraints([MaxRun([2], 2)])
