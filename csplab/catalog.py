@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab import _kernels as kern
 from csplab._kernels import Code, Heap, Run, Search
+from csplab.constraints import propagate_all
 from csplab.errors import InputError
 from csplab.problem import Problem, check_memory
 
@@ -259,8 +260,6 @@ class Propagator:
         decision). Returns -2 when a constraint propagator refutes the catalog (its
         description in ``refuted_by``), the wiped cell when arc consistency does, -1 when
         the catalog survives."""
-        from csplab.constraints import propagate_all
-
         for _ in range(1000):
             cur = self.catalog()
             why: list[str] = []

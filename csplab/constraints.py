@@ -91,6 +91,7 @@ __all__ = [
     "parse_constraints",
     "propagate_all",
     "read_constraints",
+    "read_entries",
     "rotate",
 ]
 
@@ -185,7 +186,6 @@ class ClauseContext:
         self.clauses: list[list[int]] = []
         self._sets: dict[tuple[int, bytes], Lit] = {}
         self._links: dict[tuple[int, int, int], Lit] = {}
-        self.unsat = False
         #: literals a solver should prefer after the last :meth:`cuts` (the labels of the
         #: set negated on the cells of stray components: "try without them")
         self.hints: list[int] = []
@@ -203,9 +203,7 @@ class ClauseContext:
             if x is False:
                 continue
             out.append(int(x))
-        if not out:
-            self.unsat = True
-        self.clauses.append(out)
+        self.clauses.append(out)  # an empty clause: unsatisfiable
 
     def in_set(self, cell: int, mask: NDArray[np.bool_]) -> Lit:
         """A literal true iff ``cell``'s label is in ``mask``."""
@@ -464,12 +462,9 @@ class Connected(Constraint):
         if self.ports is not None and np.shape(self.ports) != (problem.K, 2 * problem.ndim):
             raise InputError(f"connected: ports must have shape ({problem.K}, {2 * problem.ndim})")
 
-    def _edges(self, problem: Problem) -> tuple[NDArray[np.int64], ...]:
-        return grid_edges(problem)
-
     def components(self, problem: Problem, lab: NDArray[np.int64]) -> NDArray[np.int64]:
         """Component id (smallest cell) of each cell with a label in the set, -1 elsewhere."""
-        lo, hi, ax = self._edges(problem)
+        lo, hi, ax = grid_edges(problem)
         act = np.isin(lab, list(self.labels))
         on = act[lo] & act[hi]
         if self.ports is not None:
@@ -506,7 +501,7 @@ class Connected(Constraint):
         must: NDArray[np.bool_] = np.asarray(can & ~(dom & ~S).any(axis=1))
         if not must.any():
             return True
-        lo, hi, ax = self._edges(problem)
+        lo, hi, ax = grid_edges(problem)
         pe = can[lo] & can[hi]
         if self.ports is not None:
             P = np.asarray(self.ports, dtype=bool)
@@ -550,7 +545,7 @@ class Connected(Constraint):
         if ids.size <= 1:
             return
         S = label_mask(self.labels, P.K)
-        lo, hi, ax = self._edges(P)
+        lo, hi, ax = grid_edges(P)
         big = int(ids[np.argmax(sizes)])
         t = ctx.in_set(big, S)
         for cell in np.flatnonzero((comp >= 0) & (comp != big)):
@@ -1073,8 +1068,9 @@ def parse_constraints(data: Any, problem: Problem, source: object = None) -> lis
     return out
 
 
-def read_constraints(path: str | Path, problem: Problem) -> list[Constraint]:
-    """:func:`parse_constraints` of a JSON file."""
+def read_entries(path: str | Path) -> list[Any]:
+    """The entries of a constraints file, unparsed (a bad file is one
+    :class:`FormatError` line)."""
     p = Path(path)
     try:
         text = p.read_text(encoding="utf-8")
@@ -1084,7 +1080,15 @@ def read_constraints(path: str | Path, problem: Problem) -> list[Constraint]:
         data = json.loads(text)
     except json.JSONDecodeError as e:
         raise FormatError(f"not JSON: {e.msg}", path=p, line=e.lineno) from None
-    return parse_constraints(data, problem, p)
+    items = data.get("constraints") if isinstance(data, Mapping) else data
+    if not isinstance(items, list):
+        raise FormatError('a constraints file is {"constraints": [ ... ]}', path=p)
+    return items
+
+
+def read_constraints(path: str | Path, problem: Problem) -> list[Constraint]:
+    """:func:`parse_constraints` of a JSON file."""
+    return parse_constraints(read_entries(path), problem, Path(path))
 
 
 def constraints_json(problem: Problem) -> dict[str, Any]:

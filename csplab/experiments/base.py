@@ -30,8 +30,7 @@ import numpy as np
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.experiments.trial import Trial, parse_boundary
-from csplab.problem import Problem
+from csplab.experiments.trial import Trial, build_problem
 
 __all__ = [
     "Experiment",
@@ -475,27 +474,11 @@ class Experiment:
         paths = config.get("constraints") or []
         if not paths:
             return []
-        from csplab.constraints import parse_constraints
+        from csplab.constraints import parse_constraints, read_entries
 
-        entries: list[dict[str, Any]] = []
-        for path in paths:
-            try:
-                text = Path(path).read_text(encoding="utf-8")
-            except OSError as e:
-                raise InputError(f"--constraints {path}: {e.strerror or e}") from None
-            try:
-                doc = json.loads(text)
-            except json.JSONDecodeError as e:
-                raise InputError(
-                    f"--constraints {path}, line {e.lineno}: not JSON: {e.msg}"
-                ) from None
-            items = doc.get("constraints") if isinstance(doc, dict) else doc
-            if not isinstance(items, list):
-                raise InputError(f'{path}: a constraints file is {{"constraints": [ ... ]}}')
-            entries += items
-        boundary = parse_boundary(config.get("boundary", "none"))
-        P = Problem.from_example(example, size, periodic=bool(config.get("periodic")),
-                                 boundary=boundary)  # fmt: skip
+        entries = [e for path in paths for e in read_entries(path)]
+        P = build_problem(example, size, str(config.get("boundary", "none")),
+                          bool(config.get("periodic")))  # fmt: skip
         parse_constraints(entries, P, ", ".join(map(str, paths)))
         return entries
 

@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 from csplab.example import ExampleModel
 from csplab.problem import Problem
 
-__all__ = ["Trial", "execute", "grid_digest", "measure_solve", "problem_for"]
+__all__ = ["Trial", "build_problem", "execute", "grid_digest", "measure_solve", "problem_for"]
 
 
 def _canon(x: Any) -> str:
@@ -131,6 +131,17 @@ def parse_boundary(text: str) -> Any:
     return parse(text)
 
 
+def build_problem(example: Any, size: tuple[int, ...], boundary: str, periodic: bool) -> Problem:
+    """The problem of an example model or a tileset (:class:`~csplab.io.ruleset.RuleSet`,
+    whose ``"auto"`` boundary is the file's own) at ``size``."""
+    if isinstance(example, ExampleModel):
+        return Problem.from_example(
+            example, size, periodic=periodic, boundary=parse_boundary(boundary)
+        )
+    return example.problem(size, periodic=periodic or None,  # type: ignore[no-any-return]
+                           boundary=parse_boundary(boundary) or "none")  # fmt: skip
+
+
 def problem_for(trial: Trial, example: ExampleModel) -> Problem:
     """The trial's problem, built once per process and kept in a small cache."""
     cons = trial.params.get("constraints")
@@ -140,13 +151,7 @@ def problem_for(trial: Trial, example: ExampleModel) -> Problem:
         if P is not None:
             _PROBLEMS.move_to_end(key)
             return P
-    if isinstance(example, ExampleModel):
-        P = Problem.from_example(
-            example, trial.size, periodic=trial.periodic, boundary=parse_boundary(trial.boundary)
-        )
-    else:  # a tileset (RuleSet): "auto" is the file's own boundary conditions
-        P = example.problem(trial.size, periodic=trial.periodic or None,
-                            boundary=parse_boundary(trial.boundary) or "none")  # fmt: skip
+    P = build_problem(example, trial.size, trial.boundary, trial.periodic)
     if cons:  # global constraints: entries of a constraints file (csplab.constraints)
         from csplab.constraints import parse_constraints
 

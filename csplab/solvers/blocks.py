@@ -277,7 +277,7 @@ def run_blocks(
             for q in itertools.product(*starts)
         ]
     deadline = None if time_limit is None else t0 + float(time_limit)
-    soft = _Soft(energy, float(temperature), float(cooling), grid) if energy is not None else None
+    soft = _Soft(energy, float(temperature), float(cooling)) if energy is not None else None
     if workers >= 1:
         if choice == "resemblance" or soft is not None:
             raise InputError(
@@ -327,7 +327,7 @@ _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries,
 class _Soft:
     """Metropolis acceptance of consistent blocks under an energy (2007 paper Sec. 4.2)."""
 
-    def __init__(self, energy: Energy, temperature: float, cooling: float, grid: Any) -> None:
+    def __init__(self, energy: Energy, temperature: float, cooling: float) -> None:
         if not temperature > 0 or not 0 < cooling <= 1:
             raise InputError("temperature must be > 0 and cooling in (0, 1]")
         self.energy, self.T0, self.T, self.cooling = energy, temperature, temperature, cooling
@@ -335,11 +335,11 @@ class _Soft:
         self.E = float("nan")
         self.trace: list[float] = []
         self.rejected = 0
-        self._grid = grid
 
-    def start(self, shape: tuple[int, ...]) -> None:
+    def start(self, grid: Any, shape: tuple[int, ...]) -> None:
+        """The energy of the starting model (``grid`` flat)."""
         self.shape = shape
-        self.E = self.energy(self._grid.reshape(shape))
+        self.E = self.energy(grid.reshape(shape))
         self.trace = [self.E]
 
     def accept(self, grid: Any, cells: Any, labels: Any, rng: np.random.Generator) -> bool:
@@ -380,7 +380,7 @@ def _run_sweep(
     revisions = 0
     status: Status = "solved"
     if soft is not None:
-        soft.start(problem.shape)
+        soft.start(grid, problem.shape)
     for _sweep in range(sweeps):
         for cells in boxes:
             if deadline is not None and time.perf_counter() > deadline:
