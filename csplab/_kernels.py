@@ -48,8 +48,9 @@ from enum import IntEnum
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
+
+from csplab._jit import njit
 
 # ----------------------------------------------------------------------------- return codes
 

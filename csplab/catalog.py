@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab import _interp
 from csplab import _kernels as kern
 from csplab._kernels import Code, Heap, Run, Search
 from csplab.constraints import propagate_all
@@ -199,7 +200,10 @@ class Propagator:
             if changed is None
             else np.ascontiguousarray(np.asarray(changed, dtype=np.int64).ravel())
         )
-        wiped = kern.propagate(self.c.arcs, self._ac(), start, start.size, _NO_HEAP, 0, False)
+        if _interp.use_interp(self.c.n, self.c.K):
+            wiped = _interp.propagate(self.c, self.bits, self.prev, self.stats, start)
+        else:
+            wiped = kern.propagate(self.c.arcs, self._ac(), start, start.size, _NO_HEAP, 0, False)
         if wiped >= 0:
             self.ok = False
             self.wiped = int(wiped)
@@ -291,19 +295,30 @@ class Propagator:
     ) -> Code:  # fmt: skip
         """Run (or resume) Alg. 3.1 on this catalog: :func:`csplab._kernels.alg31`.
 
-        The cells come from ``run.order``, or from the entropy ``heap`` when one is given;
+        The cells come from ``run.order``, or from the entropy ``heap`` when one is given
+        (the cells ``heap.heap[:run.state[1]]`` with their ``heap.key``; ordered into a heap
+        when the run starts);
         labels are drawn uniformly or, with ``weighted``, by the problem's weights (the heap's
         entropy keys too, unless ``key_weighted`` says otherwise). Stops
         after ``max_steps`` assignments (default: none) with :attr:`~csplab._kernels.Code.PAUSED`.
         On :attr:`~csplab._kernels.Code.FAILED` the engine is marked wiped out (``ok``,
-        ``wiped``). The catalog must be arc consistent (``ok``) when the run starts.
+        ``wiped``). The catalog must be arc consistent (``ok``) when the run starts. Small
+        problems run in :mod:`csplab._interp` until numba is loaded (same results).
         """
         n = self.c.n
-        code = kern.alg31(
-            self.c.arcs, self._ac(), run, _NO_HEAP if heap is None else heap,
-            heap is not None, weighted, weighted if key_weighted is None else key_weighted,
-            n + 1 if max_steps is None else int(max_steps),
-        )  # fmt: skip
+        if (max_steps is None or max_steps >= n - run.steps) and _interp.use_interp(n, self.c.K):
+            code = _interp.alg31(
+                self.c, self.bits, self.prev, self.stats, run, heap, heap is not None, weighted,
+                weighted if key_weighted is None else key_weighted,
+            )  # fmt: skip
+        else:
+            if heap is not None and run.steps == 0:  # a new run: its cells, by key
+                kern.heap_build(heap.heap, heap.pos, heap.key, int(run.state[1]))
+            code = kern.alg31(
+                self.c.arcs, self._ac(), run, _NO_HEAP if heap is None else heap,
+                heap is not None, weighted, weighted if key_weighted is None else key_weighted,
+                n + 1 if max_steps is None else int(max_steps),
+            )  # fmt: skip
         result = Code(code)
         if result is Code.FAILED:
             self.ok = False

@@ -86,6 +86,27 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: object
 _KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check"}
 
 
+_ANNOUNCING = [False]
+
+
+def _compiling_notice(module: str) -> None:
+    """The :func:`csplab._jit.on_load` hook of the console script: one line on stderr when
+    the kernels of :mod:`csplab._kernels` become numba dispatchers with numba's cache cold
+    (small models, which the interpreted engine solves, never reach them)."""
+    from csplab.cli.common import COMPILING, kernels_cold
+
+    if module == "csplab._kernels" and kernels_cold():
+        print(f"csplab: {COMPILING}", file=sys.stderr, flush=True)
+
+
+def _announce_compiling() -> None:
+    if not _ANNOUNCING[0]:
+        from csplab import _jit
+
+        _ANNOUNCING[0] = True
+        _jit.on_load(_compiling_notice)
+
+
 def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> int:
     """Entry point of the ``csplab`` console script.
 
@@ -101,10 +122,7 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
     if announce is None:
         announce = argv is None
     if announce and args.command in _KERNEL_COMMANDS:
-        from csplab.cli.common import COMPILING, kernels_cold
-
-        if kernels_cold():
-            print(f"csplab: {COMPILING}", file=sys.stderr, flush=True)
+        _announce_compiling()
     try:
         with warnings.catch_warnings():  # library warnings: one line each, no source line
             warnings.showwarning = _show_warning

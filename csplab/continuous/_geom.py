@@ -31,8 +31,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numba import njit, prange
 from numpy.typing import NDArray
+
+from csplab._jit import njit, prange
 
 __all__ = ["point_labels", "points_on_segments", "triangulate_rings"]
 

@@ -125,11 +125,11 @@ def run_alg31(
             if pristine:
                 eng.c.entropies[key_weighted] = cached
         ent, sw, swl = cached[0], cached[1].copy(), cached[2].copy()
+        # the cells and their keys; Propagator.alg31 orders them into a heap when the run starts
         heap = kern.Heap(
             heap=np.arange(n, dtype=np.int64), pos=np.zeros(n, dtype=np.int64),
             key=ent + 1e-6 * noise, noise=noise, sw=sw, swl=swl,
         )  # fmt: skip
-        kern.heap_build(heap.heap, heap.pos, heap.key, n)
     run = kern.Run(
         order=perm if perm is not None else np.arange(n, dtype=np.int64), ustream=ustream,
         grid=grid, trace_cell=np.full(n, -1, dtype=np.int64),

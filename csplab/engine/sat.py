@@ -35,9 +35,9 @@ from collections.abc import Iterator, Sequence
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, Encoding, amo_clauses, encode
 from csplab.constraints import ClauseContext, constraint_clauses
 from csplab.deps import require

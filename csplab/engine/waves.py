@@ -49,6 +49,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab import _interp
 from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -204,6 +205,8 @@ class BlockContext:
     order: str
     choice: str
     root: int
+    #: cells times labels of the whole problem (large: the workers load the kernels)
+    size: int = 0
 
 
 class BlockTask(NamedTuple):
@@ -241,6 +244,7 @@ def run_tasks(
     c = _CONTEXT if ctx is None else ctx
     if c is None:
         raise RuntimeError("run_tasks needs a BlockContext (none installed in this process)")
+    _interp.kernels_for(c.size, 1)
     deadline = (
         None if wall_deadline is None else time.perf_counter() + (wall_deadline - time.time())
     )

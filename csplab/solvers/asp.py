@@ -114,9 +114,9 @@ from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, Encoding, encode
 from csplab.constraints import ClauseContext, constraint_clauses
 from csplab.deps import require

@@ -48,6 +48,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab import _interp
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError, NoTrivialSolutionError
@@ -244,6 +245,7 @@ def run_blocks(
         problem = problem.without_constraints()
     if retries < 0 or sweeps < 1:
         raise InputError("retries must be >= 0 and sweeps >= 1")
+    _interp.kernels_for(problem.n, problem.K)  # a large job: its blocks run compiled
     if workers < 0:
         raise InputError(f"workers must be >= 0, not {workers}")
     if scheduler is not None and workers < 1:
@@ -443,7 +445,8 @@ def _run_waves(
 
     classes = wv.colour_classes(counts)
     assert sum(len(c) for c in classes) == len(boxes), "one block per lattice index"
-    ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root)
+    ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root,
+                          size=problem.n * problem.K)  # fmt: skip
     runner: wv.PoolRunner | wv.DaskRunner | None = None
     if scheduler is not None:
         runner = wv.DaskRunner(scheduler, workers, ctx)

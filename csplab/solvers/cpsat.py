@@ -66,9 +66,9 @@ import time
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import NDArray
 
+from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, encode
 from csplab.constraints import ClauseContext
 from csplab.deps import require

@@ -352,20 +352,34 @@ def test_count_solutions_time_limit(method):
 
 
 # ---------------------------------------------------------------------------- compilation notice
-def test_compilation_notice_only_when_cold_and_announced(capsys, monkeypatch):
+def test_compilation_notice_only_when_cold_and_for_the_kernels(capsys, monkeypatch):
+    import csplab.cli as cli
     import csplab.cli.common as common
 
     monkeypatch.setattr(common, "kernels_cold", lambda: True)
-    code, _, err = run(capsys, "synthesize", "line", "--size", "4x3", "--seed", "1")
-    assert code == 0 and "compiling" not in err  # library-style calls (tests) stay silent
-    assert main(["synthesize", "line", "--size", "4x3", "--seed", "1"], announce=True) == 0
-    err = capsys.readouterr().err
-    assert err.splitlines()[0] == f"csplab: {common.COMPILING}"
-    assert main(["info"], announce=True) == 0  # info compiles nothing: no notice
-    assert "compiling" not in capsys.readouterr().err
+    cli._compiling_notice("csplab._kernels")
+    assert capsys.readouterr().err.splitlines() == [f"csplab: {common.COMPILING}"]
+    cli._compiling_notice("csplab.solvers.cpsat")  # other modules' kernels: no notice
+    assert capsys.readouterr().err == ""
     monkeypatch.setattr(common, "kernels_cold", lambda: False)
-    assert main(["synthesize", "line", "--size", "4x3", "--seed", "1"], announce=True) == 0
-    assert "compiling" not in capsys.readouterr().err
+    cli._compiling_notice("csplab._kernels")
+    assert capsys.readouterr().err == ""
+
+
+def test_small_synthesis_needs_no_numba_and_prints_no_notice(tmp_path):
+    """A cold numba cache and a small model: the interpreted engine solves it, so numba is
+    never imported and the compiling notice is not printed."""
+    code = (
+        "import sys; from csplab.cli import main; "
+        "rc = main(['synthesize', 'line', '--size', '12x8', '--seed', '1', '--out', "
+        f"{str(tmp_path / 'o.npy')!r}], announce=True); "
+        "print('numba' in sys.modules, rc)"
+    )
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert out.stdout.strip().splitlines()[-1] == "False 0", out.stdout + out.stderr
+    assert "compiling" not in out.stderr
+    assert (tmp_path / "o.npy").is_file()
 
 
 def test_kernels_cold_reads_numbas_cache_index(tmp_path):

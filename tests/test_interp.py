@@ -1,0 +1,172 @@
+"""The interpreted engine (:mod:`csplab._interp`) against the compiled kernels, and the lazy
+``@njit`` of :mod:`csplab._jit`."""
+
+import importlib
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+
+from csplab import ExampleModel, Problem, _interp, _jit, load_example
+from csplab.catalog import Propagator, unpack
+from csplab.engine.alg31 import run_alg31
+
+ORDERS = ["scanline", "random", "min-entropy", "min-domain", "scan:yx"]
+CHOICES = ["uniform", "weighted"]
+
+
+@pytest.fixture
+def engine(monkeypatch):
+    def use(name):
+        monkeypatch.setattr(_interp, "ENGINE", name)
+
+    return use
+
+
+def _both(engine, build, seed, **kw):
+    """The same run with the kernels and interpreted, each on a freshly built problem."""
+    out = []
+    for name in ("kernels", "interp"):
+        engine(name)
+        out.append(run_alg31(build(), np.random.default_rng(seed), **kw))
+    return out
+
+
+def _same(a, b):
+    assert a.status == b.status
+    assert np.array_equal(a.grid, b.grid)
+    assert np.array_equal(a.trace, b.trace)
+    assert a.stats == b.stats  # queue pops, removals, fail cell: pop for pop
+
+
+def _random_example(rng, K, shape):
+    return ExampleModel(rng.integers(0, K, size=shape).astype(np.int32))
+
+
+@pytest.mark.parametrize("order", ORDERS)
+@pytest.mark.parametrize("choice", CHOICES)
+def test_alg31_same_as_kernels_on_random_examples(engine, order, choice):
+    rng = np.random.default_rng(7)
+    statuses = set()
+    for trial in range(6):
+        E = _random_example(rng, int(rng.integers(3, 9)), (5, 4))
+        w = rng.random(E.K) + 0.05
+        shape = (int(rng.integers(4, 14)), int(rng.integers(4, 14)))
+
+        def build(E=E, w=w, shape=shape):
+            P = Problem.from_example(E, shape)
+            return Problem(P.shape, P.domains, P.relations, P.arcs, weights=w)
+
+        a, b = _both(engine, build, trial, order=order, choice=choice)
+        _same(a, b)
+        statuses.add(a.status)
+    assert statuses & {"solved", "failed"}
+
+
+@pytest.mark.parametrize(
+    "name,shape,kw",
+    [
+        ("city", (6, 6, 4), {"boundary": "auto"}),  # K = 119: two words per domain
+        ("castle", (5, 7, 4), {}),
+        ("fig3_10", (12, 12), {"periodic": True}),
+        ("loops", (30, 30), {}),
+    ],
+)
+def test_alg31_same_as_kernels_on_builtins(engine, name, shape, kw):
+    E = load_example(name)
+    for order in ("scanline", "min-entropy"):
+        for seed in range(3):
+            a, b = _both(engine, lambda: Problem.from_example(E, shape, **kw), seed,
+                         order=order, choice="weighted")  # fmt: skip
+            _same(a, b)
+
+
+def test_propagate_same_as_kernels_on_random_catalogs(engine):
+    rng = np.random.default_rng(3)
+    E = load_example("fig3_10")
+    P = Problem.from_example(E, (9, 11))
+    wipes = 0
+    C0 = Propagator(P).catalog()
+    for _ in range(40):
+        changed = rng.choice(P.n, size=int(rng.integers(1, 12)), replace=False)
+        C = C0.copy()
+        C[changed] &= rng.random((changed.size, P.K)) < rng.uniform(0.05, 0.9)
+        got = []
+        for name in ("kernels", "interp"):
+            engine(name)
+            eng = Propagator(P, domains=C, propagate_initial=False)
+            ok = eng.propagate(changed)
+            got.append((ok, eng.catalog(), eng.stats.copy(), eng.prev.copy()))
+        (ok1, C1, s1, p1), (ok2, C2, s2, p2) = got
+        assert ok1 == ok2 and np.array_equal(s1, s2) and np.array_equal(p1, p2)
+        wipes += not ok1
+        if ok1:
+            assert np.array_equal(C1, C2)
+    assert 0 < wipes < 40
+
+
+def test_int_bitsets_round_trip():
+    rng = np.random.default_rng(0)
+    C = rng.random((7, 130)) < 0.5
+    from csplab.catalog import pack
+
+    bits = pack(C)
+    ints = _interp._ints(bits)
+    assert all(i == sum(1 << int(b) for b in np.flatnonzero(C[r])) for r, i in enumerate(ints))
+    out = np.zeros_like(bits)
+    _interp._store(ints, out)
+    assert np.array_equal(unpack(out, 130), C)
+
+
+def test_auto_rule(monkeypatch):
+    monkeypatch.setattr(_interp, "ENGINE", "auto")
+    monkeypatch.setattr(_jit, "compiled", lambda module: False)
+    assert _interp.use_interp(100, 10) and not _interp.use_interp(10_000, 10)
+    monkeypatch.setattr(_jit, "compiled", lambda module: True)
+    assert not _interp.use_interp(100, 10)  # numba is loaded: the kernels are faster
+
+
+def test_lazy_njit_materializes_a_module_at_first_call(tmp_path, monkeypatch):
+    src = textwrap.dedent(
+        """
+        import numpy as np
+        from csplab._jit import njit, prange
+
+        @njit(cache=False)
+        def inner(x):
+            return x + 1
+
+        @njit(cache=False)
+        def outer(a):
+            s = 0
+            for i in prange(a.shape[0]):
+                s += inner(a[i])
+            return s
+        """
+    )
+    (tmp_path / "lazymod.py").write_text(src)
+    monkeypatch.syspath_prepend(str(tmp_path))
+    mod = importlib.import_module("lazymod")
+    assert isinstance(mod.outer, _jit.Kernel) and not _jit.compiled("lazymod")
+    assert mod.outer.py_func is not None and mod.inner.py_func(1) == 2
+    seen = []
+    _jit.on_load(seen.append)
+    assert mod.outer(np.arange(4)) == 10  # compiles both: outer calls inner as a dispatcher
+    assert _jit.compiled("lazymod") and seen[-1] == "lazymod"
+    assert not isinstance(mod.outer, _jit.Kernel) and not isinstance(mod.inner, _jit.Kernel)
+    import numba
+
+    assert mod.prange is numba.prange
+
+
+def test_import_and_small_solve_do_not_load_numba():
+    code = (
+        "import sys, numpy as np, csplab\n"
+        "P = csplab.Problem.from_example(csplab.load_example('fig3_10'), (20, 20))\n"
+        "r = csplab.solve(P, 'catalog', rng=1)\n"
+        "print(r.status, 'numba' in sys.modules)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.stdout.split() == ["solved", "False"], out.stderr
