@@ -125,6 +125,7 @@ def main() -> None:
         print(head)
         print("-" * len(head))
         base = None
+        totals: dict[str, float] = {}
         for spec, opts in specs:
             rows, grids = [], []
             ok = 0
@@ -148,6 +149,8 @@ def main() -> None:
             sol = statistics.median(x[2] for x in rows)
             if spec == "catalog" and not opts:
                 base = tot
+            if not opts and ok == args.seeds:
+                totals[spec] = tot
             ratio = f"{tot / base:.1f}" if base else "-"
             diffs = [np.mean(grids[i] != grids[j]) for i in range(len(grids))
                      for j in range(i + 1, len(grids))]  # fmt: skip
@@ -160,7 +163,19 @@ def main() -> None:
                 f"{ratio:>10}{differ:>8}{nonempty:>10}",
                 flush=True,
             )
+        _targets(name, P.K, totals)
         time.sleep(0)
+
+
+def _targets(name: str, K: int, totals: dict[str, float]) -> None:
+    """The issue's targets for the exact solvers at this size (every seed solved)."""
+    sat, cp = totals.get("sat"), totals.get("cpsat")
+    if sat is not None:
+        print(f"  target sat end to end <= 1 s ({name}, K={K}): {sat:.2f} s, "
+              f"{'meets' if sat <= 1 else 'misses'}")  # fmt: skip
+    if sat is not None and cp is not None:
+        print(f"  target cpsat <= 2x sat ({name}, K={K}): {cp:.2f} s = {cp / sat:.1f}x, "
+              f"{'meets' if cp <= 2 * sat else 'misses'}")  # fmt: skip
 
 
 if __name__ == "__main__":
