@@ -47,7 +47,16 @@ from numpy.typing import NDArray
 
 from csplab import _jit
 
-__all__ = ["ENGINE", "LIMIT", "Tables", "alg31", "kernels_for", "propagate", "use_interp"]
+__all__ = [
+    "ENGINE",
+    "LIMIT",
+    "Tables",
+    "alg31",
+    "compiled_engine",
+    "kernels_for",
+    "propagate",
+    "use_interp",
+]
 
 #: ``"auto"``, ``"kernels"`` or ``"interp"`` (see the module docstring)
 ENGINE = os.environ.get("CSPLAB_ENGINE", "auto")
@@ -64,6 +73,11 @@ def use_interp(n: int, K: int) -> bool:
     if ENGINE == "kernels":
         return False
     return n * K <= LIMIT and not _jit.compiled("csplab._kernels")
+
+
+def compiled_engine() -> bool:
+    """Whether csplab's compiled kernels are the engine now (loaded, or forced)."""
+    return ENGINE == "kernels" or (ENGINE == "auto" and _jit.compiled("csplab._kernels"))
 
 
 def kernels_for(n: int, K: int) -> None:

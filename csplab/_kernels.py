@@ -1217,3 +1217,163 @@ def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: i
     for v in range(n):
         out[v, 1] = disc[v] >= 0
     return out
+
+
+# ----------------------------------------------------------------------------- modify in blocks
+
+
+@njit(cache=True)
+def blocks_sweep(
+    arcs: Arcs,
+    doms: np.ndarray,
+    grid: np.ndarray,
+    bptr: np.ndarray,
+    bcells: np.ndarray,
+    first: int,
+    last: int,
+    scan: np.ndarray,
+    retries: int,
+    use_heap: bool,
+    weighted: bool,
+    key_weighted: bool,
+    rng: np.random.Generator,
+    counters: np.ndarray,
+) -> None:
+    """Alg. 3.4's sweep over blocks ``first .. last - 1`` (thesis Sec. 3.3.6), in place.
+
+    Block ``b`` is the sorted cells ``bcells[bptr[b]:bptr[b + 1]]``; every other cell keeps
+    its label in ``grid`` (``int32 (n,)``, a consistent model). Per block this does what
+    :meth:`csplab.problem.Problem.subproblem` and :func:`csplab.engine.alg31.run_alg31` do
+    in Python, with arrays of the block's size only (the catalog of the block, its internal
+    arcs, the heap): the block's domains are ``doms`` (the problem's packed domains) cut by
+    the supports of the fixed labels around it, then arc consistency, then Alg. 3.1 in the
+    local cell order ``scan`` (or by least entropy, ``use_heap``) with ``rng``'s uniforms
+    drawn as ``run_alg31`` draws them (one per cell, then one tie-breaking number per cell
+    for the heap), retried up to ``retries`` times; a solved block is written into ``grid``,
+    a failed one is left as it was. The internal arcs of a cell keep the order of the
+    problem's arcs, as in the subproblem, so the queue (and the counts) agree with the
+    Python sweep. ``counters += [blocks tried, accepted, retries, queue pops]``.
+    """
+    ptr, nbr, sidx, sup, supall, full = (
+        arcs.ptr,
+        arcs.nbr,
+        arcs.sidx,
+        arcs.sup,
+        arcs.supall,
+        arcs.full,
+    )
+    weights, wlogw = arcs.weights, arcs.wlogw
+    W = doms.shape[1]
+    zi = np.zeros(0, dtype=np.int64)
+    zf = np.zeros(0, dtype=np.float64)
+    for b in range(first, last):
+        lo = bptr[b]
+        nb = bptr[b + 1] - lo
+        if nb == 0:
+            continue
+        counters[0] += 1
+        cells = bcells[lo : lo + nb]
+        deg = 0
+        for i in range(nb):
+            deg += ptr[cells[i] + 1] - ptr[cells[i]]
+        # the block's catalog before propagation, and its internal arcs (local numbers)
+        dom0 = np.empty((nb, W), dtype=np.uint64)
+        lptr = np.zeros(nb + 1, dtype=np.int64)
+        lnbr = np.empty(max(deg, 1), dtype=np.int64)
+        lsidx = np.empty(max(deg, 1), dtype=np.int64)
+        k = 0
+        for i in range(nb):
+            v = cells[i]
+            lptr[i] = k
+            for w in range(W):
+                dom0[i, w] = doms[v, w]
+            for e in range(ptr[v], ptr[v + 1]):
+                u = nbr[e]
+                j = np.searchsorted(cells, u)
+                if j < nb and cells[j] == u:
+                    lnbr[k] = j
+                    lsidx[k] = sidx[e]
+                    k += 1
+                else:
+                    a = grid[u]
+                    if a >= 0:  # labels of v that the fixed label a of u supports
+                        s1 = sidx[e] ^ 1
+                        for w in range(W):
+                            dom0[i, w] &= sup[s1, a, w]
+        lptr[nb] = k
+        local = Arcs(full, lptr, lnbr[:k].copy(), lsidx[:k].copy(), sup, supall, weights, wlogw)
+        dom = np.empty((nb, W), dtype=np.uint64)
+        prev = np.zeros((nb, W), dtype=np.uint64)
+        queue = np.zeros(nb, dtype=np.int64)
+        inq = np.zeros(nb, dtype=np.bool_)
+        stats = np.zeros(2, dtype=np.int64)
+        start = np.arange(nb, dtype=np.int64)
+        lgrid = np.empty(nb, dtype=np.int32)
+        tcell = np.empty(nb, dtype=np.int64)
+        tlab = np.empty(nb, dtype=np.int64)
+        for attempt in range(retries + 1):
+            us = rng.random(nb)
+            noise = rng.random(nb) if use_heap else zf
+            ok = True
+            for i in range(nb):
+                some = False
+                for w in range(W):
+                    dom[i, w] = dom0[i, w]
+                    prev[i, w] = 0
+                    if dom0[i, w]:
+                        some = True
+                if not some:
+                    ok = False
+            stats[0] = 0
+            stats[1] = 0
+            code = _FAILED
+            if ok:
+                wiped = _propagate(
+                    dom, prev, full, lptr, local.nbr, local.sidx, sup, supall, queue, inq,
+                    start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, False, zf, zf,
+                )  # fmt: skip
+                if wiped < 0:
+                    if use_heap:
+                        hheap = np.arange(nb, dtype=np.int64)
+                        hpos = np.zeros(nb, dtype=np.int64)
+                        hkey = np.empty(nb, dtype=np.float64)
+                        sw = np.empty(nb if key_weighted else 0, dtype=np.float64)
+                        swl = np.empty(nb if key_weighted else 0, dtype=np.float64)
+                        for i in range(nb):
+                            cnt = domain_size(dom, i)
+                            ent = np.log(max(cnt, 1))
+                            if key_weighted:
+                                s = 0.0
+                                sl = 0.0
+                                for w in range(W):
+                                    x = dom[i, w]
+                                    while x:
+                                        a = w * 64 + ctz64(x)
+                                        x &= x - np.uint64(1)
+                                        s += weights[a]
+                                        sl += wlogw[a]
+                                sw[i] = s
+                                swl[i] = sl
+                                if s > 0:
+                                    ent = np.log(s) - sl / s
+                            hkey[i] = ent + 1e-6 * noise[i]
+                        heap_build(hheap, hpos, hkey, nb)
+                        hp = Heap(hheap, hpos, hkey, noise, sw, swl)
+                    else:
+                        hp = Heap(zi, zi, zf, zf, zf, zf)
+                    for i in range(nb):
+                        lgrid[i] = -1
+                    state = np.zeros(3, dtype=np.int64)
+                    state[1] = nb if use_heap else 0
+                    state[2] = -1
+                    run = Run(scan, us, lgrid, tcell, tlab, state)
+                    ac = AcState(dom, prev, queue, inq, stats)
+                    code = alg31(local, ac, run, hp, use_heap, weighted, key_weighted, nb + 1)
+            counters[3] += stats[0]
+            if code == _SOLVED:
+                for i in range(nb):
+                    grid[cells[i]] = lgrid[i]
+                counters[1] += 1
+                break
+            if attempt < retries:
+                counters[2] += 1

@@ -57,6 +57,7 @@ __all__ = [
     "propagate_reference",
     "reference_adjacency",
     "reference_fixpoint",
+    "sweep_blocks",
     "unpack",
 ]
 
@@ -119,6 +120,8 @@ class _Compiled:
         #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
         #: wiped): every solve of the problem starts from it, so it is computed once
         self.initial: tuple[Any, Any, Any, bool, int] | None = None
+        #: the problem's domains packed (modify in blocks builds each block's from them)
+        self.doms: NDArray[np.uint64] | None = None
         #: per weighting, the entropies (and weight sums) of that catalog
         self.entropies: dict[bool, tuple[Any, Any, Any]] = {}
         w = np.asarray(problem.weights, dtype=np.float64)
@@ -378,6 +381,32 @@ class Propagator:
 
     def sizes(self) -> NDArray[np.int64]:
         return np.asarray(self.catalog().sum(axis=1), dtype=np.int64)
+
+
+def sweep_blocks(
+    problem: Problem,
+    grid: NDArray[np.int32],
+    bptr: NDArray[np.int64],
+    bcells: NDArray[np.int64],
+    span: tuple[int, int],
+    scan: NDArray[np.int64],
+    retries: int,
+    heap: bool,
+    weighted: bool,
+    key_weighted: bool,
+    rng: np.random.Generator,
+    counters: NDArray[np.int64],
+) -> None:
+    """Modify in blocks ``span[0] .. span[1] - 1`` of the blocks ``bcells[bptr[b]:bptr[b +
+    1]]`` (sorted cells) of ``grid`` (flat, consistent, changed in place), one compiled
+    kernel for the whole span: :func:`csplab._kernels.blocks_sweep`."""
+    c = _compiled_for(problem)
+    if c.doms is None:
+        c.doms = pack(problem.domains)
+    kern.blocks_sweep(
+        c.arcs, c.doms, grid, bptr, bcells, int(span[0]), int(span[1]), scan, int(retries),
+        bool(heap), bool(weighted), bool(key_weighted), rng, counters,
+    )  # fmt: skip
 
 
 # ----------------------------------------------------------------------------- pure API

@@ -8,6 +8,16 @@ is retried with fresh random choices up to ``retries`` times, then the block is 
 The grid is consistent after every block, so the result is always a solution. With ``m``
 equal to the model size and ``retries=0`` this is exactly Alg. 3.1 for the same seed.
 
+Compiled sweep. With numba's kernels loaded (a large job loads them first) and a plain
+setting -- grid blocks, a scan or entropy order, uniform or weighted choice, no energy --
+the whole sweep runs in one kernel (:func:`csplab._kernels.blocks_sweep`, 64 blocks per
+call so that ``time_limit`` is checked between calls): each block's domains are cut from the
+problem's by the fixed labels around it, in arrays of the block's size only (thesis Sec.
+3.3.6: the catalog of the block, ``m ** d * K`` bits, not of the model), then arc
+consistency and Alg. 3.1 with retries, with no Python per block. It draws the same random
+numbers in the same order as the Python sweep and gives the same grid and counts (tested);
+the ``random`` order, ``choice="resemblance"`` and ``energy=`` keep the Python sweep.
+
 Parallel blocks (``workers >= 1``). Blocks that neither overlap nor share an arc are
 independent; :mod:`csplab.engine.waves` colours the blocks by their block index modulo 3 on
 each axis and runs the ``3 ** d`` colour classes as waves, in order, the blocks of a wave in
@@ -49,8 +59,9 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab import _interp
+from csplab.catalog import sweep_blocks
 from csplab.engine import waves as wv
-from csplab.engine.alg31 import run_alg31
+from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result, Status
@@ -376,7 +387,14 @@ def _run_sweep(
     soft: _Soft | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
-    ``grid`` (flat) in place."""
+    ``grid`` (flat) in place. With the compiled kernels loaded and a plain setting (grid
+    blocks, scan or entropy orders, uniform or weighted choice, no energy) the whole sweep
+    runs in one kernel (:func:`_run_sweep_compiled`)."""
+    if _compiled_sweep_applies(boxes, m, order, choice, soft):
+        return _run_sweep_compiled(
+            problem, grid, boxes, m, rng, retries=retries, sweeps=sweeps, order=order,
+            deadline=deadline, choice=choice,
+        )  # fmt: skip
     touching = _arc_index(problem) if len(boxes) > 1 else None
     tried = accepted = retry_count = 0
     revisions = 0
@@ -416,6 +434,67 @@ def _run_sweep(
             soft.end_sweep()
         if status == "timeout":
             break
+    return status, tried, accepted, retry_count, revisions
+
+
+_SWEEP_CHUNK = 64  # blocks per kernel call (the deadline is checked between calls)
+
+
+def _compiled_sweep_applies(
+    boxes: Sequence[NDArray[np.int64]], m: tuple[int, ...] | None, order: str, choice: str,
+    soft: _Soft | None,
+) -> bool:  # fmt: skip
+    return (
+        m is not None
+        and soft is None
+        and choice in ("uniform", "weighted")
+        and order != "random"
+        and _interp.compiled_engine()
+        and all(b.size < 2 or bool(np.all(np.diff(b) > 0)) for b in boxes)
+    )
+
+
+def _run_sweep_compiled(
+    problem: Problem,
+    grid: NDArray[np.int32],
+    boxes: Sequence[NDArray[np.int64]],
+    m: tuple[int, ...] | None,
+    rng: np.random.Generator,
+    *,
+    retries: int,
+    sweeps: int,
+    order: str,
+    choice: str,
+    deadline: float | None,
+) -> _Counts:
+    """:func:`_run_sweep` in one compiled kernel per :data:`_SWEEP_CHUNK` blocks
+    (:func:`csplab.catalog.sweep_blocks`): the same blocks, draws and results."""
+    assert m is not None
+    heap = order in ("min-entropy", "min-domain")
+    nb = int(np.prod(m))
+    scan = scan_order(m, order) if not heap else None
+    scan = np.arange(nb, dtype=np.int64) if scan is None else scan.astype(np.int64)
+    sizes = np.array([b.size for b in boxes], dtype=np.int64)
+    bptr = np.zeros(len(boxes) + 1, dtype=np.int64)
+    np.cumsum(sizes, out=bptr[1:])
+    bcells = np.concatenate(list(boxes)).astype(np.int64) if boxes else np.zeros(0, np.int64)
+    if np.any((sizes != nb) & (sizes > 0)):
+        raise AssertionError("grid blocks all have the block's shape")
+    weighted = choice == "weighted"
+    key_weighted = weighted and order == "min-entropy"
+    counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, queue pops
+    status: Status = "solved"
+    for _sweep in range(sweeps):
+        for a in range(0, len(boxes), _SWEEP_CHUNK):
+            if deadline is not None and time.perf_counter() > deadline:
+                status = "timeout"
+                break
+            span = (a, min(a + _SWEEP_CHUNK, len(boxes)))
+            sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, heap, weighted,
+                         key_weighted, rng, counters)  # fmt: skip
+        if status == "timeout":
+            break
+    tried, accepted, retry_count, revisions = (int(x) for x in counters)
     return status, tried, accepted, retry_count, revisions
 
 
