@@ -96,6 +96,8 @@ def parse_xml(text: str | bytes, *, path: object = "<string>") -> Node:
         ) from None
     except RecursionError:
         raise FormatError("XML nesting is too deep", path=path) from None
+    except LookupError as e:  # expat asks Python's codecs for an encoding it does not know
+        raise FormatError(f"unknown XML encoding ({e})", path=path) from None
     if not root:
         raise FormatError("no XML root element", path=path)
     return root[0]

@@ -127,6 +127,13 @@ def test_errors_name_the_line(xml, line, what):
     assert isinstance(e.value, CsplabError)
 
 
+def test_unknown_xml_encoding_is_a_format_error():
+    """expat asks Python's codecs for the declared encoding (found by the fuzz test)."""
+    with pytest.raises(FormatError, match="unknown XML encoding") as e:
+        parse_wfc(b'<?xml version="1.0" encoding="ATF-8"?><set/>', path="bad.xml")
+    assert "bad.xml" in str(e.value)
+
+
 @pytest.mark.parametrize("sym", list(CARDINALITY))
 def test_wfc_action_table_is_the_group_action(sym):
     """WFC's table (its maps a, b on orientation indices) agrees with csplab's group: entry
