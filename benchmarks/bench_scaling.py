@@ -60,6 +60,9 @@ def _child(method: str, side: int, seed: int) -> None:
             return model.problem((n, n))
         return Problem.from_example(model, (n, n))
 
+    from csplab.engine.alg31 import jit_warmup
+
+    jit_warmup()  # the kernels (a 24x24 warm-up alone would run interpreted)
     solve(problem(24), solver, rng=0, **{**opts, "workers": 1} if "workers" in opts else opts)
     t0 = time.perf_counter()
     P = problem(side)
