@@ -1377,3 +1377,45 @@ def blocks_sweep(
                 break
             if attempt < retries:
                 counters[2] += 1
+
+
+# ----------------------------------------------------------------------------- problem arrays
+
+
+@njit(cache=True)
+def arc_csr(arcs: np.ndarray, ptr: np.ndarray, nbr: np.ndarray, sidx: np.ndarray) -> None:
+    """The arcs of each cell as CSR rows, by counting sort (the arrays of
+    :class:`csplab.catalog._Compiled`; ``arcs`` is ``Problem.arcs``, ``(m, 3)``).
+
+    Row ``v`` lists the arcs with ``src = v`` in arc order (support index ``2r``), then
+    those with ``dst = v`` (``2r + 1``); self-arcs are left out. ``ptr`` (``n + 1``, zeros)
+    and ``nbr``, ``sidx`` (two entries per other arc) are filled in place: the same rows as
+    a stable sort of both arc ends by cell, in O(m) and without temporaries of that size.
+    """
+    m = arcs.shape[0]
+    n = ptr.shape[0] - 1
+    for i in range(m):
+        s = arcs[i, 0]
+        d = arcs[i, 1]
+        if s != d:
+            ptr[s + 1] += 1
+            ptr[d + 1] += 1
+    for v in range(n):
+        ptr[v + 1] += ptr[v]
+    fill = ptr[:n].copy()
+    for i in range(m):
+        s = arcs[i, 0]
+        d = arcs[i, 1]
+        if s != d:
+            k = fill[s]
+            nbr[k] = d
+            sidx[k] = 2 * arcs[i, 2]
+            fill[s] = k + 1
+    for i in range(m):
+        s = arcs[i, 0]
+        d = arcs[i, 1]
+        if s != d:
+            k = fill[d]
+            nbr[k] = s
+            sidx[k] = 2 * arcs[i, 2] + 1
+            fill[d] = k + 1

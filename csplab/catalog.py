@@ -100,15 +100,21 @@ class _Compiled:
         W = words(K)
         a = problem.arcs
         keep = a[:, 0] != a[:, 1]  # self-arcs are folded into the domains
-        a = a[keep]
-        src = np.concatenate([a[:, 0], a[:, 1]])
-        dst = np.concatenate([a[:, 1], a[:, 0]])
-        sid = np.concatenate([2 * a[:, 2], 2 * a[:, 2] + 1])
-        o = np.argsort(src, kind="stable")
-        self.nbr = np.ascontiguousarray(dst[o], dtype=np.int64)
-        self.sidx = np.ascontiguousarray(sid[o], dtype=np.int64)
         self.ptr = np.zeros(n + 1, dtype=np.int64)
-        np.cumsum(np.bincount(src, minlength=n), out=self.ptr[1:])
+        if _interp.use_interp(n, K):  # small: numpy (numba stays unloaded)
+            a = a[keep]
+            src = np.concatenate([a[:, 0], a[:, 1]])
+            dst = np.concatenate([a[:, 1], a[:, 0]])
+            sid = np.concatenate([2 * a[:, 2], 2 * a[:, 2] + 1])
+            o = np.argsort(src, kind="stable")
+            self.nbr = np.ascontiguousarray(dst[o], dtype=np.int64)
+            self.sidx = np.ascontiguousarray(sid[o], dtype=np.int64)
+            np.cumsum(np.bincount(src, minlength=n), out=self.ptr[1:])
+        else:  # the same rows by counting sort, in O(arcs) (5x faster at 10^7 cells)
+            ends = 2 * int(np.count_nonzero(keep))
+            self.nbr = np.empty(ends, dtype=np.int64)
+            self.sidx = np.empty(ends, dtype=np.int64)
+            kern.arc_csr(np.ascontiguousarray(a, dtype=np.int64), self.ptr, self.nbr, self.sidx)
         rel = problem.relations
         both = np.empty((2 * R, K, K), dtype=bool)
         both[0::2] = rel

@@ -1,4 +1,5 @@
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -160,3 +161,24 @@ def test_incremental_restrictions_match_reference(P, seed):
             eng.assign(cell, int(eng.domain(cell)[0]))
             eng.load(state)
             assert eng.ok and np.array_equal(eng.catalog(), C)
+
+
+@pytest.mark.parametrize(
+    "name,shape,kw",
+    [("fig3_10", (37, 23), {"periodic": True}), ("city", (9, 7, 5), {}),
+     ("line", (1, 5), {"periodic": True})],  # the last one has self-arcs
+)  # fmt: skip
+def test_arc_rows_by_counting_sort_equal_the_numpy_rows(monkeypatch, name, shape, kw):
+    """``_kernels.arc_csr`` (large problems) builds the rows the stable sort builds."""
+    from csplab import _interp
+    from csplab.catalog import _Compiled
+    from csplab.examples import load_example
+
+    P = Problem.from_example(load_example(name), shape, **kw)
+    got = []
+    for engine in ("interp", "kernels"):
+        monkeypatch.setattr(_interp, "ENGINE", engine)
+        c = _Compiled(P)
+        got.append((c.ptr, c.nbr, c.sidx))
+    for x, y in zip(*got, strict=True):
+        assert x.dtype == y.dtype == np.int64 and np.array_equal(x, y)
