@@ -7,8 +7,10 @@ a small problem before the timed run. Methods:
 
 * ``catalog`` -- Alg. 3.1 on ``fig3_16`` (thesis Fig. 3.16, infallible: one run always
   succeeds), scanline order;
-* ``blocks w=1`` / ``blocks w=2`` -- Alg. 3.4 in 20x20 blocks, the wave schedule in-process
-  and on two worker processes (same output), on ``fig3_10`` (Fig. 3.10);
+* ``blocks0`` -- Alg. 3.4 in 20x20 blocks on ``fig3_10`` (Fig. 3.10), the thesis' sweep (the
+  default, one compiled kernel);
+* ``blocks1`` / ``blocks2`` -- the same with the wave schedule in-process and on two worker
+  processes (same output);
 * ``overlapping`` -- the WFC overlapping model of ``tests/io/data/sample.png`` (N=3, periodic
   input, min-entropy order, weighted choice: its defaults), ``catalog`` with up to 10 restarts.
 
@@ -21,7 +23,7 @@ never asserted.
 
 Usage::
 
-    python benchmarks/bench_scaling.py [--max-exp 7] [--methods catalog blocks1 blocks2 overlapping]
+    python benchmarks/bench_scaling.py [--max-exp 7] [--methods catalog blocks0 blocks1 blocks2 overlapping]
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SIDES = {4: 100, 5: 316, 6: 1000, 7: 3162}
 METHODS = {
     "catalog": ("fig3_16", "catalog", {}),
+    "blocks0": ("fig3_10", "blocks", {"block": 20}),
     "blocks1": ("fig3_10", "blocks", {"block": 20, "workers": 1}),
     "blocks2": ("fig3_10", "blocks", {"block": 20, "workers": 2}),
     "overlapping": (str(ROOT / "tests/io/data/sample.png"), "catalog", {"restarts": 10}),
