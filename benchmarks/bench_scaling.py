@@ -23,7 +23,8 @@ never asserted.
 
 Usage::
 
-    python benchmarks/bench_scaling.py [--max-exp 7] [--methods catalog blocks0 blocks1 blocks2 overlapping]
+    python benchmarks/bench_scaling.py [--max-exp 7]
+        [--methods catalog blocks0 blocks1 blocks2 overlapping]
 """
 
 from __future__ import annotations
