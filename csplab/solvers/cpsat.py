@@ -23,13 +23,17 @@ and the README): CP-SAT's presolve expands binary tables into clauses and probes
 which costs seconds to minutes on grids of a few thousand cells, so the defaults switch
 presolve, probing, symmetry detection and linearization off (``presolve=True`` turns them
 back on; table model with hints at 16×16×8: 27 s with them, 1.9 s without). At
-40×40×10 (``boundary="auto"``, one-hot, medians of 3 runs) end to end: city 2.5 s
-(was 5.9 s), castle 2.9 s (was 6.5 s), canal 1.1 s (was 2.9 s), against 0.8, 1.1–1.7
-and 0.45 s for ``sat``; what remains is CP-SAT's own work in ``Solve`` (2.0–2.3 s at city
-and castle: validating, importing and loading the model, then repairing the hint; the
-search itself is about 0.2 s). Why one-hot is the default: the table model solved only 1
-of 6 40×40×10 settings within 60 s (11 s; it searches slowly); at 12×12×6 both take
-3–5 s.
+40×40×10 (``boundary="auto"``, one-hot, medians of 3 runs) end to end: city 2.6 s
+(was 5.9 s), castle 2.7 s (was 6.5 s), against 0.7 and 0.8 s for ``sat`` (3.3–3.8×);
+what remains is CP-SAT's own work in ``Solve``: its log on castle (2.67M ``bool_or``,
+459k Booleans) shows validation to 0.36 s and the search starting at 1.9–2.5 s, the
+search itself about 0.2 s. That set-up did not move with ``use_sat_inprocessing``,
+``cp_model_use_sat_presolve``, ``max_presolve_iterations=0``,
+``disable_constraint_expansion``, ``remove_fixed_variables_early`` or LNS off (all
+3.7–4.0 s, one run each); the forward-only clauses (``supports="forward"``, half the
+model) halve it to 1.0 s but the hint is then repaired in 5 s instead of 0.5 s. Why
+one-hot is the default: the table model solved only 1 of 6 40×40×10 settings within 60 s
+(11 s; it searches slowly); at 12×12×6 both take 3–5 s.
 
 Diversity: CP-SAT returns the same solution for every ``random_seed`` by default.
 ``diversity="hint"`` (default) gives a solution hint with one random label per cell drawn
