@@ -45,7 +45,7 @@ within 5-9%).
 from __future__ import annotations
 
 from enum import IntEnum
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import NDArray
@@ -1223,6 +1223,157 @@ def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: i
 
 
 @njit(cache=True)
+def block_catalog(
+    arcs: Arcs,
+    doms: np.ndarray,
+    grid: np.ndarray,
+    cells: np.ndarray,
+    dom0: np.ndarray,
+    lptr: np.ndarray,
+    lnbr: np.ndarray,
+    lsidx: np.ndarray,
+) -> int:
+    """The catalog of one block of Alg. 3.4 before propagation, and its internal arcs.
+
+    ``cells`` (sorted) is the block; every other cell keeps its label in ``grid``. Fills
+    ``dom0`` (``(nb, W)``: ``doms``, the problem's packed domains, cut by the supports of
+    the fixed labels around the block, as :meth:`csplab.problem.Problem.subproblem` cuts
+    them) and the block's arcs as CSR rows in local cell numbers (``lptr``, ``nb + 1``;
+    ``lnbr``/``lsidx``, as long as the block's arc ends in the problem), in the order of the
+    problem's arcs, as in the subproblem. Returns the number of internal arc ends.
+    """
+    ptr, nbr, sidx, sup = arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup
+    W = doms.shape[1]
+    nb = cells.shape[0]
+    k = 0
+    for i in range(nb):
+        v = cells[i]
+        lptr[i] = k
+        for w in range(W):
+            dom0[i, w] = doms[v, w]
+        for e in range(ptr[v], ptr[v + 1]):
+            u = nbr[e]
+            j = np.searchsorted(cells, u)
+            if j < nb and cells[j] == u:
+                lnbr[k] = j
+                lsidx[k] = sidx[e]
+                k += 1
+            else:
+                a = grid[u]
+                if a >= 0:  # labels of v that the fixed label a of u supports
+                    s1 = sidx[e] ^ 1
+                    for w in range(W):
+                        dom0[i, w] &= sup[s1, a, w]
+    lptr[nb] = k
+    return k
+
+
+@njit(cache=True)
+def block_alg31(
+    local: Arcs,
+    dom0: np.ndarray,
+    scan: np.ndarray,
+    retries: int,
+    use_heap: bool,
+    weighted: bool,
+    key_weighted: bool,
+    rng: Any,  # a numpy.random.Generator
+    lgrid: np.ndarray,
+    counters: np.ndarray,
+) -> bool:
+    """Alg. 3.1 on one block (catalog ``dom0``, arcs ``local``), retried up to ``retries``
+    times: the inner loop of Alg. 3.4, as :func:`csplab.engine.alg31.run_alg31` runs it on
+    the block's subproblem, with the same draws from ``rng`` (per attempt one uniform per
+    cell, then, for ``use_heap``, one tie-breaking number per cell), the same queue and the
+    same result. On success ``lgrid`` holds the labels and ``True`` is returned.
+    ``counters[2] += retries``, ``counters[3] += queue pops``.
+    """
+    nb = dom0.shape[0]
+    W = dom0.shape[1]
+    full, sup, supall, weights, wlogw = (
+        local.full,
+        local.sup,
+        local.supall,
+        local.weights,
+        local.wlogw,
+    )
+    zi = np.zeros(0, dtype=np.int64)
+    zf = np.zeros(0, dtype=np.float64)
+    dom = np.empty((nb, W), dtype=np.uint64)
+    prev = np.zeros((nb, W), dtype=np.uint64)
+    queue = np.zeros(nb, dtype=np.int64)
+    inq = np.zeros(nb, dtype=np.bool_)
+    stats = np.zeros(2, dtype=np.int64)
+    start = np.arange(nb, dtype=np.int64)
+    tcell = np.empty(nb, dtype=np.int64)
+    tlab = np.empty(nb, dtype=np.int64)
+    for attempt in range(retries + 1):
+        us = rng.random(nb)
+        noise = rng.random(nb) if use_heap else zf
+        ok = True
+        for i in range(nb):
+            some = False
+            for w in range(W):
+                dom[i, w] = dom0[i, w]
+                prev[i, w] = 0
+                if dom0[i, w]:
+                    some = True
+            if not some:
+                ok = False
+        stats[0] = 0
+        stats[1] = 0
+        code = _FAILED
+        if ok:
+            wiped = _propagate(
+                dom, prev, full, local.ptr, local.nbr, local.sidx, sup, supall, queue, inq,
+                start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, False, zf, zf,
+            )  # fmt: skip
+            if wiped < 0:
+                if use_heap:
+                    hheap = np.arange(nb, dtype=np.int64)
+                    hpos = np.zeros(nb, dtype=np.int64)
+                    hkey = np.empty(nb, dtype=np.float64)
+                    sw = np.empty(nb if key_weighted else 0, dtype=np.float64)
+                    swl = np.empty(nb if key_weighted else 0, dtype=np.float64)
+                    for i in range(nb):
+                        cnt = domain_size(dom, i)
+                        ent = np.log(max(cnt, 1))
+                        if key_weighted:
+                            s = 0.0
+                            sl = 0.0
+                            for w in range(W):
+                                x = dom[i, w]
+                                while x:
+                                    a = w * 64 + ctz64(x)
+                                    x &= x - np.uint64(1)
+                                    s += weights[a]
+                                    sl += wlogw[a]
+                            sw[i] = s
+                            swl[i] = sl
+                            if s > 0:
+                                ent = np.log(s) - sl / s
+                        hkey[i] = ent + 1e-6 * noise[i]
+                    heap_build(hheap, hpos, hkey, nb)
+                    hp = Heap(hheap, hpos, hkey, noise, sw, swl)
+                else:
+                    hp = Heap(zi, zi, zf, zf, zf, zf)
+                for i in range(nb):
+                    lgrid[i] = -1
+                state = np.zeros(3, dtype=np.int64)
+                state[1] = nb if use_heap else 0
+                state[2] = -1
+                run = Run(scan, us, lgrid, tcell, tlab, state)
+                ac = AcState(dom, prev, queue, inq, stats)
+                code = alg31(local, ac, run, hp, use_heap, weighted, key_weighted, nb + 1)
+        counters[3] += stats[0]
+        if code == _SOLVED:
+            return True
+        if attempt < retries:
+            counters[2] += 1
+    return False
+
+
+@njit(cache=True)
 def blocks_sweep(
     arcs: Arcs,
     doms: np.ndarray,
@@ -1236,36 +1387,19 @@ def blocks_sweep(
     use_heap: bool,
     weighted: bool,
     key_weighted: bool,
-    rng: np.random.Generator,
+    rng: Any,  # a numpy.random.Generator
     counters: np.ndarray,
 ) -> None:
     """Alg. 3.4's sweep over blocks ``first .. last - 1`` (thesis Sec. 3.3.6), in place.
 
     Block ``b`` is the sorted cells ``bcells[bptr[b]:bptr[b + 1]]``; every other cell keeps
-    its label in ``grid`` (``int32 (n,)``, a consistent model). Per block this does what
-    :meth:`csplab.problem.Problem.subproblem` and :func:`csplab.engine.alg31.run_alg31` do
-    in Python, with arrays of the block's size only (the catalog of the block, its internal
-    arcs, the heap): the block's domains are ``doms`` (the problem's packed domains) cut by
-    the supports of the fixed labels around it, then arc consistency, then Alg. 3.1 in the
-    local cell order ``scan`` (or by least entropy, ``use_heap``) with ``rng``'s uniforms
-    drawn as ``run_alg31`` draws them (one per cell, then one tie-breaking number per cell
-    for the heap), retried up to ``retries`` times; a solved block is written into ``grid``,
-    a failed one is left as it was. The internal arcs of a cell keep the order of the
-    problem's arcs, as in the subproblem, so the queue (and the counts) agree with the
-    Python sweep. ``counters += [blocks tried, accepted, retries, queue pops]``.
+    its label in ``grid`` (``int32 (n,)``, a consistent model). Per block, in arrays of the
+    block's size only: :func:`block_catalog` (what :meth:`csplab.problem.Problem.subproblem`
+    builds) and :func:`block_alg31` (what :func:`csplab.engine.alg31.run_alg31` does, with
+    its draws from ``rng``); a solved block is written into ``grid``, a failed one is left
+    as it was. ``counters += [blocks tried, accepted, retries, queue pops]``.
     """
-    ptr, nbr, sidx, sup, supall, full = (
-        arcs.ptr,
-        arcs.nbr,
-        arcs.sidx,
-        arcs.sup,
-        arcs.supall,
-        arcs.full,
-    )
-    weights, wlogw = arcs.weights, arcs.wlogw
     W = doms.shape[1]
-    zi = np.zeros(0, dtype=np.int64)
-    zf = np.zeros(0, dtype=np.float64)
     for b in range(first, last):
         lo = bptr[b]
         nb = bptr[b + 1] - lo
@@ -1275,108 +1409,20 @@ def blocks_sweep(
         cells = bcells[lo : lo + nb]
         deg = 0
         for i in range(nb):
-            deg += ptr[cells[i] + 1] - ptr[cells[i]]
-        # the block's catalog before propagation, and its internal arcs (local numbers)
+            deg += arcs.ptr[cells[i] + 1] - arcs.ptr[cells[i]]
         dom0 = np.empty((nb, W), dtype=np.uint64)
         lptr = np.zeros(nb + 1, dtype=np.int64)
         lnbr = np.empty(max(deg, 1), dtype=np.int64)
         lsidx = np.empty(max(deg, 1), dtype=np.int64)
-        k = 0
-        for i in range(nb):
-            v = cells[i]
-            lptr[i] = k
-            for w in range(W):
-                dom0[i, w] = doms[v, w]
-            for e in range(ptr[v], ptr[v + 1]):
-                u = nbr[e]
-                j = np.searchsorted(cells, u)
-                if j < nb and cells[j] == u:
-                    lnbr[k] = j
-                    lsidx[k] = sidx[e]
-                    k += 1
-                else:
-                    a = grid[u]
-                    if a >= 0:  # labels of v that the fixed label a of u supports
-                        s1 = sidx[e] ^ 1
-                        for w in range(W):
-                            dom0[i, w] &= sup[s1, a, w]
-        lptr[nb] = k
-        local = Arcs(full, lptr, lnbr[:k].copy(), lsidx[:k].copy(), sup, supall, weights, wlogw)
-        dom = np.empty((nb, W), dtype=np.uint64)
-        prev = np.zeros((nb, W), dtype=np.uint64)
-        queue = np.zeros(nb, dtype=np.int64)
-        inq = np.zeros(nb, dtype=np.bool_)
-        stats = np.zeros(2, dtype=np.int64)
-        start = np.arange(nb, dtype=np.int64)
+        k = block_catalog(arcs, doms, grid, cells, dom0, lptr, lnbr, lsidx)
+        local = Arcs(arcs.full, lptr, lnbr[:k].copy(), lsidx[:k].copy(), arcs.sup,
+                     arcs.supall, arcs.weights, arcs.wlogw)  # fmt: skip
         lgrid = np.empty(nb, dtype=np.int32)
-        tcell = np.empty(nb, dtype=np.int64)
-        tlab = np.empty(nb, dtype=np.int64)
-        for attempt in range(retries + 1):
-            us = rng.random(nb)
-            noise = rng.random(nb) if use_heap else zf
-            ok = True
+        if block_alg31(local, dom0, scan, retries, use_heap, weighted, key_weighted, rng,
+                       lgrid, counters):  # fmt: skip
             for i in range(nb):
-                some = False
-                for w in range(W):
-                    dom[i, w] = dom0[i, w]
-                    prev[i, w] = 0
-                    if dom0[i, w]:
-                        some = True
-                if not some:
-                    ok = False
-            stats[0] = 0
-            stats[1] = 0
-            code = _FAILED
-            if ok:
-                wiped = _propagate(
-                    dom, prev, full, lptr, local.nbr, local.sidx, sup, supall, queue, inq,
-                    start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, False, zf, zf,
-                )  # fmt: skip
-                if wiped < 0:
-                    if use_heap:
-                        hheap = np.arange(nb, dtype=np.int64)
-                        hpos = np.zeros(nb, dtype=np.int64)
-                        hkey = np.empty(nb, dtype=np.float64)
-                        sw = np.empty(nb if key_weighted else 0, dtype=np.float64)
-                        swl = np.empty(nb if key_weighted else 0, dtype=np.float64)
-                        for i in range(nb):
-                            cnt = domain_size(dom, i)
-                            ent = np.log(max(cnt, 1))
-                            if key_weighted:
-                                s = 0.0
-                                sl = 0.0
-                                for w in range(W):
-                                    x = dom[i, w]
-                                    while x:
-                                        a = w * 64 + ctz64(x)
-                                        x &= x - np.uint64(1)
-                                        s += weights[a]
-                                        sl += wlogw[a]
-                                sw[i] = s
-                                swl[i] = sl
-                                if s > 0:
-                                    ent = np.log(s) - sl / s
-                            hkey[i] = ent + 1e-6 * noise[i]
-                        heap_build(hheap, hpos, hkey, nb)
-                        hp = Heap(hheap, hpos, hkey, noise, sw, swl)
-                    else:
-                        hp = Heap(zi, zi, zf, zf, zf, zf)
-                    for i in range(nb):
-                        lgrid[i] = -1
-                    state = np.zeros(3, dtype=np.int64)
-                    state[1] = nb if use_heap else 0
-                    state[2] = -1
-                    run = Run(scan, us, lgrid, tcell, tlab, state)
-                    ac = AcState(dom, prev, queue, inq, stats)
-                    code = alg31(local, ac, run, hp, use_heap, weighted, key_weighted, nb + 1)
-            counters[3] += stats[0]
-            if code == _SOLVED:
-                for i in range(nb):
-                    grid[cells[i]] = lgrid[i]
-                counters[1] += 1
-                break
-            if attempt < retries:
-                counters[2] += 1
+                grid[cells[i]] = lgrid[i]
+            counters[1] += 1
 
 
 # ----------------------------------------------------------------------------- problem arrays

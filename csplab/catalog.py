@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import weakref
 from collections import deque
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -45,18 +45,23 @@ from csplab.errors import InputError
 from csplab.problem import Problem, check_memory
 
 __all__ = [
+    "BlockArrays",
     "Code",
     "Heap",
     "Propagator",
     "Run",
     "Search",
+    "SupportTables",
     "assign",
+    "block_arrays",
     "initial_catalog",
     "pack",
     "propagate",
     "propagate_reference",
     "reference_adjacency",
     "reference_fixpoint",
+    "solve_block_arrays",
+    "support_tables",
     "sweep_blocks",
     "unpack",
 ]
@@ -90,11 +95,38 @@ def unpack(bits: NDArray[np.uint64], K: int) -> NDArray[np.bool_]:
 # ----------------------------------------------------------------------------- engine
 
 
+class SupportTables(NamedTuple):
+    """What the kernels read of a rule set: the support bitsets of every label in both
+    directions of every relation, and the label weights."""
+
+    full: NDArray[np.uint64]  #: ``(W,)`` bitset of every label
+    sup: NDArray[np.uint64]  #: ``(2R, K, W)`` supports of each label
+    supall: NDArray[np.uint64]  #: ``(2R, W)`` union of the supports of all labels
+    weights: NDArray[np.float64]  #: ``(K,)``
+    wlogw: NDArray[np.float64]  #: ``(K,)`` ``w log w`` (0 where ``w = 0``)
+
+
+def support_tables(relations: NDArray[np.bool_], weights: ArrayLike) -> SupportTables:
+    """The :class:`SupportTables` of ``relations`` (``(R, K, K)``) and label ``weights``."""
+    R, K = relations.shape[0], relations.shape[1]
+    W = words(K)
+    both = np.empty((2 * R, K, K), dtype=bool)
+    both[0::2] = relations
+    both[1::2] = relations.transpose(0, 2, 1)
+    sup = pack(both.reshape(2 * R * K, K)).reshape(2 * R, K, W)
+    supall = pack(both.any(axis=1))  # (2R, W): union of supports of all labels
+    full = pack(np.ones((1, K), dtype=bool))[0]
+    w = np.ascontiguousarray(np.asarray(weights, dtype=np.float64))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        wlogw = np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0)
+    return SupportTables(full, sup, supall, w, wlogw)
+
+
 class _Compiled:
     """CSR adjacency and support bitsets of a problem (shared by engines of one problem)."""
 
     def __init__(self, problem: Problem) -> None:
-        n, K, R = problem.n, problem.K, problem.R
+        n, K = problem.n, problem.K
         # the problem exists already: only what the engine adds must still fit
         check_memory(problem.shape, K, len(problem.arcs), problem=False)
         W = words(K)
@@ -115,13 +147,8 @@ class _Compiled:
             self.nbr = np.empty(ends, dtype=np.int64)
             self.sidx = np.empty(ends, dtype=np.int64)
             kern.arc_csr(np.ascontiguousarray(a, dtype=np.int64), self.ptr, self.nbr, self.sidx)
-        rel = problem.relations
-        both = np.empty((2 * R, K, K), dtype=bool)
-        both[0::2] = rel
-        both[1::2] = rel.transpose(0, 2, 1)
-        self.sup = pack(both.reshape(2 * R * K, K)).reshape(2 * R, K, W)
-        self.supall = pack(both.any(axis=1))  # (2R, W): union of supports of all labels
-        self.full = pack(np.ones((1, K), dtype=bool))[0]
+        t = support_tables(problem.relations, problem.weights)
+        self.sup, self.supall, self.full = t.sup, t.supall, t.full
         self.n, self.K, self.W = n, K, W
         #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
         #: wiped): every solve of the problem starts from it, so it is computed once
@@ -130,10 +157,7 @@ class _Compiled:
         self.doms: NDArray[np.uint64] | None = None
         #: per weighting, the entropies (and weight sums) of that catalog
         self.entropies: dict[bool, tuple[Any, Any, Any]] = {}
-        w = np.asarray(problem.weights, dtype=np.float64)
-        self.weights = np.ascontiguousarray(w)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            self.wlogw = np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0)
+        self.weights, self.wlogw = t.weights, t.wlogw
         # the same arrays as one kernel argument
         self.arcs = kern.Arcs(
             self.full, self.ptr, self.nbr, self.sidx, self.sup, self.supall, self.weights,
@@ -387,6 +411,59 @@ class Propagator:
 
     def sizes(self) -> NDArray[np.int64]:
         return np.asarray(self.catalog().sum(axis=1), dtype=np.int64)
+
+
+class BlockArrays(NamedTuple):
+    """One block of Alg. 3.4 as the kernels take it: its catalog before propagation
+    (``dom0``, packed, with the fixed labels around it applied) and its internal arcs as CSR
+    rows in local cell numbers (the arrays a worker process receives)."""
+
+    dom0: NDArray[np.uint64]
+    lptr: NDArray[np.int64]
+    lnbr: NDArray[np.int64]
+    lsidx: NDArray[np.int64]
+
+
+def block_arrays(
+    problem: Problem, grid: NDArray[np.int32], cells: NDArray[np.int64]
+) -> BlockArrays:
+    """The :class:`BlockArrays` of the block ``cells`` (sorted) of ``grid`` (flat,
+    labelled): :func:`csplab._kernels.block_catalog`, what :meth:`Problem.subproblem`
+    builds."""
+    c = _compiled_for(problem)
+    if c.doms is None:
+        c.doms = pack(problem.domains)
+    cells = np.ascontiguousarray(cells, dtype=np.int64)
+    nb = cells.size
+    deg = int((c.ptr[cells + 1] - c.ptr[cells]).sum())
+    dom0 = np.empty((nb, c.W), dtype=np.uint64)
+    lptr = np.zeros(nb + 1, dtype=np.int64)
+    lnbr = np.empty(max(deg, 1), dtype=np.int64)
+    lsidx = np.empty(max(deg, 1), dtype=np.int64)
+    k = kern.block_catalog(c.arcs, c.doms, grid, cells, dom0, lptr, lnbr, lsidx)
+    return BlockArrays(dom0, lptr, lnbr[:k].copy(), lsidx[:k].copy())
+
+
+def solve_block_arrays(
+    tables: SupportTables,
+    block: BlockArrays,
+    scan: NDArray[np.int64],
+    retries: int,
+    heap: bool,
+    weighted: bool,
+    key_weighted: bool,
+    rng: np.random.Generator,
+) -> tuple[NDArray[np.int32] | None, int, int]:
+    """Alg. 3.1 with retries on one block (:func:`csplab._kernels.block_alg31`): the labels
+    (``None`` if every attempt failed), the retries and the queue pops spent."""
+    local = kern.Arcs(tables.full, block.lptr, block.lnbr, block.lsidx, tables.sup,
+                      tables.supall, tables.weights, tables.wlogw)  # fmt: skip
+    nb = block.dom0.shape[0]
+    lgrid = np.empty(nb, dtype=np.int32)
+    counters = np.zeros(4, dtype=np.int64)
+    ok = kern.block_alg31(local, block.dom0, scan, int(retries), bool(heap), bool(weighted),
+                          bool(key_weighted), rng, lgrid, counters)  # fmt: skip
+    return (lgrid if ok else None), int(counters[2]), int(counters[3])
 
 
 def sweep_blocks(
