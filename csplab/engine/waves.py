@@ -19,6 +19,11 @@ Each block draws its random numbers from its own generator, :func:`block_rng`, s
 not depend on which process solves which block, nor in which order. Executors:
 
 * in-process (``workers=1``): :func:`solve_block` on each block in turn;
+* with the compiled kernels loaded and a plain setting (grid blocks, scan or entropy
+  orders, uniform or weighted choice; :class:`BlockContext` ``compiled``), a block is its
+  arrays (:class:`CompiledTask`: its catalog and internal arcs, built by a kernel in the
+  parent) and one kernel call solves it (:func:`solve_compiled`), with the same generator,
+  draws and outcome as :func:`solve_block` on its subproblem;
 * :class:`PoolRunner`: a local :class:`~concurrent.futures.ProcessPoolExecutor`; each task
   carries a few blocks (:class:`BlockTask`: packed domains and the block's arcs; the
   relations and weights, the same for every block, reach each worker once);
@@ -50,6 +55,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab import _interp
+from csplab.catalog import BlockArrays, SupportTables, solve_block_arrays, support_tables
 from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -58,6 +64,7 @@ __all__ = [
     "BlockContext",
     "BlockOutcome",
     "BlockTask",
+    "CompiledTask",
     "DaskRunner",
     "PoolRunner",
     "block_rng",
@@ -66,6 +73,7 @@ __all__ = [
     "pack_block",
     "run_tasks",
     "solve_block",
+    "solve_compiled",
     "waves",
 ]
 
@@ -207,6 +215,44 @@ class BlockContext:
     root: int
     #: cells times labels of the whole problem (large: the workers load the kernels)
     size: int = 0
+    #: the blocks travel as :class:`CompiledTask` and are solved by one kernel each
+    #: (grid blocks, scan or entropy orders, uniform or weighted choice); ``scan`` is the
+    #: cell order inside a block (``arange`` for the entropy orders)
+    compiled: bool = False
+    scan: NDArray[np.int64] | None = None
+
+
+class CompiledTask(NamedTuple):
+    """A block for :func:`csplab.catalog.solve_block_arrays`: flat index, sweep, and the
+    block's catalog and internal arcs (:class:`csplab.catalog.BlockArrays`)."""
+
+    block: int
+    sweep: int
+    arrays: BlockArrays
+
+
+_TABLES: list[tuple[BlockContext, SupportTables]] = []
+
+
+def solve_compiled(
+    task: CompiledTask, ctx: BlockContext, deadline: float | None = None
+) -> BlockOutcome:
+    """One block in one kernel call, with its own generator (:func:`block_rng`): the same
+    outcome as :func:`solve_block` on the block's subproblem (``deadline``, a
+    ``time.perf_counter()`` value, is checked before the block starts)."""
+    if deadline is not None and time.perf_counter() > deadline:
+        return BlockOutcome(task.block, None, "timeout", 0, 0)
+    if not _TABLES or _TABLES[0][0] is not ctx:  # once per context and process
+        _TABLES[:] = [(ctx, support_tables(ctx.relations, ctx.weights))]
+    assert ctx.scan is not None
+    heap = ctx.order in ("min-entropy", "min-domain")
+    weighted = ctx.choice == "weighted"
+    labels, retries, pops = solve_block_arrays(
+        _TABLES[0][1], task.arrays, ctx.scan, ctx.retries, heap, weighted,
+        weighted and ctx.order == "min-entropy", block_rng(ctx.root, task.sweep, task.block),
+    )  # fmt: skip
+    status = "solved" if labels is not None else "failed"
+    return BlockOutcome(task.block, labels, status, retries, pops)
 
 
 class BlockTask(NamedTuple):
@@ -237,7 +283,9 @@ _CONTEXT: BlockContext | None = None
 
 
 def run_tasks(
-    tasks: Sequence[BlockTask], wall_deadline: float | None, ctx: BlockContext | None = None
+    tasks: Sequence[BlockTask | CompiledTask],
+    wall_deadline: float | None,
+    ctx: BlockContext | None = None,
 ) -> list[BlockOutcome]:
     """Worker side: solve ``tasks`` by ``wall_deadline`` (a ``time.time()`` value, or
     ``None``); ``ctx`` defaults to the one the pool initializer installed."""
@@ -249,7 +297,9 @@ def run_tasks(
         None if wall_deadline is None else time.perf_counter() + (wall_deadline - time.time())
     )
     return [
-        solve_block(
+        solve_compiled(t, c, deadline)
+        if isinstance(t, CompiledTask)
+        else solve_block(
             _unpack(t, c),
             block_rng(c.root, t.sweep, t.block),
             t.block,
@@ -316,7 +366,9 @@ class PoolRunner:
             initializer=_init_worker, initargs=(os.getpid(), ctx),
         )  # fmt: skip
 
-    def submit(self, tasks: Sequence[BlockTask], wall_deadline: float | None) -> Future[Any]:
+    def submit(
+        self, tasks: Sequence[BlockTask | CompiledTask], wall_deadline: float | None
+    ) -> Future[Any]:
         return self.pool.submit(run_tasks, list(tasks), wall_deadline)
 
     def gather(
@@ -370,7 +422,7 @@ class DaskRunner:
             self.close()
             raise
 
-    def submit(self, tasks: Sequence[BlockTask], wall_deadline: float | None) -> Any:
+    def submit(self, tasks: Sequence[BlockTask | CompiledTask], wall_deadline: float | None) -> Any:
         return self.client.submit(run_tasks, list(tasks), wall_deadline, self.ctx, pure=False)
 
     def gather(

@@ -16,7 +16,8 @@ problem's by the fixed labels around it, in arrays of the block's size only (the
 3.3.6: the catalog of the block, ``m ** d * K`` bits, not of the model), then arc
 consistency and Alg. 3.1 with retries, with no Python per block. It draws the same random
 numbers in the same order as the Python sweep and gives the same grid and counts (tested);
-the ``random`` order, ``choice="resemblance"`` and ``energy=`` keep the Python sweep.
+the ``random`` order, ``choice="resemblance"`` and ``energy=`` keep the Python sweep. The
+wave schedule below does the same per block (one kernel call each, in the workers too).
 
 Parallel blocks (``workers >= 1``). Blocks that neither overlap nor share an arc are
 independent; :mod:`csplab.engine.waves` colours the blocks by their block index modulo 3 on
@@ -59,7 +60,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab import _interp
-from csplab.catalog import sweep_blocks
+from csplab.catalog import block_arrays, sweep_blocks
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
@@ -454,6 +455,13 @@ def _compiled_sweep_applies(
     )
 
 
+def _block_scan(m: tuple[int, ...], order: str) -> NDArray[np.int64]:
+    """The cell order inside a block (``arange`` for the entropy orders, unused there)."""
+    scan = scan_order(m, order)
+    n = int(np.prod(m))
+    return np.arange(n, dtype=np.int64) if scan is None else scan.astype(np.int64)
+
+
 def _run_sweep_compiled(
     problem: Problem,
     grid: NDArray[np.int32],
@@ -472,8 +480,7 @@ def _run_sweep_compiled(
     assert m is not None
     heap = order in ("min-entropy", "min-domain")
     nb = int(np.prod(m))
-    scan = scan_order(m, order) if not heap else None
-    scan = np.arange(nb, dtype=np.int64) if scan is None else scan.astype(np.int64)
+    scan = _block_scan(m, order)
     sizes = np.array([b.size for b in boxes], dtype=np.int64)
     bptr = np.zeros(len(boxes) + 1, dtype=np.int64)
     np.cumsum(sizes, out=bptr[1:])
@@ -524,8 +531,10 @@ def _run_waves(
 
     classes = wv.colour_classes(counts)
     assert sum(len(c) for c in classes) == len(boxes), "one block per lattice index"
+    compiled = _compiled_sweep_applies(boxes, m, order, choice, None)
+    scan = _block_scan(m, order) if compiled and m is not None else None
     ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root,
-                          size=problem.n * problem.K)  # fmt: skip
+                          size=problem.n * problem.K, compiled=compiled, scan=scan)  # fmt: skip
     runner: wv.PoolRunner | wv.DaskRunner | None = None
     if scheduler is not None:
         runner = wv.DaskRunner(scheduler, workers, ctx)
@@ -546,6 +555,11 @@ def _run_waves(
                         if deadline is not None and time.perf_counter() > deadline:
                             stopped = True
                             break
+                        if compiled:
+                            arrays = block_arrays(problem, grid, b.cells)
+                            task = wv.CompiledTask(b.block, sweep, arrays)
+                            outcomes.append(wv.solve_compiled(task, ctx))
+                            continue
                         sub = problem.subproblem(b.cells, grid, shape=m, arc_ids=b.arc_ids)
                         outcomes.append(
                             wv.solve_block(
@@ -564,10 +578,14 @@ def _run_waves(
                         None if deadline is None else time.time() + deadline - time.perf_counter()
                     )
                     futures: list[Any] = []
-                    chunk: list[wv.BlockTask] = []
+                    chunk: list[wv.BlockTask | wv.CompiledTask] = []
                     for b in wave:
-                        sub = problem.subproblem(b.cells, grid, shape=m, arc_ids=b.arc_ids)
-                        chunk.append(wv.pack_block(sub, b.block, sweep))
+                        if compiled:
+                            arrays = block_arrays(problem, grid, b.cells)
+                            chunk.append(wv.CompiledTask(b.block, sweep, arrays))
+                        else:
+                            sub = problem.subproblem(b.cells, grid, shape=m, arc_ids=b.arc_ids)
+                            chunk.append(wv.pack_block(sub, b.block, sweep))
                         if len(chunk) == size:
                             futures.append(runner.submit(chunk, wall))
                             chunk = []

@@ -175,10 +175,31 @@ def test_worker_exception_reaches_the_caller(monkeypatch):
     def boom(*a, **k):
         raise RuntimeError("boom in a worker")
 
-    monkeypatch.setattr(wv, "solve_block", boom)
+    monkeypatch.setattr(wv, "solve_block", boom)  # the Python path
+    monkeypatch.setattr(wv, "solve_compiled", boom)  # the compiled one
     P = Problem.from_example(load_example("fig3_10"), (20, 20), boundary="auto")
     with pytest.raises(RuntimeError, match="boom"):
         solve(P, "blocks", rng=0, block=10, workers=2)
+
+
+@pytest.mark.parametrize("order", ["scanline", "min-entropy"])
+def test_compiled_blocks_same_as_python_blocks_in_waves(monkeypatch, order):
+    """The wave schedule with one kernel call per block (:func:`wv.solve_compiled`, the
+    block's arrays built by a kernel) gives the grids and counts of the Python path."""
+    from csplab import _interp
+
+    for name, shape, kw in [("castle", (24, 24, 10), {}), ("loops", (24, 24), {"periodic": True})]:
+        for workers in (1, 2):
+            out = []
+            for engine in ("interp", "kernels"):
+                monkeypatch.setattr(_interp, "ENGINE", engine)
+                P = Problem.from_example(load_example(name), shape, **kw)
+                out.append(solve(P, "blocks", rng=4, block=8, order=order, choice="weighted",
+                                 workers=workers, sweeps=2))  # fmt: skip
+            a, b = out
+            assert a.status == b.status == "solved" and np.array_equal(a.grid, b.grid)
+            for k in ("blocks_tried", "blocks_accepted", "retries", "revisions"):
+                assert a.stats[k] == b.stats[k], (name, workers, k)
 
 
 @pytest.mark.slow
