@@ -20,7 +20,10 @@ same order of operations (``math.log`` is the C library's ``log``, as numba's ``
 on a scalar), so the pick is the same unless two cells have bit-identical keys, which the
 random tie-breaking term makes practically impossible.
 
-``CSPLAB_ENGINE`` (environment) or :data:`ENGINE` selects ``"auto"`` (the rule above),
+The rule loads the kernels once :data:`BUDGET` seconds of interpreted work have been spent
+in the process (many small solves, as experiments and witness searches make, run faster
+compiled after that). ``CSPLAB_ENGINE`` (environment) or :data:`ENGINE` selects ``"auto"``
+(the rule above),
 ``"kernels"`` or ``"interp"`` (every problem whose run fits one call; for tests and
 benchmarks).
 
@@ -39,6 +42,7 @@ from __future__ import annotations
 import heapq
 import math
 import os
+import time
 from collections import deque
 from typing import Any
 
@@ -62,6 +66,10 @@ __all__ = [
 ENGINE = os.environ.get("CSPLAB_ENGINE", "auto")
 #: largest ``cells * labels`` the ``auto`` rule interprets (about 0.1 s of Python at most)
 LIMIT = 50_000
+#: seconds of interpreted work after which the ``auto`` rule loads the kernels (many small
+#: solves in one process, as an experiment runs them, are faster compiled after that)
+BUDGET = 0.5
+_SPENT = [0.0]
 
 _SOLVED, _FAILED = 0, 1  # csplab._kernels.Code values (that module defines the enum)
 
@@ -72,7 +80,14 @@ def use_interp(n: int, K: int) -> bool:
         return True
     if ENGINE == "kernels":
         return False
-    return n * K <= LIMIT and not _jit.compiled("csplab._kernels")
+    if n * K > LIMIT or _jit.compiled("csplab._kernels"):
+        return False
+    if _SPENT[0] > BUDGET:  # enough interpreted work in this process: load the kernels
+        from csplab import _kernels
+
+        _jit.load(_kernels.__name__)
+        return False
+    return True
 
 
 def compiled_engine() -> bool:
@@ -263,6 +278,7 @@ def propagate(c: Any, bits: NDArray[np.uint64], prev: NDArray[np.uint64],
               stats: NDArray[np.int64], start: Any) -> int:  # fmt: skip
     """Arc consistency from the cells ``start`` on the packed catalog ``bits`` (in place, as
     :func:`csplab._kernels.propagate` without a heap); returns the wiped cell or -1."""
+    t0 = time.perf_counter()
     T = _tables(c)
     dom, pv = _ints(bits), _ints(prev)
     st = [0, 0]
@@ -271,6 +287,7 @@ def propagate(c: Any, bits: NDArray[np.uint64], prev: NDArray[np.uint64],
     _store(pv, prev)
     stats[0] += st[0]
     stats[1] += st[1]
+    _SPENT[0] += time.perf_counter() - t0
     return wiped
 
 
@@ -315,6 +332,7 @@ def alg31(
     """:func:`csplab._kernels.alg31` to the end of the run (solved or failed); updates
     ``bits``, ``prev``, ``stats`` and the :class:`~csplab._kernels.Run` as the kernel does.
     Returns the kernel's code (0 solved, 1 failed)."""
+    t_start = time.perf_counter()
     T = _tables(c)
     n = T.n
     dom, pv = _ints(bits), _ints(prev)
@@ -354,4 +372,5 @@ def alg31(
     _store(pv, prev)
     stats[0] += st[0]
     stats[1] += st[1]
+    _SPENT[0] += time.perf_counter() - t_start
     return code

@@ -122,10 +122,24 @@ def test_int_bitsets_round_trip():
 
 def test_auto_rule(monkeypatch):
     monkeypatch.setattr(_interp, "ENGINE", "auto")
+    monkeypatch.setattr(_interp, "_SPENT", [0.0])
     monkeypatch.setattr(_jit, "compiled", lambda module: False)
+    loads = []
+    monkeypatch.setattr(_jit, "load", loads.append)
     assert _interp.use_interp(100, 10) and not _interp.use_interp(10_000, 10)
+    assert loads == []
+    _interp._SPENT[0] = _interp.BUDGET + 0.1  # much interpreted work: load the kernels
+    assert not _interp.use_interp(100, 10) and loads == ["csplab._kernels"]
     monkeypatch.setattr(_jit, "compiled", lambda module: True)
     assert not _interp.use_interp(100, 10)  # numba is loaded: the kernels are faster
+
+
+def test_interpreted_work_is_counted(monkeypatch):
+    monkeypatch.setattr(_interp, "ENGINE", "interp")
+    monkeypatch.setattr(_interp, "_SPENT", [0.0])
+    P = Problem.from_example(load_example("fig3_10"), (16, 16))
+    run_alg31(P, np.random.default_rng(0))
+    assert _interp._SPENT[0] > 0
 
 
 def test_lazy_njit_materializes_a_module_at_first_call(tmp_path, monkeypatch):
