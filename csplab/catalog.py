@@ -55,6 +55,7 @@ __all__ = [
     "assign",
     "block_arrays",
     "initial_catalog",
+    "neighbourhood",
     "pack",
     "propagate",
     "propagate_reference",
@@ -419,9 +420,15 @@ class BlockArrays(NamedTuple):
     rows in local cell numbers (the arrays a worker process receives)."""
 
     dom0: NDArray[np.uint64]
-    lptr: NDArray[np.int64]
+    lptr: NDArray[np.int64]  #: (``int32`` after :meth:`compact`)
     lnbr: NDArray[np.int64]
     lsidx: NDArray[np.int64]
+
+    def compact(self) -> BlockArrays:
+        """The same block with ``int32`` arcs (to send to a worker: 40 % fewer bytes)."""
+        i32 = np.int32
+        return BlockArrays(self.dom0, self.lptr.astype(i32), self.lnbr.astype(i32),
+                           self.lsidx.astype(i32))  # fmt: skip
 
 
 def block_arrays(
@@ -456,14 +463,28 @@ def solve_block_arrays(
 ) -> tuple[NDArray[np.int32] | None, int, int]:
     """Alg. 3.1 with retries on one block (:func:`csplab._kernels.block_alg31`): the labels
     (``None`` if every attempt failed), the retries and the queue pops spent."""
-    local = kern.Arcs(tables.full, block.lptr, block.lnbr, block.lsidx, tables.sup,
-                      tables.supall, tables.weights, tables.wlogw)  # fmt: skip
+
+    def i64(x: NDArray[Any]) -> NDArray[np.int64]:
+        return np.ascontiguousarray(x, dtype=np.int64)
+
+    local = kern.Arcs(tables.full, i64(block.lptr), i64(block.lnbr), i64(block.lsidx),
+                      tables.sup, tables.supall, tables.weights, tables.wlogw)  # fmt: skip
     nb = block.dom0.shape[0]
     lgrid = np.empty(nb, dtype=np.int32)
     counters = np.zeros(4, dtype=np.int64)
     ok = kern.block_alg31(local, block.dom0, scan, int(retries), bool(heap), bool(weighted),
                           bool(key_weighted), rng, lgrid, counters)  # fmt: skip
     return (lgrid if ok else None), int(counters[2]), int(counters[3])
+
+
+def neighbourhood(problem: Problem, cells: NDArray[np.int64]) -> NDArray[np.int64]:
+    """``cells`` and every cell joined to one of them by an arc (with repeats)."""
+    c = _compiled_for(problem)
+    start = c.ptr[cells]
+    lens = c.ptr[cells + 1] - start
+    total = int(lens.sum())
+    offs = np.repeat(start - np.cumsum(lens) + lens, lens) + np.arange(total, dtype=np.int64)
+    return np.concatenate([cells, c.nbr[offs]])
 
 
 def sweep_blocks(

@@ -114,7 +114,8 @@ def waves(
     cells: Sequence[NDArray[np.int64]],
     n_cells: int,
     n_arcs: int,
-    touching: Callable[[NDArray[np.int64]], NDArray[np.int64]],
+    touching: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None,
+    near: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None,
 ) -> Iterator[list[WaveBlock]]:
     """The waves of one sweep: colour classes split so that every wave is independent.
 
@@ -122,9 +123,13 @@ def waves(
     (``touching(cells)``: the sorted ids of the arcs with an end in ``cells``) with a block
     already in it; such a block waits for the next wave of the class (first fit, in sweep
     order, so the schedule depends on the problem only). Empty blocks are skipped. The
-    generator is lazy: the caller may change the grid between waves.
+    generator is lazy: the caller may change the grid between waves. Instead of
+    ``touching``, ``near(cells)`` may give the cells and their neighbours across the arcs:
+    a block that shares an arc or a cell with another has a cell of it in that
+    neighbourhood, so the waves are the same (and no arc ids are built:
+    :attr:`WaveBlock.arc_ids` is ``None``).
     """
-    arc_mark = np.zeros(n_arcs, dtype=bool)
+    arc_mark = np.zeros(n_arcs if near is None else 0, dtype=bool)
     cell_mark = np.zeros(n_cells, dtype=bool)
     for cls in classes:
         pending = [b for b in cls if cells[b].size]
@@ -133,6 +138,14 @@ def waves(
             deferred: list[int] = []
             for b in pending:
                 c = cells[b]
+                if near is not None:
+                    if cell_mark[near(c)].any():
+                        deferred.append(b)
+                        continue
+                    cell_mark[c] = True
+                    wave.append(WaveBlock(b, c, None))
+                    continue
+                assert touching is not None
                 ids = touching(c)
                 if arc_mark[ids].any() or cell_mark[c].any():
                     deferred.append(b)
@@ -141,8 +154,8 @@ def waves(
                 cell_mark[c] = True
                 wave.append(WaveBlock(b, c, ids))
             for w in wave:  # unmark for the next wave
-                assert w.arc_ids is not None
-                arc_mark[w.arc_ids] = False
+                if w.arc_ids is not None:
+                    arc_mark[w.arc_ids] = False
                 cell_mark[w.cells] = False
             yield wave
             pending = deferred

@@ -53,14 +53,14 @@ from __future__ import annotations
 import itertools
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab import _interp
-from csplab.catalog import block_arrays, sweep_blocks
+from csplab.catalog import block_arrays, neighbourhood, sweep_blocks
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
@@ -524,14 +524,19 @@ def _run_waves(
     """The wave schedule (``workers >= 1``, see the module docstring); updates ``grid``
     (flat) in place after each wave."""
     root = int(rng.integers(2**63))
-    indptr, ids = _arc_index(problem)
+    compiled = _compiled_sweep_applies(boxes, m, order, choice, None)
+    touching: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None
+    if not compiled:  # arc ids for the subproblems (the compiled blocks read the CSR rows)
+        indptr, ids = _arc_index(problem)
 
-    def touching(cells: NDArray[np.int64]) -> NDArray[np.int64]:
-        return _arcs_touching(cells, indptr, ids)
+        def touching(cells: NDArray[np.int64]) -> NDArray[np.int64]:
+            return _arcs_touching(cells, indptr, ids)
+
+    def near(cells: NDArray[np.int64]) -> NDArray[np.int64]:
+        return neighbourhood(problem, cells)
 
     classes = wv.colour_classes(counts)
     assert sum(len(c) for c in classes) == len(boxes), "one block per lattice index"
-    compiled = _compiled_sweep_applies(boxes, m, order, choice, None)
     scan = _block_scan(m, order) if compiled and m is not None else None
     ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root,
                           size=problem.n * problem.K, compiled=compiled, scan=scan)  # fmt: skip
@@ -545,7 +550,8 @@ def _run_waves(
     stopped = False  # a wave did not finish in time: its workers are stopped
     try:
         for sweep in range(sweeps):
-            for wave in wv.waves(classes, boxes, problem.n, len(problem.arcs), touching):
+            for wave in wv.waves(classes, boxes, problem.n, len(problem.arcs), touching,
+                                 near if compiled else None):  # fmt: skip
                 if deadline is not None and time.perf_counter() > deadline:
                     status = "timeout"
                     break
@@ -581,7 +587,7 @@ def _run_waves(
                     chunk: list[wv.BlockTask | wv.CompiledTask] = []
                     for b in wave:
                         if compiled:
-                            arrays = block_arrays(problem, grid, b.cells)
+                            arrays = block_arrays(problem, grid, b.cells).compact()
                             chunk.append(wv.CompiledTask(b.block, sweep, arrays))
                         else:
                             sub = problem.subproblem(b.cells, grid, shape=m, arc_ids=b.arc_ids)

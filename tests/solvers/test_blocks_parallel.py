@@ -102,6 +102,12 @@ def test_every_wave_is_independent(name, shape, m, boundary):
         P = Problem.from_example(load_example(name), shape, boundary=boundary)
     boxes, counts = _grid_blocks(P, m)
     schedule = _schedule(P, boxes, counts)
+    # by neighbourhoods (the compiled blocks' test): the same waves
+    from csplab.catalog import neighbourhood
+
+    near = list(wv.waves(wv.colour_classes(counts), boxes, P.n, len(P.arcs), None,
+                         lambda c: neighbourhood(P, c)))  # fmt: skip
+    assert [[b.block for b in w] for w in near] == [[b.block for b in w] for w in schedule]
     seen = [b.block for w in schedule for b in w]
     assert sorted(seen) == list(range(len(boxes)))  # every block exactly once per sweep
     for w in schedule:
