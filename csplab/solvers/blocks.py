@@ -445,13 +445,14 @@ def _compiled_sweep_applies(
     boxes: Sequence[NDArray[np.int64]], m: tuple[int, ...] | None, order: str, choice: str,
     soft: _Soft | None,
 ) -> bool:  # fmt: skip
+    # grid blocks (m given) are C-order slices of the cell numbers: sorted, as the kernels
+    # need; boxes of positions are not
     return (
         m is not None
         and soft is None
         and choice in ("uniform", "weighted")
         and order != "random"
         and _interp.compiled_engine()
-        and all(b.size < 2 or bool(np.all(np.diff(b) > 0)) for b in boxes)
     )
 
 
