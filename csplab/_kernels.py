@@ -1336,9 +1336,7 @@ def block_alg31(
                     sw = np.empty(nb if key_weighted else 0, dtype=np.float64)
                     swl = np.empty(nb if key_weighted else 0, dtype=np.float64)
                     for i in range(nb):
-                        cnt = domain_size(dom, i)
-                        ent = np.log(max(cnt, 1))
-                        if key_weighted:
+                        if key_weighted:  # the sums the propagation keeps up to date
                             s = 0.0
                             sl = 0.0
                             for w in range(W):
@@ -1350,8 +1348,7 @@ def block_alg31(
                                     sl += wlogw[a]
                             sw[i] = s
                             swl[i] = sl
-                            if s > 0:
-                                ent = np.log(s) - sl / s
+                        ent = entropy_of(dom, i, weights, wlogw, key_weighted)
                         hkey[i] = ent + 1e-6 * noise[i]
                     heap_build(hheap, hpos, hkey, nb)
                     hp = Heap(hheap, hpos, hkey, noise, sw, swl)

@@ -154,8 +154,7 @@ class _Compiled:
         #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
         #: wiped): every solve of the problem starts from it, so it is computed once
         self.initial: tuple[Any, Any, Any, bool, int] | None = None
-        #: the problem's domains packed (modify in blocks builds each block's from them)
-        self.doms: NDArray[np.uint64] | None = None
+        self._doms: NDArray[np.uint64] | None = None  # packed_domains(), built on demand
         #: per weighting, the entropies (and weight sums) of that catalog
         self.entropies: dict[bool, tuple[Any, Any, Any]] = {}
         self.weights, self.wlogw = t.weights, t.wlogw
@@ -164,6 +163,12 @@ class _Compiled:
             self.full, self.ptr, self.nbr, self.sidx, self.sup, self.supall, self.weights,
             self.wlogw,
         )  # fmt: skip
+
+    def packed_domains(self, problem: Problem) -> NDArray[np.uint64]:
+        """The problem's domains packed, once (modify in blocks cuts each block's from them)."""
+        if self._doms is None:
+            self._doms = pack(problem.domains)
+        return self._doms
 
 
 class Propagator:
@@ -438,8 +443,6 @@ def block_arrays(
     labelled): :func:`csplab._kernels.block_catalog`, what :meth:`Problem.subproblem`
     builds."""
     c = _compiled_for(problem)
-    if c.doms is None:
-        c.doms = pack(problem.domains)
     cells = np.ascontiguousarray(cells, dtype=np.int64)
     nb = cells.size
     deg = int((c.ptr[cells + 1] - c.ptr[cells]).sum())
@@ -447,7 +450,8 @@ def block_arrays(
     lptr = np.zeros(nb + 1, dtype=np.int64)
     lnbr = np.empty(max(deg, 1), dtype=np.int64)
     lsidx = np.empty(max(deg, 1), dtype=np.int64)
-    k = kern.block_catalog(c.arcs, c.doms, grid, cells, dom0, lptr, lnbr, lsidx)
+    k = kern.block_catalog(c.arcs, c.packed_domains(problem), grid, cells, dom0, lptr, lnbr,
+                           lsidx)  # fmt: skip
     return BlockArrays(dom0, lptr, lnbr[:k].copy(), lsidx[:k].copy())
 
 
@@ -505,11 +509,9 @@ def sweep_blocks(
     1]]`` (sorted cells) of ``grid`` (flat, consistent, changed in place), one compiled
     kernel for the whole span: :func:`csplab._kernels.blocks_sweep`."""
     c = _compiled_for(problem)
-    if c.doms is None:
-        c.doms = pack(problem.domains)
     kern.blocks_sweep(
-        c.arcs, c.doms, grid, bptr, bcells, int(span[0]), int(span[1]), scan, int(retries),
-        bool(heap), bool(weighted), bool(key_weighted), rng, counters,
+        c.arcs, c.packed_domains(problem), grid, bptr, bcells, int(span[0]), int(span[1]),
+        scan, int(retries), bool(heap), bool(weighted), bool(key_weighted), rng, counters,
     )  # fmt: skip
 
 
