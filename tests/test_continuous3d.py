@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from csplab.continuous.csp3d import ContinuousCSP3, labels_at
+from csplab.continuous._geom import labels_at
+from csplab.continuous.csp3d import ContinuousCSP3
 from csplab.continuous.space import Arrangement3, Lattice3, central_cells
 from csplab.errors import InputError
 from csplab.solvers import solve

@@ -10,7 +10,7 @@ looks at the triangles of one column only. The ray direction is irrational with 
 every lattice direction, so it meets an edge exactly with probability zero; to be safe the
 query is made with two directions and every point where they disagree (or that is too
 close to a face) is decided by the generalised winding number instead
-(:func:`csplab.continuous.csp3d.labels_at`).
+(:func:`labels_at`).
 
 :func:`points_on_segments` finds the vertices lying inside each segment (T-junctions),
 with the same sorted-by-x candidate search as before, compiled.
@@ -35,7 +35,7 @@ from numpy.typing import NDArray
 
 from csplab._jit import njit, prange
 
-__all__ = ["point_labels", "points_on_segments", "triangulate_rings"]
+__all__ = ["labels_at", "point_labels", "points_on_segments", "triangulate_rings"]
 
 # two ray directions, irrational w.r.t. lattice directions (components of sqrt(2), sqrt(3),
 # sqrt(5), sqrt(7) fractional parts), mostly upwards
@@ -175,6 +175,49 @@ def _one_ray(
     return _first_hits(q, t, lab, start, items, float(lo[0]), float(lo[1]), h, nx, ny, tol)
 
 
+def _solid_angles(p: NDArray[np.float64], tri: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Signed solid angles ``(len(p),)`` of the triangles ``tri`` ``(m, 3, 3)`` summed, seen
+    from the points ``p`` (Van Oosterom & Strackee)."""
+    out = np.zeros(len(p))
+    step = max(1, 200_000 // max(1, len(tri)))  # points per chunk: about 2e5 pairs
+    for start in range(0, len(p), step):
+        q = p[start : start + step, None, None, :]
+        r = tri[None, :, :, :] - q  # (P, m, 3, 3)
+        ln = np.linalg.norm(r, axis=3)
+        a, b, c = r[:, :, 0], r[:, :, 1], r[:, :, 2]
+        la, lb, lc = ln[:, :, 0], ln[:, :, 1], ln[:, :, 2]
+        num = np.einsum("pmi,pmi->pm", a, np.cross(b, c))
+        ab = np.einsum("pmi,pmi->pm", a, b)
+        ac = np.einsum("pmi,pmi->pm", a, c)
+        bc = np.einsum("pmi,pmi->pm", b, c)
+        den = la * lb * lc + ab * lc + ac * lb + bc * la
+        out[start : start + step] = 2 * np.arctan2(num, den).sum(axis=1)
+    return out
+
+
+def labels_at(
+    points: NDArray[np.float64],
+    triangles: dict[int, NDArray[np.float64]] | list[tuple[int, NDArray[np.float64]]],
+) -> NDArray[np.int64]:
+    """The label at each point: the label whose closed triangle mesh (``(m, 3, 3)``, outward
+    orientation; a dict by label, or a list of ``(label, mesh)`` per solid) winds around it
+    (generalised winding number > 1/2), else 0. A closed surface does not wind around points
+    outside its bounding box, so each mesh is evaluated only at the points inside its box."""
+    items = list(triangles.items()) if isinstance(triangles, dict) else list(triangles)
+    lab = np.zeros(len(points), dtype=np.int64)
+    order = np.argsort(points[:, 0], kind="stable")
+    xs = points[order, 0]
+    for b, tri in items:
+        lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
+        cand = order[np.searchsorted(xs, lo[0], "left") : np.searchsorted(xs, hi[0], "right")]
+        inside = cand[((points[cand] >= lo) & (points[cand] <= hi)).all(axis=1)]
+        if not inside.size:
+            continue
+        w = _solid_angles(points[inside], tri) / (4 * np.pi)
+        lab[inside[w > 0.5]] = b
+    return lab
+
+
 def point_labels(
     points: NDArray[np.float64], solids: Sequence[tuple[int, NDArray[np.float64]]]
 ) -> NDArray[np.int64]:
@@ -191,8 +234,6 @@ def point_labels(
     -------
     ndarray of int64, shape (P,)
     """
-    from csplab.continuous.csp3d import labels_at
-
     pts = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
     items = [(int(b), np.asarray(t, dtype=np.float64).reshape(-1, 3, 3)) for b, t in solids]
     items = [(b, t) for b, t in items if len(t)]

@@ -38,11 +38,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab.continuous._geom import labels_at
 from csplab.continuous.space import Arrangement3, Lattice3
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3", "labels_at"]
+__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3"]
 
 #: the region's faces; a point outside several takes the label of the first (the ground
 #: ``z-`` wins at the bottom edges)
@@ -61,49 +62,6 @@ def _boundary_faces(boundary: int | Mapping[str, int]) -> dict[str, int]:
 
 
 Labeling = tuple[int, ...]
-
-
-def _solid_angles(p: NDArray[np.float64], tri: NDArray[np.float64]) -> NDArray[np.float64]:
-    """Signed solid angles ``(len(p),)`` of the triangles ``tri`` ``(m, 3, 3)`` summed, seen
-    from the points ``p`` (Van Oosterom & Strackee)."""
-    out = np.zeros(len(p))
-    step = max(1, 200_000 // max(1, len(tri)))  # points per chunk: about 2e5 pairs
-    for start in range(0, len(p), step):
-        q = p[start : start + step, None, None, :]
-        r = tri[None, :, :, :] - q  # (P, m, 3, 3)
-        ln = np.linalg.norm(r, axis=3)
-        a, b, c = r[:, :, 0], r[:, :, 1], r[:, :, 2]
-        la, lb, lc = ln[:, :, 0], ln[:, :, 1], ln[:, :, 2]
-        num = np.einsum("pmi,pmi->pm", a, np.cross(b, c))
-        ab = np.einsum("pmi,pmi->pm", a, b)
-        ac = np.einsum("pmi,pmi->pm", a, c)
-        bc = np.einsum("pmi,pmi->pm", b, c)
-        den = la * lb * lc + ab * lc + ac * lb + bc * la
-        out[start : start + step] = 2 * np.arctan2(num, den).sum(axis=1)
-    return out
-
-
-def labels_at(
-    points: NDArray[np.float64],
-    triangles: dict[int, NDArray[np.float64]] | list[tuple[int, NDArray[np.float64]]],
-) -> NDArray[np.int64]:
-    """The label at each point: the label whose closed triangle mesh (``(m, 3, 3)``, outward
-    orientation; a dict by label, or a list of ``(label, mesh)`` per solid) winds around it
-    (generalised winding number > 1/2), else 0. A closed surface does not wind around points
-    outside its bounding box, so each mesh is evaluated only at the points inside its box."""
-    items = list(triangles.items()) if isinstance(triangles, dict) else list(triangles)
-    lab = np.zeros(len(points), dtype=np.int64)
-    order = np.argsort(points[:, 0], kind="stable")
-    xs = points[order, 0]
-    for b, tri in items:
-        lo, hi = tri.reshape(-1, 3).min(axis=0), tri.reshape(-1, 3).max(axis=0)
-        cand = order[np.searchsorted(xs, lo[0], "left") : np.searchsorted(xs, hi[0], "right")]
-        inside = cand[((points[cand] >= lo) & (points[cand] <= hi)).all(axis=1)]
-        if not inside.size:
-            continue
-        w = _solid_angles(points[inside], tri) / (4 * np.pi)
-        lab[inside[w > 0.5]] = b
-    return lab
 
 
 def _groups(signs: NDArray[np.int8], fams: NDArray[np.int64]) -> tuple[NDArray[np.int64], int]:
