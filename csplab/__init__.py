@@ -4,7 +4,7 @@ Quickstart
 ----------
 >>> import csplab
 >>> E = csplab.load_example("line")                      # thesis Fig. 3.1(c)
->>> P = csplab.Problem.from_example(E, (20, 10))
+>>> P = csplab.from_example(E, (20, 10))
 >>> r = csplab.solve(P, solver="catalog", rng=1)
 >>> r.status, P.is_solution(r.grid)
 ('solved', True)

@@ -234,7 +234,7 @@ class ExampleModel:
         if self.topology.startswith(("hex", "tri")):
             raise InputError(
                 f"{self.name or 'the example'} is on a {self.topology} grid: this tool works "
-                "on square grids (synthesis takes it: Problem.from_example, csplab synthesize)"
+                "on square grids (synthesis takes it: csplab.from_example, csplab synthesize)"
             )
         return pair_transitions(self.labels, self.K)
 

@@ -514,7 +514,7 @@ def _check_label(b: Any, K: int, what: str) -> int:
 
 
 def auto_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, int]:
-    """The ``boundary="auto"`` labelling for an example (see :meth:`Problem.from_example`).
+    """The ``boundary="auto"`` labelling for an example (see :func:`~csplab.grids.from_example`).
 
     Returns a mapping face -> label. Raises :class:`~csplab.errors.InputError` when the
     example has no empty-space label (one that tiles itself along every axis) or, for 2D and

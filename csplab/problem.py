@@ -16,8 +16,9 @@ Examples
 --------
 >>> import numpy as np
 >>> from csplab.example import ExampleModel
+>>> from csplab.grids import from_example
 >>> E1 = ExampleModel([[0, 1], [1, 0]])                  # checkerboard
->>> P = Problem.from_example(E1, (3, 3))
+>>> P = from_example(E1, (3, 3))
 >>> P.n, P.K, len(P.arcs)
 (9, 2, 12)
 >>> P.is_solution(np.array([[0, 1, 0], [1, 0, 1], [0, 1, 0]]))
