@@ -71,7 +71,7 @@ def main() -> None:
     # --- 2D output first: the process' peak memory is its own
     size2 = csplab.grids.parse_shape(args.size2d)
     t = time.perf_counter()
-    P2 = csplab.Problem.from_example(csplab.load_example(args.example2d), size2, boundary="auto")
+    P2 = csplab.from_example(csplab.load_example(args.example2d), size2, boundary="auto")
     t_build = time.perf_counter() - t
     r2 = csplab.solve(P2, "blocks", rng=args.seed, block=args.block2d, workers=args.workers2d)
     t2 = time.perf_counter() - t
@@ -90,7 +90,7 @@ def main() -> None:
 
     # --- castle
     size = csplab.grids.parse_shape(args.size)
-    P = csplab.Problem.from_example(csplab.load_example("castle"), size, boundary="auto")
+    P = csplab.from_example(csplab.load_example("castle"), size, boundary="auto")
     print(f"\ncastle {args.size} (K={P.K}, {len(P.arcs)} arcs) in blocks of {args.block}:")
     runs: list[tuple[str, dict[str, object]]] = [
         ("sequential (workers=0)", {"workers": 0}),
@@ -108,7 +108,7 @@ def main() -> None:
         print(f"  (Dask LocalCluster of 2 workers started in {time.perf_counter() - t:.2f} s)")
         address = cluster.scheduler_address
         t = time.perf_counter()  # the workers load the compiled kernels on their first task
-        small = csplab.Problem.from_example(csplab.load_example("castle"), (20, 20, 10))
+        small = csplab.from_example(csplab.load_example("castle"), (20, 20, 10))
         csplab.solve(small, "blocks", rng=0, block=10, workers=2, scheduler=address)
         print(f"  (its workers warmed up in {time.perf_counter() - t:.2f} s)")
         runs.append(("waves, Dask 2 workers (running)", {"workers": 2, "scheduler": address}))
@@ -150,9 +150,7 @@ def main() -> None:
         # --- a large 2D output on the running Dask cluster (reported, no target)
         size3 = csplab.grids.parse_shape(args.size_dask)
         t = time.perf_counter()
-        P3 = csplab.Problem.from_example(
-            csplab.load_example(args.example2d), size3, boundary="auto"
-        )
+        P3 = csplab.from_example(csplab.load_example(args.example2d), size3, boundary="auto")
         tb = time.perf_counter() - t
         r3 = csplab.solve(P3, "blocks", rng=args.seed, block=args.block2d, workers=2,
                           scheduler=cluster.scheduler_address)  # fmt: skip

@@ -76,7 +76,7 @@ def main() -> None:
     print("-" * len(header))
     for name in names:
         E = csplab.load_example(name)
-        P = csplab.Problem.from_example(E, size, boundary=args.boundary)
+        P = csplab.from_example(E, size, boundary=args.boundary)
         times, solved_times = [], []
         for s in range(args.seeds):
             r = csplab.solve(P, "catalog", rng=s)
@@ -85,7 +85,7 @@ def main() -> None:
                 solved_times.append(r.time_s)
         ok = len(solved_times)
         med_solved = f"{statistics.median(solved_times):>9.3f}" if solved_times else f"{'-':>9}"
-        Pr = csplab.Problem.from_example(E, rsize, boundary=args.boundary)
+        Pr = csplab.from_example(E, rsize, boundary=args.boundary)
         tr, tf, same = [], [], True
         for s in range(args.ref_seeds):
             a = time.perf_counter()

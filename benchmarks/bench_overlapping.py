@@ -49,7 +49,7 @@ def main() -> None:
     ap.add_argument("--seconds", type=float, default=5.0)
     ap.add_argument("--sample", default=str(ROOT / "tests/io/data/sample.png"))
     a = ap.parse_args()
-    from csplab.io import load_model
+    from csplab.examples import load_model
 
     model = load_model(a.sample)
     print(f"{Path(a.sample).name}: overlapping model, K={model.K} patterns")  # type: ignore[union-attr]

@@ -37,6 +37,8 @@ import sys
 import time
 from pathlib import Path
 
+from csplab.grids import from_example
+
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -53,7 +55,7 @@ METHODS = {
 def _child(method: str, side: int, seed: int) -> None:
     """In a fresh process: warm up, build, solve, check; print one JSON line."""
     from csplab import Problem
-    from csplab.io import load_model
+    from csplab.examples import load_model
     from csplab.solvers import solve
 
     spec, solver, opts = METHODS[method]
@@ -62,7 +64,7 @@ def _child(method: str, side: int, seed: int) -> None:
     def problem(n: int) -> Problem:
         if hasattr(model, "problem"):  # a rule set (the overlapping model)
             return model.problem((n, n))
-        return Problem.from_example(model, (n, n))
+        return from_example(model, (n, n))
 
     from csplab.engine.alg31 import jit_warmup
 

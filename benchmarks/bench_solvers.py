@@ -112,14 +112,14 @@ def main() -> None:
     specs = [(s, o) for s, o in specs if s.split(":")[0] in installed]
 
     # warm every solver's compiled code on a tiny problem
-    tiny = csplab.Problem.from_example(box_town(1, rng=0), (3, 3, 3))
+    tiny = csplab.from_example(box_town(1, rng=0), (3, 3, 3))
     for spec, opts in specs:
         csplab.solve(tiny, spec, rng=0, **opts)
 
     head = (f"{'example':<12}{'K':>4}  {'solver':<28}{'solved':>7}{'encode':>8}{'load':>7}"
             f"{'solve':>8}{'total':>8}{'x catalog':>10}{'differ':>8}{'non-empty':>10}")  # fmt: skip
     for name, E in examples:
-        P = csplab.Problem.from_example(E, args.size, boundary=args.boundary)
+        P = csplab.from_example(E, args.size, boundary=args.boundary)
         common = int(np.argmax(E.counts()))
         print()
         print(head)

@@ -4,7 +4,7 @@ Quickstart
 ----------
 >>> import csplab
 >>> E = csplab.load_example("line")                      # thesis Fig. 3.1(c)
->>> P = csplab.Problem.from_example(E, (20, 10))
+>>> P = csplab.from_example(E, (20, 10))
 >>> r = csplab.solve(P, solver="catalog", rng=1)
 >>> r.status, P.is_solution(r.grid)
 ('solved', True)
@@ -16,6 +16,7 @@ from csplab.catalog import propagate, propagate_reference
 from csplab.errors import CsplabError
 from csplab.example import ExampleModel
 from csplab.examples import example_names, load_example
+from csplab.grids import from_example
 from csplab.problem import Problem, Violations
 from csplab.result import Result, Verdict
 from csplab.solvers import Solver, available_solvers, solve
@@ -33,6 +34,7 @@ __all__ = [
     "__version__",
     "available_solvers",
     "example_names",
+    "from_example",
     "load_example",
     "propagate",
     "propagate_reference",

@@ -30,9 +30,9 @@ benchmarks).
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
+>>> from csplab import ExampleModel, from_example
 >>> from csplab.engine.alg31 import run_alg31
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 3))
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 3))
 >>> run_alg31(P, np.random.default_rng(1)).status
 'solved'
 """

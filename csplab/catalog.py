@@ -17,9 +17,9 @@ codes (defined in :mod:`csplab._kernels`).
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
+>>> from csplab import ExampleModel, from_example
 >>> E = ExampleModel([[0, 1], [1, 0]])                  # checkerboard
->>> P = Problem.from_example(E, (3, 3))
+>>> P = from_example(E, (3, 3))
 >>> C = initial_catalog(P)
 >>> C, ok = assign(P, C, P.cell((0, 0)), 1)
 >>> ok
@@ -191,8 +191,8 @@ class Propagator:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([0, 1, 2]), (3,))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([0, 1, 2]), (3,))
     >>> eng = Propagator(P)
     >>> eng.catalog().astype(int).tolist()              # 1D: only the example itself
     [[1, 0, 0], [0, 1, 0], [0, 0, 1]]

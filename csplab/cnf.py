@@ -41,8 +41,8 @@ of clauses); clause ``i`` is ``lits[starts[i]:starts[i + 1]]``.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))   # checkerboard
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))           # checkerboard
 >>> enc = encode(P)
 >>> enc.nvars, enc.nclauses
 (8, 20)

@@ -47,8 +47,8 @@ becomes when the tileset's symmetry group turns it) and the identity for example
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 0, 1], [1, 0, 0], [0, 1, 0]]), (4, 4))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 0, 1], [1, 0, 0], [0, 1, 0]]), (4, 4))
 >>> P = P.with_constraints([Count([1], min=2, max=2)])
 >>> g = np.zeros((4, 4), dtype=int)
 >>> g[0, 0] = 1

@@ -31,10 +31,10 @@ Methods
 
 Examples
 --------
->>> from csplab import Problem, load_example
->>> int(count_solutions(Problem.from_example(load_example("fig3_1b"), (7, 9))))
+>>> from csplab import from_example, load_example
+>>> int(count_solutions(from_example(load_example("fig3_1b"), (7, 9))))
 2
->>> c = count_solutions(Problem.from_example(load_example("line"), (4, 4)))
+>>> c = count_solutions(from_example(load_example("line"), (4, 4)))
 >>> int(c), c.method, c.exact
 (4096, 'transfer', True)
 """
@@ -53,6 +53,7 @@ from numpy.typing import NDArray
 from csplab.catalog import Propagator
 from csplab.deps import available, require
 from csplab.errors import CsplabError, InputError
+from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.progress import progress_bar
 from csplab.rng import RngLike, make_rng
@@ -541,8 +542,8 @@ def entropy_per_cell(
     if not 1 <= L1 < L2:
         raise InputError("lengths must be two increasing positive integers")
     w = tuple(int(v) for v in width)
-    c1 = count_solutions(Problem.from_example(example, (*w, L1), periodic=periodic), method, **kw)
-    c2 = count_solutions(Problem.from_example(example, (*w, L2), periodic=periodic), method, **kw)
+    c1 = count_solutions(from_example(example, (*w, L1), periodic=periodic), method, **kw)
+    c2 = count_solutions(from_example(example, (*w, L2), periodic=periodic), method, **kw)
     cells = math.prod(w)
     if int(c1) == 0 or int(c2) == 0:
         rate = float("-inf")

@@ -22,13 +22,13 @@ consistency) is a polynomial over-approximation: ``C* <= C`` (Theorem 3.3.2), an
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
+>>> from csplab import ExampleModel, from_example
 >>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])           # parity
->>> P = Problem.from_example(E, (3, 3))
+>>> P = from_example(E, (3, 3))
 >>> X = exact_catalog(P)
 >>> bool(X.consistent), int(X.gap.sum())                     # 2x2 checkerboards only
 (True, 0)
->>> Q = Problem.from_example(E, (3, 3), fixed={(0, 0): 0, (2, 0): 1})
+>>> Q = from_example(E, (3, 3), fixed={(0, 0): 0, (2, 0): 1})
 >>> v = explain_unsat(Q)
 >>> v.holds, v.witness["unary"]
 (True, ['fixed cell (0, 0) = 0', 'fixed cell (2, 0) = 1'])
@@ -103,8 +103,8 @@ def is_consistent(problem: Problem, partial: ArrayLike | None = None,
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
     >>> is_consistent(P, [[0, -1, -1], [-1, -1, -1], [-1, -1, 1]])
     False
     """
@@ -225,8 +225,8 @@ def catalog_gap(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
     >>> catalog_gap(P, rng=1).holds                # the checkerboard never goes wrong
     True
     """
@@ -331,9 +331,9 @@ def explain_unsat(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
+    >>> from csplab import ExampleModel, from_example
     >>> E = ExampleModel([[1, 0, 0], [1, 0, 0], [1, 0, 0]])   # ground under empty space
-    >>> P = Problem.from_example(E, (4, 4), boundary={"y-": 1, "y+": 1},
+    >>> P = from_example(E, (4, 4), boundary={"y-": 1, "y+": 1},
     ...                          fixed={(2, 2): 0})
     >>> v = explain_unsat(P)
     >>> v.holds, v.witness["unary"]

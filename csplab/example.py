@@ -24,7 +24,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -234,7 +233,7 @@ class ExampleModel:
         if self.topology.startswith(("hex", "tri")):
             raise InputError(
                 f"{self.name or 'the example'} is on a {self.topology} grid: this tool works "
-                "on square grids (synthesis takes it: Problem.from_example, csplab synthesize)"
+                "on square grids (synthesis takes it: csplab.from_example, csplab synthesize)"
             )
         return pair_transitions(self.labels, self.K)
 
@@ -280,25 +279,6 @@ class ExampleModel:
         )
 
     __hash__ = None  # type: ignore[assignment]
-
-    # ------------------------------------------------------------------ files
-    @classmethod
-    def load(cls, path: str | Path) -> ExampleModel:
-        """Read an example model file; the format is detected from extension and content.
-
-        See :mod:`csplab.io` for the formats (Merrell's tiled-model text format, the csplab
-        grid text format, ``.npy``).
-        """
-        from csplab.io import read_example
-
-        return read_example(path)
-
-    def save(self, path: str | Path, format: str | None = None) -> None:
-        """Write the model; ``format`` is ``"merrell"``, ``"grid"`` or ``"npy"`` (default:
-        from the extension, ``.txt`` meaning Merrell's format)."""
-        from csplab.io import write_example
-
-        write_example(self, path, format=format)
 
     def _repr_png_(self) -> bytes:
         from csplab.render import render_png_bytes

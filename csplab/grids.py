@@ -1,10 +1,11 @@
 """Grid builders: the model-synthesis problem of an example model on a grid (Sec. 3.1).
 
-:func:`from_example` (also :meth:`Problem.from_example <csplab.problem.Problem.from_example>`)
-turns an example model E and an output size into a :class:`~csplab.problem.Problem`: one
-variable per cell, one relation per axis (E's transition matrices, Eq. 3.2), wrap-around
-arcs for periodic axes, and the unary restrictions (fixed cells, boundary labels, masks);
-:func:`grid` does the same from transition matrices. :func:`auto_boundary` finds E's ground
+:func:`from_example` (also ``csplab.from_example``) turns an example model E and an output
+size into a :class:`~csplab.problem.Problem`: one variable per cell, one relation per axis
+(E's transition matrices, Eq. 3.2), wrap-around arcs for periodic axes, and the unary
+restrictions (fixed cells, boundary labels, masks); :func:`grid` does the same from
+transition matrices; :func:`with_fixed` pre-assigns cells of a problem that has been built
+(a derived problem, as in :mod:`csplab.problem`). :func:`auto_boundary` finds E's ground
 and empty-space labels (Fig. 3.11); :func:`parse_shape` and :func:`parse_boundary` read
 ``40x40x10`` and ``z-=1,x-=0``.
 
@@ -41,6 +42,7 @@ __all__ = [
     "merrell_boundary",
     "parse_boundary",
     "parse_shape",
+    "with_fixed",
 ]
 
 
@@ -477,6 +479,30 @@ def build_unary(
     return out
 
 
+def with_fixed(problem: Problem, fixed: ArrayLike | Mapping[Sequence[int], int]) -> Problem:
+    """A copy of ``problem`` with some cells pre-assigned, recorded as unary restrictions.
+
+    Parameters
+    ----------
+    problem : Problem
+    fixed : int array with -1 for free cells, or mapping ``{coords: label}``
+        The same forms as ``fixed`` of :func:`from_example`.
+
+    Returns
+    -------
+    Problem
+        ``problem`` with its domains intersected (``problem.with_unary``).
+
+    Examples
+    --------
+    >>> from csplab.example import ExampleModel
+    >>> P = with_fixed(from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3)), {(0, 0): 1})
+    >>> P.fixed_grid[0].tolist()
+    [1, -1, -1]
+    """
+    return problem.with_unary(build_unary(problem.shape, problem.K, fixed=fixed))
+
+
 def _check_label(b: Any, K: int, what: str) -> int:
     try:
         lb = int(b)
@@ -488,7 +514,7 @@ def _check_label(b: Any, K: int, what: str) -> int:
 
 
 def auto_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, int]:
-    """The ``boundary="auto"`` labelling for an example (see :meth:`Problem.from_example`).
+    """The ``boundary="auto"`` labelling for an example (see :func:`~csplab.grids.from_example`).
 
     Returns a mapping face -> label. Raises :class:`~csplab.errors.InputError` when the
     example has no empty-space label (one that tiles itself along every axis) or, for 2D and

@@ -10,14 +10,16 @@ are domain restrictions, remembered one by one in :attr:`Problem.unary` so that 
 tools can explain which of them make a problem unsatisfiable.
 
 :meth:`Problem.violations` is the one solver-independent checker used by every solver and
-test.
+test. Problems on grids are built by :mod:`csplab.grids` (``from_example``, ``grid``,
+``with_fixed``), which sits above this module: a problem knows nothing of examples or files.
 
 Examples
 --------
 >>> import numpy as np
 >>> from csplab.example import ExampleModel
+>>> from csplab.grids import from_example
 >>> E1 = ExampleModel([[0, 1], [1, 0]])                  # checkerboard
->>> P = Problem.from_example(E1, (3, 3))
+>>> P = from_example(E1, (3, 3))
 >>> P.n, P.K, len(P.arcs)
 (9, 2, 12)
 >>> P.is_solution(np.array([[0, 1, 0], [1, 0, 1], [0, 1, 0]]))
@@ -42,7 +44,6 @@ from csplab.errors import InputError, MemoryLimitError
 
 if TYPE_CHECKING:
     from csplab.constraints import Constraint
-    from csplab.example import ExampleModel
 
 __all__ = [
     "AXIS_NAMES",
@@ -361,25 +362,6 @@ class Problem:
         for i in np.flatnonzero(a[:, 1] == cell):
             yield int(a[i, 0]), int(a[i, 2]), False
 
-    # ------------------------------------------------------------------ building
-    @classmethod
-    def grid(cls, shape: Sequence[int] | str, transitions: ArrayLike, **options: Any) -> Problem:
-        """A grid problem from per-axis transition matrices (:func:`csplab.grids.grid`)."""
-        from csplab.grids import grid
-
-        return grid(shape, transitions, **options)
-
-    @classmethod
-    def from_example(
-        cls, example: ExampleModel, shape: Sequence[int] | str, **options: Any
-    ) -> Problem:
-        """The model-synthesis problem for an example model and an output size
-        (:func:`csplab.grids.from_example`: ``periodic``, ``fixed``, ``boundary``,
-        ``mask``)."""
-        from csplab.grids import from_example
-
-        return from_example(example, shape, **options)
-
     # ------------------------------------------------------------------ derived problems
     def restrict(
         self, allowed: ArrayLike, *, kind: UnaryKind = "domain", key: Any = None
@@ -391,12 +373,6 @@ class Problem:
         cells = np.flatnonzero(~al.all(axis=1)).astype(np.int64)
         u = Unary(kind, key, cells, al[cells].copy())
         return self.with_unary([u])
-
-    def with_fixed(self, fixed: ArrayLike | Mapping[Sequence[int], int]) -> Problem:
-        """A copy with some cells pre-assigned (same forms as in :meth:`from_example`)."""
-        from csplab.grids import build_unary
-
-        return self.with_unary(build_unary(self.shape, self.K, fixed=fixed))
 
     def _replace(self, **changes: Any) -> Problem:
         """A new problem with the given constructor arguments changed (the one way every

@@ -23,10 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
-from csplab import ExampleModel, Problem, example_names, load_example
+from csplab import ExampleModel, example_names, load_example
 from csplab.complexity.grammar import RegularGrammar, abc_example, abc_rows_ok
 from csplab.count import count_solutions, entropy_per_cell, lower_bound_3_2_1
 from csplab.engine.sat import enumerate_solutions
+from csplab.grids import from_example
 
 OUT = Path(__file__).resolve().parent / "results" / "issue5"
 
@@ -36,23 +37,23 @@ def main() -> None:
     res: dict[str, object] = {}
     sizes = [(1, 1), (2, 3), (5, 5), (8, 13), (16, 9), (30, 30)]
     res["D_E0"] = {
-        f"{a}x{b}": int(count_solutions(Problem.from_example(load_example("fig3_1a"), (a, b))))
+        f"{a}x{b}": int(count_solutions(from_example(load_example("fig3_1a"), (a, b))))
         for a, b in sizes
     }
     res["D_E1"] = {
-        f"{a}x{b}": int(count_solutions(Problem.from_example(load_example("fig3_1b"), (a, b))))
+        f"{a}x{b}": int(count_solutions(from_example(load_example("fig3_1b"), (a, b))))
         for a, b in sizes
     }
     E3 = load_example("fig3_1d")
     res["D_E3"] = {
-        f"{a}x{b}": int(count_solutions(Problem.from_example(E3, (a, b))))
+        f"{a}x{b}": int(count_solutions(from_example(E3, (a, b))))
         for a, b in [(3, 3), (2, 3), (4, 3), (3, 4), (5, 5), (10, 10)]
     }
     E = load_example("line")
     rows = []
     for shape in [(3, 2), (6, 4), (9, 6), (12, 8), (6, 30), (12, 40)]:
         t0 = time.perf_counter()
-        c = count_solutions(Problem.from_example(E, shape))
+        c = count_solutions(from_example(E, shape))
         lo = lower_bound_3_2_1(E, shape)
         rows.append({
             "size": f"{shape[0]}x{shape[1]}",
@@ -76,7 +77,7 @@ def main() -> None:
     if importlib.util.find_spec("pyganak") is not None:
         cmp = []
         for shape in [(6, 6), (8, 8), (10, 10)]:
-            P = Problem.from_example(E, shape)
+            P = from_example(E, shape)
             a = count_solutions(P, "transfer")
             b = count_solutions(P, "ganak")
             cmp.append({"size": f"{shape[0]}x{shape[1]}", "equal": int(a) == int(b),
@@ -85,7 +86,7 @@ def main() -> None:
     abc = []
     faces = {f: 0 for f in ("x-", "x+", "y-", "y+")}
     for shape in [(5, 5), (8, 7), (9, 9), (11, 9), (12, 11)]:
-        P = Problem.from_example(abc_example(), shape, boundary=faces)
+        P = from_example(abc_example(), shape, boundary=faces)
         n, iset = 0, set()
         for g in enumerate_solutions(P):
             iset.update(abc_rows_ok(g))
@@ -100,15 +101,14 @@ def main() -> None:
         G = RegularGrammar.from_example(E1)
         counts = G.count(12)
         same_counts = all(
-            counts[n] == int(count_solutions(Problem.from_example(E1, (n,)))) for n in range(1, 13)
+            counts[n] == int(count_solutions(from_example(E1, (n,)))) for n in range(1, 13)
         )
         checked_sets = 0
         same_sets = True
         for n in range(1, 13):
             if counts[n] <= 5000:
                 sols = {
-                    tuple(int(v) for v in g)
-                    for g in enumerate_solutions(Problem.from_example(E1, (n,)))
+                    tuple(int(v) for v in g) for g in enumerate_solutions(from_example(E1, (n,)))
                 }
                 same_sets &= sols == G.generate(n)[n]
                 checked_sets += 1

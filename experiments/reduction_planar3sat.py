@@ -25,8 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from csplab.complexity.draw import save_reduction_png
-from csplab.complexity.gadgets import label_sheet
+from csplab.complexity.draw import label_sheet, save_reduction_png
 from csplab.complexity.planar3sat import random_planar3sat
 from csplab.complexity.reduction import reduce_planar3sat, verify_instance
 
@@ -97,7 +96,7 @@ def main() -> None:
     red = reduce_planar3sat(f)
     save_reduction_png(red.fixed, OUT / "fig3_7c.png", 10)
     save_reduction_png(red.encode(f.models()[0]), OUT / "fig3_7d.png", 10)  # type: ignore[arg-type]
-    label_sheet().save(OUT / "gadget_labels.png")  # type: ignore[attr-defined]
+    label_sheet().save(OUT / "gadget_labels.png")
     summary["pictures"] = {
         "formula": str(f),
         "M_t": "experiments/results/issue5/fig3_7c.png",

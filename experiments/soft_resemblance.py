@@ -21,9 +21,10 @@ from pathlib import Path
 import numpy as np
 
 import csplab
-from csplab import Problem, load_example
+from csplab import load_example
 from csplab.experiments.base import background_labels
 from csplab.experiments.measures import pattern_distance
+from csplab.grids import from_example
 from csplab.soft import Energy, HeightField, Region
 
 
@@ -32,7 +33,7 @@ def resemblance(seeds: int) -> list[str]:
             "|---|---|---|---|---|---|---|"]  # fmt: skip
     for ex in ("loops", "fig3_10", "fig3_6a", "fig3_4a", "line"):
         E = load_example(ex)
-        P = Problem.from_example(E, (32, 32))
+        P = from_example(E, (32, 32))
         for solver, choice, kw in [
             ("catalog", "uniform", {"restarts": 20}),
             ("catalog", "weighted", {"restarts": 20}),
@@ -59,13 +60,13 @@ def soft(seeds: int) -> list[str]:
     rows = ["| model | energy | Metropolis | energy after each sweep (mean over seeds) | "
             "rejected | mean s |", "|---|---|---|---|---|---|"]  # fmt: skip
     loops = load_example("loops")
-    P = Problem.from_example(loops, (32, 32))
+    P = from_example(loops, (32, 32))
     yy, xx = np.mgrid[0:32, 0:32]
     r = np.hypot(xx - 15.5, yy - 15.5)
     paths = [b for b in range(loops.K) if loops.names[b] != "empty"]
     ring = Energy([Region((r > 6) & (r < 13), paths, outside=True)])
     city = load_example("city")
-    Q = Problem.from_example(city, (24, 24, 8), boundary="auto")
+    Q = from_example(city, (24, 24, 8), boundary="auto")
     yy, xx = np.mgrid[0:24, 0:24]
     dome = np.clip(7 - 0.5 * np.hypot(xx - 11.5, yy - 11.5), 1, 7)
     hf = Energy([HeightField(dome, empty=background_labels(city)[:1])])

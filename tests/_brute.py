@@ -5,8 +5,8 @@ The exhaustive searches themselves live in the package (``csplab.analysis``,
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
 >>> len(solutions(P))
 2
 """

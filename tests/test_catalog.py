@@ -3,7 +3,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel
 from csplab.catalog import (
     Propagator,
     assign,
@@ -13,6 +13,7 @@ from csplab.catalog import (
     propagate_reference,
     unpack,
 )
+from csplab.grids import from_example
 from csplab.testing.brute import exact_catalog
 from csplab.testing.strategies import example_models, problems, random_problems
 
@@ -48,7 +49,7 @@ def test_kernel_reference_on_example_problems(P, seed):
 
 def test_propagate_does_not_mutate_and_changed_subset_matches_full():
     E = ExampleModel([[0, 0, 0, 0], [0, 1, 2, 0], [0, 3, 4, 0], [0, 0, 0, 0]])
-    P = Problem.from_example(E, (6, 6))
+    P = from_example(E, (6, 6))
     C, ok = propagate(P, initial_catalog(P))
     assert ok
     before = C.copy()
@@ -87,7 +88,7 @@ def test_theorem_3_3_2_never_removes_a_label_of_some_solution(P, seed):
 @given(example_models(ndim=1, max_side=6, max_labels=5), st.integers(2, 7), st.integers(0, 2**31))
 def test_1d_catalog_equals_exact_catalog(E, n, seed):
     """Thesis remark after Theorem 3.3.5: in 1D, C = C*."""
-    P = Problem.from_example(E, (n,))
+    P = from_example(E, (n,))
     rng = np.random.default_rng(seed)
     partial = np.full(n, -1)
     eng = Propagator(P)
@@ -110,7 +111,7 @@ def test_1d_catalog_equals_exact_catalog(E, n, seed):
 
 def test_propagator_save_load_copy():
     E = ExampleModel([[0, 1], [1, 0]])
-    P = Problem.from_example(E, (3, 3))
+    P = from_example(E, (3, 3))
     eng = Propagator(P)
     st_ = eng.save()
     assert eng.assign(0, 0)
@@ -174,7 +175,7 @@ def test_arc_rows_by_counting_sort_equal_the_numpy_rows(monkeypatch, name, shape
     from csplab.catalog import _Compiled
     from csplab.examples import load_example
 
-    P = Problem.from_example(load_example(name), shape, **kw)
+    P = from_example(load_example(name), shape, **kw)
     got = []
     for engine in ("interp", "kernels"):
         monkeypatch.setattr(_interp, "ENGINE", engine)

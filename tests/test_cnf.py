@@ -5,10 +5,11 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel
 from csplab.catalog import propagate
 from csplab.cnf import AMO_ENCODINGS, amo_clauses, encode
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.testing.strategies import csp_problems
 
 pysat = pytest.importorskip("pysat")
@@ -88,7 +89,7 @@ def test_amo_templates_allow_exactly_the_single_labels(amo):
 
 
 def test_clause_layout_and_literals():
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
     enc = encode(P)
     assert enc.nclauses == enc.starts.size - 1 == len(enc.clauses())
     assert enc.stats["support_clauses"] == 16 and enc.stats["alo_clauses"] == 4
@@ -97,28 +98,29 @@ def test_clause_layout_and_literals():
     assert fwd.stats["support_clauses"] == 8
     d = encode(P, encoding="direct")
     assert all(len(c) == 2 for c in d.clauses()[: d.stats["conflict_clauses"]])
-    Q = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2), fixed={(0, 0): 1})
+    Q = from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2), fixed={(0, 0): 1})
     e = encode(Q)
     assert e.nx == 0 and e.literal(0, 1) is True and e.literal(0, 0) is False
 
 
 def test_wipe_out_gives_the_empty_clause():
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 0, (0, 1): 0})
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 0, (0, 1): 0})
     enc = encode(P)
     assert not enc.ok and enc.wiped >= 0
 
 
 def test_bad_arguments():
-    P = Problem.from_example(ExampleModel([0, 1]), (3,))
+    P = from_example(ExampleModel([0, 1]), (3,))
     for kw in ({"encoding": "log"}, {"supports": "sideways"}, {"amo": "magic"}):
         with pytest.raises(InputError):
             encode(P, **kw)
 
 
 def test_fixed_cell_that_forces_the_board_leaves_no_variables():
-    from csplab import ExampleModel, Problem
+    from csplab import ExampleModel
+    from csplab.grids import from_example
 
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 1})
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 1})
     enc = encode(P, amo="pairwise")
     assert enc.ok and enc.nx == 0 and enc.nclauses == 0  # one label forces the checkerboard
     assert P.is_solution(enc.const.reshape(P.shape))

@@ -28,6 +28,7 @@ from csplab.constraints import (
 )
 from csplab.engine.sat import enumerate_solutions
 from csplab.errors import FormatError
+from csplab.grids import from_example
 
 from .io._helpers import installed_solvers
 
@@ -60,7 +61,7 @@ def kinds(P: Problem) -> list:
 
 @pytest.mark.parametrize("i", range(9))
 def test_every_exact_solver_agrees_with_brute_force(i):
-    base = Problem.from_example(E2, (3, 4))
+    base = from_example(E2, (3, 4))
     con = kinds(base)[i]
     P = base.with_constraints([con])
     sols = brute(P)
@@ -78,7 +79,7 @@ def test_every_exact_solver_agrees_with_brute_force(i):
 
 
 def test_violations_catch_each_planted_breach():
-    P = Problem.from_example(E2, (4, 4))
+    P = from_example(E2, (4, 4))
     g = np.zeros((4, 4), dtype=np.int32)
     g[0, 0] = g[3, 3] = 1
     g[1, 0] = 1
@@ -101,7 +102,7 @@ def test_violations_catch_each_planted_breach():
 
 def test_propagators_are_sound_and_complete_on_assignments():
     """No solution loses a label to propagate_all; a breaking assignment is refuted."""
-    base = Problem.from_example(E3, (3, 3))
+    base = from_example(E3, (3, 3))
     rng = np.random.default_rng(0)
     for con in kinds(base)[:8]:
         if isinstance(con, MaxRun | Separation | Count | Connected):
@@ -148,7 +149,7 @@ def random_constraints(draw, P):
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_random_constraints_sat_and_backtrack_against_brute_force(data):
-    base = Problem.from_example(E3, (3, 3))
+    base = from_example(E3, (3, 3))
     entries = data.draw(random_constraints(base))
     P = base.with_constraints(parse_constraints(entries, base))
     sols = brute(P)
@@ -165,7 +166,7 @@ def test_random_constraints_sat_and_backtrack_against_brute_force(data):
 
 
 def test_file_round_trip_and_errors(tmp_path):
-    P = csplab.io.load_model(DATA / "pipes.xml").problem((6, 6))
+    P = csplab.examples.load_model(DATA / "pipes.xml").problem((6, 6))
     doc = {"constraints": [
         {"type": "count", "labels": ["cross"], "min": 0, "max": 2,
          "region": {"from": [0, 0], "to": [-1, 2]}},
@@ -207,7 +208,7 @@ def test_file_round_trip_and_errors(tmp_path):
 
 
 def test_incomplete_solvers_retry_or_report(tmp_path):
-    P = csplab.io.load_model(DATA / "pipes.xml").problem(
+    P = csplab.examples.load_model(DATA / "pipes.xml").problem(
         (10, 10), boundary={f: 0 for f in ("x-", "x+", "y-", "y+")}
     )
     Q = P.with_constraints(parse_constraints(
@@ -244,7 +245,7 @@ def test_cli_synthesize_and_check_honour_the_file(tmp_path, capsys, solver):
                         "--restarts", "20", "--out", out)  # fmt: skip
     assert code == 0, err
     g = np.load(out)
-    P = csplab.io.load_model(DATA / "pipes.xml").problem((24, 24))
+    P = csplab.examples.load_model(DATA / "pipes.xml").problem((24, 24))
     Q = P.with_constraints(read_constraints(cfile, P))
     assert not Q.violations(g)
     assert int(np.isin(g, [P.names.index("cross 0")]).sum()) <= 2
@@ -301,7 +302,7 @@ def test_debroglie_constraints_are_imported():
 def test_shared_edged_path_is_honoured(solver):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        rs = csplab.io.load_model(SHARED / "DeBroglie" / "edged_path_constraint.json")
+        rs = csplab.examples.load_model(SHARED / "DeBroglie" / "edged_path_constraint.json")
     P = rs.problem()
     assert [c.kind for c in P.constraints] == ["connected"]
     r = csplab.solve(P, solver, rng=1, restarts=20, time_limit=60)
@@ -322,14 +323,14 @@ def test_shared_edged_path_is_honoured(solver):
 
 def test_blocks_repairs_a_model_that_breaks_the_constraints():
     E = csplab.load_example("loops")
-    P = Problem.from_example(E, (16, 16))
+    P = from_example(E, (16, 16))
     paths = [b for b in range(E.K) if E.names[b] != "empty"]
     Q = P.with_constraints([Connected(paths), Count(paths, min=20, max=60)])
     r = csplab.solve(Q, "blocks", rng=1, block=6, sweeps=3)
     assert r.status == "solved" and not Q.violations(r.grid)
     assert r.stats["energies"][0] > 0 and r.stats["breaches"] == 0  # started broken
     for con, grid in [(Count([1], min=3), np.zeros((4, 4), dtype=np.int64))]:
-        R = Problem.from_example(E, (4, 4)).with_constraints([con])
+        R = from_example(E, (4, 4)).with_constraints([con])
         assert con.excess(R, grid.reshape(-1)) == 3
 
 

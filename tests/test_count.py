@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import assume, given, settings
 
-from csplab import ExampleModel, Problem, load_example
+from csplab import ExampleModel, load_example
 from csplab.count import (
     count_solutions,
     enclosed_sets,
@@ -16,6 +16,7 @@ from csplab.count import (
     lower_bound_3_2_1,
 )
 from csplab.errors import InputError
+from csplab.grids import from_example, with_fixed
 from csplab.testing import brute
 from csplab.testing.strategies import problems, random_problems
 
@@ -61,15 +62,15 @@ def test_ganak_equals_transfer(P):
 
 @pytest.mark.parametrize("shape", [(1, 1), (2, 7), (5, 5), (9, 4), (13, 6)])
 def test_d_e0_is_1_and_d_e1_is_2_at_every_size(shape):
-    assert int(count_solutions(Problem.from_example(load_example("fig3_1a"), shape))) == 1
-    assert int(count_solutions(Problem.from_example(load_example("fig3_1b"), shape))) == 2
+    assert int(count_solutions(from_example(load_example("fig3_1a"), shape))) == 1
+    assert int(count_solutions(from_example(load_example("fig3_1b"), shape))) == 2
 
 
 def test_d_e3_is_zero_above_its_own_size():
     E3 = load_example("fig3_1d")
-    assert int(count_solutions(Problem.from_example(E3, (3, 3)))) >= 1
+    assert int(count_solutions(from_example(E3, (3, 3)))) >= 1
     for shape in [(4, 3), (3, 4), (4, 4), (5, 5), (4, 1), (1, 4), (8, 2)]:
-        assert int(count_solutions(Problem.from_example(E3, shape))) == 0
+        assert int(count_solutions(from_example(E3, shape))) == 0
 
 
 @pytest.mark.parametrize("shape", [(3, 2), (6, 4), (7, 7), (9, 6), (12, 5), (20, 3)])
@@ -78,7 +79,7 @@ def test_theorem_3_2_1_and_3_2_2_bounds_on_line(shape):
     assert [h.extent for h in enclosed_sets(E)] == [(2, 1)]
     lo = lower_bound_3_2_1(E, shape)
     assert lo == 2 ** ((shape[0] // 3) * (shape[1] // 2))
-    c = count_solutions(Problem.from_example(E, shape))
+    c = count_solutions(from_example(E, shape))
     assert lo <= int(c) <= E.K ** math.prod(shape)
 
 
@@ -88,28 +89,28 @@ def test_no_enclosed_set_without_self_tiling_empty_space():
 
 
 def test_counts_are_python_ints_beyond_64_bits():
-    c = count_solutions(Problem.from_example(load_example("line"), (8, 30)))
+    c = count_solutions(from_example(load_example("line"), (8, 30)))
     assert int(c) > 2**64 and c.stats["exact_arithmetic"] == "object"
     # additivity check: fixing the first cell to each label partitions the solutions
-    P = Problem.from_example(load_example("line"), (8, 30))
-    parts = [int(count_solutions(P.with_fixed({(0, 0): b}))) for b in range(P.K)]
+    P = from_example(load_example("line"), (8, 30))
+    parts = [int(count_solutions(with_fixed(P, {(0, 0): b}))) for b in range(P.K)]
     assert sum(parts) == int(c)
 
 
 def test_enumerate_and_limits():
-    P = Problem.from_example(load_example("line"), (3, 3))
+    P = from_example(load_example("line"), (3, 3))
     assert int(count_solutions(P, "enumerate")) == brute.count(P)
     with pytest.raises(InputError, match="more than 10"):
         count_solutions(P, "enumerate", limit=10)
     with pytest.raises(InputError, match="too wide"):
-        count_solutions(Problem.from_example(load_example("line"), (12, 12)), "transfer",
+        count_solutions(from_example(load_example("line"), (12, 12)), "transfer",
                         max_states=10)  # fmt: skip
     with pytest.raises(InputError):
         count_solutions(P, "magic")
 
 
 def test_auto_falls_back_beyond_max_states():
-    P = Problem.from_example(load_example("line"), (6, 6))
+    P = from_example(load_example("line"), (6, 6))
     c = count_solutions(P, "auto", max_states=4)
     assert c.method in ("ganak", "enumerate") or c.method == "transfer"
     if HAS_GANAK:
@@ -119,7 +120,7 @@ def test_auto_falls_back_beyond_max_states():
 @pytest.mark.skipif(not HAS_AMC, reason="pyapproxmc not installed")
 def test_approxmc_within_its_tolerance_on_small_models():
     for name, shape in [("fig3_1b", (5, 5)), ("line", (4, 4)), ("line", (5, 4))]:
-        P = Problem.from_example(load_example(name), shape)
+        P = from_example(load_example(name), shape)
         exact = int(count_solutions(P))
         est = count_solutions(P, "approxmc", rng=1, epsilon=0.8, delta=0.2)
         assert not est.exact
@@ -127,7 +128,7 @@ def test_approxmc_within_its_tolerance_on_small_models():
 
 
 def test_frontier_order_picks_the_narrow_axis():
-    P = Problem.from_example(load_example("line"), (40, 3))
+    P = from_example(load_example("line"), (40, 3))
     order = frontier_order(P)
     assert P.coords(order[1]) == (0, 1)  # x outermost, the 3-cell axis scanned inside
 

@@ -3,8 +3,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, example_names, load_example
+from csplab import ExampleModel, example_names, grids, load_example
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.testing import brute
 from csplab.testing.strategies import csp_problems
 
@@ -45,11 +46,11 @@ def _first_gap(P, seeds=range(40), order="scanline"):
 
 
 def test_fallible_example_shows_c_differs_from_cstar():
-    small = Problem.from_example(FALLIBLE, (4, 4))  # 5445 solutions: brute force is quick
+    small = from_example(FALLIBLE, (4, 4))  # 5445 solutions: brute force is quick
     X = exact_catalog(small)
     assert X.consistent and X.gap.sum() == 9
     assert np.array_equal(X.exact, brute.exact_catalog(small))
-    P = Problem.from_example(FALLIBLE, (5, 5))
+    P = from_example(FALLIBLE, (5, 5))
     found = _first_gap(P)
     assert found is not None
     _s, v, X, c, b = found
@@ -65,7 +66,7 @@ def test_fig3_5_reproduction():
     from csplab.catalog import propagate
 
     E = load_example("fig3_5a")
-    P = Problem.from_example(E, (6, 4))
+    P = from_example(E, (6, 4))
     partial = np.full(P.shape, -1)
     partial[0, 0] = 2
     X = exact_catalog(P, partial)
@@ -78,21 +79,21 @@ def test_fig3_5_reproduction():
     dom[right] = np.eye(P.K, dtype=bool)[1]
     assert propagate(P, dom)[1] is False  # the catalog becomes empty
     # scanline runs never fail on it; in random order about 4% of 8x6 runs do
-    found = _first_gap(Problem.from_example(E, (8, 6)), range(200), order="random")
+    found = _first_gap(from_example(E, (8, 6)), range(200), order="random")
     assert found is not None
     _s, _v, X2, c, b = found
     assert X2.catalog[c, b] and not X2.exact[c, b]
 
 
 def test_catalog_gap_on_infallible_and_unsat_problems():
-    P = Problem.from_example(load_example("line"), (6, 6))
+    P = from_example(load_example("line"), (6, 6))
     v = catalog_gap(P, rng=3, sizes=True)
     assert v.holds is True and len(v.stats["per_step"]) == P.n
     assert all(row[3] == row[4] for row in v.stats["per_step"])  # C = C* (infallible)
-    odd = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)
+    odd = grids.grid((5,), [[[False, True], [True, False]]], periodic=True)
     w = catalog_gap(odd, rng=0)
     assert w.holds is False and "unsatisfiable" in w.message
-    ac = catalog_gap(Problem.from_example(load_example("fig3_1d"), (5, 5)), rng=0)
+    ac = catalog_gap(from_example(load_example("fig3_1d"), (5, 5)), rng=0)
     assert ac.holds is True and "arc consistency" in ac.message
 
 
@@ -113,19 +114,17 @@ def test_explanations_are_minimal_unsatisfiable_subsets(P):
 def test_explanation_names_the_conflicting_boundary_and_cells():
     E = ExampleModel([[1, 0, 0], [1, 0, 0], [1, 0, 0]])  # ground under empty space
     fixed = {(1, 1): 0, (2, 2): 0, (3, 3): 0}
-    P = Problem.from_example(E, (4, 4), boundary={"y-": 1, "y+": 1}, fixed=fixed)
+    P = from_example(E, (4, 4), boundary={"y-": 1, "y+": 1}, fixed=fixed)
     v = explain_unsat(P)
     assert v.witness["unary"] == ["boundary face y+ = 1 (4 cells)"]
-    Q = Problem.from_example(E, (4, 4), fixed={(0, 0): 0, (0, 1): 1, (3, 3): 0})
+    Q = from_example(E, (4, 4), fixed={(0, 0): 0, (0, 1): 1, (3, 3): 0})
     w = explain_unsat(Q)
     assert sorted(w.witness["unary"]) == ["fixed cell (0, 1) = 1"]
-    assert (
-        explain_unsat(Problem.from_example(load_example("fig3_1d"), (5, 5))).witness["core"] == []
-    )
+    assert explain_unsat(from_example(load_example("fig3_1d"), (5, 5))).witness["core"] == []
 
 
 def test_time_limits_and_bad_partials():
-    P = Problem.from_example(FALLIBLE, (30, 30))
+    P = from_example(FALLIBLE, (30, 30))
     X = exact_catalog(P, time_limit=0.05)
     assert not X.complete and X.undecided is not None
     assert not (X.exact & X.undecided).any()

@@ -71,7 +71,7 @@ def test_hash_and_equality():
 def test_sparse_labels_are_compacted_and_synthesize_fast():
     import time
 
-    from csplab import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
     t = time.perf_counter()
@@ -79,7 +79,7 @@ def test_sparse_labels_are_compacted_and_synthesize_fast():
     assert E.K == 2 and E.labels.tolist() == [[0, 1], [1, 0]]
     assert E.meta["label_ids"] == (0, 100000)
     assert E.file_labels().tolist() == [[0, 100000], [100000, 0]]
-    r = solve(Problem.from_example(E, (4, 4)), "catalog", rng=0)
+    r = solve(from_example(E, (4, 4)), "catalog", rng=0)
     assert r.ok and set(np.unique(r.grid).tolist()) == {0, 1}
     assert time.perf_counter() - t < 1.0
 
@@ -108,17 +108,17 @@ def test_labels_beyond_64_bits_are_one_line():
 
 @pytest.mark.parametrize("ext", [".txt", ".npy", ".grid"])
 def test_sparse_ids_round_trip_through_files(tmp_path, ext):
-    from csplab import Problem
-    from csplab.io import read_example, write_labels
+    from csplab.grids import from_example
+    from csplab.io import read_example, write_example, write_labels
     from csplab.solvers import solve
 
     E = ExampleModel(np.array([[0, 100000], [100000, 0]]).reshape(2, 2, 1))
     src = tmp_path / f"e{ext}"
-    E.save(src)
+    write_example(E, src)
     F = read_example(src)
     assert F.K == 2 and F.meta["label_ids"] == (0, 100000)
     assert F.file_labels().tolist() == E.file_labels().tolist()
-    r = solve(Problem.from_example(F, (3, 3, 1)), "catalog", rng=1)
+    r = solve(from_example(F, (3, 3, 1)), "catalog", rng=1)
     assert r.ok
     out = tmp_path / f"out{ext}"
     write_labels(r.grid, out, model=F)

@@ -6,9 +6,8 @@ import numpy as np
 import pytest
 
 import csplab
-from csplab import Problem
 from csplab.examples import EXAMPLES, build3d, load_example
-from csplab.grids import auto_boundary
+from csplab.grids import auto_boundary, from_example
 
 NAMES = list(build3d.EXAMPLES3D)
 SIZE = (40, 40, 10)
@@ -88,7 +87,7 @@ def test_label_counts():
 def test_example_is_a_solution_of_its_own_problem(name):
     E = load_example(name)
     for boundary in ("auto", None):
-        P = Problem.from_example(E, E.shape, boundary=boundary)
+        P = from_example(E, E.shape, boundary=boundary)
         assert P.is_solution(E.labels), (name, boundary)
 
 
@@ -98,7 +97,7 @@ def test_auto_boundary_is_ground_and_air(name):
     b = auto_boundary(E)
     assert b.pop("z-") == 1  # the ground label
     assert set(b.values()) == {0}  # air on the other five faces
-    P = Problem.from_example(E, SIZE, boundary="auto")
+    P = from_example(E, SIZE, boundary="auto")
     assert P.shape == SIZE and P.K == E.K
 
 
@@ -139,7 +138,7 @@ def test_headers_record_the_measurement():
 
 @pytest.mark.parametrize("boundary", ["auto", None])
 def test_city_alg31_solves_40x40x10(boundary):
-    P = Problem.from_example(load_example("city"), SIZE, boundary=boundary)
+    P = from_example(load_example("city"), SIZE, boundary=boundary)
     for seed in range(3):
         r = csplab.solve(P, "catalog", rng=seed)
         assert r.status == "solved", (boundary, seed, r.stats)
@@ -147,13 +146,13 @@ def test_city_alg31_solves_40x40x10(boundary):
 
 
 def test_castle_alg31_fails_often():
-    P = Problem.from_example(load_example("castle"), SIZE, boundary="auto")
+    P = from_example(load_example("castle"), SIZE, boundary="auto")
     failed = sum(csplab.solve(P, "catalog", rng=s).status == "failed" for s in range(10))
     assert failed >= 8
 
 
 def test_castle_blocks_solver_solves_40x40x10():
-    P = Problem.from_example(load_example("castle"), SIZE, boundary="auto")
+    P = from_example(load_example("castle"), SIZE, boundary="auto")
     r = csplab.solve(P, "blocks", rng=0, block=10)
     assert r.status == "solved" and r.stats["final_violations"] == 0
     assert P.is_solution(r.grid)

@@ -16,6 +16,7 @@ from csplab import Problem, solve
 from csplab.analysis import alg31_exhaustive, alg36_failure, corner_condition, prove_infallible
 from csplab.catalog import Propagator
 from csplab.examples import load_example
+from csplab.grids import from_example
 from tests._brute import assign_all, catalogs, satisfiable, solutions
 
 FIG = "scan:yx"  # the thesis' 2D figures: left to right, then bottom to top
@@ -37,7 +38,7 @@ def window_proof(name: str, region: tuple[int, int]) -> bool | None:
 
 
 def problem(name: str, shape: tuple[int, ...], **kw: object) -> Problem:
-    return Problem.from_example(load_example(name), shape, **kw)  # type: ignore[arg-type]
+    return from_example(load_example(name), shape, **kw)  # type: ignore[arg-type]
 
 
 def successors(T: np.ndarray, axis: int, b: int) -> set[int]:
@@ -326,7 +327,7 @@ def test_pillar_columns_cannot_levitate():
     assert E.ndim == 3 and E.K == 4
     assert not T[2, 0, 1:].any()  # empty space is never below a piece
     assert not T[2, :, 1].any()  # nothing is ever below a base
-    P = Problem.from_example(E, (8, 8, 6))
+    P = from_example(E, (8, 8, 6))
     pillars = 0
     for seed in range(5):
         r = solve(P, "catalog", rng=seed)

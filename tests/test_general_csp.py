@@ -6,7 +6,8 @@ only with ``Problem.violations``."""
 import numpy as np
 import pytest
 
-from csplab import ExampleModel, Problem, load_example, solve
+from csplab import ExampleModel, load_example, solve
+from csplab.grids import from_example
 
 pytest.importorskip("pysat")
 
@@ -39,7 +40,7 @@ def solved(P, solver, seeds=range(30)):
 def test_diagonal_neighbours_are_one_more_relation(solver):
     """Sec. 3.5.1: diagonal neighbours = a transition matrix between more pairs of points."""
     E = load_example("fig3_4a")
-    P = Problem.from_example(E, (9, 8))
+    P = from_example(E, (9, 8))
     T = np.zeros((E.K, E.K), dtype=bool)
     for a, b in pairs(E.labels, 0, (1, 1)):
         T[a, b] = True
@@ -55,7 +56,7 @@ def test_diagonal_neighbours_are_one_more_relation(solver):
 def test_cylinder_wraps_around(solver):
     """Sec. 3.5.1: a cylinder is the grid plus arcs from the last column to the first."""
     E = load_example("line")
-    P = Problem.from_example(E, (7, 6), periodic=(True, False))
+    P = from_example(E, (7, 6), periodic=(True, False))
     g = solved(P, solver)
     wrapped = np.concatenate([g, g[:1]], axis=0)  # column 0 again after the last one
     assert pairs(wrapped, 0) <= pairs(E.labels, 0) and pairs(g, 1) <= pairs(E.labels, 1)
@@ -68,7 +69,7 @@ def test_mirror_symmetry_pairs(solver):
     E = load_example("fig3_4a")
     T = E.transitions()
     assert (T[0] == T[0].T).all()
-    P = Problem.from_example(E, (10, 9))
+    P = from_example(E, (10, 9))
     idx = np.arange(P.n).reshape(P.shape)
     half = P.shape[0] // 2
     P2 = P.add_arcs(np.eye(E.K, dtype=bool), idx[:half], idx[::-1][:half], name="mirror")
@@ -89,7 +90,7 @@ def test_shape_mask(solver):
     mask = np.ones((*shape, E.K), dtype=bool)
     mask[~disk, 1:] = False  # outside: only empty space (label 0)
     mask[disk & (y == 8) & (abs(x - 7.5) < 4), 0] = False  # inside: a line is forced
-    P = Problem.from_example(E, shape, mask=mask)
+    P = from_example(E, shape, mask=mask)
     g = solved(P, solver)
     assert (g[~disk] == 0).all() and (g[disk & (y == 8) & (abs(x - 7.5) < 4)] != 0).all()
     assert pairs(g, 0) <= pairs(E.labels, 0) and pairs(g, 1) <= pairs(E.labels, 1)
@@ -109,7 +110,7 @@ def rolling_ball() -> ExampleModel:
 @pytest.mark.parametrize("solver", ["catalog", "sat"])
 def test_4d_time_varying_model(solver):
     E = rolling_ball()
-    P = Problem.from_example(E, (8, 3, 2, 7), fixed={(2, 1, 1, 0): 1})
+    P = from_example(E, (8, 3, 2, 7), fixed={(2, 1, 1, 0): 1})
     g = solved(P, solver)
     for d in range(4):
         assert pairs(g, d) <= pairs(E.labels, d)

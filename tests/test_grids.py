@@ -10,8 +10,7 @@ import pytest
 
 from csplab.example import ExampleModel
 from csplab.examples import load_example
-from csplab.grids import auto_boundary, merrell_boundary
-from csplab.problem import Problem
+from csplab.grids import auto_boundary, from_example, merrell_boundary
 from csplab.solvers import solve
 
 
@@ -25,7 +24,7 @@ def _layered(nx: int = 3, layers: tuple[int, ...] = (1, 2, 0, 0)) -> ExampleMode
 def test_auto_falls_back_to_merrell_when_the_auto_rule_has_no_solution() -> None:
     E = _layered()
     assert auto_boundary(E) == {"x-": 0, "x+": 0, "y-": 0, "y+": 0, "z+": 0, "z-": 1}
-    P = Problem.from_example(E, (5, 5, 4), boundary="auto")
+    P = from_example(E, (5, 5, 4), boundary="auto")
     assert P.meta["boundary"] == {"z-": 1, "z+": 0} == merrell_boundary(E)
     assert P.meta["boundary_rule"].startswith("merrell: z-=1, z+=0, sides free")
     r = solve(P, "backtrack", rng=0)
@@ -33,21 +32,20 @@ def test_auto_falls_back_to_merrell_when_the_auto_rule_has_no_solution() -> None
     assert (r.grid[:, :, 1] == 2).all()
     # the auto rule itself really has no solution there
     assert (
-        solve(Problem.from_example(E, (5, 5, 4), boundary=auto_boundary(E)), "backtrack").status
-        == "unsat"
+        solve(from_example(E, (5, 5, 4), boundary=auto_boundary(E)), "backtrack").status == "unsat"
     )
 
 
 def test_auto_falls_back_when_the_example_has_no_empty_space_label() -> None:
     E = _layered(layers=(1, 2, 0))  # nothing tiles itself vertically; top layer 0
-    P = Problem.from_example(E, (4, 4, 3), boundary="auto")
+    P = from_example(E, (4, 4, 3), boundary="auto")
     assert P.meta["boundary_rule"].startswith("merrell: z-=1, z+=0")
     assert solve(P, "catalog", rng=1).status == "solved"
 
 
 def test_auto_keeps_the_current_rule_when_it_works() -> None:
     E = _layered(layers=(1, 0, 0))  # empty space right on the ground
-    P = Problem.from_example(E, (5, 5, 4), boundary="auto")
+    P = from_example(E, (5, 5, 4), boundary="auto")
     assert P.meta["boundary"] == auto_boundary(E)
     assert P.meta["boundary_rule"] == "auto: ground z-=1, empty space 0 on every other face"
 
@@ -55,16 +53,16 @@ def test_auto_keeps_the_current_rule_when_it_works() -> None:
 @pytest.mark.parametrize("name", ["city", "castle", "canal"])
 def test_builtin_3d_examples_keep_the_auto_rule(name: str) -> None:
     E = load_example(name)
-    P = Problem.from_example(E, (10, 10, 6), boundary="auto")
+    P = from_example(E, (10, 10, 6), boundary="auto")
     assert P.meta["boundary"] == {"x-": 0, "x+": 0, "y-": 0, "y+": 0, "z+": 0, "z-": 1}
     assert P.meta["boundary_rule"].startswith("auto: ")
-    explicit = Problem.from_example(E, (10, 10, 6), boundary=auto_boundary(E, 3))
+    explicit = from_example(E, (10, 10, 6), boundary=auto_boundary(E, 3))
     assert np.array_equal(P.domains, explicit.domains)
 
 
 def test_2d_auto_is_unchanged() -> None:
     E = ExampleModel([[1, 0, 0], [1, 0, 0], [1, 0, 0]])
-    P = Problem.from_example(E, (4, 4), boundary="auto")
+    P = from_example(E, (4, 4), boundary="auto")
     assert P.meta["boundary"] == auto_boundary(E)
     assert P.meta["boundary_rule"].startswith("auto: ground y-=1")
 
@@ -83,7 +81,7 @@ def test_merrell_models_are_satisfiable_with_auto(path: Path) -> None:
     E = read_model(path)
     if not isinstance(E, ExampleModel) or E.ndim != 3:
         pytest.skip("not a 3D example model")
-    P = Problem.from_example(E, (6, 6, E.shape[2]), boundary="auto")
+    P = from_example(E, (6, 6, E.shape[2]), boundary="auto")
     assert solve(P, "backtrack", rng=0, time_limit=30).status == "solved"
 
 
@@ -104,11 +102,11 @@ def test_synthesize_says_which_boundary_rule_it_used(
 def test_auto_never_makes_the_problem_unsat() -> None:
     E = _layered()  # ground 1, floor 2, then empty space 0
     # nz = 2: Merrell's top label 0 cannot sit on the ground; the ground alone can
-    P = Problem.from_example(E, (4, 4, 2), boundary="auto")
+    P = from_example(E, (4, 4, 2), boundary="auto")
     assert P.meta["boundary"] == {"z-": 1}
     assert P.meta["boundary_rule"].startswith("merrell, bottom only: z-=1")
     assert solve(P, "backtrack", rng=0).status == "solved"
     # nz = 1: the bottom face holds every cell, the ground tiles sideways: auto works
-    P1 = Problem.from_example(E, (3, 3, 1), boundary="auto")
+    P1 = from_example(E, (3, 3, 1), boundary="auto")
     assert P1.meta["boundary_rule"].startswith("auto: ground z-=1")
     assert solve(P1, "backtrack", rng=0).status == "solved"

@@ -12,6 +12,7 @@ import pytest
 from csplab import ExampleModel, Problem, _interp, _jit, load_example
 from csplab.catalog import Propagator, unpack
 from csplab.engine.alg31 import run_alg31
+from csplab.grids import from_example
 
 ORDERS = ["scanline", "random", "min-entropy", "min-domain", "scan:yx"]
 CHOICES = ["uniform", "weighted"]
@@ -56,7 +57,7 @@ def test_alg31_same_as_kernels_on_random_examples(engine, order, choice):
         shape = (int(rng.integers(4, 14)), int(rng.integers(4, 14)))
 
         def build(E=E, w=w, shape=shape):
-            P = Problem.from_example(E, shape)
+            P = from_example(E, shape)
             return Problem(P.shape, P.domains, P.relations, P.arcs, weights=w)
 
         a, b = _both(engine, build, trial, order=order, choice=choice)
@@ -78,7 +79,7 @@ def test_alg31_same_as_kernels_on_builtins(engine, name, shape, kw):
     E = load_example(name)
     for order in ("scanline", "min-entropy"):
         for seed in range(3):
-            a, b = _both(engine, lambda: Problem.from_example(E, shape, **kw), seed,
+            a, b = _both(engine, lambda: from_example(E, shape, **kw), seed,
                          order=order, choice="weighted")  # fmt: skip
             _same(a, b)
 
@@ -86,7 +87,7 @@ def test_alg31_same_as_kernels_on_builtins(engine, name, shape, kw):
 def test_propagate_same_as_kernels_on_random_catalogs(engine):
     rng = np.random.default_rng(3)
     E = load_example("fig3_10")
-    P = Problem.from_example(E, (9, 11))
+    P = from_example(E, (9, 11))
     wipes = 0
     C0 = Propagator(P).catalog()
     for _ in range(40):
@@ -137,7 +138,7 @@ def test_auto_rule(monkeypatch):
 def test_interpreted_work_is_counted(monkeypatch):
     monkeypatch.setattr(_interp, "ENGINE", "interp")
     monkeypatch.setattr(_interp, "_SPENT", [0.0])
-    P = Problem.from_example(load_example("fig3_10"), (16, 16))
+    P = from_example(load_example("fig3_10"), (16, 16))
     run_alg31(P, np.random.default_rng(0))
     assert _interp._SPENT[0] > 0
 
@@ -178,7 +179,7 @@ def test_lazy_njit_materializes_a_module_at_first_call(tmp_path, monkeypatch):
 def test_import_and_small_solve_do_not_load_numba():
     code = (
         "import sys, numpy as np, csplab\n"
-        "P = csplab.Problem.from_example(csplab.load_example('fig3_10'), (20, 20))\n"
+        "P = csplab.from_example(csplab.load_example('fig3_10'), (20, 20))\n"
         "r = csplab.solve(P, 'catalog', rng=1)\n"
         "print(r.status, 'numba' in sys.modules)\n"
     )

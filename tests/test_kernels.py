@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 import csplab
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel, grids
 from csplab import _kernels as kern
 from csplab.catalog import Code, Propagator, Run, Search
 from csplab.engine.alg31 import run_alg31
+from csplab.grids import from_example
 from csplab.testing.synthetic import box_town
 
 PKG = Path(csplab.__file__).resolve().parent
@@ -170,7 +171,7 @@ def test_codes_are_distinct_and_match_the_kernel_constants():
 
 
 def _fallible():
-    return Problem.from_example(ExampleModel([[0, 0, 0, 2], [2, 0, 0, 1], [0, 1, 2, 1]]), (8, 8))
+    return from_example(ExampleModel([[0, 0, 0, 2], [2, 0, 0, 1], [0, 1, 2, 1]]), (8, 8))
 
 
 def _manual_run(P, seed, max_steps):
@@ -209,7 +210,7 @@ def test_alg31_in_chunks_equals_one_run(seed):
 
 
 def test_alg31_time_limit_chunks_do_not_change_the_grid():
-    P = Problem.from_example(box_town(1, rng=0), (20, 20, 12), boundary="auto")  # > 4096 cells
+    P = from_example(box_town(1, rng=0), (20, 20, 12), boundary="auto")  # > 4096 cells
     for order in ("scanline", "min-entropy"):
         a = run_alg31(P, np.random.default_rng(3), order=order)
         b = run_alg31(P, np.random.default_rng(3), order=order, time_limit=1e6)
@@ -218,7 +219,7 @@ def test_alg31_time_limit_chunks_do_not_change_the_grid():
 
 
 def test_mac_search_codes_restart_and_resume():
-    odd = Problem.grid((7,), [[[False, True], [True, False]]], periodic=True)
+    odd = grids.grid((7,), [[[False, True], [True, False]]], periodic=True)
     eng = Propagator(odd)
     root = eng.catalog()
     se = Search.new(odd.n, eng.c.W, seed=5)
@@ -248,7 +249,7 @@ def test_mac_search_codes_restart_and_resume():
 
 
 def test_trail_growth_code():
-    P = Problem.from_example(box_town(1, rng=0), (12, 12, 6), boundary="auto")
+    P = from_example(box_town(1, rng=0), (12, 12, 6), boundary="auto")
     eng = Propagator(P)
     se = Search.new(P.n, eng.c.W, seed=2)
     se = se._replace(tcell=se.tcell[: P.n + 1], tbits=se.tbits[: P.n + 1])  # nearly full

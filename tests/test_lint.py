@@ -64,3 +64,20 @@ def _private_imports():
 
 def test_no_module_imports_another_packages_private_names():
     assert _private_imports() == []
+
+
+def test_the_core_keeps_its_own_order():
+    """The core's layers contract (enforced by ``lint-imports`` above) stays in the config,
+    without ignored imports: examples over file formats over the grid builder over the data
+    types, type-only imports excluded."""
+    import tomllib
+
+    text = (ROOT / "pyproject.toml").read_text(encoding="utf-8")
+    cfg = tomllib.loads(text)["tool"]["importlinter"]
+    assert cfg.get("exclude_type_checking_imports") is True
+    (core,) = [
+        c for c in cfg["contracts"] if c["type"] == "layers" and c["layers"][0] == "csplab.examples"
+    ]
+    names = ("csplab.examples", "csplab.io", "csplab.grids", "csplab.catalog", "csplab.problem")
+    order = [core["layers"].index(m) for m in (*names, "csplab.errors")]
+    assert order == sorted(order) and "ignore_imports" not in core

@@ -21,7 +21,7 @@ def png(obj):
 def test_example_and_result_pictures():
     E = csplab.load_example("line")
     assert png(E).size[0] > 0
-    r = csplab.solve(csplab.Problem.from_example(E, (10, 6)), "catalog", rng=1)
+    r = csplab.solve(csplab.from_example(E, (10, 6)), "catalog", rng=1)
     assert png(r).size[0] > 0
 
 

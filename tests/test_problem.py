@@ -6,24 +6,24 @@ from hypothesis import given
 
 from csplab import ExampleModel, Problem
 from csplab.errors import InputError
-from csplab.grids import auto_boundary, parse_shape
+from csplab.grids import auto_boundary, from_example, parse_shape
 from csplab.testing.strategies import problems
 
 
 def test_grid_arcs_count_and_order():
     E = ExampleModel(np.zeros((2, 2, 2), dtype=int))
-    P = Problem.from_example(E, (3, 4, 5))
+    P = from_example(E, (3, 4, 5))
     nx, ny, nz = 3, 4, 5
     assert len(P.arcs) == (nx - 1) * ny * nz + nx * (ny - 1) * nz + nx * ny * (nz - 1)
     # cell numbering is the thesis scan order: x outermost, z innermost
     assert P.cell((0, 0, 1)) == 1 and P.cell((0, 1, 0)) == nz and P.cell((1, 0, 0)) == ny * nz
-    Pp = Problem.from_example(E, (3, 4, 5), periodic=True)
+    Pp = from_example(E, (3, 4, 5), periodic=True)
     assert len(Pp.arcs) == 3 * nx * ny * nz
 
 
 def test_periodic_axis_of_length_one_is_a_unary_constraint():
     E = ExampleModel([[0, 1], [1, 1]])  # T_x(0,0) never happens
-    P = Problem.from_example(E, (1, 3), periodic=(True, False))
+    P = from_example(E, (1, 3), periodic=(True, False))
     assert not P.domains[:, 0].any()
 
 
@@ -32,13 +32,13 @@ def test_example_is_a_solution_of_its_own_problem():
     for _ in range(30):
         lab = rng.integers(0, 5, size=tuple(rng.integers(1, 5, size=rng.integers(1, 4))))
         E = ExampleModel(lab)
-        P = Problem.from_example(E, E.shape)
+        P = from_example(E, E.shape)
         assert P.is_solution(E.labels)
 
 
 def test_violations_reports_arcs_and_cells():
     E = ExampleModel([[0, 1], [1, 0]])
-    P = Problem.from_example(E, (2, 2), fixed={(0, 0): 1})
+    P = from_example(E, (2, 2), fixed={(0, 0): 1})
     g = np.array([[0, 1], [1, 0]])
     v = P.violations(g)
     assert v.cells.tolist() == [0] and v.arcs.size == 0
@@ -55,24 +55,24 @@ def test_violations_reports_arcs_and_cells():
 
 def test_fixed_boundary_mask():
     E = ExampleModel([[1, 0, 0], [1, 0, 0], [1, 0, 0]])
-    P = Problem.from_example(E, (4, 3), boundary="auto")
+    P = from_example(E, (4, 3), boundary="auto")
     kinds = [u.kind for u in P.unary]
     assert kinds.count("boundary") == 4
     fg = P.fixed_grid
     assert fg[:, 0].tolist() == [1, 1, 1, 1]  # bottom face wins at corners
     assert fg[0, 1] == 0 and fg[3, 2] == 0 and fg[1, 2] == 0
-    P2 = Problem.from_example(E, (4, 3), fixed=np.array([[-1] * 3] * 3 + [[1, 0, -1]]))
+    P2 = from_example(E, (4, 3), fixed=np.array([[-1] * 3] * 3 + [[1, 0, -1]]))
     assert [u.key for u in P2.unary] == [(3, 0), (3, 1)]
     mask = np.ones((4, 3, 2), dtype=bool)
     mask[2, 2, 1] = False
-    P3 = Problem.from_example(E, (4, 3), mask=mask)
+    P3 = from_example(E, (4, 3), mask=mask)
     assert not P3.domains[P3.cell((2, 2)), 1] and len(P3.unary) == 1
     with pytest.raises(InputError):
-        Problem.from_example(E, (4, 3), fixed={(9, 9): 0})
+        from_example(E, (4, 3), fixed={(9, 9): 0})
     with pytest.raises(InputError):
-        Problem.from_example(E, (4, 3), fixed={(0, 0): 5})
+        from_example(E, (4, 3), fixed={(0, 0): 5})
     with pytest.raises(InputError):
-        Problem.from_example(E, (4, 3), boundary={"q+": 0})
+        from_example(E, (4, 3), boundary={"q+": 0})
     # without_unary restores the base domains
     assert P.without_unary().domains.all()
 
@@ -84,9 +84,9 @@ def test_auto_boundary_errors_clearly():
 
 def test_shape_matching_and_parse_shape():
     E = ExampleModel(np.zeros((2, 2, 1), dtype=int))
-    assert Problem.from_example(E, "5x6").shape == (5, 6, 1)
+    assert from_example(E, "5x6").shape == (5, 6, 1)
     with pytest.raises(InputError):
-        Problem.from_example(ExampleModel(np.zeros((2, 2), dtype=int)), (3, 3, 3))
+        from_example(ExampleModel(np.zeros((2, 2), dtype=int)), (3, 3, 3))
     for bad in ["", "3x", "0x3", "axb", "1x2x3x4x5"]:
         with pytest.raises(InputError):
             parse_shape(bad)
@@ -119,7 +119,7 @@ def test_subproblem_with_full_grid_context(P):
 
 def test_add_arcs_symmetry_pairs():
     E = ExampleModel([[0, 1], [2, 3]])
-    P = Problem.from_example(E, (4, 1), boundary=None)
+    P = from_example(E, (4, 1), boundary=None)
     mirror = np.zeros((4, 4), dtype=bool)
     mirror[[0, 1, 2, 3], [2, 3, 0, 1]] = True  # a toy mirror map
     P2 = P.add_arcs(mirror, [P.cell((0, 0))], [P.cell((3, 0))], name="mirror")
@@ -138,6 +138,6 @@ def test_problem_constructor_validates():
 
 def test_labels_absent_from_the_example_are_excluded():
     E = ExampleModel([[0, 3], [3, 0]])  # K = 4, labels 1 and 2 never occur
-    P = Problem.from_example(E, (1, 1))
+    P = from_example(E, (1, 1))
     assert P.domains[0].tolist() == [True, False, False, True]
     assert not P.is_solution([[1]])

@@ -97,7 +97,7 @@ def test_legend_shows_each_drawn_object_once() -> None:
 
 
 def test_tileset_orientations_share_a_colour() -> None:
-    from csplab.io import load_model
+    from csplab.examples import load_model
     from csplab.io.ruleset import RuleSet
 
     R = load_model(Path(__file__).parent / "io" / "data" / "pipes.xml", {"images": False})

@@ -13,7 +13,8 @@ from csplab import problem as problem_mod
 from csplab.catalog import Propagator
 from csplab.errors import CsplabError, MemoryLimitError
 from csplab.example import ExampleModel
-from csplab.problem import Problem, check_memory, memory_estimate
+from csplab.grids import from_example
+from csplab.problem import check_memory, memory_estimate
 
 
 def test_estimate_grows_with_cells_and_labels() -> None:
@@ -29,7 +30,7 @@ def test_too_large_output_is_one_line_before_allocating(monkeypatch: Any) -> Non
     E = ExampleModel(np.arange(119 * 2).reshape(119, 2, 1) % 119)
     t = time.perf_counter()
     with pytest.raises(MemoryLimitError) as exc:
-        Problem.from_example(E, (2000, 2000, 10))
+        from_example(E, (2000, 2000, 10))
     assert time.perf_counter() - t < 2.0
     msg = str(exc.value)
     assert msg == (
@@ -49,7 +50,7 @@ def test_small_problems_do_not_read_meminfo(monkeypatch: Any) -> None:
 
 def test_propagator_checks_what_it_adds(monkeypatch: Any) -> None:
     E = ExampleModel([[0, 1], [1, 0]])
-    P = Problem.from_example(E, (3000, 3000))  # 9e6 cells: above the small threshold
+    P = from_example(E, (3000, 3000))  # 9e6 cells: above the small threshold
     monkeypatch.setattr(problem_mod, "available_memory", lambda: 2**20)
     with pytest.raises(MemoryLimitError, match=r"^3000x3000 with K=2 needs about"):
         Propagator(P)

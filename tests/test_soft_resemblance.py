@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 import csplab
-from csplab import ExampleModel, Problem, load_example
+from csplab import ExampleModel, load_example
 from csplab.engine.resemblance import Resemblance
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.soft import Energy, HeightField, Histogram, Region
 
 
@@ -60,7 +61,7 @@ def test_resemblance_choice_is_consistent_and_closer_to_the_example():
     from csplab.experiments.measures import pattern_distance
 
     E = load_example("loops")
-    P = Problem.from_example(E, (24, 24))
+    P = from_example(E, (24, 24))
     dist = {}
     for choice in ("uniform", "resemblance"):
         ds = []
@@ -78,10 +79,10 @@ def test_resemblance_choice_is_consistent_and_closer_to_the_example():
 
 
 def test_resemblance_needs_an_example():
-    P = csplab.Problem.grid((4, 4), np.ones((2, 2, 2), dtype=bool))
+    P = csplab.grids.grid((4, 4), np.ones((2, 2, 2), dtype=bool))
     with pytest.raises(InputError, match="needs a problem built from an example"):
         csplab.solve(P, "catalog", choice="resemblance")
-    Q = Problem.from_example(load_example("line"), (6, 6))
+    Q = from_example(load_example("line"), (6, 6))
     with pytest.raises(InputError, match="scan orders and random"):
         csplab.solve(Q, "catalog", choice="resemblance", order="min-entropy")
 
@@ -102,7 +103,7 @@ def test_energy_terms():
 
 def test_metropolis_lowers_the_energy_and_keeps_consistency():
     E = load_example("loops")
-    P = Problem.from_example(E, (24, 24))
+    P = from_example(E, (24, 24))
     yy, xx = np.mgrid[0:24, 0:24]
     disk = np.hypot(xx - 11.5, yy - 11.5) < 8
     paths = [b for b in range(E.K) if E.names[b] != "empty"]

@@ -11,6 +11,7 @@ import pytest
 import csplab
 from csplab import ExampleModel, Problem, load_example
 from csplab.errors import FormatError, InputError
+from csplab.grids import from_example
 from csplab.io.gridtext import format_grid, parse_grid
 from csplab.render import render
 from csplab.topology import Topology
@@ -56,7 +57,7 @@ def brute(P: Problem) -> set[bytes]:
 @pytest.mark.parametrize("name", ["hex:odd-r", "hex:odd-q", "tri"])
 def test_exact_solvers_agree_with_brute_force(name):
     E = ExampleModel([[0, 1, 1, 0], [1, 0, 0, 1], [1, 1, 0, 0]], meta={"topology": name})
-    P = Problem.from_example(E, (3, 3))
+    P = from_example(E, (3, 3))
     assert P.meta["topology"] == name and P.R == 3
     sols = brute(P)
     from csplab.engine.sat import enumerate_solutions
@@ -72,12 +73,12 @@ def test_exact_solvers_agree_with_brute_force(name):
 def test_builtin_examples_synthesize_with_every_solver():
     for name in ("hexriver", "trifan"):
         E = load_example(name)
-        P = Problem.from_example(E, (12, 10))
+        P = from_example(E, (12, 10))
         for solver in installed_solvers():
             r = csplab.solve(P, solver, rng=2, restarts=10)
             assert r.status == "solved" and P.is_solution(r.grid), (name, solver)
         # the example itself is a solution at its own size
-        assert Problem.from_example(E, E.shape).is_solution(E.labels)
+        assert from_example(E, E.shape).is_solution(E.labels)
         with pytest.raises(InputError, match="square grids"):
             E.transitions()
 
@@ -95,17 +96,17 @@ def test_grid_text_round_trip_and_pictures():
 
 def test_cylinder_and_affine_grids():
     E = load_example("loops")
-    P = Problem.from_example(E, (6, 12), topology="cylinder")
+    P = from_example(E, (6, 12), topology="cylinder")
     assert P.meta["periodic"] == (False, True) and P.meta["topology"] == "cylinder"
     r = csplab.solve(P, "sat", rng=0)
     assert r.ok and P.is_solution(r.grid)
-    A = Problem.from_example(E, (6, 6), topology="affine:1,0.5,0,1")
-    assert len(A.arcs) == len(Problem.from_example(E, (6, 6)).arcs)
+    A = from_example(E, (6, 6), topology="affine:1,0.5,0,1")
+    assert len(A.arcs) == len(from_example(E, (6, 6)).arcs)
     for bad in ("pentagon", "affine:1,2", "affine:1,1,1,1"):
         with pytest.raises(InputError):
             Topology.parse(bad)
     with pytest.raises(InputError, match="cannot be periodic"):
-        Problem.from_example(load_example("hexriver"), (6, 6), periodic=True)
+        from_example(load_example("hexriver"), (6, 6), periodic=True)
 
 
 def _run(capsys, *args):
@@ -135,7 +136,7 @@ def test_cli(tmp_path, capsys):
 
 
 def test_tiled_maps_and_debroglie_hex_configs(tmp_path):
-    from csplab.io import load_model
+    from csplab.examples import load_model
     from csplab.io.tiled import parse_tmx
 
     data = Path(__file__).parent / "io" / "data"
@@ -143,11 +144,11 @@ def test_tiled_maps_and_debroglie_hex_configs(tmp_path):
     # 6 rows, odd ones shifted in the file: after the flip (y up) the even rows are
     assert E.topology == "hex:even-r" and E.shape == (8, 6) and E.K == 3
     assert E.names == ("gid 1", "gid 2", "gid 3")
-    P = Problem.from_example(E, (12, 9))
+    P = from_example(E, (12, 9))
     r = csplab.solve(P, "sat", rng=1)
     assert r.ok and P.is_solution(r.grid)
     # the map's own river is consistent with what the map teaches
-    assert Problem.from_example(E, E.shape).is_solution(E.labels)
+    assert from_example(E, E.shape).is_solution(E.labels)
     rs = load_model(data / "tiled" / "hex_debroglie.json")
     assert rs.topology == "hex:even-r" and rs.ndim == 2 and rs.shape == (16, 12)
     assert np.array_equal(rs.relations, Topology.parse(E.topology).learn(E.labels, E.K))
@@ -180,7 +181,7 @@ def test_tiled_maps_and_debroglie_hex_configs(tmp_path):
 def test_connectivity_uses_the_grid_s_own_neighbours():
     from csplab.constraints import Connected, MaxRun, grid_edges
 
-    P = Problem.from_example(load_example("hexriver"), (6, 5))
+    P = from_example(load_example("hexriver"), (6, 5))
     lo = grid_edges(P)[0]
     assert len(lo) == len(P.arcs)  # every hexagonal neighbour pair, diagonal ones too
     # two cells that touch only through a hex diagonal (odd-r: row 1 is shifted right, so

@@ -82,9 +82,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab import grids
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.problem import AXIS_NAMES, Problem
+from csplab.grids import from_example
+from csplab.problem import AXIS_NAMES
 from csplab.result import Verdict
 
 __all__ = [
@@ -108,7 +110,7 @@ class Rules:
 
     ``fwd[d][a]``: labels that may follow ``a`` along ``+d``; ``bwd[d][c]``: labels that
     may precede ``c``. ``used``: labels that occur in the example (the only labels a cell
-    may take, as in :meth:`Problem.from_example`).
+    may take, as in :func:`~csplab.grids.from_example`).
     """
 
     def __init__(self, T: ArrayLike, used: ArrayLike | None = None) -> None:
@@ -269,7 +271,7 @@ def region_catalog(
     sl = tuple(slice(a, b + 1) for a, b in zip(lo, hi, strict=True))
     sub = G[sl]
     fixed = np.where(sub >= 0, sub, -1).astype(np.int64)
-    P = Problem.grid(sub.shape, example.transitions(), fixed=fixed, labels=example.counts() > 0)
+    P = grids.grid(sub.shape, example.transitions(), fixed=fixed, labels=example.counts() > 0)
     eng = Propagator(P)
     if not eng.ok:
         return np.zeros(0, dtype=np.int64)
@@ -712,7 +714,7 @@ def _as_alg31_failure(
     from csplab.catalog import Propagator
 
     shape = tuple(run["shape"])
-    P = Problem.from_example(example, shape)
+    P = from_example(example, shape)
     eng = Propagator(P)
     choices: list[list[Any]] = []
     for c, b in run["choices"]:

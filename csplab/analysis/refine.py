@@ -43,7 +43,8 @@ from csplab.analysis.infallible import parse_region, prove_infallible
 from csplab.engine.completability import search_solutions
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.problem import AXIS_NAMES, Problem
+from csplab.grids import from_example
+from csplab.problem import AXIS_NAMES
 from csplab.result import Verdict
 
 __all__ = ["closed_boundary", "lift_check", "refine_labels", "to_infallible"]
@@ -89,7 +90,7 @@ def refine_labels(
 def _images(
     EI: ExampleModel, f: NDArray[np.int64], shape: tuple[int, ...], boundary: Any
 ) -> set[bytes]:
-    P = Problem.from_example(EI, shape, boundary=boundary)
+    P = from_example(EI, shape, boundary=boundary)
     return {f[s].astype(np.int32).tobytes() for s in search_solutions(P)}
 
 
@@ -127,7 +128,7 @@ def lift_check(
     rows: list[dict[str, Any]] = []
     for s in sizes:
         shape = tuple(int(t) for t in s)
-        PF = Problem.from_example(EF, shape, boundary=boundary)
+        PF = from_example(EF, shape, boundary=boundary)
         models = {m.astype(np.int32).tobytes() for m in search_solutions(PF, limit=max_models)}
         if len(models) >= max_models:
             rows.append({"shape": list(shape), "models": len(models), "checked": False})

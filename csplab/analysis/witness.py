@@ -60,7 +60,7 @@ from csplab.engine.completability import (
 )
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-from csplab.grids import parse_boundary, parse_shape
+from csplab.grids import from_example, parse_boundary, parse_shape
 from csplab.problem import Problem
 from csplab.result import Verdict
 from csplab.rng import make_rng
@@ -98,7 +98,8 @@ def alg31_exhaustive(
     Examples
     --------
     >>> from csplab.examples import load_example
-    >>> P = Problem.from_example(load_example("fig3_6a"), (9, 3))
+    >>> from csplab import from_example
+    >>> P = from_example(load_example("fig3_6a"), (9, 3))
     >>> v = alg31_exhaustive(P, "scan:yx", late=True)   # inconsistent, C not yet empty
     >>> v.stats["first_outside_cstar"] < len(v.witness)
     True
@@ -250,7 +251,7 @@ class _Search:
         P = self._problems.get(shape)
         if P is None:
             kw = {} if self.boundary is None else {"boundary": self.boundary}
-            P = Problem.from_example(self.example, shape, **kw)
+            P = from_example(self.example, shape, **kw)
             if P.n <= 200_000:
                 self._problems[shape] = P
         return P
@@ -475,7 +476,7 @@ def find_failure(
         sizes); the random search stops at 70 % of it, shrinking at 90 %, the exact check
         uses the rest.
     boundary : optional
-        Boundary of the outputs, as in :meth:`Problem.from_example` (``"auto"``, a
+        Boundary of the outputs, as in :func:`~csplab.grids.from_example` (``"auto"``, a
         mapping face -> label); recorded in the witness.
 
     Returns
@@ -520,11 +521,9 @@ def find_failure(
             raise InputError(f"max_size {max_size!r} has more axes than the example ({ndim})")
     is_scan = order == "scanline" or order.startswith("scan:")
     scan_order(lim, order)  # validates the order
-    bnd = boundary
-    if isinstance(boundary, str):
-        bnd = parse_boundary(boundary)
+    bnd = parse_boundary(boundary) if isinstance(boundary, str) else boundary
     if boundary is not None:
-        Problem.from_example(example, (2,) * ndim, boundary=bnd)  # validates the boundary
+        from_example(example, (2,) * ndim, boundary=bnd)  # validates the boundary
     gen, seed0 = make_rng(rng)
     stats: dict[str, Any] = {
         "states": 0,
@@ -704,7 +703,7 @@ def replay(example: ExampleModel, witness: dict[str, Any]) -> Verdict:
     bnd = witness.get("boundary")
     if isinstance(bnd, str):
         bnd = parse_boundary(bnd)
-    P = Problem.from_example(example, shape) if bnd is None else Problem.from_example(
+    P = from_example(example, shape) if bnd is None else from_example(
         example, shape, boundary=bnd)  # fmt: skip
     eng = Propagator(P)
     choices = witness.get("choices", [])

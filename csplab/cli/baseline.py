@@ -47,9 +47,8 @@ def run(args: argparse.Namespace) -> int:
 
     from csplab.baselines import BASELINES, run_baseline
     from csplab.example import ExampleModel
-    from csplab.grids import parse_shape
+    from csplab.grids import from_example, parse_shape
     from csplab.io import write_labels
-    from csplab.problem import Problem
     from csplab.rng import make_rng
 
     b = BASELINES[args.name]
@@ -68,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     grid = run_baseline(args.name, example, size, rng=seed, **opts)
     dt = time.perf_counter() - t0
-    P = Problem.from_example(example, size)
+    P = from_example(example, size)
     v = P.violations(grid)
     if args.out:
         write_labels(grid, args.out, names=example.names, name=example.name, model=example)

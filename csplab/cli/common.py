@@ -21,7 +21,7 @@ from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
-from csplab.grids import parse_boundary, parse_shape
+from csplab.grids import from_example, parse_boundary, parse_shape
 from csplab.io.registry import input_help, option_help
 from csplab.io.ruleset import RuleSet
 from csplab.problem import Problem
@@ -70,7 +70,7 @@ def model_options(items: list[str] | None) -> dict[str, Any]:
 
 
 def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
-    """:func:`csplab.io.load_model`, printing the loader's warnings to stderr, one line
+    """:func:`csplab.examples.load_model`, printing the loader's warnings to stderr, one line
     each.
 
     A model file that takes longer than :data:`csplab.progress.DELAY_S` to read (a tileset
@@ -83,7 +83,7 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     import warnings
 
     from csplab import progress
-    from csplab.io import load_model as load
+    from csplab.examples import load_model as load
 
     def notice() -> None:
         try:
@@ -376,7 +376,7 @@ def problem_from_args(
             from csplab.topology import Topology
 
             topology = Topology.parse(topology).name  # one line for a bad name
-        P = Problem.from_example(
+        P = from_example(
             model, shape, periodic=bool(args.periodic), boundary=boundary or "none",
             topology=topology,
         )  # fmt: skip

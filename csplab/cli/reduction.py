@@ -72,8 +72,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run_planar(args: argparse.Namespace) -> int:
-    from csplab.complexity.draw import save_reduction_png
-    from csplab.complexity.gadgets import label_sheet
+    from csplab.complexity.draw import label_sheet, save_reduction_png
     from csplab.complexity.planar3sat import random_planar3sat
     from csplab.complexity.reduction import reduce_planar3sat, verify_instance
     from csplab.rng import make_rng
@@ -91,7 +90,7 @@ def _run_planar(args: argparse.Namespace) -> int:
         save_reduction_png(red.fixed, args.png, args.scale)
         out["png"] = args.png
     if args.labels_png:
-        label_sheet().save(args.labels_png)  # type: ignore[attr-defined]
+        label_sheet().save(args.labels_png)
         out["labels_png"] = args.labels_png
     code = 0
     if args.check:

@@ -57,7 +57,9 @@ def run(args: argparse.Namespace) -> int:
                 )
             print(f"  f: {v.witness['map']} (new label -> label of {E.name or args.model})")
         if args.out:
-            EI.save(args.out)
+            from csplab.io import write_example
+
+            write_example(EI, args.out)
         elif not args.json:
             from csplab.io.gridtext import format_grid
 

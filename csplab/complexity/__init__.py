@@ -36,12 +36,13 @@ def complete_model(problem: Problem, rng: RngLike = None) -> Result:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 1})
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 1})
     >>> r = complete_model(P, rng=1)
     >>> r.status, r.grid[0].tolist()
     ('solved', [1, 0, 1])
-    >>> r = complete_model(P.with_fixed({(1, 1): 0}), rng=1)
+    >>> from csplab.grids import with_fixed
+    >>> r = complete_model(with_fixed(P, {(1, 1): 0}), rng=1)
     >>> r.status, r.stats["proof"]
     ('unsat', 'arc-consistency wipe-out (unit propagation on the support encoding)')
     """

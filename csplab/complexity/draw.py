@@ -12,13 +12,22 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["draw_cell", "render_reduction", "save_reduction_png"]
+from csplab.complexity.gadgets import (
+    COLORS,
+    NAMES,
+    OR_BOT,
+    OR_TOP,
+    K,
+    arrow_direction,
+    label_color,
+    sockets,
+)
+
+__all__ = ["draw_cell", "label_sheet", "render_reduction", "save_reduction_png"]
 
 
 def draw_cell(dr: Any, x0: int, y0: int, s: int, b: int) -> None:
     """Draw label ``b`` of the reduction as an ``s``-pixel square at ``(x0, y0)`` (top-left)."""
-    from csplab.complexity.gadgets import OR_BOT, OR_TOP, arrow_direction, label_color
-
     dr.rectangle([x0, y0, x0 + s - 1, y0 + s - 1], fill=label_color(b))
     d = arrow_direction(b)
     if d is not None and s >= 5:
@@ -57,3 +66,33 @@ def save_reduction_png(grid: ArrayLike, path: str | Path, scale: int = 10) -> No
     if p.parent and not p.parent.exists():
         p.parent.mkdir(parents=True, exist_ok=True)
     render_reduction(grid, scale).save(p)
+
+
+def label_sheet(scale: int = 36) -> Any:
+    """A PIL image with one small picture per label: the piece in its colour, its sockets
+    marked on its sides (thick dark bar = ``X``, white = ``I``, green/red = demanded value,
+    blue = NOT pin, yellow = OR pin), its id and name."""
+    from PIL import Image, ImageDraw
+
+    cols = 8
+    rows = (K + cols - 1) // cols
+    cw, ch = scale * 3, scale * 2 + 14
+    img = Image.new("RGB", (cols * cw, rows * ch), (250, 250, 250))
+    dr = ImageDraw.Draw(img)
+    sk = sockets()
+    sock_col = {
+        "X": (40, 40, 40), "I": (255, 255, 255), "T": COLORS["TRUE"], "F": COLORS["FALSE"],
+        "a": (150, 150, 255), "n": COLORS["NOT"], "o": COLORS["OR"], "p": COLORS["OR"],
+    }  # fmt: skip
+    for b in range(K):
+        r, c = divmod(b, cols)
+        x0, y0 = c * cw + scale, r * ch + 4
+        draw_cell(dr, x0, y0, scale, b)
+        t = max(3, scale // 8)
+        s = sk[b]
+        dr.rectangle([x0 - t, y0, x0 - 1, y0 + scale - 1], fill=sock_col[s["L"]])
+        dr.rectangle([x0 + scale, y0, x0 + scale + t - 1, y0 + scale - 1], fill=sock_col[s["R"]])
+        dr.rectangle([x0, y0 - t + 1, x0 + scale - 1, y0], fill=sock_col[s["U"]])
+        dr.rectangle([x0, y0 + scale, x0 + scale - 1, y0 + scale + t - 1], fill=sock_col[s["D"]])
+        dr.text((c * cw + 4, y0 + scale + t + 2), f"{b} {NAMES[b]}", fill=(0, 0, 0))
+    return img

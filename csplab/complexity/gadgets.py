@@ -17,8 +17,9 @@ name   meaning                                                    compatible wit
 ``o``  OR gate pin                                                ``o``
 =====  =========================================================  ==================
 
-The labels (pictures: ``label_sheet()``, drawn by ``csplab reduction planar3sat --labels``;
-in the ASCII pictures ``#`` is enclosure, ``.`` a wire cell, ``T``/``F`` the demanded value):
+The labels (pictures: :func:`csplab.complexity.draw.label_sheet`, drawn by ``csplab reduction
+planar3sat --labels``; in the ASCII pictures ``#`` is enclosure, ``.`` a wire cell, ``T``/``F``
+the demanded value):
 
 * ``wall`` (0): all sides ``X``; the space outside the wires and the outer corner of a bend.
 * ``TRUE`` (1) and ``FALSE`` (2): the fill of a wire, all sides ``T`` or ``F``, so TRUE and
@@ -83,7 +84,6 @@ __all__ = [
     "WALL",
     "K",
     "enclosure",
-    "label_sheet",
     "sockets",
     "transitions",
 ]
@@ -201,35 +201,3 @@ def arrow_direction(b: int) -> str | None:
         NOT_DN: "D", NOT_UP: "U", ARROW_TOP[0]: "L", ARROW_TOP[1]: "D", ARROW_TOP[2]: "R",
         ARROW_BOT[0]: "L", ARROW_BOT[1]: "U", ARROW_BOT[2]: "R",
     }.get(b)  # fmt: skip
-
-
-def label_sheet(scale: int = 36) -> object:
-    """A PIL image with one small picture per label: the piece in its colour, its sockets
-    marked on its sides (thick dark bar = ``X``, white = ``I``, green/red = demanded value,
-    blue = NOT pin, yellow = OR pin), its id and name."""
-    from PIL import Image, ImageDraw
-
-    from csplab.complexity.draw import draw_cell
-
-    cols = 8
-    rows = (K + cols - 1) // cols
-    cw, ch = scale * 3, scale * 2 + 14
-    img = Image.new("RGB", (cols * cw, rows * ch), (250, 250, 250))
-    dr = ImageDraw.Draw(img)
-    sk = sockets()
-    sock_col = {
-        "X": (40, 40, 40), "I": (255, 255, 255), "T": COLORS["TRUE"], "F": COLORS["FALSE"],
-        "a": (150, 150, 255), "n": COLORS["NOT"], "o": COLORS["OR"], "p": COLORS["OR"],
-    }  # fmt: skip
-    for b in range(K):
-        r, c = divmod(b, cols)
-        x0, y0 = c * cw + scale, r * ch + 4
-        draw_cell(dr, x0, y0, scale, b)
-        t = max(3, scale // 8)
-        s = sk[b]
-        dr.rectangle([x0 - t, y0, x0 - 1, y0 + scale - 1], fill=sock_col[s["L"]])
-        dr.rectangle([x0 + scale, y0, x0 + scale + t - 1, y0 + scale - 1], fill=sock_col[s["R"]])
-        dr.rectangle([x0, y0 - t + 1, x0 + scale - 1, y0], fill=sock_col[s["U"]])
-        dr.rectangle([x0, y0 + scale, x0 + scale - 1, y0 + scale + t - 1], fill=sock_col[s["D"]])
-        dr.text((c * cw + 4, y0 + scale + t + 2), f"{b} {NAMES[b]}", fill=(0, 0, 0))
-    return img

@@ -115,7 +115,7 @@ class RegularGrammar:
             raise InputError(f"Theorem 5.2.3 needs a 1D example, got shape {example.shape}")
         T = example.transitions()[0]
         K = example.K
-        # as Problem.from_example: labels absent from E never occur in a model
+        # as csplab.grids.from_example: labels absent from E never occur in a model
         present = np.flatnonzero(example.counts() > 0).tolist()
         rules: dict[str, tuple[tuple[int, str | None], ...]] = {}
         for b in present:

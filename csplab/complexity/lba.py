@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab import grids
 from csplab.errors import FormatError, InputError
 from csplab.problem import Problem
 from csplab.result import Verdict
@@ -442,7 +443,7 @@ def lba_problem(lba: LBA, word: str, rows: int | None = None) -> tuple[Problem, 
     fixed = np.full((W, H), -1, dtype=np.int64)
     for x, s in enumerate(tape):
         fixed[x, H - 1] = con.index[(s, lba.start, "")] if x == 1 else con.index[(s, "", "")]
-    P = Problem.grid(
+    P = grids.grid(
         (W, H), con.T, fixed=fixed, names=con.names, name=f"lba:{lba.name}:{word}",
         meta={"lba": lba.name, "input": word},
     )  # fmt: skip

@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab import grids
 from csplab.complexity import complete_model
 from csplab.complexity import gadgets as G
 from csplab.complexity.planar3sat import Planar3SAT
@@ -104,7 +105,7 @@ class Reduction:
 
     @cached_property
     def _problem(self) -> Problem:
-        return Problem.grid(
+        return grids.grid(
             self.shape,
             G.transitions(),
             fixed=self.fixed,
@@ -281,7 +282,7 @@ def _check_layout(red: Reduction) -> None:
                 raise AssertionError(f"regions touch at {(int(cx), int(cy))}")
         if not guarded:
             raise AssertionError(f"free cell {(int(cx), int(cy))} has no fixed neighbour")
-    P = Problem.grid(red.shape, G.transitions(), fixed=red.fixed)
+    P = grids.grid(red.shape, G.transitions(), fixed=red.fixed)
     # fixed–fixed neighbours must be allowed by T
     g = np.where(free, 0, fx)
     v = P.violations(g)

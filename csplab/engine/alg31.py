@@ -21,8 +21,8 @@ over the catalog (thesis), ``weighted`` by the problem's label weights, or ``res
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 3))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 3))
 >>> r = run_alg31(P, np.random.default_rng(1))
 >>> r.status, r.trace.shape
 ('solved', (12, 2))
@@ -190,7 +190,7 @@ def _resemblance(
     if not isinstance(example, ExampleModel):
         raise InputError(
             "choice='resemblance' needs a problem built from an example model "
-            "(Problem.from_example); tilesets have no example to resemble"
+            "(csplab.from_example); tilesets have no example to resemble"
         )
     if order in _HEAP_ORDERS:
         raise InputError("choice='resemblance' takes the scan orders and random, not " + order)
@@ -323,8 +323,9 @@ def jit_warmup() -> float:
     t0 = time.perf_counter()
     from csplab import _interp
     from csplab.example import ExampleModel
+    from csplab.grids import from_example
 
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
     rng = np.random.default_rng(0)
     saved, _interp.ENGINE = _interp.ENGINE, "kernels"
     try:

@@ -30,8 +30,8 @@ calls, for the ``perfect`` and ``hybrid`` solvers.
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
 >>> o = SearchCompletability(P)
 >>> o.completable([0, 1], [1, 1])
 False
@@ -148,8 +148,8 @@ class SearchCompletability:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
     >>> o = SearchCompletability(P)
     >>> o.fix([0], [1])
     >>> o.completable([1], [0]), o.completable([1], [1]), o.completable([0, 0], [1, 0]), o.calls
@@ -230,8 +230,8 @@ def search_solutions(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (2, 2))
     >>> [g.tolist() for g in search_solutions(P, [[1, -1], [-1, -1]])]
     [[[1, 0], [0, 1]]]
     """
@@ -268,8 +268,8 @@ class SatCompletability:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
     >>> with SatCompletability(P) as o:
     ...     o.fix([0], [1])
     ...     o.completable([1], [0]), o.completable([1], [1]), o.solution is None
@@ -340,8 +340,8 @@ def make_completability(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
     >>> make_completability(P, "search", max_nodes=10).name
     'search'
     """
@@ -389,9 +389,9 @@ def first_inconsistent_prefix(
     the bottom row and failed at the third choice; the third label (index 2) was the first
     outside C*.
 
-    >>> from csplab import Problem
+    >>> from csplab import from_example
     >>> from csplab.examples import load_example
-    >>> P = Problem.from_example(load_example("fig3_5a"), (3, 3))
+    >>> P = from_example(load_example("fig3_5a"), (3, 3))
     >>> run = [[P.cell((0, 0)), 2], [P.cell((1, 0)), 0], [P.cell((2, 0)), 0]]
     >>> first_inconsistent_prefix(SearchCompletability(P), run, full_inconsistent=True)
     2
@@ -442,9 +442,9 @@ def catalog_at(
     row, the catalog of the third cell still holds six labels, but only one can be
     completed.
 
-    >>> from csplab import Problem
+    >>> from csplab import from_example
     >>> from csplab.examples import load_example
-    >>> P = Problem.from_example(load_example("fig3_5a"), (3, 3))
+    >>> P = from_example(load_example("fig3_5a"), (3, 3))
     >>> cells = [P.cell((0, 0)), P.cell((1, 0))]
     >>> o = SearchCompletability(P)
     >>> o.fix(cells, [2, 0])

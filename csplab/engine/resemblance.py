@@ -21,9 +21,9 @@ labels around the block, which the windows see as the paper's ``M'`` does).
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
+>>> from csplab import ExampleModel, from_example
 >>> E = ExampleModel([[0, 0, 1, 1], [0, 0, 1, 1], [2, 2, 2, 2]])
->>> P = Problem.from_example(E, (6, 6))
+>>> P = from_example(E, (6, 6))
 >>> r = run_resemblance(P, E, np.random.default_rng(0))
 >>> r.status, P.is_solution(r.grid)
 ('solved', True)

@@ -19,8 +19,8 @@ solver the same clauses in the same order (a property test compares their models
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4))
 >>> len(list(enumerate_solutions(P)))
 2
 """
@@ -223,8 +223,8 @@ class SatOracle:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([0, 1, 2, 0]), (7,))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([0, 1, 2, 0]), (7,))
     >>> o = SatOracle(P)
     >>> o.solve([o.literal(0, 1)]), o.grid.tolist()     # cell 0 = 1 under an assumption
     ('sat', [1, 2, 0, 1, 2, 0, 1])
@@ -579,8 +579,8 @@ def enumerate_solutions(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4))
     >>> len(list(enumerate_solutions(P)))
     2
     """

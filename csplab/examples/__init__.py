@@ -1,4 +1,5 @@
-"""Built-in example models, loadable by name with :func:`load_example`.
+"""Built-in example models, loadable by name with :func:`load_example`; :func:`load_model`
+takes the name of any built-in example (grid, polygons, polyhedra) or a model file.
 
 The 2D examples reconstruct the thesis' small figures (each file documents which figure it
 stands for and which property it has; where the text does not pin the exact grid, the file
@@ -16,11 +17,18 @@ True
 from __future__ import annotations
 
 from importlib import resources
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from csplab.errors import InputError
+from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 
-__all__ = ["EXAMPLES", "example_info", "example_names", "load_example"]
+if TYPE_CHECKING:
+    from csplab.continuous.model import PolygonModel
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.io.ruleset import RuleSet
+
+__all__ = ["ALIASES", "EXAMPLES", "example_info", "example_names", "load_example", "load_model"]
 
 # name -> (file, one-line description); aliases below
 EXAMPLES: dict[str, tuple[str, str]] = {
@@ -84,3 +92,53 @@ def load_example(name: str) -> ExampleModel:
     text = resources.files(__package__).joinpath(fname).read_text(encoding="utf-8")
     ex = parse_grid(text, path=f"csplab/examples/{fname}", name=key)
     return ex
+
+
+def load_model(
+    spec: str | Path, options: dict[str, Any] | None = None
+) -> ExampleModel | RuleSet | PolygonModel | PolyhedralModel:
+    """A built-in example name (``csplab info`` lists them) or a model file path (any
+    format of :func:`csplab.io.read_model`, with its loader ``options``).
+
+    An existing file wins over a built-in name; a name that is neither raises.
+
+    Examples
+    --------
+    >>> load_model("line").shape
+    (4, 3)
+    >>> load_model("line", {"N": 2})
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: model options apply to model files only, not to the built-in \
+example 'line'
+    """
+    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
+    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
+    from csplab.io import read_model
+
+    p = Path(spec)
+    if p.exists():
+        return read_model(p, **(options or {}))
+    text = str(spec)
+    builtin = (
+        load_example
+        if text in EXAMPLES or text in ALIASES
+        else load_polygon_example
+        if text in CONTINUOUS_EXAMPLES
+        else load_polyhedral_example
+        if text in POLYHEDRAL_EXAMPLES
+        else None
+    )
+    if builtin is not None:
+        if options:
+            raise InputError(
+                f"model options apply to model files only, not to the built-in example {text!r}"
+            )
+        return builtin(text)
+    if p.suffix or "/" in text or "\\" in text:
+        raise FormatError("no such file", path=text)
+    raise InputError(
+        f"{text!r} is neither a model file nor a built-in example "
+        f"({', '.join([*EXAMPLES, *CONTINUOUS_EXAMPLES, *POLYHEDRAL_EXAMPLES])}); "
+        "see `csplab info`"
+    )

@@ -519,10 +519,10 @@ def measure(
     Returns ``{"solved", "seeds", "failed_seeds", "median_s", "median_solved_s"}`` (median
     run times over all runs and over the solved ones).
     """
-    from csplab.problem import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
-    P = Problem.from_example(build(name), shape, boundary=boundary)
+    P = from_example(build(name), shape, boundary=boundary)
     solved, failed, times, times_ok = 0, [], [], []
     for seed in range(seeds):
         r = solve(P, "catalog", rng=seed)

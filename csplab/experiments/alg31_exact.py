@@ -12,8 +12,8 @@ probability of being produced by Alg. 3.1.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))   # checkerboard
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))           # checkerboard
 >>> d = alg31_distribution(P)
 >>> d.failure, sorted(d.outputs.values())
 (Fraction(0, 1), [Fraction(1, 2), Fraction(1, 2)])

@@ -89,7 +89,7 @@ def load_examples(specs: Sequence[str], tilesets: bool = False) -> list[tuple[st
     """Built-in names or model files -> ``(spec, model)``: example models, and tilesets
     (:class:`~csplab.io.ruleset.RuleSet`) for experiments that take them; bad input raises
     one line."""
-    from csplab.io import load_model
+    from csplab.examples import load_model
     from csplab.io.ruleset import RuleSet
 
     if not specs:

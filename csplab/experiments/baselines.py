@@ -44,11 +44,11 @@ METHODS = ("model-synthesis", "texture:efros-leung", "texture:graphcut")
 
 def _make(trial: Trial, example: ExampleModel) -> NDArray[np.int32]:
     from csplab.baselines import run_baseline
-    from csplab.problem import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
     if trial.solver == "model-synthesis":
-        P = Problem.from_example(example, trial.size)
+        P = from_example(example, trial.size)
         r = solve(P, "blocks", rng=trial.seed, block=int(trial.params.get("block", 10)))
         return np.asarray(r.grid, dtype=np.int32)
     method = trial.solver.split(":", 1)[1]
@@ -144,7 +144,7 @@ class Baselines(Experiment):
         return rep
 
     def _figure(self, config: dict[str, Any], out: Path) -> list[Path]:
-        from csplab.io import load_model
+        from csplab.examples import load_model
 
         specs = list(config["examples"])
         methods = list(config["methods"])

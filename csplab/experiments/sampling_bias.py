@@ -43,7 +43,7 @@ from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
 from csplab.experiments.trial import Trial
 from csplab.experiments.uniform import StripSampler
-from csplab.grids import parse_shape
+from csplab.grids import from_example, parse_shape
 from csplab.problem import Problem
 
 __all__ = ["SamplingBias", "measure"]
@@ -285,7 +285,7 @@ def _report_sampler(row: dict[str, Any], spec: str) -> StripSampler:
     if E.hash() != row["example_hash"]:
         raise InputError(f"example {spec} changed since its trials were stored")
     size = tuple(int(v) for v in row["size"].split("x"))
-    P = Problem.from_example(E, size, boundary=parse_boundary(row["boundary"]))
+    P = from_example(E, size, boundary=parse_boundary(row["boundary"]))
     return StripSampler(P)
 
 

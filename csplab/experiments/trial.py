@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.example import ExampleModel
+from csplab.grids import from_example
 from csplab.problem import Problem
 
 __all__ = ["Trial", "build_problem", "execute", "grid_digest", "measure_solve", "problem_for"]
@@ -125,7 +126,7 @@ _WARM = False
 
 
 def parse_boundary(text: str) -> Any:
-    """``"auto"``/``"none"`` or ``"z-=1,x-=0"`` -> what :meth:`Problem.from_example` takes."""
+    """``"auto"``/``"none"`` or ``"z-=1,x-=0"`` -> what :func:`~csplab.grids.from_example` takes."""
     from csplab.grids import parse_boundary as parse
 
     return parse(text)
@@ -135,9 +136,7 @@ def build_problem(example: Any, size: tuple[int, ...], boundary: str, periodic: 
     """The problem of an example model or a tileset (:class:`~csplab.io.ruleset.RuleSet`,
     whose ``"auto"`` boundary is the file's own) at ``size``."""
     if isinstance(example, ExampleModel):
-        return Problem.from_example(
-            example, size, periodic=periodic, boundary=parse_boundary(boundary)
-        )
+        return from_example(example, size, periodic=periodic, boundary=parse_boundary(boundary))
     return example.problem(size, periodic=periodic or None,  # type: ignore[no-any-return]
                            boundary=parse_boundary(boundary) or "none")  # fmt: skip
 

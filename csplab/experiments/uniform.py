@@ -21,8 +21,8 @@ states grows exponentially with the slice size. Probabilities use scaled floatin
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (6, 3))   # checkerboard
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (6, 3))           # checkerboard
 >>> S = StripSampler(P)
 >>> S.count()                                           # exactly two solutions
 2

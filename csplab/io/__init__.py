@@ -8,16 +8,16 @@ overlapping model of a sample picture, and the outputs ``.png`` and Wavefront ``
 * :func:`read_model` reads any model file: an :class:`ExampleModel` or a rule set
   (:class:`~csplab.io.ruleset.RuleSet`); :func:`model_format` tells which format a file
   holds, from its extension and its first bytes.
-* :func:`load_model` takes a built-in example name or a model file.
 * :func:`read_example` / :func:`write_example` read and write example grids.
 * :func:`write_labels` writes a result grid; the format follows the extension.
 
 Examples
 --------
 >>> import tempfile, pathlib
+>>> from csplab.examples import load_example
 >>> with tempfile.TemporaryDirectory() as d:
 ...     p = pathlib.Path(d) / "line.txt"
-...     write_example(load_model("line"), p)
+...     write_example(load_example("line"), p)
 ...     model_format(p), read_model(p).shape
 ('merrell', (4, 3, 1))
 """
@@ -31,7 +31,6 @@ from numpy.typing import ArrayLike
 
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
-from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.io.common import Output
 from csplab.io.gridtext import format_grid, grid_safe_names, parse_grid
@@ -48,7 +47,6 @@ __all__ = [
     "format_grid",
     "format_merrell",
     "grid_safe_names",
-    "load_model",
     "model_format",
     "parse_grid",
     "parse_merrell",
@@ -87,57 +85,6 @@ def read_model(
     p = _existing(path)
     fmt = get_format(format) if format else detect(p)
     return fmt.read(p, **options)
-
-
-def load_model(
-    spec: str | Path, options: dict[str, Any] | None = None
-) -> ExampleModel | RuleSet | PolygonModel | PolyhedralModel:
-    """A built-in example name (``csplab info`` lists them) or a model file path (any
-    format of :func:`read_model`, with its loader ``options``).
-
-    Examples
-    --------
-    >>> load_model("line").shape
-    (4, 3)
-    >>> load_model("line", {"N": 2})
-    Traceback (most recent call last):
-    ...
-    csplab.errors.InputError: model options apply to model files only, not to the built-in \
-example 'line'
-    """
-    from csplab.examples import ALIASES, EXAMPLES, load_example
-    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
-    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
-
-    p = Path(spec)
-    if p.exists():
-        return read_model(p, **(options or {}))
-    text = str(spec)
-    if text in EXAMPLES or text in ALIASES:
-        if options:
-            raise InputError(
-                f"model options apply to model files only, not to the built-in example {text!r}"
-            )
-        return load_example(text)
-    if text in CONTINUOUS_EXAMPLES:
-        if options:
-            raise InputError(
-                f"model options apply to model files only, not to the built-in example {text!r}"
-            )
-        return load_polygon_example(text)
-    if text in POLYHEDRAL_EXAMPLES:
-        if options:
-            raise InputError(
-                f"model options apply to model files only, not to the built-in example {text!r}"
-            )
-        return load_polyhedral_example(text)
-    if p.suffix or "/" in text or "\\" in text:
-        raise FormatError("no such file", path=text)
-    raise InputError(
-        f"{text!r} is neither a model file nor a built-in example "
-        f"({', '.join([*EXAMPLES, *CONTINUOUS_EXAMPLES, *POLYHEDRAL_EXAMPLES])}); "
-        "see `csplab info`"
-    )
 
 
 def detect_format(path: str | Path, text: str | None = None) -> str:

@@ -38,6 +38,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab import grids
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 from csplab.problem import AXIS_NAMES, Problem, Unary
@@ -330,10 +331,10 @@ class RuleSet:
             on periodic axes (there is no outside).
         boundary : "auto" (default), "none", None or mapping face -> label
             ``"auto"``: the file's boundary conditions; ``"none"`` or ``None``: none (as in
-            :meth:`Problem.from_example`, where ``None`` also means none); a mapping puts
+            :func:`~csplab.grids.from_example`, where ``None`` also means none); a mapping puts
             one label on each named face. The file's other restrictions are always applied.
         fixed, mask :
-            As in :meth:`Problem.grid`.
+            As in :func:`~csplab.grids.grid`.
         """
         if shape is None:
             if self.shape is None:
@@ -376,7 +377,7 @@ class RuleSet:
             "rule_set": self.name,
             "model": self,  # lets Result._repr_png_ draw the tiles
         }
-        P = Problem.grid(
+        P = grids.grid(
             shp,
             self.relations,
             topology=self.topology,

@@ -15,8 +15,8 @@ process and its workers.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
+>>> from csplab import ExampleModel, from_example, solve
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
 >>> r = solve(P, "catalog", rng=3)
 >>> r.status, P.is_solution(r.grid)
 ('solved', True)
@@ -261,8 +261,8 @@ def solve(
 
     Examples
     --------
-    >>> from csplab import Problem, load_example
-    >>> P = Problem.from_example(load_example("fig3_5a"), (8, 8))   # Fig. 3.5: fallible
+    >>> from csplab import from_example, load_example
+    >>> P = from_example(load_example("fig3_5a"), (8, 8))           # Fig. 3.5: fallible
     >>> solve(P, "catalog", rng=3, order="scan:yx").status          # fails on this seed
     'failed'
     >>> r = solve(P, "catalog", rng=3, order="scan:yx", restarts=10)

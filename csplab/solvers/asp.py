@@ -86,15 +86,16 @@ label per cell, that is the solution and clingo is not started.
 Examples
 --------
 >>> import numpy as np
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 5))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 5))
 >>> r = AspSolver().solve(P, rng=np.random.default_rng(0), seed=0)
 >>> r.status, P.is_solution(r.grid), r.stats["solver_status"]
 ('solved', True, 'SAT')
->>> Q = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (5, 4), periodic=True)
+>>> Q = from_example(ExampleModel([[0, 1], [1, 0]]), (5, 4), periodic=True)
 >>> AspSolver().solve(Q, rng=np.random.default_rng(0), seed=0).stats["proof"]
 'clingo ...: no answer set (exhaustive search)'
->>> R = P.with_fixed({(0, 0): 0, (0, 1): 0})
+>>> from csplab.grids import with_fixed
+>>> R = with_fixed(P, {(0, 0): 0, (0, 1): 0})
 >>> AspSolver().solve(R, rng=np.random.default_rng(0), seed=0).stats["proof"]
 'arc-consistency wipe-out before encoding (Theorem 3.3.2)'
 """
@@ -259,9 +260,9 @@ def ground_program(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
+    >>> from csplab import ExampleModel, from_example
     >>> from csplab.cnf import encode
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (1, 2))
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (1, 2))
     >>> print(b"".join(ground_program(encode(P))).decode(), end="")
     asp 1 0 0
     1 1 2 1 2 0 0
@@ -381,8 +382,8 @@ def facts(problem: Problem, catalog: NDArray[np.bool_], supports: str, encoding:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (1, 2))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (1, 2))
     >>> print(facts(P, P.domains, "forward", "support"))
     cell(0..1).
     d(0,(0;1)).

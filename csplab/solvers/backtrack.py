@@ -14,13 +14,13 @@ backtracking: the same cell order and uniform label choice from the catalog.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
+>>> from csplab import ExampleModel, from_example, solve
 >>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
->>> P = Problem.from_example(E, (5, 5), fixed={(4, 4): 1})
+>>> P = from_example(E, (5, 5), fixed={(4, 4): 1})
 >>> r = solve(P, "backtrack", rng=0)
 >>> r.status, int(r.grid[4, 4])
 ('solved', 1)
->>> Q = Problem.from_example(E, (3, 3), fixed={(0, 0): 0, (2, 0): 1})   # parity clash
+>>> Q = from_example(E, (3, 3), fixed={(0, 0): 0, (2, 0): 1})           # parity clash
 >>> solve(Q, "backtrack", rng=0).status
 'unsat'
 """

@@ -36,9 +36,9 @@ at the limit is stopped (its finished blocks are kept) and the status is ``timeo
 
 Examples
 --------
->>> from csplab import Problem, solve
+>>> from csplab import from_example, solve
 >>> from csplab.examples import load_example
->>> P = Problem.from_example(load_example("fig3_4a"), (12, 12))
+>>> P = from_example(load_example("fig3_4a"), (12, 12))
 >>> r = solve(P, "blocks", rng=0, block=4)
 >>> r.status, r.stats["blocks_tried"], r.stats["final_violations"]
 ('solved', 25, 0)
@@ -114,9 +114,9 @@ def trivial_solution(problem: Problem, attempts: int = 5) -> NDArray[np.int32]:
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
+    >>> from csplab import ExampleModel, from_example
     >>> E = ExampleModel([[1, 0, 0], [1, 0, 0]])        # ground 1 under empty space 0
-    >>> P = Problem.from_example(E, (3, 3), boundary="auto")
+    >>> P = from_example(E, (3, 3), boundary="auto")
     >>> trivial_solution(P).tolist()
     [[1, 0, 0], [1, 0, 0], [1, 0, 0]]
     """

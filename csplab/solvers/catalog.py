@@ -7,9 +7,9 @@ a proof of unsatisfiability (Theorem 3.3.2) and gives ``unsat``.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
+>>> from csplab import ExampleModel, from_example, solve
 >>> from csplab.examples import load_example
->>> P = Problem.from_example(load_example("line"), (8, 6))
+>>> P = from_example(load_example("line"), (8, 6))
 >>> r = solve(P, "catalog", rng=1, order="min-entropy")
 >>> r.status, r.stats["assigned"]
 ('solved', 48)

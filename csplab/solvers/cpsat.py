@@ -55,8 +55,8 @@ instead of overrunning the limit by seconds.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 5))
+>>> from csplab import ExampleModel, from_example, solve
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 5))
 >>> r = solve(P, "cpsat", rng=0)
 >>> r.status, r.stats["model"]
 ('solved', 'onehot')

@@ -19,9 +19,9 @@ the exact distribution checks this: ``tests/solvers/test_perfect_hybrid.py``.) S
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
+>>> from csplab import ExampleModel, from_example, solve
 >>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
->>> P = Problem.from_example(E, (5, 5), fixed={(4, 4): 1})
+>>> P = from_example(E, (5, 5), fixed={(4, 4): 1})
 >>> r = solve(P, "hybrid", rng=3)
 >>> r.status, r.stats["repairs"] >= 0
 ('solved', True)

@@ -15,9 +15,9 @@ negative units (C* only shrinks as the model grows), so every call has one assum
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
+>>> from csplab import ExampleModel, from_example, solve
 >>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
->>> P = Problem.from_example(E, (5, 5), fixed={(4, 4): 1})
+>>> P = from_example(E, (5, 5), fixed={(4, 4): 1})
 >>> r = solve(P, "perfect", rng=3)
 >>> r.status, r.stats["rejected"] >= 0
 ('solved', True)

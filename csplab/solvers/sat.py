@@ -17,14 +17,14 @@ wipe-out before any choice (what unit propagation on the support encoding also d
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem, solve
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (5, 4))
+>>> from csplab import ExampleModel, from_example, solve
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (5, 4))
 >>> r = solve(P, "sat", rng=1)
 >>> r.status, r.stats["backend"]
 ('solved', 'cadical195')
 >>> solve(P, "sat:glucose4", rng=1).status
 'solved'
->>> Q = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 0, (0, 1): 0})
+>>> Q = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3), fixed={(0, 0): 0, (0, 1): 0})
 >>> solve(Q, "sat", rng=1).stats["proof"]
 'arc-consistency wipe-out (unit propagation on the support encoding)'
 """

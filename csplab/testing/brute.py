@@ -9,8 +9,8 @@ the tests check against this module; nothing in the library imports it.
 
 Examples
 --------
->>> from csplab import ExampleModel, Problem
->>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4))
+>>> from csplab import ExampleModel, from_example
+>>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4))
 >>> len(list(solutions(P)))          # the checkerboard has two solutions at every size
 2
 >>> bool(exact_catalog(P).all())
@@ -87,8 +87,8 @@ def satisfiable(
 
     Examples
     --------
-    >>> from csplab import ExampleModel, Problem
-    >>> P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    >>> from csplab import ExampleModel, from_example
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
     >>> satisfiable(P, [[0, -1, -1], [-1, 0, -1], [-1, -1, -1]]), satisfiable(P, [[0, 0, -1],
     ...     [-1, -1, -1], [-1, -1, -1]])
     (True, False)

@@ -23,7 +23,9 @@ from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 
+from csplab import grids
 from csplab.example import ExampleModel
+from csplab.grids import from_example, with_fixed
 from csplab.problem import Problem
 
 if TYPE_CHECKING:
@@ -146,7 +148,7 @@ def problems(
             np.array(bits, dtype=bool).reshape(*shp, E.K)
             | draw(st.sampled_from([False, True])) * np.eye(E.K, dtype=bool)[0]
         )
-    return Problem.from_example(E, shp, periodic=per, fixed=fx, mask=mk)
+    return from_example(E, shp, periodic=per, fixed=fx, mask=mk)
 
 
 @_composite
@@ -160,7 +162,7 @@ def random_problems(draw: Any, max_side: int = 4, max_labels: int = 4, max_ndim:
     p = rng.uniform(*density)
     T = rng.random((len(shp), k, k)) < p
     per = draw(st.booleans())
-    return Problem.grid(shp, T, periodic=per)
+    return grids.grid(shp, T, periodic=per)
 
 
 @_composite
@@ -251,7 +253,7 @@ def csp_problems(draw: Any, max_side: int = 3, max_labels: int = 4, max_ndim: in
         P = P.subproblem(np.arange(max_cells), np.full(P.n, -1))
     if not P.unary and draw(st.booleans()):
         c = draw(st.integers(0, P.n - 1))
-        P = P.with_fixed({P.coords(c): draw(st.integers(0, P.K - 1))})
+        P = with_fixed(P, {P.coords(c): draw(st.integers(0, P.K - 1))})
     return P
 
 

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel
 from csplab.analysis import (
     alg31_exhaustive,
     alg36_failure,
@@ -25,6 +25,7 @@ from csplab.analysis import (
 from csplab.analysis.infallible import Rules, _scan_cells, _Walk, region_box
 from csplab.errors import InputError
 from csplab.examples import load_example
+from csplab.grids import from_example
 from csplab.testing.strategies import analysis_examples
 
 FIG = "scan:yx"
@@ -165,7 +166,7 @@ def test_prover_is_sound_against_exhaustive_runs(E, order, region):
     v = prove_infallible(E, region, order=order, refute=False, max_states=20_000)
     if v.holds is True:
         for shape in small_shapes(2):
-            P = Problem.from_example(E, shape)
+            P = from_example(E, shape)
             ex = alg31_exhaustive(P, order, max_states=20_000)
             assert ex.holds is not False, (shape, ex.witness)
             assert alg36_failure(E, shape, region, order=order).holds is not False
@@ -187,7 +188,7 @@ def test_prover_is_sound_in_3d(E):
     v = prove_infallible(E, 2, refute=False, max_states=20_000)
     if v.holds is True:
         for shape in small_shapes(3):
-            ex = alg31_exhaustive(Problem.from_example(E, shape), max_states=20_000)
+            ex = alg31_exhaustive(from_example(E, shape), max_states=20_000)
             assert ex.holds is not False, (shape, ex.witness)
 
 
@@ -229,7 +230,7 @@ def test_region_catalog_kernel_matches_propagator(E, data):
     # the walk leaves out fixed cells that border no unassigned cell: equal when the fixed
     # cells are consistent among themselves (always so in a run), else only a superset
     assert set(ref) <= {b for b in range(E.K) if got >> b & 1}
-    P = Problem.from_example(E, shape)
+    P = from_example(E, shape)
     g = grid.reshape(-1)
     s, d, r = P.arcs[:, 0], P.arcs[:, 1], P.arcs[:, 2]
     both = (g[s] >= 0) & (g[d] >= 0)
@@ -252,10 +253,10 @@ def test_examples_with_no_model_are_not_proven():
 def test_fig3_13_twelve_regions_in_fill_order():
     """Fig. 3.13 lists R1..R12: a 2x2 region filled in the figure's order (bottom-left,
     bottom-right, top-left) holding 1, 2 or 3 labels with a non-empty catalog: 2 + 4 + 6."""
-    from csplab import Problem
     from csplab.catalog import Propagator
+    from csplab.grids import from_example
 
-    P = Problem.from_example(load_example("line"), (2, 2))
+    P = from_example(load_example("line"), (2, 2))
     fill = [(0, 0), (1, 0), (0, 1)]
     counts = []
     for k in range(1, 4):

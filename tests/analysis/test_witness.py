@@ -7,12 +7,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from csplab import Problem, solve
+from csplab import solve
 from csplab.analysis import alg31_exhaustive, find_failure, replay
 from csplab.catalog import Propagator
 from csplab.engine.completability import SearchCompletability, first_inconsistent_prefix
 from csplab.errors import InputError
 from csplab.examples import load_example
+from csplab.grids import from_example, with_fixed
 from csplab.testing.brute import exact_catalog, satisfiable
 from csplab.testing.strategies import analysis_examples
 
@@ -34,10 +35,10 @@ def test_fig3_5a_witness_like_fig3_5efg():  # I4
     assert replay(E, w).holds
     # the last label was outside C* but inside C, and C emptied at once (Fig. 3.5(e-g))
     assert w["first_outside_cstar"] == w["fail_step"] and w["detection_delay"] == 0
-    P = Problem.from_example(E, tuple(w["shape"]))
+    P = from_example(E, tuple(w["shape"]))
     t = w["fail_step"] - 1
     partial = prefix_grid(P.shape, w["choices"], t)
-    eng = Propagator(P.with_fixed(partial))
+    eng = Propagator(with_fixed(P, partial))
     cell = P.cell(tuple(w["choices"][t][0]))
     C = set(eng.domain(cell).tolist())
     Cs = set(np.flatnonzero(exact_catalog(P, partial)[cell]).tolist())
@@ -55,14 +56,14 @@ def test_fig3_5a_random_order_witness_has_a_seed():
     v = find_failure(E, order="random", max_size=(6, 3), random_runs=100, rng=3)
     assert v.holds is False
     assert "seed" in v.witness and replay(E, v.witness).holds
-    r = solve(Problem.from_example(E, tuple(v.witness["shape"])), "catalog",
+    r = solve(from_example(E, tuple(v.witness["shape"])), "catalog",
               rng=v.witness["seed"], order="random")  # fmt: skip
     assert r.status == "failed"
 
 
 def test_fig3_6a_late_detection():  # I7
     E = load_example("fig3_6a")
-    P = Problem.from_example(E, (9, 3))
+    P = from_example(E, (9, 3))
     v = alg31_exhaustive(P, FIG, late=True)
     assert v.holds is False
     w = {"shape": [9, 3], "order": FIG, "choices": v.witness}
@@ -71,7 +72,7 @@ def test_fig3_6a_late_detection():  # I7
     assert t < len(v.witness)  # C not yet empty when the model became inconsistent
     assert satisfiable(P, prefix_grid(P.shape, v.witness, t - 1)) is True
     assert satisfiable(P, prefix_grid(P.shape, v.witness, t)) is False
-    eng = Propagator(P.with_fixed(prefix_grid(P.shape, v.witness, t)))
+    eng = Propagator(with_fixed(P, prefix_grid(P.shape, v.witness, t)))
     assert eng.ok
     choices = [[P.cell(tuple(c)), b] for c, b in v.witness]
     # 0-based index of the bad choice; the witness counts choices from 1
@@ -88,7 +89,7 @@ def test_fig3_6a_is_fallible_in_figure_order():
 
 def test_bad_orders():
     with pytest.raises(InputError):
-        alg31_exhaustive(Problem.from_example(load_example("line"), (2, 2)), "random")
+        alg31_exhaustive(from_example(load_example("line"), (2, 2)), "random")
     with pytest.raises(InputError):
         find_failure(load_example("line"), order="diagonal")
 
@@ -112,13 +113,13 @@ def test_find_failure_witnesses_replay_and_bounds_hold(E, order):
         assert replay(E, v.witness).holds
         t = v.witness.get("first_outside_cstar")
         if t is not None:
-            P = Problem.from_example(E, tuple(v.witness["shape"]))
+            P = from_example(E, tuple(v.witness["shape"]))
             ch = v.witness["choices"]
             assert satisfiable(P, prefix_grid(P.shape, ch, t - 1)) is True
             assert satisfiable(P, prefix_grid(P.shape, ch, t)) is False
     elif v.holds is True:
         for shape in [(2, 2), (3, 2), (2, 3), (3, 3)]:
-            P = Problem.from_example(E, shape)
+            P = from_example(E, shape)
             for seed in range(5):
                 assert solve(P, "catalog", rng=seed, order=order).status == "solved"
 
@@ -137,7 +138,7 @@ def test_3d_witness_with_defaults_in_a_few_seconds():
     assert int(np.prod(w["shape"])) <= int(np.prod(st["found_on"]))  # shrunk (or kept)
     t = w["first_outside_cstar"]
     assert t is not None and w["detection_delay"] == w["fail_step"] - t
-    P = Problem.from_example(E, tuple(w["shape"]), boundary="auto")
+    P = from_example(E, tuple(w["shape"]), boundary="auto")
     ch = w["choices"]
     assert satisfiable(P, prefix_grid(P.shape, ch, t - 1)) is True
     assert satisfiable(P, prefix_grid(P.shape, ch, t)) is False
@@ -207,6 +208,6 @@ def test_3d_window_shrink_finds_failures_seeds_miss(seed):
     v = find_failure(E, time_limit=10, rng=seed, max_states=0)
     assert v.holds is False and replay(E, v.witness).holds
     assert int(np.prod(v.stats["found_on"])) >= 800 and int(np.prod(v.witness["shape"])) <= 60
-    P = Problem.from_example(E, tuple(v.witness["shape"]))
+    P = from_example(E, tuple(v.witness["shape"]))
     fails = sum(solve(P, "catalog", rng=s).status != "solved" for s in range(200))
     assert fails < 20  # a window, not a size where random runs fail anyway

@@ -10,11 +10,11 @@ import sys
 import numpy as np
 import pytest
 
-from csplab import Problem
 from csplab.baselines import BASELINES, run_baseline
 from csplab.baselines.texture import _offsets, efros_leung
 from csplab.errors import InputError
 from csplab.examples import load_example
+from csplab.grids import from_example
 
 
 def test_causal_offsets_are_the_cells_already_grown() -> None:
@@ -39,7 +39,7 @@ def test_violations_are_counted_by_the_one_checker() -> None:
     with a 5-wide window it breaks arcs that model synthesis never breaks."""
     E = load_example("castle")
     g = efros_leung(E, (24, 24, 8), window=5, rng=2)
-    assert len(Problem.from_example(E, (24, 24, 8)).violations(g)) > 0
+    assert len(from_example(E, (24, 24, 8)).violations(g)) > 0
 
 
 def test_bad_options_are_one_line() -> None:
@@ -80,7 +80,7 @@ def test_graphcut_patches(name: str) -> None:
     assert a.shape == size and int(a.min()) >= 0
     assert set(np.unique(a).tolist()) <= set(np.unique(E.labels).tolist())
     assert np.array_equal(a, graphcut(E, size, patch=4, overlap=2, rng=3))
-    assert len(Problem.from_example(E, size).violations(a)) >= 0
+    assert len(from_example(E, size).violations(a)) >= 0
     with pytest.raises(InputError, match="overlap"):
         graphcut(E, size, patch=4, overlap=4)
 
@@ -91,4 +91,4 @@ def test_graphcut_seams_follow_the_cheapest_cut() -> None:
     pytest.importorskip("maxflow")
     E = load_example("fig3_1b")  # checkerboard
     g = run_baseline("texture", E, (12, 12), rng=1, method="graphcut", patch=2, overlap=1)
-    assert len(Problem.from_example(E, (12, 12)).violations(g)) == 0
+    assert len(from_example(E, (12, 12)).violations(g)) == 0

@@ -156,10 +156,10 @@ def test_experiment_time_limit_must_be_positive(capsys, tmp_path, value):
 @pytest.mark.parametrize("value", [0, -1.0, float("nan"), float("inf"), "0", True])
 def test_solver_time_limit_must_be_positive_and_finite(value):
     from csplab import load_example
-    from csplab.problem import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
-    P = Problem.from_example(load_example("line"), (6, 4))
+    P = from_example(load_example("line"), (6, 4))
     with pytest.raises(InputError, match="time_limit must be a positive number of seconds"):
         solve(P, "catalog", rng=0, time_limit=value)
     assert solve(P, "catalog", rng=0, time_limit=5).status == "solved"
@@ -232,10 +232,10 @@ def test_size_cap_is_documented():
 # ---------------------------------------------------------------------------- -1 grids and .vox
 def _partial_grid(tmp_path, shape=(6, 4)):
     from csplab import load_example
-    from csplab.problem import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
-    r = solve(Problem.from_example(load_example("line"), shape), "catalog", rng=0)
+    r = solve(from_example(load_example("line"), shape), "catalog", rng=0)
     g = np.array(r.grid, dtype=np.int32)
     g[0, 0] = -1
     g[2, 1] = -1
@@ -281,12 +281,12 @@ def test_show_draws_unassigned_cells(capsys, tmp_path):
 
 def test_check_reads_its_own_vox(capsys, tmp_path):
     from csplab import load_example
+    from csplab.grids import from_example
     from csplab.io import write_labels
-    from csplab.problem import Problem
     from csplab.solvers import solve
 
     city = load_example("city")
-    P = Problem.from_example(city, (6, 6, 5), boundary="auto")
+    P = from_example(city, (6, 6, 5), boundary="auto")
     r = solve(P, "catalog", rng=1)
     assert r.status == "solved"
     v = tmp_path / "city.vox"
@@ -336,14 +336,14 @@ def test_count_solutions_time_limit(method):
     from csplab import load_example
     from csplab.count import CountTimeoutError, count_solutions
     from csplab.deps import available
-    from csplab.problem import Problem
+    from csplab.grids import from_example
 
     if method == "ganak" and not available("pyganak"):
         pytest.skip("pyganak not installed")
     line = load_example("line")
-    small = Problem.from_example(line, (4, 3))
+    small = from_example(line, (4, 3))
     assert count_solutions(small, method, time_limit=30) == 625
-    big = Problem.from_example(line, (30, 30))
+    big = from_example(line, (30, 30))
     with pytest.raises(CountTimeoutError, match=method) as e:
         count_solutions(big, method, time_limit=1e-6)
     assert isinstance(e.value, CsplabError) and isinstance(e.value, TimeoutError)

@@ -69,9 +69,10 @@ def test_options_that_do_not_apply_are_rejected(capsys):
 def test_original_model_in_merrells_format(capsys, tmp_path):
     """Users have the thesis' models as Merrell-format .txt files: --example takes them."""
     from csplab.examples import load_example
+    from csplab.io import write_example
 
     path = tmp_path / "castle.txt"
-    load_example("castle").save(path)
+    write_example(load_example("castle"), path)
     code, out, _ = run(capsys, "experiment", "fig3_8", "--example", str(path), "--sizes", "6",
                        "--nz", "4", "--seeds", "3", "--store", str(tmp_path / "r.sqlite"),
                        "--out", str(tmp_path / "o"), "--jobs", "1", "--no-progress",
@@ -82,7 +83,7 @@ def test_original_model_in_merrells_format(capsys, tmp_path):
     assert row["example"] == path.stem and row["size"] == "6x6x4"  # the path: in the config
     # trials are identified by the example's content hash, not by its name or path
     grid = tmp_path / "castle.grid"
-    load_example("castle").save(grid)
+    write_example(load_example("castle"), grid)
     args = ["--sizes", "6", "--nz", "4", "--seeds", "3", "--store", str(tmp_path / "s.sqlite"),
             "--out", str(tmp_path / "o"), "--jobs", "1", "--no-progress", "--no-figures",
             "--json"]  # fmt: skip

@@ -4,10 +4,11 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel
 from csplab.complexity.grammar import RegularGrammar, abc_example, abc_figure, abc_rows_ok
 from csplab.count import count_solutions
 from csplab.engine.sat import enumerate_solutions
+from csplab.grids import from_example
 from csplab.testing.strategies import example_models
 
 FACES = {f: 0 for f in ("x-", "x+", "y-", "y+")}
@@ -15,7 +16,7 @@ FACES = {f: 0 for f in ("x-", "x+", "y-", "y+")}
 
 @pytest.mark.parametrize("shape", [(5, 5), (8, 7), (9, 9), (11, 9), (8, 12)])
 def test_every_consistent_model_has_only_abc_rows(shape):
-    P = Problem.from_example(abc_example(), shape, boundary=FACES)
+    P = from_example(abc_example(), shape, boundary=FACES)
     n, sizes = 0, set()
     for g in enumerate_solutions(P):
         sizes.update(abc_rows_ok(g))
@@ -29,12 +30,12 @@ def test_figures_are_consistent_and_other_rows_are_not():
     E = abc_example()
     for i in (1, 2, 3, 5):
         g = abc_figure(i)
-        assert Problem.from_example(E, g.shape, boundary=FACES).is_solution(g)
+        assert from_example(E, g.shape, boundary=FACES).is_solution(g)
     g = abc_figure(3)
     g[7, 4] = 0  # drop the last c: the row is a^3 b^3 c^2
     with pytest.raises(ValueError, match="not a\\^i"):
         abc_rows_ok(g)
-    assert not Problem.from_example(E, g.shape, boundary=FACES).is_solution(g)
+    assert not from_example(E, g.shape, boundary=FACES).is_solution(g)
 
 
 @settings(max_examples=30)
@@ -43,7 +44,7 @@ def test_regular_grammar_generates_exactly_the_consistent_models(E):
     G = RegularGrammar.from_example(E)
     counts = G.count(12)
     for n in range(1, 13):
-        P = Problem.from_example(E, (n,))
+        P = from_example(E, (n,))
         c = int(count_solutions(P))
         assert counts[n] == c
         if c <= 3000:

@@ -6,10 +6,11 @@ def test_min_domain_is_mrv_whatever_the_choice():
     is exactly ``min-entropy``; with a weighted choice it still ignores the weights."""
     import numpy as np
 
-    from csplab import Problem, solve
+    from csplab import solve
     from csplab.examples import load_example
+    from csplab.grids import from_example
 
-    P = Problem.from_example(load_example("castle"), (10, 10, 6), boundary="auto")
+    P = from_example(load_example("castle"), (10, 10, 6), boundary="auto")
     for seed in range(3):
         a = solve(P, "catalog", rng=seed, order="min-domain")
         b = solve(P, "catalog", rng=seed, order="min-entropy")

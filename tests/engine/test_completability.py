@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, solve
+from csplab import ExampleModel, solve
 from csplab.deps import available
 from csplab.engine.completability import (
     Completability,
@@ -21,6 +21,7 @@ from csplab.engine.completability import (
 )
 from csplab.errors import InputError
 from csplab.examples import load_example
+from csplab.grids import from_example
 from csplab.testing import brute
 from csplab.testing.strategies import csp_problems
 
@@ -58,7 +59,7 @@ def test_completable_equals_brute_force(P, seed):
 
 
 def test_contradictions_and_labels_outside_the_domain():
-    P = Problem.from_example(FALLIBLE, (3, 3))
+    P = from_example(FALLIBLE, (3, 3))
     for o in _oracles(P):
         assert o.completable([0, 0], [0, 2]) is False  # one cell, two labels
         assert o.completable([0, 0], [0, 0]) is brute.satisfiable(P, _partial(P, [0], [0]))
@@ -68,7 +69,7 @@ def test_contradictions_and_labels_outside_the_domain():
 
 
 def test_fix_adds_the_partial_model_to_every_query():
-    P = Problem.from_example(FALLIBLE, (4, 4))
+    P = from_example(FALLIBLE, (4, 4))
     sols = list(brute.solutions(P))
     g = sols[len(sols) // 2].reshape(-1)
     for o in _oracles(P):
@@ -90,7 +91,7 @@ def _linear_first_bad(P, ch):
 def test_first_inconsistent_prefix_is_the_linear_scan(seed):
     from csplab.engine.alg31 import run_alg31
 
-    P = Problem.from_example(FALLIBLE, (4, 4))
+    P = from_example(FALLIBLE, (4, 4))
     r = run_alg31(P, np.random.default_rng(seed), order="scanline")
     ch = np.asarray(r.trace, dtype=np.int64)
     want = _linear_first_bad(P, ch)
@@ -103,7 +104,7 @@ def test_first_inconsistent_prefix_is_the_linear_scan(seed):
 
 
 def test_first_inconsistent_prefix_edges():
-    P = Problem.from_example(FALLIBLE, (3, 3))
+    P = from_example(FALLIBLE, (3, 3))
     o = SearchCompletability(P)
     assert first_inconsistent_prefix(o, np.zeros((0, 2), dtype=np.int64)) is None
     assert first_inconsistent_prefix(o, [], full_inconsistent=True) is None
@@ -137,7 +138,7 @@ def test_catalog_at_equals_brute_force(P, seed):
 
 
 def test_catalog_at_shows_fig3_5():
-    P = Problem.from_example(load_example("fig3_5a"), (3, 3))
+    P = from_example(load_example("fig3_5a"), (3, 3))
     cells = [P.cell((0, 0)), P.cell((1, 0))]
     o = SearchCompletability(P)
     o.fix(cells, [2, 0])
@@ -159,7 +160,7 @@ def test_search_solutions_is_the_reference_enumeration(P):
 
 
 def test_make_completability():
-    P = Problem.from_example(FALLIBLE, (3, 3))
+    P = from_example(FALLIBLE, (3, 3))
     assert make_completability(P, "search", max_nodes=5).max_nodes == 5
     assert make_completability(P).name in ("sat", "search")
     with pytest.raises(InputError):
@@ -171,7 +172,7 @@ def test_sat_completability_wraps_an_oracle_and_matches_the_sat_solver():
     from csplab.complexity import complete_model
     from csplab.engine.sat import SatOracle
 
-    P = Problem.from_example(load_example("fig3_6a"), (9, 5))
+    P = from_example(load_example("fig3_6a"), (9, 5))
     with SatOracle(P) as raw:
         c = SatCompletability(P, oracle=raw)
         assert c.completable([0], [0]) is True

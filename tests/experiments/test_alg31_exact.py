@@ -3,11 +3,12 @@ from fractions import Fraction
 import numpy as np
 from hypothesis import given, settings
 
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel
 from csplab.errors import InputError
 from csplab.experiments import run
 from csplab.experiments.alg31_exact import alg31_distribution
 from csplab.experiments.stats import wilson
+from csplab.grids import from_example
 from csplab.testing import brute
 from csplab.testing.strategies import example_models
 
@@ -17,7 +18,7 @@ from csplab.testing.strategies import example_models
 def test_every_consistent_model_has_positive_probability(E):
     """Sec. 3.3.6: 'there is always a tiny chance that a given model M consistent with E
     could be produced' by Alg. 3.1 -- exactly: its outputs are the solutions."""
-    P = Problem.from_example(E, (3, 3))
+    P = from_example(E, (3, 3))
     try:
         d = alg31_distribution(P, max_leaves=20_000)
     except InputError:
@@ -32,7 +33,7 @@ def test_every_consistent_model_has_positive_probability(E):
 
 def test_harness_success_rate_agrees_with_the_exact_probability(tmp_path, fallible_npy):
     E = ExampleModel(np.load(fallible_npy))
-    exact = alg31_distribution(Problem.from_example(E, (4, 4))).success
+    exact = alg31_distribution(from_example(E, (4, 4))).success
     assert exact == Fraction(1, 3)
     _, rep = run("fig3_8", examples=[str(fallible_npy)], sizes=[4], seeds=600, boundary="none",
                  store=tmp_path / "r.sqlite", out=tmp_path, jobs=1, progress=False,

@@ -40,16 +40,16 @@ def test_alg31_can_build_the_large_square_of_fig3_10h():
     of side m keep the smaller side of every rectangle at most m (test above)."""
     import numpy as np
 
-    from csplab import Problem
     from csplab.catalog import Propagator
     from csplab.examples import load_example
+    from csplab.grids import from_example
 
     E = load_example("fig3_10").labels
     M = np.zeros((14, 14), dtype=np.int32)
     M[1:13, 1:13] = E[2, 2]  # interior
     M[1:13, 1], M[1:13, 12], M[1, 1:13], M[12, 1:13] = E[2, 1], E[2, 4], E[1, 2], E[4, 2]
     M[1, 1], M[12, 1], M[1, 12], M[12, 12] = E[1, 1], E[4, 1], E[1, 4], E[4, 4]
-    P = Problem.from_example(load_example("fig3_10"), (14, 14))
+    P = from_example(load_example("fig3_10"), (14, 14))
     assert P.is_solution(M)
     eng = Propagator(P)
     for cell in range(P.n):  # Alg. 3.1's scan-line order

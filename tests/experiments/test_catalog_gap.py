@@ -1,7 +1,8 @@
 import numpy as np
 
-from csplab import Problem, solve
+from csplab import solve
 from csplab.experiments import ResultsStore, run
+from csplab.grids import from_example
 from csplab.io import read_example
 from csplab.testing.brute import solutions
 
@@ -30,7 +31,7 @@ def test_first_bad_step_and_per_step_gap_agree_with_brute_force(tmp_path, fallib
             assert st_["bad_choice"] == 0 and st_["gap_steps"] >= 0
             continue
         size = tuple(int(v) for v in r["size"].split("x"))
-        P = Problem.from_example(E, size)
+        P = from_example(E, size)
         res = solve(P, "catalog", rng=r["seed"], **r["params"]["options"])
         k = st_["first_bad"]
         assert 1 <= k <= st_["fail_step"] == res.trace.shape[0]
@@ -86,7 +87,7 @@ def test_fig3_6_inconsistency_can_show_late():
     from csplab.engine.completability import SearchCompletability, first_inconsistent_prefix
     from csplab.examples import load_example
 
-    P = Problem.from_example(load_example("fig3_6a"), (9, 3))
+    P = from_example(load_example("fig3_6a"), (9, 3))
     eng = Propagator(P)
     trace = []
     for x, b in enumerate([0, 0, 2, 0, 2, 0, 2, 0, 0]):

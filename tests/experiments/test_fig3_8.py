@@ -3,11 +3,12 @@ import gzip
 
 import pytest
 
-from csplab import Problem, solve
+from csplab import solve
 from csplab.errors import InputError
 from csplab.examples import load_example
 from csplab.experiments import get_experiment, run
 from csplab.experiments.trial import grid_digest
+from csplab.grids import from_example
 
 
 def test_quick_run_rates_intervals_files_and_resume(tmp_path):
@@ -26,7 +27,7 @@ def test_quick_run_rates_intervals_files_and_resume(tmp_path):
     assert len(raw) == 16 and {r["solver"] for r in raw} == {"catalog"}
     # a stored trial is reproduced by its seed
     r = next(r for r in raw if r["example"] == "castle" and r["size"] == "8x8x4")
-    P = Problem.from_example(load_example("castle"), (8, 8, 4), boundary="auto")
+    P = from_example(load_example("castle"), (8, 8, 4), boundary="auto")
     again = solve(P, "catalog", rng=int(r["seed"]), order="scanline", choice="uniform")
     assert again.status == r["status"] and grid_digest(again.grid) == r["stats.grid"]
     # the same sweep again runs nothing; more seeds run only the new ones

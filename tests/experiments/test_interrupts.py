@@ -34,7 +34,7 @@ def _trials(n: int, solver: str = "sat", size: tuple[int, int] = (6, 6)) -> tupl
 
 
 def test_pysat_keyboard_interrupt_becomes_keyboard_interrupt(monkeypatch: Any) -> None:
-    from csplab.problem import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
     def raw(self: Any, *a: Any) -> bool:
@@ -42,11 +42,11 @@ def test_pysat_keyboard_interrupt_becomes_keyboard_interrupt(monkeypatch: Any) -
 
     monkeypatch.setattr(sat.SatOracle, "_raw", raw)
     with pytest.raises(KeyboardInterrupt):
-        solve(Problem.from_example(load_example("line"), (5, 5)), "sat", rng=0)
+        solve(from_example(load_example("line"), (5, 5)), "sat", rng=0)
 
 
 def test_other_solver_errors_are_not_interrupts(monkeypatch: Any) -> None:
-    from csplab.problem import Problem
+    from csplab.grids import from_example
     from csplab.solvers import solve
 
     def raw(self: Any, *a: Any) -> bool:
@@ -54,7 +54,7 @@ def test_other_solver_errors_are_not_interrupts(monkeypatch: Any) -> None:
 
     monkeypatch.setattr(sat.SatOracle, "_raw", raw)
     with pytest.raises(_PysolversError):
-        solve(Problem.from_example(load_example("line"), (5, 5)), "sat", rng=0)
+        solve(from_example(load_example("line"), (5, 5)), "sat", rng=0)
 
 
 def test_ctrl_c_stops_a_one_process_sweep(monkeypatch: Any, tmp_path: Path) -> None:

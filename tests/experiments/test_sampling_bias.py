@@ -1,8 +1,8 @@
 import numpy as np
 
-from csplab import Problem
 from csplab.experiments import ResultsStore, run
 from csplab.experiments.measures import label_counts
+from csplab.grids import from_example
 from csplab.io import read_example
 from csplab.testing.brute import solutions
 
@@ -16,7 +16,7 @@ def test_exact_row_is_the_brute_force_average_and_bias_is_detected(tmp_path, fal
     assert not s.errors
     with ResultsStore(db) as st:
         exact = next(r for r in st.rows("sampling_bias") if r["solver"] == "exact")
-    P = Problem.from_example(read_example(fallible_npy), (5, 3))
+    P = from_example(read_example(fallible_npy), (5, 3))
     sols = list(solutions(P))
     want = np.mean([label_counts(g, P.K) for g in sols], axis=0)
     assert np.allclose(exact["stats"]["labels"], want)

@@ -6,10 +6,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem
+from csplab import ExampleModel, grids
 from csplab.errors import InputError
 from csplab.experiments.measures import label_counts, pattern_counts
 from csplab.experiments.uniform import StripSampler
+from csplab.grids import from_example
 from csplab.testing import brute
 from csplab.testing.strategies import example_models
 
@@ -19,7 +20,7 @@ from csplab.testing.strategies import example_models
        st.sampled_from(["none", "faces"]))  # fmt: skip
 def test_counts_and_frequencies_match_brute_force(E, L, w, bnd):
     boundary = {"x-": 0, "y+": 0} if bnd == "faces" else None
-    P = Problem.from_example(E, (L, w), boundary=boundary)
+    P = from_example(E, (L, w), boundary=boundary)
     S = StripSampler(P)
     sols = list(brute.solutions(P))
     assert S.count() == len(sols)
@@ -44,7 +45,7 @@ def test_counts_and_frequencies_match_brute_force(E, L, w, bnd):
 
 def test_samples_are_uniform():
     E = ExampleModel([[0, 0, 0], [1, 2, 2], [0, 1, 2]])
-    P = Problem.from_example(E, (4, 3))
+    P = from_example(E, (4, 3))
     S = StripSampler(P)
     n = S.count()
     assert 5 < n < 100
@@ -62,8 +63,8 @@ def test_samples_are_uniform():
 def test_refuses_wide_or_wrapped_problems():
     E = ExampleModel([[0, 1], [1, 0]])
     with pytest.raises(InputError, match="neighbours"):
-        StripSampler(Problem.from_example(E, (4, 4), periodic=True))
-    anything = Problem.grid((3, 9), np.ones((2, 2, 2), dtype=bool))  # 512 states per slice
+        StripSampler(from_example(E, (4, 4), periodic=True))
+    anything = grids.grid((3, 9), np.ones((2, 2, 2), dtype=bool))  # 512 states per slice
     with pytest.raises(InputError, match="states"):
         StripSampler(anything, max_states=10)
-    assert StripSampler(Problem.grid((3, 4), np.ones((2, 2, 2), dtype=bool))).count() == 2**12
+    assert StripSampler(grids.grid((3, 4), np.ones((2, 2, 2), dtype=bool))).count() == 2**12

@@ -92,7 +92,7 @@ def test_results_carry_the_object_table(tmp_path):
     E = read_example(src)
     trailer = E.meta["merrell_trailer"]
     assert trailer.startswith("<Objects>\n0 ground.obj")
-    r = csplab.solve(csplab.Problem.from_example(E, (5, 4, 2)), "catalog", rng=1)
+    r = csplab.solve(csplab.from_example(E, (5, 4, 2)), "catalog", rng=1)
     assert r.ok
     out = tmp_path / "out.txt"
     write_labels(r.grid, out, name=E.name, model=E)

@@ -11,7 +11,8 @@ import pytest
 from csplab.cli import main
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
-from csplab.io import load_model, model_format, read_example, read_model, write_labels
+from csplab.examples import load_model
+from csplab.io import model_format, read_example, read_model, write_labels
 from csplab.io.registry import (
     BEGIN,
     END,

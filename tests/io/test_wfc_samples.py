@@ -268,19 +268,19 @@ def test_cli_missing_file_is_one_line(wfc, capsys):
 
 # ---------------------------------------------------------------------------- notice
 def test_slow_reads_get_one_notice_line_and_quick_ones_none(wfc, capsys, monkeypatch):
-    import csplab.io
+    import csplab.examples
     from csplab import progress
     from csplab.cli.common import load_model
 
     load_model(str(wfc), {"name": "Flowers"})
     assert capsys.readouterr().err == ""  # quick: nothing
-    real = csplab.io.load_model
+    real = csplab.examples.load_model
 
     def slow(spec, options=None):
         time.sleep(0.5)
         return real(spec, options)
 
-    monkeypatch.setattr(csplab.io, "load_model", slow)
+    monkeypatch.setattr(csplab.examples, "load_model", slow)
     monkeypatch.setattr(progress, "DELAY_S", 0.05)
     m = load_model(str(wfc), {"name": "Flowers"})
     assert m.name == "Flowers"

@@ -16,6 +16,7 @@ pytest.importorskip("clingo")
 from csplab import ExampleModel, Problem, solve
 from csplab.cnf import encode
 from csplab.errors import CsplabError, DependencyError, InputError
+from csplab.grids import from_example, with_fixed
 from csplab.solvers import REGISTRY, STATS
 from csplab.solvers.asp import AspSolver, _run_child, facts, ground_program
 from csplab.testing.brute import count, solutions
@@ -94,7 +95,7 @@ def test_passes_the_conformance_suite_checks():
     rng = np.random.default_rng(1)
     for _ in range(8):
         E = ExampleModel(rng.integers(0, 3, size=(3, 3)))
-        P = Problem.from_example(E, (4, 3), fixed={(0, 0): int(rng.integers(0, 3))})
+        P = from_example(E, (4, 3), fixed={(0, 0): int(rng.integers(0, 3))})
         check_solver_on("asp", {}, P, int(rng.integers(1000)))
 
 
@@ -143,20 +144,20 @@ def test_answer_sets_are_exactly_the_solutions(grounding, encoding, supports, P)
 
 def _variants():
     E = ExampleModel([[0, 0, 1, 2], [0, 1, 2, 2], [1, 2, 2, 0], [0, 0, 0, 0]])
-    yield "plain", Problem.from_example(E, (9, 7))
-    yield "periodic", Problem.from_example(E, (8, 8), periodic=True)
-    yield "periodic x only", Problem.from_example(E, (8, 6), periodic=(True, False))
-    yield "fixed", Problem.from_example(E, (9, 7), fixed={(0, 0): 1, (4, 3): 2, (8, 6): 0})
+    yield "plain", from_example(E, (9, 7))
+    yield "periodic", from_example(E, (8, 8), periodic=True)
+    yield "periodic x only", from_example(E, (8, 6), periodic=(True, False))
+    yield "fixed", from_example(E, (9, 7), fixed={(0, 0): 1, (4, 3): 2, (8, 6): 0})
     mask = np.ones((9, 7, E.K), dtype=bool)
     mask[3:6, 2:5, 0] = False
-    yield "mask", Problem.from_example(E, (9, 7), mask=mask)
-    P = Problem.from_example(E, (7, 7))
+    yield "mask", from_example(E, (9, 7), mask=mask)
+    P = from_example(E, (7, 7))
     idx = np.arange(49).reshape(7, 7)
     differ = ~np.eye(E.K, dtype=bool)
     yield "diagonal arcs", P.add_arcs(differ, idx[:-1, :-1].ravel(), idx[1:, 1:].ravel(), "diag")
     T = box_town(2, rng=0)
-    yield "3D boundary auto", Problem.from_example(T, (8, 8, 5), boundary="auto")
-    yield "3D periodic fixed", Problem.from_example(T, (6, 6, 4), periodic=(True, True, False),
+    yield "3D boundary auto", from_example(T, (8, 8, 5), boundary="auto")
+    yield "3D periodic fixed", from_example(T, (6, 6, 4), periodic=(True, True, False),
                                                     fixed={(2, 2, 0): 1})  # fmt: skip
 
 
@@ -176,7 +177,7 @@ def test_grid_variants_agree_with_backtracking(what, P):
 
 
 def test_fixed_cell_conflict_wiped_out_by_arc_consistency():
-    P = Problem.from_example(CHECKER, (3, 3), fixed={(0, 0): 0, (0, 1): 0})
+    P = from_example(CHECKER, (3, 3), fixed={(0, 0): 0, (0, 1): 0})
     r = solve(P, "asp", rng=0)
     assert r.status == "unsat"
     assert "arc-consistency wipe-out" in r.stats["proof"]
@@ -190,7 +191,7 @@ def _clique_colouring(n, colours, fixed=None):
     arcs = [(u, v, 0) for u in range(n) for v in range(u + 1, n)]
     eq = np.eye(colours, dtype=bool)
     P = Problem((n,), np.ones((n, colours), dtype=bool), [~eq], arcs)
-    return P if fixed is None else P.with_fixed(fixed)
+    return P if fixed is None else with_fixed(P, fixed)
 
 
 @pytest.mark.parametrize(
@@ -198,7 +199,7 @@ def _clique_colouring(n, colours, fixed=None):
     [
         _clique_colouring(4, 3, {(0,): 0}),
         _clique_colouring(5, 4, {(2,): 3}),
-        Problem.from_example(CHECKER, (5, 4), periodic=True),  # odd cycle
+        from_example(CHECKER, (5, 4), periodic=True),  # odd cycle
     ],
     ids=["K4 3 colours fixed", "K5 4 colours fixed", "odd periodic checkerboard"],
 )
@@ -232,8 +233,8 @@ def test_time_limit_cancels_the_search():
 
 @pytest.mark.parametrize("limit", [0.3, 1.5])
 def test_time_limit_while_grounding_a_large_problem(limit):
-    big = Problem.from_example(box_town(2, rng=0), (30, 30, 8))  # 1.7 million rules
-    solve(Problem.from_example(box_town(1, rng=0), (3, 3, 3)), "asp", rng=0)  # load kernels
+    big = from_example(box_town(2, rng=0), (30, 30, 8))  # 1.7 million rules
+    solve(from_example(box_town(1, rng=0), (3, 3, 3)), "asp", rng=0)  # load kernels
     t0 = time.perf_counter()
     r = solve(big, "asp", rng=0, time_limit=limit)
     wall = time.perf_counter() - t0
@@ -246,7 +247,7 @@ def test_time_limit_while_grounding_a_large_problem(limit):
 
 
 def test_same_seed_same_grid_different_seeds_differ():
-    P = Problem.from_example(box_town(2, rng=0), (12, 12, 6), boundary="auto")
+    P = from_example(box_town(2, rng=0), (12, 12, 6), boundary="auto")
     a, b, c = (solve(P, "asp", rng=s) for s in (7, 7, 8))
     assert a.ok and b.ok and c.ok
     assert np.array_equal(a.grid, b.grid)
@@ -259,7 +260,7 @@ def test_same_seed_same_grid_different_seeds_differ():
 
 
 def test_seed_is_drawn_from_rng_only():
-    P = Problem.from_example(CHECKER, (4, 4))
+    P = from_example(CHECKER, (4, 4))
     np.random.seed(1)  # noqa: NPY002 - the global RNG must not matter
     a = solve(P, "asp", rng=5).stats["solver_stats"]["seed"]
     np.random.seed(2)  # noqa: NPY002
@@ -271,14 +272,14 @@ def test_seed_is_drawn_from_rng_only():
 
 
 def test_arc_consistency_alone_solves_it_without_clingo():
-    P = Problem.from_example(ExampleModel([0, 1, 2]), (3,))
+    P = from_example(ExampleModel([0, 1, 2]), (3,))
     r = solve(P, "asp", rng=0)
     assert r.ok and r.grid.tolist() == [0, 1, 2]
     assert r.stats["solve_s"] == 0.0 and "solver_stats" not in r.stats
 
 
 def test_stats():
-    P = Problem.from_example(box_town(2, rng=0), (6, 6, 4))
+    P = from_example(box_town(2, rng=0), (6, 6, 4))
     s = solve(P, "asp", rng=0).stats
     assert s["rules"] > s["x_vars"] > 0 and s["atoms"] == s["x_vars"]
     assert s["ground_s"] >= s["encode_s"] and s["solve_s"] > 0
@@ -287,7 +288,7 @@ def test_stats():
 
 
 def test_options_are_checked():
-    P = Problem.from_example(CHECKER, (3, 3))
+    P = from_example(CHECKER, (3, 3))
     with pytest.raises(InputError, match="unknown option"):
         solve(P, "asp", rng=0, order="scanline")
     with pytest.raises(InputError, match="no backends"):
@@ -298,7 +299,7 @@ def test_options_are_checked():
 
 def test_missing_clingo_is_one_dependency_error(monkeypatch):
     monkeypatch.setitem(sys.modules, "clingo", None)
-    P = Problem.from_example(CHECKER, (3, 3))
+    P = from_example(CHECKER, (3, 3))
     with pytest.raises(DependencyError, match=r"csplab\[asp\]"):
         AspSolver().solve(P, rng=np.random.default_rng(0), seed=0)
 
@@ -316,6 +317,6 @@ def test_a_child_crash_is_an_error(monkeypatch):
     import csplab.solvers.asp as asp
 
     monkeypatch.setattr(asp, "_child_source", lambda: "import sys; sys.exit(3)")
-    P = Problem.from_example(box_town(2, rng=0), (5, 5, 3))
+    P = from_example(box_town(2, rng=0), (5, 5, 3))
     with pytest.raises(CsplabError, match="exited with code 3"):
         solve(P, "asp", rng=0)

@@ -3,8 +3,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, load_example, solve
+from csplab import ExampleModel, load_example, solve
 from csplab.errors import InputError, NoTrivialSolutionError
+from csplab.grids import from_example
 from csplab.solvers.blocks import block_starts, trivial_solution
 from csplab.testing.strategies import problems
 
@@ -49,22 +50,22 @@ def test_block_starts_cover_everything():
 
 def test_trivial_solution_layers_and_errors():
     E = ExampleModel(np.array([[[1, 0, 0]] * 2] * 2))  # ground below empty space
-    P = Problem.from_example(E, (4, 4, 3), boundary="auto")
+    P = from_example(E, (4, 4, 3), boundary="auto")
     g = trivial_solution(P)
     assert (g[:, :, 0] == 1).all() and (g[:, :, 1:] == 0).all()
     # no empty space: the checkerboard starts from an Alg. 3.1 run
-    g = trivial_solution(Problem.from_example(load_example("E1"), (4, 4)))
-    assert Problem.from_example(load_example("E1"), (4, 4)).is_solution(g)
+    g = trivial_solution(from_example(load_example("E1"), (4, 4)))
+    assert from_example(load_example("E1"), (4, 4)).is_solution(g)
     with pytest.raises(NoTrivialSolutionError, match="unsatisfiable"):
-        trivial_solution(Problem.from_example(load_example("E3"), (5, 5)))
+        trivial_solution(from_example(load_example("E3"), (5, 5)))
     # a parity constraint arc consistency cannot see: a checkerboard on an odd torus
-    P = Problem.from_example(load_example("E1"), (3, 3), periodic=True)
+    P = from_example(load_example("E1"), (3, 3), periodic=True)
     with pytest.raises(NoTrivialSolutionError, match="failed 5 times"):
         trivial_solution(P)
 
 
 def test_blocks_from_given_init_and_bad_init():
-    P = Problem.from_example(load_example("line"), (10, 8))
+    P = from_example(load_example("line"), (10, 8))
     init = solve(P, "catalog", rng=1).grid
     r = solve(P, "blocks", rng=2, init=init, block=4)
     assert r.ok and r.stats["init"] == "given"
@@ -80,7 +81,7 @@ def test_blocks_from_given_init_and_bad_init():
 def test_block_stats_and_timeout():
     # 6x6 blocks on 20 cells start every 3 cells, the last flush with the end:
     # 0, 3, 6, 9, 12, 14 -> 6 x 6 = 36 blocks
-    P = Problem.from_example(load_example("line"), (20, 20))
+    P = from_example(load_example("line"), (20, 20))
     r = solve(P, "blocks", rng=0, block=(6, 6))
     assert r.stats["blocks_tried"] == 36
     assert r.stats["acceptance_rate"] == r.stats["blocks_accepted"] / 36
@@ -88,7 +89,7 @@ def test_block_stats_and_timeout():
     # in any block: all 36 are accepted at the first attempt
     E = ExampleModel([[0, 0, 1, 1], [0, 0, 1, 1], [1, 1, 0, 0], [1, 1, 0, 0]])
     assert E.transitions().all()
-    r = solve(Problem.from_example(E, (20, 20)), "blocks", rng=0, block=(6, 6), retries=5)
+    r = solve(from_example(E, (20, 20)), "blocks", rng=0, block=(6, 6), retries=5)
     stats = {k: r.stats[k] for k in ("blocks_tried", "blocks_accepted", "retries")}
     assert stats == {"blocks_tried": 36, "blocks_accepted": 36, "retries": 0}
     t = solve(P, "blocks", rng=0, block=4, time_limit=1e-9)
@@ -103,7 +104,7 @@ def test_acceptance_and_retries_replay_alg31_attempts(shape):
     retries are the failed attempts before that one, and the output is that attempt's grid
     (or the untouched trivial solution). This example makes Alg. 3.1 fail often."""
     R = 3
-    P = Problem.from_example(ExampleModel(np.array([[0, 0, 0], [1, 2, 2], [0, 1, 2]])), shape)
+    P = from_example(ExampleModel(np.array([[0, 0, 0], [1, 2, 2], [0, 1, 2]])), shape)
     start = trivial_solution(P)
     seen = set()
     for seed in range(25):
@@ -147,7 +148,7 @@ def test_compiled_sweep_same_as_python_sweep(monkeypatch, name, shape, block, kw
         out = []
         for engine in ("interp", "kernels"):
             monkeypatch.setattr(_interp, "ENGINE", engine)
-            P = Problem.from_example(E, shape, **kw)
+            P = from_example(E, shape, **kw)
             calls: list[int] = []
 
             def counted(*a, calls=calls, **k):

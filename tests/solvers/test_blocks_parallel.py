@@ -6,10 +6,11 @@ import time
 import numpy as np
 import pytest
 
-from csplab import Problem, load_example, solve
+from csplab import load_example, solve
 from csplab.deps import available
 from csplab.engine import waves as wv
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.solvers.blocks import (
     _arc_index,
     _arcs_touching,
@@ -47,7 +48,7 @@ def _continuous(side=12):
 
 @pytest.fixture(scope="module")
 def castle():
-    return Problem.from_example(load_example("castle"), (30, 30, 10), boundary="auto")
+    return from_example(load_example("castle"), (30, 30, 10), boundary="auto")
 
 
 def test_same_output_for_one_and_two_workers_and_consistent(castle):
@@ -66,7 +67,7 @@ def test_same_output_for_one_and_two_workers_and_consistent(castle):
 
 
 def test_sweeps_and_odd_blocks_same_for_any_workers():
-    P = Problem.from_example(load_example("fig3_10"), (23, 19), boundary="auto")
+    P = from_example(load_example("fig3_10"), (23, 19), boundary="auto")
     a = solve(P, "blocks", rng=5, block=(5, 3), sweeps=2, order="random", workers=1)
     b = solve(P, "blocks", rng=5, block=(5, 3), sweeps=2, order="random", workers=2)
     assert a.status == "solved" and np.array_equal(a.grid, b.grid)
@@ -75,11 +76,11 @@ def test_sweeps_and_odd_blocks_same_for_any_workers():
 
 def test_workers_0_is_the_thesis_sweep_unchanged():
     # hashes of the sequential sweep before the wave schedule was added
-    P = Problem.from_example(load_example("fig3_10"), (60, 60), boundary="auto")
+    P = from_example(load_example("fig3_10"), (60, 60), boundary="auto")
     r = solve(P, "blocks", rng=3, block=10)
     assert hashlib.sha256(r.grid.tobytes()).hexdigest()[:16] == "b48226d91d3db9bc"
     assert np.array_equal(r.grid, solve(P, "blocks", rng=3, block=10, workers=0).grid)
-    P = Problem.from_example(load_example("castle"), (40, 40, 10), boundary="auto")
+    P = from_example(load_example("castle"), (40, 40, 10), boundary="auto")
     r = solve(P, "blocks", rng=2, block=10)
     assert hashlib.sha256(r.grid.tobytes()).hexdigest()[:16] == "f75bcf136c49c03a"
     assert r.stats["retries"] == 29
@@ -97,9 +98,9 @@ def test_workers_0_is_the_thesis_sweep_unchanged():
 )
 def test_every_wave_is_independent(name, shape, m, boundary):
     if boundary == "periodic":
-        P = Problem.from_example(load_example(name), shape, periodic=True)
+        P = from_example(load_example(name), shape, periodic=True)
     else:
-        P = Problem.from_example(load_example(name), shape, boundary=boundary)
+        P = from_example(load_example(name), shape, boundary=boundary)
     boxes, counts = _grid_blocks(P, m)
     schedule = _schedule(P, boxes, counts)
     # by neighbourhoods (the compiled blocks' test): the same waves
@@ -125,7 +126,7 @@ def test_every_wave_is_independent(name, shape, m, boundary):
 
 def test_colours_modulo_3_need_splitting_when_blocks_touch():
     # blocks of 3 cells step 1: blocks 0 and 3 are adjacent, so the class must split
-    P = Problem.from_example(load_example("fig3_10"), (9, 9), boundary="auto")
+    P = from_example(load_example("fig3_10"), (9, 9), boundary="auto")
     boxes, counts = _grid_blocks(P, (3, 3))
     cls0 = [boxes[i] for i in wv.colour_classes(counts)[0]]
     assert not wv.independent(P.arcs, P.n, cls0)
@@ -168,7 +169,7 @@ def test_option_errors_are_one_line(castle):
 
 
 def test_time_limit_holds_across_waves():
-    P = Problem.from_example(load_example("castle"), (60, 60, 10), boundary="auto")
+    P = from_example(load_example("castle"), (60, 60, 10), boundary="auto")
     for workers in (1, 2):
         t = time.perf_counter()
         r = solve(P, "blocks", rng=0, block=10, workers=workers, time_limit=0.05)
@@ -183,7 +184,7 @@ def test_worker_exception_reaches_the_caller(monkeypatch):
 
     monkeypatch.setattr(wv, "solve_block", boom)  # the Python path
     monkeypatch.setattr(wv, "solve_compiled", boom)  # the compiled one
-    P = Problem.from_example(load_example("fig3_10"), (20, 20), boundary="auto")
+    P = from_example(load_example("fig3_10"), (20, 20), boundary="auto")
     with pytest.raises(RuntimeError, match="boom"):
         solve(P, "blocks", rng=0, block=10, workers=2)
 
@@ -199,7 +200,7 @@ def test_compiled_blocks_same_as_python_blocks_in_waves(monkeypatch, order):
             out = []
             for engine in ("interp", "kernels"):
                 monkeypatch.setattr(_interp, "ENGINE", engine)
-                P = Problem.from_example(load_example(name), shape, **kw)
+                P = from_example(load_example(name), shape, **kw)
                 out.append(solve(P, "blocks", rng=4, block=8, order=order, choice="weighted",
                                  workers=workers, sweeps=2))  # fmt: skip
             a, b = out

@@ -5,8 +5,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, load_example, solve
+from csplab import ExampleModel, load_example, solve
 from csplab.errors import InputError, UnknownSolverError
+from csplab.grids import from_example
 from csplab.testing.brute import count
 from csplab.testing.strategies import problems
 
@@ -27,14 +28,14 @@ def test_solved_grids_have_zero_violations(P, order, choice, seed):
 @pytest.mark.parametrize("order", ["scanline", "random", "min-entropy"])
 def test_never_fails_on_infallible_examples_200_seeds(name, order):
     E = load_example(name)
-    P = Problem.from_example(E, (9, 7))
+    P = from_example(E, (9, 7))
     for seed in range(200):
         r = solve(P, "catalog", rng=seed, order=order)
         assert r.status == "solved", (name, seed)
 
 
 def test_same_seed_same_grid_and_seed_recorded():
-    P = Problem.from_example(load_example("line"), (15, 9))
+    P = from_example(load_example("line"), (15, 9))
     a = solve(P, "catalog", rng=5)
     b = solve(P, "catalog", rng=np.random.default_rng(5))
     assert np.array_equal(a.grid, b.grid) and a.seed == b.seed == 5
@@ -47,7 +48,7 @@ def test_same_seed_same_grid_and_seed_recorded():
 
 
 def test_trace_replays_to_the_grid():
-    P = Problem.from_example(load_example("line"), (6, 5))
+    P = from_example(load_example("line"), (6, 5))
     r = solve(P, "catalog", rng=2, order="random")
     g = np.full(P.n, -1)
     g[r.trace[:, 0]] = r.trace[:, 1]
@@ -57,25 +58,25 @@ def test_trace_replays_to_the_grid():
 
 def test_scanline_trace_is_thesis_loop_order():
     E = ExampleModel(np.zeros((2, 2, 2), dtype=int))
-    P = Problem.from_example(E, (2, 3, 4))
+    P = from_example(E, (2, 3, 4))
     r = solve(P, "catalog", rng=0)
     coords = [P.coords(c) for c in r.trace[:, 0]]
     assert coords == sorted(coords)  # x outermost, z innermost
 
 
 def test_checkerboard_two_solutions_both_reached():
-    P = Problem.from_example(load_example("E1"), (5, 4))
+    P = from_example(load_example("E1"), (5, 4))
     grids = {solve(P, "catalog", rng=s).grid.tobytes() for s in range(30)}
     assert len(grids) == 2
 
 
 def test_unsat_and_failure_statuses():
-    P = Problem.from_example(load_example("fig3_1d"), (5, 5))
+    P = from_example(load_example("fig3_1d"), (5, 5))
     r = solve(P, "catalog", rng=0)
     assert r.status == "unsat" and "Theorem 3.3.2" in r.stats["proof"]
     # a satisfiable problem where scanline Alg. 3.1 can fail: parity constraint
     E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
-    P2 = Problem.from_example(E, (3, 3), fixed={(2, 2): 1})
+    P2 = from_example(E, (3, 3), fixed={(2, 2): 1})
     r2 = solve(P2, "catalog", rng=0)
     assert r2.status in ("solved", "failed")
 
@@ -106,7 +107,7 @@ def test_weighted_choice_follows_weights():
     seq = [0, 0, 1, 0, 2, 1, 1, 2, 2, 0]
     uniform = [1 / 3] * 3
     for w in ([1.0, 2.0, 5.0], [6.0, 1.0, 1.0]):
-        P = Problem.from_example(ExampleModel(seq, weights=w), (60,))
+        P = from_example(ExampleModel(seq, weights=w), (60,))
         assert P.domains.all() and P.K == 3
         p = np.array(w) / sum(w)
         weighted = _label_counts(P, "weighted")
@@ -116,13 +117,13 @@ def test_weighted_choice_follows_weights():
         assert _chi2(flat, uniform) < CHI2_2DOF_P1E6, (w, flat)
         assert _chi2(flat, p) > CHI2_2DOF_P1E6, (w, flat)
     # a label of weight 0 is never chosen while another label is possible
-    P0 = Problem.from_example(ExampleModel(seq, weights=[1.0, 1.0, 0.0]), (60,))
+    P0 = from_example(ExampleModel(seq, weights=[1.0, 1.0, 0.0]), (60,))
     zero = _label_counts(P0, "weighted", seeds=10)
     assert zero[2] == 0 and zero[0] > 0 and zero[1] > 0
 
 
 def test_time_limit_and_bad_options():
-    P = Problem.from_example(load_example("line"), (40, 40))
+    P = from_example(load_example("line"), (40, 40))
     r = solve(P, "catalog", rng=0, time_limit=1e-9)
     assert r.status in ("timeout", "solved")
     with pytest.raises(InputError):
@@ -150,7 +151,7 @@ def test_compiled_alg31_equals_reference_run(P, order, choice, seed):
 def test_scan_axis_orders():
     from csplab.engine.alg31 import scan_order
 
-    P = Problem.from_example(load_example("line"), (4, 3))
+    P = from_example(load_example("line"), (4, 3))
     r = solve(P, "catalog", rng=0, order="scan:yx")
     assert [P.coords(c) for c in r.trace[:, 0]] == [(x, y) for y in range(3) for x in range(4)]
     with pytest.raises(InputError):

@@ -27,6 +27,7 @@ from hypothesis import strategies as st
 
 from csplab import Problem, solve
 from csplab.errors import InputError, NoTrivialSolutionError
+from csplab.grids import from_example
 from csplab.solvers import STATS, available_solvers, get_solver
 from csplab.testing.brute import count, solutions
 from csplab.testing.strategies import csp_problems
@@ -137,12 +138,12 @@ def test_pysat_enum_models_matches_brute_force_counts(P, backend):
     assert n == count(P)
 
 
-_BIG = Problem.from_example(box_town(2, rng=0), (30, 30, 8))
+_BIG = from_example(box_town(2, rng=0), (30, 30, 8))
 
 
 @pytest.mark.parametrize(("spec", "opts"), SPECS, ids=IDS)
 def test_time_limits_are_honoured_within_one_second(spec, opts):
-    tiny = Problem.from_example(box_town(1, rng=0), (3, 3, 3))
+    tiny = from_example(box_town(1, rng=0), (3, 3, 3))
     _run(spec, opts, tiny, 0)  # load compiled kernels first (not part of the limit)
     if spec == "sat:lingeling":
         pytest.skip("lingeling has no budgets or interrupt in pysat")

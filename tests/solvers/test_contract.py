@@ -8,9 +8,10 @@ import textwrap
 import numpy as np
 import pytest
 
-from csplab import ExampleModel, Problem, solve
+from csplab import ExampleModel, solve
 from csplab.cli import main
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.solvers import (
     REGISTRY,
     STATS,
@@ -81,20 +82,20 @@ def test_validation_comes_from_the_declaration():
     with pytest.raises(InputError, match="time_limit must be a positive number of seconds"):
         cls.validate({"time_limit": -1})
     assert solver_class("blocks").validate({"block": "4x3"})["block"] == (4, 3)
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (4, 4))
     with pytest.raises(InputError, match="has no backends"):
         solve(P, "catalog:fast")
 
 
 def test_hybrid_and_perfect_accept_scan_orders():
     # the bug that motivated the contract: hybrid rejected order="scan:yx"
-    P = Problem.from_example(ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]]), (5, 4))
+    P = from_example(ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]]), (5, 4))
     for s in ("hybrid", "perfect", "catalog", "blocks"):
         assert solve(P, s, rng=1, order="scan:yx").status == "solved", s
 
 
 def test_stats_use_the_glossary():
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (6, 5))
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (6, 5))
     for info in available_solvers():
         if not info.get("installed"):
             continue
@@ -134,7 +135,7 @@ def test_a_toy_solver_registered_once_appears_everywhere(toy, capsys):
     rng = np.random.default_rng(0)
     for _ in range(20):
         E = ExampleModel(rng.integers(0, 3, size=(3, 3)))
-        P = Problem.from_example(E, (4, 3), fixed={(0, 0): int(rng.integers(0, 3))})
+        P = from_example(E, (4, 3), fixed={(0, 0): int(rng.integers(0, 3))})
         check_solver_on("toy", {}, P, int(rng.integers(1000)))
     # the experiments (worker processes see the registration)
     tmp = os.environ["PYTHONPATH"].split(os.pathsep)[0]

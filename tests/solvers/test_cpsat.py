@@ -3,8 +3,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, solve
+from csplab import ExampleModel, grids, solve
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.testing.brute import count
 from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
@@ -23,14 +24,14 @@ def test_both_models_agree_with_brute_force(P, model, diversity, seed):
 
 
 def test_infeasible_is_a_proof():
-    P = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)  # odd cycle
+    P = grids.grid((5,), [[[False, True], [True, False]]], periodic=True)  # odd cycle
     for model in ("onehot", "table"):
         r = solve(P, "cpsat", rng=0, model=model)
         assert r.status == "unsat" and r.stats["proof"] == "CP-SAT: infeasible"
 
 
 def test_hints_make_outputs_differ_and_seeds_repeat():
-    P = Problem.from_example(box_town(1, rng=0), (8, 8, 6), boundary="auto")
+    P = from_example(box_town(1, rng=0), (8, 8, 6), boundary="auto")
     a, b = (solve(P, "cpsat", rng=s) for s in (1, 2))
     assert np.mean(a.grid != b.grid) > 0.02
     assert np.array_equal(a.grid, solve(P, "cpsat", rng=1).grid)
@@ -40,11 +41,11 @@ def test_hints_make_outputs_differ_and_seeds_repeat():
 
 
 def test_options_and_time_limit():
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 3))
     assert solve(P, "cpsat", rng=0, num_workers=2, presolve=True).status == "solved"
     for bad in ({"model": "mip"}, {"diversity": "lots"}, {"num_workers": 0}, {"x": 1}):
         with pytest.raises(InputError):
             solve(P, "cpsat", rng=0, **bad)
-    big = Problem.from_example(box_town(2, rng=0), (40, 40, 10))
+    big = from_example(box_town(2, rng=0), (40, 40, 10))
     r = solve(big, "cpsat", rng=0, time_limit=0.3)
     assert r.status == "timeout" and r.time_s < 1.3

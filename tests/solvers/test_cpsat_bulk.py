@@ -21,6 +21,7 @@ from ortools.sat.python import cp_model
 from csplab import ExampleModel, Problem, load_example, solve
 from csplab.cnf import encode
 from csplab.engine.sat import preferred_labels
+from csplab.grids import from_example
 from csplab.solvers import cpsat
 from csplab.testing.strategies import problems, random_problems
 from csplab.testing.synthetic import box_town
@@ -82,7 +83,7 @@ def test_bulk_model_equals_elementwise_model(P: Problem, hint: bool, seed: int) 
 def test_bulk_model_equals_elementwise_model_on_examples(name: str) -> None:
     E = load_example(name)
     shape = (9, 11) if E.ndim == 2 else (7, 6, 4)
-    P = Problem.from_example(E, shape)
+    P = from_example(E, shape)
     assert encode(P).nx > 0  # a model with variables and clauses
     for hint in (True, False):
         bulk, ref = _models(P, hint)
@@ -91,14 +92,14 @@ def test_bulk_model_equals_elementwise_model_on_examples(name: str) -> None:
 
 def _odd_cycle() -> Problem:
     """A checkerboard on a periodic axis of odd length: unsatisfiable, arc consistent."""
-    return Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4), periodic=(True, False))
+    return from_example(ExampleModel([[0, 1], [1, 0]]), (3, 4), periodic=(True, False))
 
 
 @pytest.mark.parametrize(
     "P",
     [
-        Problem.from_example(load_example("castle"), (8, 8, 4), boundary="auto"),
-        Problem.from_example(load_example("fig3_10"), (12, 12)),
+        from_example(load_example("castle"), (8, 8, 4), boundary="auto"),
+        from_example(load_example("fig3_10"), (12, 12)),
         _odd_cycle(),
     ],
     ids=["castle", "fig3_10", "odd-cycle"],
@@ -122,7 +123,7 @@ def test_odd_cycle_is_not_refuted_by_arc_consistency() -> None:
 
 
 def test_building_checks_the_deadline() -> None:
-    P = Problem.from_example(load_example("castle"), (8, 8, 4), boundary="auto")
+    P = from_example(load_example("castle"), (8, 8, 4), boundary="auto")
     enc = encode(P)
     with pytest.raises(cpsat._Deadline):
         cpsat._onehot_bytes(enc, None, time.perf_counter() - 1.0)
@@ -131,8 +132,8 @@ def test_building_checks_the_deadline() -> None:
 
 
 def test_time_limit_is_respected() -> None:
-    big = Problem.from_example(box_town(2, rng=0), (30, 30, 8))
-    solve(Problem.from_example(box_town(1, rng=0), (3, 3, 3)), "cpsat", rng=0)  # warm up
+    big = from_example(box_town(2, rng=0), (30, 30, 8))
+    solve(from_example(box_town(1, rng=0), (3, 3, 3)), "cpsat", rng=0)  # warm up
     limit = 0.3
     t0 = time.perf_counter()
     r = solve(big, "cpsat", rng=0, time_limit=limit)
@@ -145,7 +146,7 @@ def test_time_limit_is_respected() -> None:
 def test_a_setup_the_time_left_cannot_hold_is_not_started(model, monkeypatch) -> None:
     # CP-SAT's set-up ignores its time limit: with a (pretend) slow machine csplab returns
     # at once, saying what it estimated, rather than overrunning the limit
-    P = Problem.from_example(load_example("castle"), (8, 8, 4), boundary="auto")
+    P = from_example(load_example("castle"), (8, 8, 4), boundary="auto")
     monkeypatch.setitem(cpsat._SETUP_RATE, model, 1.0)  # one unit per second
     t0 = time.perf_counter()
     r = solve(P, "cpsat", rng=0, time_limit=5.0, model=model)

@@ -2,8 +2,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, solve
+from csplab import ExampleModel, grids, solve
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.testing.brute import count
 from csplab.testing.strategies import csp_problems
 
@@ -22,7 +23,7 @@ def test_never_fail_and_agree_with_brute_force(P, name, order, seed):
 
 
 def test_succeed_where_alg31_fails():
-    P = Problem.from_example(FALLIBLE, (8, 8))
+    P = from_example(FALLIBLE, (8, 8))
     fails = sum(solve(P, "catalog", rng=s).status == "failed" for s in range(10))
     assert fails == 10
     for s in range(10):
@@ -35,23 +36,23 @@ def test_succeed_where_alg31_fails():
 
 
 def test_hybrid_uses_no_sat_when_alg31_succeeds():
-    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (6, 6))
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (6, 6))
     r = solve(P, "hybrid", rng=0)
     assert r.status == "solved" and r.stats["sat_calls"] == 0 and "sat" not in r.stats
 
 
 def test_unsat_proofs_and_options():
-    odd = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)
+    odd = grids.grid((5,), [[[False, True], [True, False]]], periodic=True)
     for name in ("perfect", "hybrid", "perfect:glucose4", "hybrid:minisat22"):
         r = solve(odd, name, rng=0)
         assert r.status == "unsat" and r.stats["proof"].startswith("refutation by")
-    P = Problem.from_example(FALLIBLE, (4, 4))
+    P = from_example(FALLIBLE, (4, 4))
     with pytest.raises(InputError):
         solve(P, "perfect", rng=0, order="min-entropy")
     with pytest.raises(InputError):
         solve(P, "hybrid", rng=0, zz=1)
     assert solve(P, "hybrid", rng=0, order="min-entropy").status == "solved"
-    big = Problem.from_example(FALLIBLE, (40, 40))
+    big = from_example(FALLIBLE, (40, 40))
     r = solve(big, "perfect", rng=0, time_limit=0.3)
     assert r.status in ("timeout", "solved") and r.time_s < 1.3
 
@@ -78,7 +79,7 @@ def test_hybrid_samples_the_same_distribution_as_perfect():
     (hybrid) gives each step a uniform label of C*: both match the exact distribution."""
     import numpy as np
 
-    P = Problem.from_example(FALLIBLE, (2, 2))  # 17 solutions; Alg. 3.1 fails 32% of runs
+    P = from_example(FALLIBLE, (2, 2))  # 17 solutions; Alg. 3.1 fails 32% of runs
     S, probs = _perfect_distribution(P)
     assert len(S) == 17 and abs(probs.sum() - 1) < 1e-9
     N = 600

@@ -3,8 +3,9 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from csplab import ExampleModel, Problem, solve
+from csplab import ExampleModel, grids, solve
 from csplab.errors import InputError
+from csplab.grids import from_example
 from csplab.testing.brute import count
 from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
@@ -13,12 +14,12 @@ pytest.importorskip("pysat")
 from csplab.engine.sat import SatOracle, backends, enumerate_solutions
 
 CHECKER = ExampleModel([[0, 1], [1, 0]])
-ODD_CYCLE = Problem.grid((5,), [[[False, True], [True, False]]], periodic=True)
+ODD_CYCLE = grids.grid((5,), [[[False, True], [True, False]]], periodic=True)
 
 
 @pytest.mark.parametrize("backend", backends())
 def test_every_listed_backend_solves_and_refutes(backend):
-    P = Problem.from_example(CHECKER, (4, 3))
+    P = from_example(CHECKER, (4, 3))
     r = solve(P, f"sat:{backend}", rng=0)
     assert r.status == "solved" and r.stats["backend"] == backend
     # 2-colouring an odd cycle: arc consistent, yet unsatisfiable (proof from the solver)
@@ -27,7 +28,7 @@ def test_every_listed_backend_solves_and_refutes(backend):
 
 
 def test_aliases_and_unsupported_backends():
-    P = Problem.from_example(CHECKER, (2, 2))
+    P = from_example(CHECKER, (2, 2))
     assert solve(P, "sat:g4", rng=0).stats["backend"] == "glucose4"
     for bad in ("kissat404", "cd103", "nonesuch"):
         with pytest.raises(InputError):
@@ -71,7 +72,7 @@ def test_direct_loader_gives_the_solver_the_same_formula(P, seed):
 
 
 def test_outputs_differ_across_seeds_and_repeat_for_a_seed():
-    P = Problem.from_example(box_town(1, rng=0), (12, 12, 6), boundary="auto")
+    P = from_example(box_town(1, rng=0), (12, 12, 6), boundary="auto")
     g = [solve(P, "sat", rng=s).grid for s in range(4)]
     assert np.array_equal(g[0], solve(P, "sat", rng=0).grid)
     ham = [np.mean(g[i] != g[j]) for i in range(4) for j in range(i + 1, 4)]
@@ -82,7 +83,7 @@ def test_outputs_differ_across_seeds_and_repeat_for_a_seed():
 
 def test_oracle_assumptions_cores_and_blocking():
     E = ExampleModel([0, 1, 2, 0])
-    P = Problem.from_example(E, (6,))
+    P = from_example(E, (6,))
     with SatOracle(P) as o:
         a, b = o.literal(0, 1), o.literal(3, 0)
         assert o.solve([a]) == "sat" and o.grid[0] == 1
@@ -96,15 +97,15 @@ def test_oracle_assumptions_cores_and_blocking():
 
 def test_lazy_at_most_one_refinement_is_used_when_needed():
     # forward supports leave multi-labelled cells possible: refinement must repair them
-    P = Problem.from_example(box_town(1, rng=1), (10, 10, 6))
+    P = from_example(box_town(1, rng=1), (10, 10, 6))
     for s in range(3):
         r = solve(P, "sat", rng=s, supports="forward", choice="none")
         assert r.status == "solved" and r.stats["refinements"] >= 0
 
 
 def test_time_limit_on_a_large_problem():
-    P = Problem.from_example(box_town(2, rng=0), (40, 40, 10))
-    solve(Problem.from_example(CHECKER, (2, 2)), "sat", rng=0)  # load the JIT first
+    P = from_example(box_town(2, rng=0), (40, 40, 10))
+    solve(from_example(CHECKER, (2, 2)), "sat", rng=0)  # load the JIT first
     r = solve(P, "sat", rng=0, time_limit=0.2)
     assert r.status in ("timeout", "solved")
     assert r.time_s < 1.2
