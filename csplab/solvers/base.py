@@ -28,8 +28,11 @@ constraints   what it does with global constraints (:mod:`csplab.constraints`):
 bench         option variants ``benchmarks/bench_solvers.py`` times
 ============  ==================================================================
 
-Stats: a solver's ``Result.stats`` uses the names of :data:`STATS` (one name per concept);
-the conformance suite checks it.
+Every exit of :meth:`Solver.run` is :meth:`Solver.result` (the time since ``call.t0``, the
+proof of an ``unsat``), and the time limit is ``call.deadline``. Stats: ``Result.stats``
+uses only the names of :data:`STATS` (one name per concept), whichever path made them (a
+solver, :func:`csplab.solvers.solve`, continuous synthesis); the conformance suite checks
+it. ``csplab/solvers/_template.py`` is a minimal solver to copy.
 
 Examples
 --------
@@ -55,10 +58,10 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from csplab.engine.alg31 import CHOICES, ORDERS, check_order
-from csplab.errors import InputError
+from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result, Status
 
@@ -281,7 +284,9 @@ STATS: dict[str, str] = {
 class Call:
     """What :meth:`Solver.run` gets: the randomness (``rng``, and the ``seed`` it was made
     from, recorded in the result), the backend, every declared option validated, and the
-    start time."""
+    start time ``t0``. The time limit is the call's: a solver watches :attr:`deadline`
+    (or :meth:`remaining`, :meth:`expired`), never a clock of its own, and
+    :meth:`Solver.result` measures the time from ``t0``."""
 
     rng: np.random.Generator
     seed: int | None
@@ -301,6 +306,17 @@ class Call:
         """``time.perf_counter()`` value of the time limit (``None``: no limit)."""
         limit = self.options.get("time_limit")
         return None if limit is None else self.t0 + float(limit)
+
+    def remaining(self) -> float | None:
+        """Seconds left before :attr:`deadline` (at most 0 once it has passed; ``None``: no
+        limit). Hand it to an engine that takes a ``time_limit``."""
+        deadline = self.deadline
+        return None if deadline is None else deadline - time.perf_counter()
+
+    def expired(self) -> bool:
+        """Whether :attr:`deadline` has passed."""
+        deadline = self.deadline
+        return deadline is not None and time.perf_counter() > deadline
 
 
 class Solver(ABC):
@@ -360,19 +376,54 @@ class Solver(ABC):
 
     @abstractmethod
     def run(self, problem: Problem, call: Call) -> Result:
-        """Solve ``problem``; ``call`` holds the randomness, the backend and every declared
-        option, validated."""
+        """Solve ``problem``; ``call`` holds the randomness, the backend, every declared
+        option, validated, and the deadline. Every exit returns :meth:`result`."""
 
-    @classmethod
     def result(
-        cls,
+        self,
         status: Status,
-        grid: NDArray[np.integer[Any]],
+        grid: ArrayLike | None,
         problem: Problem,
         stats: dict[str, Any],
-        t0: float,
+        call: Call,
+        *,
+        proof: str | None = None,
+        trace: NDArray[np.int64] | None = None,
     ) -> Result:
-        """A :class:`Result` of this solver: the grid as int32 of the problem's shape,
-        the time since ``t0``."""
-        g = np.asarray(grid, dtype=np.int32).reshape(problem.shape)
-        return Result(status, g, cls.name, time_s=time.perf_counter() - t0, stats=stats)
+        """The one way out of :meth:`run`: a :class:`Result` of this solver.
+
+        Parameters
+        ----------
+        status : {"solved", "failed", "unsat", "timeout"}
+            The outcome.
+        grid : array_like or None
+            The labels (reshaped to the problem's shape, as int32); ``None``: no cell
+            assigned (every label ``-1``).
+        problem : Problem
+            The problem solved.
+        stats : dict
+            The figures of the run, named as in :data:`STATS` (kept by reference, so a
+            ``finally`` clause may still add to them).
+        call : Call
+            The call being answered: the time is measured from ``call.t0`` and the seed
+            recorded.
+        proof : str, optional
+            Why the status is ``unsat``; stored as ``stats["proof"]``. An ``unsat`` result
+            without a proof is a bug (:class:`~csplab.errors.CsplabError`).
+        trace : int array ``(steps, 2)``, optional
+            The ``(cell, label)`` choices of an Alg. 3.1 run.
+
+        Returns
+        -------
+        Result
+        """
+        if proof is not None:
+            stats["proof"] = proof
+        if status == "unsat" and not stats.get("proof"):
+            raise CsplabError(f"solver {self.name!r} returned unsat without a proof (a bug)")
+        if grid is None:
+            g = np.full(problem.shape, -1, dtype=np.int32)
+        else:
+            g = np.asarray(grid, dtype=np.int32).reshape(problem.shape)
+        return Result(status, g, self.name, seed=call.seed,
+                      time_s=time.perf_counter() - call.t0, stats=stats, trace=trace)  # fmt: skip

@@ -24,8 +24,6 @@ from csplab.solvers.base import Solver
 
 TOY = textwrap.dedent(
     """
-    import time
-    import numpy as np
     from csplab.catalog import Propagator
     from csplab.engine.completability import search_solution
     from csplab.solvers.base import TIME_LIMIT, Option, Solver
@@ -38,13 +36,11 @@ TOY = textwrap.dedent(
                    TIME_LIMIT)
 
         def run(self, problem, call):
-            t0 = time.perf_counter()
             eng = Propagator(problem)
             g = search_solution(eng) if eng.ok else None
             if g is None:
-                return self.result("unsat", np.full(problem.n, -1), problem,
-                                   {"proof": "exhaustive search"}, t0)
-            return self.result("solved", g, problem, {"assigned": int(problem.n)}, t0)
+                return self.result("unsat", None, problem, {}, call, proof="exhaustive search")
+            return self.result("solved", g, problem, {"assigned": int(problem.n)}, call)
     """
 )
 
