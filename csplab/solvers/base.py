@@ -75,6 +75,7 @@ __all__ = [
     "Solver",
     "order_option",
     "positive_seconds",
+    "unknown_stats",
 ]
 
 _MISSING = object()
@@ -203,7 +204,8 @@ TIME_LIMIT = Option(
     nullable=True, convert=positive_seconds,
 )  # fmt: skip
 
-# One name per concept for Result.stats (the conformance suite checks every solver's keys).
+# One name per concept for Result.stats, whichever path emits it: a solver, solve() itself or
+# continuous synthesis (the conformance suite checks every key, see unknown_stats).
 STATS: dict[str, str] = {
     "order": "the cell order used",
     "choice": "the label choice used",
@@ -277,7 +279,38 @@ STATS: dict[str, str] = {
     "choices": "choices (ASP)",
     "solver_status": "the backend's own status name",
     "solver_stats": "the backend's own statistics (a dict, backend names)",
+    "limit": "the limit that ended a timeout: time or nodes (backtrack)",
+    "restart": "failures before the first Luby restart, 0: never (backtrack)",
+    "num_workers": "search workers (CP-SAT)",
+    "presolve": "whether CP-SAT's presolve was on",
+    "setup_estimate_s": "estimated seconds of CP-SAT's set-up that did not fit in the time left",
+    "grounding": "who grounded the program: csplab (aspif) or gringo (ASP)",
+    "workers": "0: the thesis' sweep; N: the wave schedule on N workers (blocks)",
+    "scheduler": "where the waves ran: local or a Dask scheduler address (blocks)",
+    "rounds": "solve rounds of the exact connectivity cut loop (continuous synthesis in 3D)",
+    "constraint_attempts": "synthesis runs made while the output broke a user constraint "
+    "(continuous synthesis in 3D with restarts)",
 }
+
+#: stats whose value is a dict that uses the names of :data:`STATS` too
+_NESTED_STATS = ("sat",)
+
+
+def unknown_stats(stats: Mapping[str, Any]) -> list[str]:
+    """The keys of ``stats`` that :data:`STATS` does not name (a nested dict of
+    :data:`STATS` names such as ``stats["sat"]`` is checked too, as ``"sat.KEY"``).
+
+    Examples
+    --------
+    >>> unknown_stats({"assigned": 3, "sat": {"vars": 9, "speed": 1}, "mood": "good"})
+    ['mood', 'sat.speed']
+    """
+    out = [k for k in stats if k not in STATS]
+    for k in _NESTED_STATS:
+        sub = stats.get(k)
+        if isinstance(sub, Mapping):
+            out += [f"{k}.{kk}" for kk in sub if kk not in STATS]
+    return sorted(out)
 
 
 @dataclass(frozen=True)

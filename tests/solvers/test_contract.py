@@ -10,17 +10,17 @@ import pytest
 
 from csplab import ExampleModel, Problem, solve
 from csplab.cli import main
-from csplab.errors import InputError
+from csplab.errors import CsplabError, InputError
 from csplab.solvers import (
     REGISTRY,
-    STATS,
     available_solvers,
     markdown_table,
     register,
     solver_class,
     solver_names,
+    unknown_stats,
 )
-from csplab.solvers.base import Solver
+from csplab.solvers.base import Call, Solver
 
 TOY = textwrap.dedent(
     """
@@ -94,10 +94,21 @@ def test_stats_use_the_glossary():
     for info in available_solvers():
         if not info.get("installed"):
             continue
-        cls = solver_class(info["name"])
         r = solve(P, info["name"], rng=2)
-        unknown = set(r.stats) - set(STATS) - {o.name for o in cls.options}
-        assert not unknown, (info["name"], unknown)
+        assert not unknown_stats(r.stats), (info["name"], unknown_stats(r.stats))
+
+
+def test_result_is_the_one_way_out():
+    P = Problem.from_example(ExampleModel([[0, 1], [1, 0]]), (3, 2))
+    cls = solver_class("catalog")
+    call = Call(np.random.default_rng(0), 7, None, cls.validate({}))
+    r = cls().result("timeout", None, P, {"assigned": 0}, call)
+    assert r.grid.shape == (3, 2) and r.grid.dtype == np.int32 and (r.grid == -1).all()
+    assert r.solver == "catalog" and r.seed == 7 and r.time_s > 0
+    with pytest.raises(CsplabError, match="unsat without a proof"):
+        cls().result("unsat", None, P, {}, call)
+    r = cls().result("unsat", None, P, {}, call, proof="a wipe-out")
+    assert r.stats["proof"] == "a wipe-out"
 
 
 def test_readme_solver_table_is_generated():
