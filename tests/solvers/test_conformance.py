@@ -22,6 +22,7 @@ The default run uses the hypothesis profile of ``tests/conftest.py`` (60 example
 ``slow`` run (``pytest -m slow``) draws 5,000 problems and checks every solver on each.
 """
 
+import contextlib
 import time
 
 import pytest
@@ -32,7 +33,7 @@ from csplab import ExampleModel, Problem, load_example, solve
 from csplab.constraints import Connected, Count
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.examples.continuous import load_polygon_example
-from csplab.solvers import available_solvers, get_solver, unknown_stats
+from csplab.solvers import REGISTRY, available_solvers, get_solver, unknown_stats
 from csplab.testing.brute import count, solutions
 from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
@@ -218,6 +219,39 @@ def test_continuous_synthesis_stats_are_named_in_STATS(solver):
     # sat runs the exact cut loop; the others break the constraint here and are retried
     assert {"sat": "rounds"}.get(solver, "constraint_attempts") in s3.result.stats
     assert not unknown_stats(s3.result.stats), unknown_stats(s3.result.stats)
+
+
+@contextlib.contextmanager
+def _template():
+    """The solver template (``csplab/solvers/_template.py``) registered for one test."""
+    REGISTRY["template"] = "csplab.solvers._template:TemplateSolver"
+    try:
+        yield "template"
+    finally:
+        REGISTRY.pop("template", None)
+
+
+@given(P=csp_problems(), seed=st.integers(0, 2**31))
+def test_the_solver_template_conforms(P, seed):
+    with _template() as name:
+        check_solver_on(name, {}, P, seed)
+        check_solver_on(name, {"order": "random"}, P, seed)
+
+
+def test_the_solver_template_on_every_path():
+    with _template() as name:
+        cls = get_solver(name)[0]
+        assert cls.name == name and cls.options[-1].name == "time_limit"
+        statuses = set()
+        for P in _PATHS.values():
+            for restarts in (0, 3):
+                r = solve(P, name, rng=1, restarts=restarts)
+                statuses.add(r.status)
+                assert not unknown_stats(r.stats), unknown_stats(r.stats)
+                assert r.solver == name and r.grid.shape == P.shape
+        assert statuses == {"solved", "unsat", "failed"}, statuses
+        # seed 0 solves _BIG: within 1 ms it can only time out (before or during Alg. 3.1)
+        assert solve(_BIG, name, rng=0, time_limit=1e-3).status == "timeout"
 
 
 @pytest.mark.slow
