@@ -112,21 +112,15 @@ class BacktrackSolver(Solver):
         if not eng.ok:
             stats.update(nodes=0, conflicts=0, restarts=0)
             stats["fail_cell"] = list(problem.coords(eng.wiped))
-            return self.result("unsat", None, problem, stats, call, proof="arc-consistency "
-                               "wipe-out before any decision (Theorem 3.3.2)")  # fmt: skip
+            proof = "arc-consistency wipe-out before any decision (Theorem 3.3.2)"
+            return self.result("unsat", None, problem, stats, call, proof=proof)
         cons = bool(problem.constraints)
         if cons:  # global constraints: prune the root, then after every decision
             stats.update(constraint_prunings=0, constraint_conflicts=0)
             if eng.constrain() != -1:
                 stats.update(nodes=0, conflicts=0, restarts=0)
-                return self.result(
-                    "unsat",
-                    None,
-                    problem,
-                    stats,
-                    call,
-                    proof="global-constraint propagation before any decision",
-                )
+                proof = "global-constraint propagation before any decision"
+                return self.result("unsat", None, problem, stats, call, proof=proof)
         search = Search.new(n, eng.c.W, seed=int(rng.integers(0, 2**63 - 1)))
         restarts = 0
         cutoff = int(restart) * luby(1) if restart else 0

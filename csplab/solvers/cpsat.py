@@ -193,14 +193,8 @@ class CpsatSolver(Solver):
             return timeout()
         if not enc.ok:
             stats["fail_cell"] = list(problem.coords(enc.wiped))
-            return self.result(
-                "unsat",
-                None,
-                problem,
-                stats,
-                call,
-                proof="arc-consistency wipe-out before search (Theorem 3.3.2)",
-            )
+            proof = "arc-consistency wipe-out before search (Theorem 3.3.2)"
+            return self.result("unsat", None, problem, stats, call, proof=proof)
         pref = preferred_labels(enc.catalog, None, rng) if diversity == "hint" else None
         if problem.constraints and model != "onehot":
             raise InputError("solver 'cpsat': global constraints need model='onehot'")

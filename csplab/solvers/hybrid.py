@@ -101,15 +101,9 @@ class HybridSolver(Solver):
                     return self.result("solved", r.grid, problem, stats, call)
                 if r.status == "timeout":
                     return self.result("timeout", fixed, problem, stats, call)
-                if r.status == "unsat" and idx.size == 0:
-                    return self.result(
-                        "unsat",
-                        fixed,
-                        problem,
-                        stats,
-                        call,
-                        proof="arc-consistency wipe-out before any choice (Theorem 3.3.2)",
-                    )
+                if r.status == "unsat" and idx.size == 0:  # Alg. 3.1's proof (Theorem 3.3.2)
+                    proof = str(r.stats["proof"])
+                    return self.result("unsat", fixed, problem, stats, call, proof=proof)
                 if oracle is None:
                     oracle = SatOracle(problem, backend=backend, deadline=deadline,
                                        seed=int(rng.integers(2**31 - 1)))  # fmt: skip

@@ -73,8 +73,8 @@ class PerfectSolver(Solver):
                                  "rejected": 0, "assigned": 0}  # fmt: skip
         eng = Propagator(problem)
         if not eng.ok:
-            return self.result("unsat", grid, problem, stats, call, proof="arc-consistency "
-                               "wipe-out before any choice (Theorem 3.3.2)")  # fmt: skip
+            proof = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
+            return self.result("unsat", grid, problem, stats, call, proof=proof)
         scan = scan_order(problem.shape, order)
         perm = rng.permutation(n) if scan is None else scan
         w = problem.weights if choice == "weighted" else None
@@ -83,9 +83,8 @@ class PerfectSolver(Solver):
             st = o.solve(deadline=deadline)
             stats["sat_calls"] += 1
             if st == "unsat":
-                return self.result(
-                    "unsat", grid, problem, stats, call, proof=f"refutation by {o.backend}"
-                )
+                proof = f"refutation by {o.backend}"
+                return self.result("unsat", grid, problem, stats, call, proof=proof)
             if st == "timeout":
                 return self.result("timeout", grid, problem, stats, call)
             wit = WitnessPool(n, pool)
