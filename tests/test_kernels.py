@@ -1,6 +1,7 @@
 """The compiled kernels: the one-module cache rule, argument bundles and return codes."""
 
 import ast
+import re
 from pathlib import Path
 
 import numpy as np
@@ -112,6 +113,23 @@ def test_njit_callers_of_csplab_kernels_live_in_kernels():
     sources = _package_sources()
     assert KERNELS in sources and len(_jitted(ast.parse(sources[KERNELS][0]))) > 20
     assert njit_rule_violations(sources) == []
+
+
+def test_architecture_names_every_module_with_numba_code():
+    """ARCHITECTURE.md's "Compiled kernels" says where the numba code is: every module with a
+    jitted function, and no module without one."""
+    text = (PKG.parent / "ARCHITECTURE.md").read_text(encoding="utf-8")
+    section = text.split("## Compiled kernels", 1)[1].split("\n## ", 1)[0]
+    named = set(re.findall(r"`(csplab/[\w/]+\.py)`", section))
+    with_numba = {
+        m.replace(".", "/") + ("/__init__.py" if is_pkg else ".py")
+        for m, (src, is_pkg) in _package_sources().items()
+        if _jitted(ast.parse(src))
+    }
+    assert with_numba - named == set(), "numba code in modules ARCHITECTURE.md does not name"
+    assert named - with_numba - {"csplab/_jit.py", "csplab/_interp.py"} == set(), (
+        "ARCHITECTURE.md names modules without numba code"
+    )
 
 
 def test_njit_rule_checker_finds_cross_module_calls():

@@ -39,7 +39,7 @@ from csplab.errors import CsplabError, DependencyError, InputError, UnknownSolve
 from csplab.problem import Problem
 from csplab.result import STATUSES, Result
 from csplab.rng import RngLike, make_rng
-from csplab.solvers.base import STATS, Option, Solver
+from csplab.solvers.base import STATS, Option, Solver, unknown_stats
 
 __all__ = [
     "REGISTRY",
@@ -55,6 +55,7 @@ __all__ = [
     "solver_class",
     "solver_names",
     "solvers_taking",
+    "unknown_stats",
 ]
 
 # name -> "module:Class": the one place a solver is registered

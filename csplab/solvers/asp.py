@@ -629,7 +629,7 @@ class AspSolver(Solver):
         }
 
         def done(status: Status, grid: NDArray[np.int32] = empty) -> Result:
-            return self.result(status, grid, problem, stats, t0)
+            return self.result(status, grid, problem, stats, call)
 
         try:
             enc = encode(problem, encoding=encoding, supports=supports, deadline=deadline)
@@ -650,7 +650,7 @@ class AspSolver(Solver):
                 stats["proof"] = f"the only labelling arc consistency leaves breaks {broken[0]}"
                 return done("unsat")
             return done("solved", enc.const.reshape(problem.shape))
-        if deadline is not None and time.perf_counter() > deadline:
+        if call.expired():
             return done("timeout")
 
         args = ["--models=1", f"--seed={cseed}"]

@@ -27,10 +27,7 @@ Examples
 
 from __future__ import annotations
 
-import time
 from typing import Any
-
-import numpy as np
 
 from csplab import _kernels as kern
 from csplab.catalog import Code, Propagator, Search
@@ -108,29 +105,22 @@ class BacktrackSolver(Solver):
 
     def run(self, problem: Problem, call: Call) -> Result:
         rng = call.rng
-        order, choice, restart, node_limit, time_limit = call.get(
-            "order", "choice", "restart", "node_limit", "time_limit"
-        )
-        t0 = time.perf_counter()
-        deadline = None if time_limit is None else t0 + float(time_limit)
+        order, choice, restart, node_limit = call.get("order", "choice", "restart", "node_limit")
         n = problem.n
         eng = Propagator(problem)
-        grid = np.full(problem.shape, -1, dtype=np.int32)
         stats: dict[str, Any] = {"order": order, "choice": choice, "restart": int(restart)}
         if not eng.ok:
             stats.update(nodes=0, conflicts=0, restarts=0)
-            stats["proof"] = "arc-consistency wipe-out before any decision (Theorem 3.3.2)"
             stats["fail_cell"] = list(problem.coords(eng.wiped))
-            return Result("unsat", grid, "backtrack", time_s=time.perf_counter() - t0,
-                          stats=stats)  # fmt: skip
+            proof = "arc-consistency wipe-out before any decision (Theorem 3.3.2)"
+            return self.result("unsat", None, problem, stats, call, proof=proof)
         cons = bool(problem.constraints)
         if cons:  # global constraints: prune the root, then after every decision
             stats.update(constraint_prunings=0, constraint_conflicts=0)
             if eng.constrain() != -1:
                 stats.update(nodes=0, conflicts=0, restarts=0)
-                stats["proof"] = "global-constraint propagation before any decision"
-                return Result("unsat", grid, "backtrack", time_s=time.perf_counter() - t0,
-                              stats=stats)  # fmt: skip
+                proof = "global-constraint propagation before any decision"
+                return self.result("unsat", None, problem, stats, call, proof=proof)
         search = Search.new(n, eng.c.W, seed=int(rng.integers(0, 2**63 - 1)))
         restarts = 0
         cutoff = int(restart) * luby(1) if restart else 0
@@ -165,13 +155,12 @@ class BacktrackSolver(Solver):
                 cutoff = int(restart) * luby(restarts + 1)
             elif code is Code.GROW:
                 search = search.grown()
-            if deadline is not None and time.perf_counter() > deadline:
+            if call.expired():
                 status, stats["limit"] = "timeout", "time"
                 break
-        if status == "solved":
-            grid = eng.catalog().argmax(axis=1).astype(np.int32).reshape(problem.shape)
+        grid = eng.catalog().argmax(axis=1) if status == "solved" else None
         stats.update(
             nodes=search.nodes, conflicts=search.fails, restarts=restarts,
             propagations=int(search.counters[0]), removals=int(search.counters[1]),
         )  # fmt: skip
-        return Result(status, grid, "backtrack", time_s=time.perf_counter() - t0, stats=stats)
+        return self.result(status, grid, problem, stats, call)

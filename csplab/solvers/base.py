@@ -28,8 +28,11 @@ constraints   what it does with global constraints (:mod:`csplab.constraints`):
 bench         option variants ``benchmarks/bench_solvers.py`` times
 ============  ==================================================================
 
-Stats: a solver's ``Result.stats`` uses the names of :data:`STATS` (one name per concept);
-the conformance suite checks it.
+Every exit of :meth:`Solver.run` is :meth:`Solver.result` (the time since ``call.t0``, the
+proof of an ``unsat``), and the time limit is ``call.deadline``. Stats: ``Result.stats``
+uses only the names of :data:`STATS` (one name per concept), whichever path made them (a
+solver, :func:`csplab.solvers.solve`, continuous synthesis); the conformance suite checks
+it. ``csplab/solvers/_template.py`` is a minimal solver to copy.
 
 Examples
 --------
@@ -55,10 +58,10 @@ from dataclasses import dataclass, field
 from typing import Any, ClassVar, Literal
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from csplab.engine.alg31 import CHOICES, ORDERS, check_order
-from csplab.errors import InputError
+from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
 from csplab.result import Result, Status
 
@@ -72,6 +75,7 @@ __all__ = [
     "Solver",
     "order_option",
     "positive_seconds",
+    "unknown_stats",
 ]
 
 _MISSING = object()
@@ -200,7 +204,8 @@ TIME_LIMIT = Option(
     nullable=True, convert=positive_seconds,
 )  # fmt: skip
 
-# One name per concept for Result.stats (the conformance suite checks every solver's keys).
+# One name per concept for Result.stats, whichever path emits it: a solver, solve() itself or
+# continuous synthesis (the conformance suite checks every key, see unknown_stats).
 STATS: dict[str, str] = {
     "order": "the cell order used",
     "choice": "the label choice used",
@@ -274,14 +279,47 @@ STATS: dict[str, str] = {
     "choices": "choices (ASP)",
     "solver_status": "the backend's own status name",
     "solver_stats": "the backend's own statistics (a dict, backend names)",
+    "limit": "the limit that ended a timeout: time or nodes (backtrack)",
+    "restart": "failures before the first Luby restart, 0: never (backtrack)",
+    "num_workers": "search workers (CP-SAT)",
+    "presolve": "whether CP-SAT's presolve was on",
+    "setup_estimate_s": "estimated seconds of CP-SAT's set-up that did not fit in the time left",
+    "grounding": "who grounded the program: csplab (aspif) or gringo (ASP)",
+    "workers": "0: the thesis' sweep; N: the wave schedule on N workers (blocks)",
+    "scheduler": "where the waves ran: local or a Dask scheduler address (blocks)",
+    "rounds": "solve rounds of the exact connectivity cut loop (continuous synthesis in 3D)",
+    "constraint_attempts": "synthesis runs made while the output broke a user constraint "
+    "(continuous synthesis in 3D with restarts)",
 }
+
+#: stats whose value is a dict that uses the names of :data:`STATS` too
+_NESTED_STATS = ("sat",)
+
+
+def unknown_stats(stats: Mapping[str, Any]) -> list[str]:
+    """The keys of ``stats`` that :data:`STATS` does not name (a nested dict of
+    :data:`STATS` names such as ``stats["sat"]`` is checked too, as ``"sat.KEY"``).
+
+    Examples
+    --------
+    >>> unknown_stats({"assigned": 3, "sat": {"vars": 9, "speed": 1}, "mood": "good"})
+    ['mood', 'sat.speed']
+    """
+    out = [k for k in stats if k not in STATS]
+    for k in _NESTED_STATS:
+        sub = stats.get(k)
+        if isinstance(sub, Mapping):
+            out += [f"{k}.{kk}" for kk in sub if kk not in STATS]
+    return sorted(out)
 
 
 @dataclass(frozen=True)
 class Call:
     """What :meth:`Solver.run` gets: the randomness (``rng``, and the ``seed`` it was made
     from, recorded in the result), the backend, every declared option validated, and the
-    start time."""
+    start time ``t0``. The time limit is the call's: a solver watches :attr:`deadline`
+    (or :meth:`remaining`, :meth:`expired`), never a clock of its own, and
+    :meth:`Solver.result` measures the time from ``t0``."""
 
     rng: np.random.Generator
     seed: int | None
@@ -301,6 +339,17 @@ class Call:
         """``time.perf_counter()`` value of the time limit (``None``: no limit)."""
         limit = self.options.get("time_limit")
         return None if limit is None else self.t0 + float(limit)
+
+    def remaining(self) -> float | None:
+        """Seconds left before :attr:`deadline` (at most 0 once it has passed; ``None``: no
+        limit). Hand it to an engine that takes a ``time_limit``."""
+        deadline = self.deadline
+        return None if deadline is None else deadline - time.perf_counter()
+
+    def expired(self) -> bool:
+        """Whether :attr:`deadline` has passed."""
+        deadline = self.deadline
+        return deadline is not None and time.perf_counter() > deadline
 
 
 class Solver(ABC):
@@ -360,19 +409,54 @@ class Solver(ABC):
 
     @abstractmethod
     def run(self, problem: Problem, call: Call) -> Result:
-        """Solve ``problem``; ``call`` holds the randomness, the backend and every declared
-        option, validated."""
+        """Solve ``problem``; ``call`` holds the randomness, the backend, every declared
+        option, validated, and the deadline. Every exit returns :meth:`result`."""
 
-    @classmethod
     def result(
-        cls,
+        self,
         status: Status,
-        grid: NDArray[np.integer[Any]],
+        grid: ArrayLike | None,
         problem: Problem,
         stats: dict[str, Any],
-        t0: float,
+        call: Call,
+        *,
+        proof: str | None = None,
+        trace: NDArray[np.int64] | None = None,
     ) -> Result:
-        """A :class:`Result` of this solver: the grid as int32 of the problem's shape,
-        the time since ``t0``."""
-        g = np.asarray(grid, dtype=np.int32).reshape(problem.shape)
-        return Result(status, g, cls.name, time_s=time.perf_counter() - t0, stats=stats)
+        """The one way out of :meth:`run`: a :class:`Result` of this solver.
+
+        Parameters
+        ----------
+        status : {"solved", "failed", "unsat", "timeout"}
+            The outcome.
+        grid : array_like or None
+            The labels (reshaped to the problem's shape, as int32); ``None``: no cell
+            assigned (every label ``-1``).
+        problem : Problem
+            The problem solved.
+        stats : dict
+            The figures of the run, named as in :data:`STATS` (kept by reference, so a
+            ``finally`` clause may still add to them).
+        call : Call
+            The call being answered: the time is measured from ``call.t0`` and the seed
+            recorded.
+        proof : str, optional
+            Why the status is ``unsat``; stored as ``stats["proof"]``. An ``unsat`` result
+            without a proof is a bug (:class:`~csplab.errors.CsplabError`).
+        trace : int array ``(steps, 2)``, optional
+            The ``(cell, label)`` choices of an Alg. 3.1 run.
+
+        Returns
+        -------
+        Result
+        """
+        if proof is not None:
+            stats["proof"] = proof
+        if status == "unsat" and not stats.get("proof"):
+            raise CsplabError(f"solver {self.name!r} returned unsat without a proof (a bug)")
+        if grid is None:
+            g = np.full(problem.shape, -1, dtype=np.int32)
+        else:
+            g = np.asarray(grid, dtype=np.int32).reshape(problem.shape)
+        return Result(status, g, self.name, seed=call.seed,
+                      time_s=time.perf_counter() - call.t0, stats=stats, trace=trace)  # fmt: skip

@@ -208,15 +208,15 @@ def run_blocks(
     sweeps: int = 1,
     order: str = "scanline",
     choice: str = "uniform",
-    time_limit: float | None = None,
+    deadline: float | None = None,
     workers: int = 0,
     scheduler: str | None = None,
     window: int = 1,
     energy: Energy | None = None,
     temperature: float = 1.0,
     cooling: float = 1.0,
-) -> Result:
-    """Alg. 3.4 (see the module docstring).
+) -> tuple[Status, NDArray[np.int32], dict[str, Any]]:
+    """Alg. 3.4 (see the module docstring): the engine of :class:`BlocksSolver`.
 
     Parameters
     ----------
@@ -224,8 +224,10 @@ def run_blocks(
         The problem (a grid, or cells with :attr:`Problem.positions`: boxes of positions).
     rng : numpy.random.Generator
         The randomness (``workers >= 1``: one number drawn from it seeds every block).
-    block, retries, init, sweeps, order, choice, time_limit
+    block, retries, init, sweeps, order, choice
         As declared by :class:`BlocksSolver`.
+    deadline : float, optional
+        ``time.perf_counter()`` value at which the sweeps stop (the call's deadline).
     workers : int
         0: the thesis' sweep in this process; ``N >= 1``: the wave schedule on ``N``
         workers (1: in this process).
@@ -241,10 +243,12 @@ def run_blocks(
 
     Returns
     -------
-    Result
-        ``solved`` (always consistent) or ``timeout``.
+    status : {"solved", "timeout"}
+        ``solved`` (the grid is always consistent; :func:`csplab.solvers.solve` turns a
+        broken global constraint into ``failed``) or ``timeout``.
+    grid : int32 array of the problem's shape
+    stats : dict
     """
-    t0 = time.perf_counter()
     # global constraints: the blocks see only the arcs (as their subproblems do); a block
     # that breaks the constraints more than the model did is rejected (their excess is an
     # energy at zero temperature), so the sweeps repair the model; solve() checks the end
@@ -290,7 +294,6 @@ def run_blocks(
             idx[tuple(slice(a, a + b) for a, b in zip(q, m, strict=True))].reshape(-1)
             for q in itertools.product(*starts)
         ]
-    deadline = None if time_limit is None else t0 + float(time_limit)
     soft = _Soft(energy, float(temperature), float(cooling)) if energy is not None else None
     if workers >= 1:
         if choice == "resemblance" or soft is not None:
@@ -332,7 +335,7 @@ def run_blocks(
         stats["breaches"] = repair(out)
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
-    return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
+    return status, out, stats
 
 
 _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries, revisions
@@ -777,4 +780,6 @@ class BlocksSolver(Solver):
     )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:
-        return run_blocks(problem, call.rng, **call.options)
+        options = {k: v for k, v in call.options.items() if k != "time_limit"}
+        status, grid, stats = run_blocks(problem, call.rng, deadline=call.deadline, **options)
+        return self.result(status, grid, problem, stats, call)

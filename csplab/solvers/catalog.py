@@ -41,4 +41,7 @@ class CatalogSolver(Solver):
     options = (order_option(), CHOICE, WINDOW, TIME_LIMIT)
 
     def run(self, problem: Problem, call: Call) -> Result:
-        return run_alg31(problem, call.rng, **call.options)
+        order, choice, window = call.get("order", "choice", "window")
+        r = run_alg31(problem, call.rng, order=order, choice=choice, window=window,
+                      time_limit=call.remaining())  # fmt: skip
+        return self.result(r.status, r.grid, problem, r.stats, call, trace=r.trace)

@@ -168,31 +168,33 @@ class CpsatSolver(Solver):
 
     def run(self, problem: Problem, call: Call) -> Result:
         rng = call.rng
-        model, diversity, num_workers, presolve, time_limit = call.get(
-            "model", "diversity", "num_workers", "presolve", "time_limit"
+        model, diversity, num_workers, presolve = call.get(
+            "model", "diversity", "num_workers", "presolve"
         )
         cp_model = require("ortools.sat.python.cp_model", "cpsat", "solver 'cpsat'")
-        t0 = time.perf_counter()
-        deadline = None if time_limit is None else t0 + float(time_limit)
+        t0, deadline = call.t0, call.deadline
         rseed = int(rng.integers(2**31 - 1))
-        grid = np.full(problem.shape, -1, dtype=np.int32)
         stats: dict[str, Any] = {
             "model": model,
             "diversity": diversity,
             "num_workers": int(num_workers),
             "presolve": bool(presolve),
         }
+
+        def timeout() -> Result:
+            return self.result("timeout", None, problem, stats, call)
+
         try:
             enc = encode(problem, deadline=deadline)
         except DeadlineExceeded:
-            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+            return timeout()
         stats["encode_s"] = enc.stats.get("encode_s", 0.0)
-        if deadline is not None and time.perf_counter() > deadline:
-            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+        if call.expired():
+            return timeout()
         if not enc.ok:
-            stats["proof"] = "arc-consistency wipe-out before search (Theorem 3.3.2)"
             stats["fail_cell"] = list(problem.coords(enc.wiped))
-            return Result("unsat", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+            proof = "arc-consistency wipe-out before search (Theorem 3.3.2)"
+            return self.result("unsat", None, problem, stats, call, proof=proof)
         pref = preferred_labels(enc.catalog, None, rng) if diversity == "hint" else None
         if problem.constraints and model != "onehot":
             raise InputError("solver 'cpsat': global constraints need model='onehot'")
@@ -207,11 +209,11 @@ class CpsatSolver(Solver):
         except _SetupOverrun as e:
             stats["setup_estimate_s"] = e.estimate
             stats["build_s"] = time.perf_counter() - t0
-            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+            return timeout()
         except _Deadline:
             stats["load_s"] = time.perf_counter() - t_load
             stats["build_s"] = time.perf_counter() - t0
-            return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+            return timeout()
         ctx = None
         if problem.constraints:  # global constraints: clauses and linear counts, cuts below
             ctx = _LinearContext(problem, enc.literal, enc.nvars)
@@ -237,11 +239,10 @@ class CpsatSolver(Solver):
             prm.random_branches_ratio = 0.5
         if num_workers > 1:
             prm.interleave_search = True  # deterministic with several workers
-        if deadline is not None:
-            left = deadline - time.perf_counter()
+        left = call.remaining()
+        if left is not None:
             if left <= 0:
-                return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0,
-                              stats=stats)  # fmt: skip
+                return timeout()
             prm.max_time_in_seconds = left
         code = s.Solve(m)
         while ctx is not None and code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
@@ -251,8 +252,8 @@ class CpsatSolver(Solver):
                 break
             stats["cuts"] += k
             ctx.emit(m)
-            if deadline is not None:
-                left = deadline - time.perf_counter()
+            left = call.remaining()
+            if left is not None:
                 if left <= 0:
                     code = cp_model.UNKNOWN
                     break
@@ -268,12 +269,10 @@ class CpsatSolver(Solver):
             _learn_setup(model, units, stats["solve_s"], searched, solved)
         if code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
             values = np.asarray(list(s.response_proto.solution), dtype=np.int64)
-            out = read(values).reshape(problem.shape)
-            return Result("solved", out, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+            return self.result("solved", read(values), problem, stats, call)
         if code == cp_model.INFEASIBLE:
-            stats["proof"] = "CP-SAT: infeasible"
-            return Result("unsat", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
-        return Result("timeout", grid, "cpsat", time_s=time.perf_counter() - t0, stats=stats)
+            return self.result("unsat", None, problem, stats, call, proof="CP-SAT: infeasible")
+        return timeout()
 
     @staticmethod
     def _onehot(m: Any, enc: Any, pref: Any, deadline: float | None) -> tuple[Any, str, int]:

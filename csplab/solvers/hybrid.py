@@ -29,7 +29,6 @@ Examples
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 import numpy as np
@@ -76,9 +75,8 @@ class HybridSolver(Solver):
 
     def run(self, problem: Problem, call: Call) -> Result:
         rng, backend = call.rng, call.backend
-        order, choice, time_limit = call.get("order", "choice", "time_limit")
-        t0 = time.perf_counter()
-        deadline = None if time_limit is None else t0 + float(time_limit)
+        order, choice = call.get("order", "choice")
+        deadline = call.deadline
         n = problem.n
         fixed = np.full(n, -1, dtype=np.int64)
         stats: dict[str, Any] = {"order": order, "choice": choice, "alg31_runs": 0,
@@ -87,9 +85,9 @@ class HybridSolver(Solver):
         w = problem.weights if choice == "weighted" else None
         try:
             while True:
-                left = None if deadline is None else deadline - time.perf_counter()
+                left = call.remaining()
                 if left is not None and left <= 0:
-                    return self.result("timeout", fixed, problem, stats, t0)
+                    return self.result("timeout", fixed, problem, stats, call)
                 dom = problem.domains.copy()
                 idx = np.flatnonzero(fixed >= 0)
                 dom[idx] = False
@@ -100,12 +98,12 @@ class HybridSolver(Solver):
                               engine=eng)  # fmt: skip
                 if r.status == "solved":
                     stats["fixed_by_repair"] = int(idx.size)
-                    return self.result("solved", r.grid, problem, stats, t0)
+                    return self.result("solved", r.grid, problem, stats, call)
                 if r.status == "timeout":
-                    return self.result("timeout", fixed, problem, stats, t0)
-                if r.status == "unsat" and idx.size == 0:
-                    stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
-                    return self.result("unsat", fixed, problem, stats, t0)
+                    return self.result("timeout", fixed, problem, stats, call)
+                if r.status == "unsat" and idx.size == 0:  # Alg. 3.1's proof (Theorem 3.3.2)
+                    proof = str(r.stats["proof"])
+                    return self.result("unsat", fixed, problem, stats, call, proof=proof)
                 if oracle is None:
                     oracle = SatOracle(problem, backend=backend, deadline=deadline,
                                        seed=int(rng.integers(2**31 - 1)))  # fmt: skip
@@ -115,13 +113,13 @@ class HybridSolver(Solver):
                         if st == "unsat":
                             stats["proof"] = f"refutation by {oracle.backend}"
                         end: Status = "timeout" if st == "timeout" else "unsat"
-                        return self.result(end, fixed, problem, stats, t0)
+                        return self.result(end, fixed, problem, stats, call)
                 trace = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
                 if r.status != "failed" or trace.shape[0] == 0:
                     raise CsplabError("hybrid: Alg. 3.1 failed on a consistent prefix (a bug)")
                 k = self._first_bad(oracle, trace, stats, deadline)
                 if k is None:
-                    return self.result("timeout", fixed, problem, stats, t0)
+                    return self.result("timeout", fixed, problem, stats, call)
                 # fix the consistent prefix, then redraw step k from C*
                 for p, b in trace[:k].tolist():
                     if fixed[p] < 0:
@@ -139,8 +137,8 @@ class HybridSolver(Solver):
                 pool = WitnessPool(n, 1)
                 b2 = choose_from_exact(oracle, pool, p, labels, w, rng, stats, deadline)
                 if b2 is None:
-                    if deadline is not None and time.perf_counter() > deadline:
-                        return self.result("timeout", fixed, problem, stats, t0)
+                    if call.expired():
+                        return self.result("timeout", fixed, problem, stats, call)
                     raise CsplabError("hybrid: no label of C* at a consistent step (a bug)")
                 fixed[p] = b2
                 oracle.add_clause([oracle.literal(p, b2)])

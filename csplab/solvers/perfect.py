@@ -25,7 +25,6 @@ Examples
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 import numpy as np
@@ -66,19 +65,16 @@ class PerfectSolver(Solver):
 
     def run(self, problem: Problem, call: Call) -> Result:
         rng, backend = call.rng, call.backend
-        order, choice, pool, time_limit, progress = call.get(
-            "order", "choice", "pool", "time_limit", "progress"
-        )
-        t0 = time.perf_counter()
-        deadline = None if time_limit is None else t0 + float(time_limit)
+        order, choice, pool, progress = call.get("order", "choice", "pool", "progress")
+        deadline = call.deadline
         n = problem.n
         grid = np.full(n, -1, dtype=np.int32)
         stats: dict[str, Any] = {"order": order, "choice": choice, "sat_calls": 0,
                                  "rejected": 0, "assigned": 0}  # fmt: skip
         eng = Propagator(problem)
         if not eng.ok:
-            stats["proof"] = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
-            return self.result("unsat", grid, problem, stats, t0)
+            proof = "arc-consistency wipe-out before any choice (Theorem 3.3.2)"
+            return self.result("unsat", grid, problem, stats, call, proof=proof)
         scan = scan_order(problem.shape, order)
         perm = rng.permutation(n) if scan is None else scan
         w = problem.weights if choice == "weighted" else None
@@ -87,24 +83,24 @@ class PerfectSolver(Solver):
             st = o.solve(deadline=deadline)
             stats["sat_calls"] += 1
             if st == "unsat":
-                stats["proof"] = f"refutation by {o.backend}"
-                return self.result("unsat", grid, problem, stats, t0)
+                proof = f"refutation by {o.backend}"
+                return self.result("unsat", grid, problem, stats, call, proof=proof)
             if st == "timeout":
-                return self.result("timeout", grid, problem, stats, t0)
+                return self.result("timeout", grid, problem, stats, call)
             wit = WitnessPool(n, pool)
             assert o.grid is not None
             wit.add(o.grid.reshape(-1))
             cells = progress_bar(perm.tolist(), total=n, desc="perfect", enabled=progress)
             for p in cells:
-                if deadline is not None and time.perf_counter() > deadline:
-                    return self.result("timeout", grid, problem, stats, t0)
+                if call.expired():
+                    return self.result("timeout", grid, problem, stats, call)
                 labels = eng.domain(p)
                 if labels.size == 1:
                     b = int(labels[0])
                 else:
                     pick = choose_from_exact(o, wit, p, labels, w, rng, stats, deadline)
                     if pick is None:
-                        return self.result("timeout", grid, problem, stats, t0)
+                        return self.result("timeout", grid, problem, stats, call)
                     b = pick
                     o.add_clause([o.literal(p, b)])
                 grid[p] = b
@@ -113,4 +109,4 @@ class PerfectSolver(Solver):
                 if not eng.assign(p, b):  # impossible: M_t stays completable
                     raise CsplabError("perfect: arc consistency failed after a C* choice (a bug)")
             stats["sat"] = {k: o.stats[k] for k in SAT_STAT_KEYS if k in o.stats}
-        return self.result("solved", grid, problem, stats, t0)
+        return self.result("solved", grid, problem, stats, call)

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import time
 
-import numpy as np
+from numpy.typing import ArrayLike
 
 from csplab.cnf import AMO_ENCODINGS
 from csplab.engine.sat import SatOracle, backends, preferred_labels
@@ -86,13 +86,12 @@ class SatSolver(Solver):
 
     def run(self, problem: Problem, call: Call) -> Result:
         rng, backend = call.rng, call.backend
-        encoding, supports, amo, choice, loader, time_limit = call.get(
-            "encoding", "supports", "amo", "choice", "loader", "time_limit"
+        encoding, supports, amo, choice, loader = call.get(
+            "encoding", "supports", "amo", "choice", "loader"
         )
-        t0 = time.perf_counter()
-        deadline = None if time_limit is None else t0 + float(time_limit)
+        deadline = call.deadline
         cseed = int(rng.integers(2**31 - 1))
-        grid = np.full(problem.shape, -1, dtype=np.int32)
+        grid: ArrayLike | None = None
         with SatOracle(
             problem, backend=backend, encoding=encoding, supports=supports, amo=amo,
             loader=loader, deadline=deadline, seed=cseed,
@@ -123,4 +122,4 @@ class SatSolver(Solver):
         # freeing a solver with millions of clauses takes a while: it counts
         stats["free_s"] = time.perf_counter() - t1
         final: Status = "solved" if status == "sat" else "unsat" if status == "unsat" else "timeout"
-        return Result(final, grid, "sat", time_s=time.perf_counter() - t0, stats=stats)
+        return self.result(final, grid, problem, stats, call)

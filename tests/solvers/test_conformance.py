@@ -13,22 +13,28 @@ periodic or not, with fixed cells and masks; some unsatisfiable):
 4. ``unsat`` always comes with ``stats["proof"]``;
 5. SAT enumeration (csplab's blocking clauses, and pysat's ``enum_models`` on the support
    encoding with pairwise at-most-one) counts exactly the brute-force solutions;
-6. time limits are honoured within 1 s on a problem too large to finish in time.
+6. time limits are honoured within 1 s on a problem too large to finish in time;
+7. every stat any path emits is named in :data:`csplab.solvers.STATS`: every solver's
+   (including its ``timeout``, ``unsat`` and restart paths), :func:`csplab.solvers.solve`'s
+   own and continuous synthesis' (2D, and 3D with a connectivity constraint).
 
 The default run uses the hypothesis profile of ``tests/conftest.py`` (60 examples); the
 ``slow`` run (``pytest -m slow``) draws 5,000 problems and checks every solver on each.
 """
 
+import contextlib
 import time
 
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from csplab import Problem, solve
+from csplab import ExampleModel, Problem, load_example, solve
+from csplab.constraints import Connected, Count
 from csplab.errors import InputError, NoTrivialSolutionError
+from csplab.examples.continuous import load_polygon_example
 from csplab.grids import from_example
-from csplab.solvers import STATS, available_solvers, get_solver
+from csplab.solvers import REGISTRY, available_solvers, get_solver, unknown_stats
 from csplab.testing.brute import count, solutions
 from csplab.testing.strategies import csp_problems
 from csplab.testing.synthetic import box_town
@@ -88,9 +94,7 @@ def check_solver_on(spec, opts, P, seed):
     status = _check_one(spec, opts, P, seed, _satisfiable(P))
     r = _run(spec, opts, P, seed)
     if r is not None:
-        cls = get_solver(spec)[0]
-        unknown = set(r.stats) - set(STATS) - {o.name for o in cls.options}
-        assert not unknown, (spec, "stats outside the glossary", unknown)
+        assert not unknown_stats(r.stats), (spec, "stats outside STATS", unknown_stats(r.stats))
     return status
 
 
@@ -157,10 +161,98 @@ def test_time_limits_are_honoured_within_one_second(spec, opts):
     r = solve(_BIG, spec, rng=0, time_limit=limit, **opts)
     wall = time.perf_counter() - t0
     assert r.status in ("timeout", "solved", "failed")
+    assert not unknown_stats(r.stats), (spec, unknown_stats(r.stats))  # the timeout path
     # CP-SAT loads a table model without looking at its time limit or StopSearch (measured
     # 1.7-2.1 s for this instance, documented in csplab/solvers/cpsat.py)
     slack = 3.0 if spec == "cpsat" and opts.get("model") == "table" else 1.0
     assert wall < limit + slack, (spec, wall)
+
+
+_CHECKER = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
+_PATHS = {
+    "solved": from_example(_CHECKER, (5, 5)),
+    "unsat": from_example(_CHECKER, (3, 3), fixed={(0, 0): 0, (2, 0): 1}),
+    "fallible": from_example(load_example("fig3_5a"), (8, 8)),  # Alg. 3.1 fails often
+    "constraints": from_example(_CHECKER, (4, 4)).with_constraints(
+        [Count([1], min=8, max=8), Connected([0])]
+    ),
+}
+
+
+@pytest.mark.parametrize(("spec", "opts"), SPECS, ids=IDS)
+def test_every_stat_of_every_path_is_named_in_STATS(spec, opts):
+    """Rule 7 on the paths hypothesis rarely reaches: proofs of unsatisfiability, failures
+    and restarts (solve()'s ``attempts``, ``attempt_seed``), global constraints (their
+    pruning, clauses and cuts, or solve()'s breach check)."""
+    for name, P in _PATHS.items():
+        for seed in range(3):
+            for restarts in (0, 2):
+                try:
+                    r = solve(P, spec, rng=seed, restarts=restarts, **opts)
+                except NoTrivialSolutionError:
+                    continue  # blocks: no consistent starting model
+                except InputError as e:  # cpsat's table model takes no global constraints
+                    assert name == "constraints", e
+                    continue
+                assert not unknown_stats(r.stats), (spec, name, unknown_stats(r.stats))
+
+
+@pytest.mark.parametrize("solver", ["catalog", "blocks", "sat"])
+def test_continuous_synthesis_stats_are_named_in_STATS(solver):
+    """Rule 7 for the continuous path (through its public API): the solver's stats, plus
+    what synthesis adds (``synthesize3``'s ``rounds`` of the connectivity cut loop and its
+    ``constraint_attempts``)."""
+    from csplab.continuous import synthesize
+
+    if solver == "sat" and "sat" not in _INSTALLED:
+        pytest.skip("python-sat not installed")
+    s = synthesize(load_polygon_example("triangle"), (8, 8), solver=solver, rng=1, restarts=2)
+    assert s.result.status == "solved"
+    assert not unknown_stats(s.result.stats), unknown_stats(s.result.stats)
+    pytest.importorskip("trimesh")
+    from csplab.continuous.synthesis import synthesize3
+    from csplab.continuous.user3d import parse_user_constraints
+    from csplab.examples.continuous3d import load_polyhedral_example
+
+    tet = load_polyhedral_example("tetrahedron")
+    connected = parse_user_constraints({"constraints": [{"type": "connected", "labels": [1]}]})
+    s3 = synthesize3(tet, (3, 3, 2), solver=solver, rng=2, restarts=1, constraints=connected)
+    # sat runs the exact cut loop; the others break the constraint here and are retried
+    assert {"sat": "rounds"}.get(solver, "constraint_attempts") in s3.result.stats
+    assert not unknown_stats(s3.result.stats), unknown_stats(s3.result.stats)
+
+
+@contextlib.contextmanager
+def _template():
+    """The solver template (``csplab/solvers/_template.py``) registered for one test."""
+    REGISTRY["template"] = "csplab.solvers._template:TemplateSolver"
+    try:
+        yield "template"
+    finally:
+        REGISTRY.pop("template", None)
+
+
+@given(P=csp_problems(), seed=st.integers(0, 2**31))
+def test_the_solver_template_conforms(P, seed):
+    with _template() as name:
+        check_solver_on(name, {}, P, seed)
+        check_solver_on(name, {"order": "random"}, P, seed)
+
+
+def test_the_solver_template_on_every_path():
+    with _template() as name:
+        cls = get_solver(name)[0]
+        assert cls.name == name and cls.options[-1].name == "time_limit"
+        statuses = set()
+        for P in _PATHS.values():
+            for restarts in (0, 3):
+                r = solve(P, name, rng=1, restarts=restarts)
+                statuses.add(r.status)
+                assert not unknown_stats(r.stats), unknown_stats(r.stats)
+                assert r.solver == name and r.grid.shape == P.shape
+        assert statuses == {"solved", "unsat", "failed"}, statuses
+        # seed 0 solves _BIG: within 1 ms it can only time out (before or during Alg. 3.1)
+        assert solve(_BIG, name, rng=0, time_limit=1e-3).status == "timeout"
 
 
 @pytest.mark.slow

@@ -10,23 +10,21 @@ import pytest
 
 from csplab import ExampleModel, solve
 from csplab.cli import main
-from csplab.errors import InputError
+from csplab.errors import CsplabError, InputError
 from csplab.grids import from_example
 from csplab.solvers import (
     REGISTRY,
-    STATS,
     available_solvers,
     markdown_table,
     register,
     solver_class,
     solver_names,
+    unknown_stats,
 )
-from csplab.solvers.base import Solver
+from csplab.solvers.base import Call, Solver
 
 TOY = textwrap.dedent(
     """
-    import time
-    import numpy as np
     from csplab.catalog import Propagator
     from csplab.engine.completability import search_solution
     from csplab.solvers.base import TIME_LIMIT, Option, Solver
@@ -39,13 +37,11 @@ TOY = textwrap.dedent(
                    TIME_LIMIT)
 
         def run(self, problem, call):
-            t0 = time.perf_counter()
             eng = Propagator(problem)
             g = search_solution(eng) if eng.ok else None
             if g is None:
-                return self.result("unsat", np.full(problem.n, -1), problem,
-                                   {"proof": "exhaustive search"}, t0)
-            return self.result("solved", g, problem, {"assigned": int(problem.n)}, t0)
+                return self.result("unsat", None, problem, {}, call, proof="exhaustive search")
+            return self.result("solved", g, problem, {"assigned": int(problem.n)}, call)
     """
 )
 
@@ -99,10 +95,21 @@ def test_stats_use_the_glossary():
     for info in available_solvers():
         if not info.get("installed"):
             continue
-        cls = solver_class(info["name"])
         r = solve(P, info["name"], rng=2)
-        unknown = set(r.stats) - set(STATS) - {o.name for o in cls.options}
-        assert not unknown, (info["name"], unknown)
+        assert not unknown_stats(r.stats), (info["name"], unknown_stats(r.stats))
+
+
+def test_result_is_the_one_way_out():
+    P = from_example(ExampleModel([[0, 1], [1, 0]]), (3, 2))
+    cls = solver_class("catalog")
+    call = Call(np.random.default_rng(0), 7, None, cls.validate({}))
+    r = cls().result("timeout", None, P, {"assigned": 0}, call)
+    assert r.grid.shape == (3, 2) and r.grid.dtype == np.int32 and (r.grid == -1).all()
+    assert r.solver == "catalog" and r.seed == 7 and r.time_s > 0
+    with pytest.raises(CsplabError, match="unsat without a proof"):
+        cls().result("unsat", None, P, {}, call)
+    r = cls().result("unsat", None, P, {}, call, proof="a wipe-out")
+    assert r.stats["proof"] == "a wipe-out"
 
 
 def test_readme_solver_table_is_generated():
