@@ -541,11 +541,9 @@ def _run_waves(
     scan = _block_scan(m, order) if compiled and m is not None else None
     ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root,
                           size=problem.n * problem.K, compiled=compiled, scan=scan)  # fmt: skip
-    runner: wv.PoolRunner | wv.DaskRunner | None = None
-    if scheduler is not None:
-        runner = wv.DaskRunner(scheduler, workers, ctx)
-    elif workers > 1:
-        runner = wv.PoolRunner(workers, ctx)
+    runner: wv.BlockRunner | None = None
+    if scheduler is not None or workers > 1:
+        runner = wv.BlockRunner(workers, ctx, scheduler)
     tried = accepted = retry_count = revisions = 0
     status: Status = "solved"
     stopped = False  # a wave did not finish in time: its workers are stopped
@@ -580,7 +578,7 @@ def _run_waves(
                             )
                         )
                 else:
-                    size = wv.chunk_size(len(wave), runner.workers)
+                    size = wv.chunk_size(len(wave), runner.size)
                     wall = (
                         None if deadline is None else time.time() + deadline - time.perf_counter()
                     )
