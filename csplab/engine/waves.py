@@ -192,14 +192,18 @@ def solve_block(
     order: str,
     choice: str,
     deadline: float | None,
+    window: int = 1,
+    context: tuple[Any, Any, tuple[int, ...]] | None = None,
 ) -> BlockOutcome:
     """Alg. 3.1 on a block's subproblem, retried up to ``retries`` times on failure (the
-    inner loop of Alg. 3.4); ``deadline`` is a ``time.perf_counter()`` value."""
+    inner loop of Alg. 3.4); ``deadline`` is a ``time.perf_counter()`` value; ``window``
+    and ``context`` go to :func:`~csplab.engine.alg31.run_alg31` (resemblance choice)."""
     revisions = retry_count = 0
     status = "failed"
     for attempt in range(retries + 1):
         left = None if deadline is None else max(0.0, deadline - time.perf_counter())
-        r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left)
+        r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left, window=window,
+                      context=context)  # fmt: skip
         revisions += int(r.stats.get("revisions", 0))
         status = r.status
         if r.status == "solved":

@@ -388,54 +388,73 @@ def _run_sweep(
     soft: _Soft | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
-    ``grid`` (flat) in place. With the compiled kernels loaded and a plain setting (grid
-    blocks, scan or entropy orders, uniform or weighted choice, no energy) the whole sweep
-    runs in one kernel (:func:`_run_sweep_compiled`)."""
+    ``grid`` (flat) in place. A step solves one block (:func:`_block_step`) or, with the
+    compiled kernels loaded and a plain setting (grid blocks, scan or entropy orders,
+    uniform or weighted choice, no energy), the :data:`_SWEEP_CHUNK` blocks from the
+    given one on in one kernel call (:func:`_chunk_step`: the same blocks, draws and
+    results); the deadline is checked between steps."""
+    counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, revisions
     if _compiled_sweep_applies(boxes, m, order, choice, soft):
-        return _run_sweep_compiled(
-            problem, grid, boxes, m, rng, retries=retries, sweeps=sweeps, order=order,
-            deadline=deadline, choice=choice,
-        )  # fmt: skip
-    touching = _arc_index(problem) if len(boxes) > 1 else None
-    tried = accepted = retry_count = 0
-    revisions = 0
+        assert m is not None
+        step = _chunk_step(problem, grid, boxes, m, rng, retries, order, choice, counters)
+        units = range(0, len(boxes), _SWEEP_CHUNK)
+    else:
+        step = _block_step(problem, grid, boxes, m, rng, counters, retries=retries,
+                           order=order, choice=choice, deadline=deadline, window=window,
+                           soft=soft)  # fmt: skip
+        units = range(len(boxes))
     status: Status = "solved"
     if soft is not None:
         soft.start(grid, problem.shape)
     for _sweep in range(sweeps):
-        for cells in boxes:
-            if deadline is not None and time.perf_counter() > deadline:
+        for unit in units:
+            if (deadline is not None and time.perf_counter() > deadline) or not step(unit):
                 status = "timeout"
-                break
-            if not cells.size:
-                continue
-            arc_ids = None if touching is None else _arcs_touching(cells, *touching)
-            sub = problem.subproblem(cells, grid, shape=m, arc_ids=arc_ids)
-            tried += 1
-            for attempt in range(retries + 1):
-                left = None if deadline is None else max(0.0, deadline - time.perf_counter())
-                ctx = (grid, cells, problem.shape) if choice == "resemblance" else None
-                r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left,
-                              window=window, context=ctx)  # fmt: skip
-                revisions += int(r.stats.get("revisions", 0))
-                if r.status == "solved":
-                    new = r.grid.reshape(-1)
-                    if soft is None or soft.accept(grid, cells, new, rng):
-                        grid[cells] = new
-                        accepted += 1
-                    break
-                if r.status == "timeout":
-                    status = "timeout"
-                    break
-                if attempt < retries:
-                    retry_count += 1
-            if status == "timeout":
                 break
         if soft is not None:
             soft.end_sweep()
         if status == "timeout":
             break
+    tried, accepted, retry_count, revisions = (int(x) for x in counters)
     return status, tried, accepted, retry_count, revisions
+
+
+def _block_step(
+    problem: Problem,
+    grid: NDArray[np.int32],
+    boxes: Sequence[NDArray[np.int64]],
+    m: tuple[int, ...] | None,
+    rng: np.random.Generator,
+    counters: NDArray[np.int64],
+    *,
+    retries: int,
+    order: str,
+    choice: str,
+    deadline: float | None,
+    window: int,
+    soft: _Soft | None,
+) -> Callable[[int], bool]:
+    """The sweep's step on block ``b``: Alg. 3.1 on its subproblem, retried
+    (:func:`csplab.engine.waves.solve_block`), its labels kept if consistent (and accepted
+    by ``soft``); ``False`` when the time ran out."""
+    touching = _arc_index(problem) if len(boxes) > 1 else None
+
+    def step(b: int) -> bool:
+        cells = boxes[b]
+        if not cells.size:
+            return True
+        arc_ids = None if touching is None else _arcs_touching(cells, *touching)
+        sub = problem.subproblem(cells, grid, shape=m, arc_ids=arc_ids)
+        ctx = (grid, cells, problem.shape) if choice == "resemblance" else None
+        o = wv.solve_block(sub, rng, 0, retries=retries, order=order, choice=choice,
+                           deadline=deadline, window=window, context=ctx)  # fmt: skip
+        counters[:] += (1, 0, o.retries, o.revisions)
+        if o.labels is not None and (soft is None or soft.accept(grid, cells, o.labels, rng)):
+            grid[cells] = o.labels
+            counters[1] += 1
+        return o.status != "timeout"
+
+    return step
 
 
 _SWEEP_CHUNK = 64  # blocks per kernel call (the deadline is checked between calls)
@@ -463,22 +482,20 @@ def _block_scan(m: tuple[int, ...], order: str) -> NDArray[np.int64]:
     return np.arange(n, dtype=np.int64) if scan is None else scan.astype(np.int64)
 
 
-def _run_sweep_compiled(
+def _chunk_step(
     problem: Problem,
     grid: NDArray[np.int32],
     boxes: Sequence[NDArray[np.int64]],
-    m: tuple[int, ...] | None,
+    m: tuple[int, ...],
     rng: np.random.Generator,
-    *,
     retries: int,
-    sweeps: int,
     order: str,
     choice: str,
-    deadline: float | None,
-) -> _Counts:
-    """:func:`_run_sweep` in one compiled kernel per :data:`_SWEEP_CHUNK` blocks
-    (:func:`csplab.catalog.sweep_blocks`): the same blocks, draws and results."""
-    assert m is not None
+    counters: NDArray[np.int64],
+) -> Callable[[int], bool]:
+    """The sweep's step on the :data:`_SWEEP_CHUNK` blocks from block ``a`` on in one
+    compiled kernel call (:func:`csplab.catalog.sweep_blocks`, which adds to
+    ``counters``)."""
     heap = order in ("min-entropy", "min-domain")
     nb = int(np.prod(m))
     scan = _block_scan(m, order)
@@ -490,20 +507,14 @@ def _run_sweep_compiled(
         raise AssertionError("grid blocks all have the block's shape")
     weighted = choice == "weighted"
     key_weighted = weighted and order == "min-entropy"
-    counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, queue pops
-    status: Status = "solved"
-    for _sweep in range(sweeps):
-        for a in range(0, len(boxes), _SWEEP_CHUNK):
-            if deadline is not None and time.perf_counter() > deadline:
-                status = "timeout"
-                break
-            span = (a, min(a + _SWEEP_CHUNK, len(boxes)))
-            sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, heap, weighted,
-                         key_weighted, rng, counters)  # fmt: skip
-        if status == "timeout":
-            break
-    tried, accepted, retry_count, revisions = (int(x) for x in counters)
-    return status, tried, accepted, retry_count, revisions
+
+    def step(a: int) -> bool:
+        span = (a, min(a + _SWEEP_CHUNK, len(boxes)))
+        sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, heap, weighted,
+                     key_weighted, rng, counters)  # fmt: skip
+        return True
+
+    return step
 
 
 def _run_waves(
