@@ -257,11 +257,9 @@ def solve_compiled(
     if not _TABLES or _TABLES[0][0] is not ctx:  # once per context and process
         _TABLES[:] = [(ctx, support_tables(ctx.relations, ctx.weights))]
     assert ctx.scan is not None
-    heap = ctx.order in ("min-entropy", "min-domain")
-    weighted = ctx.choice == "weighted"
     labels, retries, pops = solve_block_arrays(
-        _TABLES[0][1], task.arrays, ctx.scan, ctx.retries, heap, weighted,
-        weighted and ctx.order == "min-entropy", block_rng(ctx.root, task.sweep, task.block),
+        _TABLES[0][1], task.arrays, ctx.scan, ctx.retries, ctx.order, ctx.choice,
+        block_rng(ctx.root, task.sweep, task.block),
     )  # fmt: skip
     status = "solved" if labels is not None else "failed"
     return BlockOutcome(task.block, labels, status, retries, pops)

@@ -496,7 +496,6 @@ def _chunk_step(
     """The sweep's step on the :data:`_SWEEP_CHUNK` blocks from block ``a`` on in one
     compiled kernel call (:func:`csplab.catalog.sweep_blocks`, which adds to
     ``counters``)."""
-    heap = order in ("min-entropy", "min-domain")
     nb = int(np.prod(m))
     scan = _block_scan(m, order)
     sizes = np.array([b.size for b in boxes], dtype=np.int64)
@@ -505,13 +504,11 @@ def _chunk_step(
     bcells = np.concatenate(list(boxes)).astype(np.int64) if boxes else np.zeros(0, np.int64)
     if np.any((sizes != nb) & (sizes > 0)):
         raise AssertionError("grid blocks all have the block's shape")
-    weighted = choice == "weighted"
-    key_weighted = weighted and order == "min-entropy"
 
     def step(a: int) -> bool:
         span = (a, min(a + _SWEEP_CHUNK, len(boxes)))
-        sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, heap, weighted,
-                     key_weighted, rng, counters)  # fmt: skip
+        sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, order, choice, rng,
+                     counters)  # fmt: skip
         return True
 
     return step
