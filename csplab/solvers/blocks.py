@@ -54,7 +54,7 @@ import itertools
 import math
 import time
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -292,21 +292,19 @@ def run_blocks(
         ]
     deadline = None if time_limit is None else t0 + float(time_limit)
     soft = _Soft(energy, float(temperature), float(cooling)) if energy is not None else None
+    plan = _Plan(retries, sweeps, order, choice, deadline)
     if workers >= 1:
         if choice == "resemblance" or soft is not None:
             raise InputError(
                 "choice='resemblance' and energy= run in the thesis' sweep (workers=0)"
             )
         status, tried, accepted, retry_count, revisions = _run_waves(
-            problem, grid, boxes, counts, None if m == (0,) else m, rng,
-            retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
+            problem, grid, boxes, counts, None if m == (0,) else m, rng, plan,
             workers=workers, scheduler=scheduler,
         )  # fmt: skip
     else:
         status, tried, accepted, retry_count, revisions = _run_sweep(
-            problem, grid, boxes, None if m == (0,) else m, rng,
-            retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
-            window=window, soft=soft,
+            problem, grid, boxes, None if m == (0,) else m, rng, plan, window=window, soft=soft,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -336,6 +334,18 @@ def run_blocks(
 
 
 _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries, revisions
+
+
+class _Plan(NamedTuple):
+    """The settings of Alg. 3.4 that the sweep and the waves share: retries per block,
+    sweeps, Alg. 3.1's order and choice, and the deadline (a ``time.perf_counter()``
+    value)."""
+
+    retries: int
+    sweeps: int
+    order: str
+    choice: str
+    deadline: float | None
 
 
 class _Soft:
@@ -378,12 +388,8 @@ def _run_sweep(
     boxes: Sequence[NDArray[np.int64]],
     m: tuple[int, ...] | None,
     rng: np.random.Generator,
+    plan: _Plan,
     *,
-    retries: int,
-    sweeps: int,
-    order: str,
-    choice: str,
-    deadline: float | None,
     window: int = 1,
     soft: _Soft | None = None,
 ) -> _Counts:
@@ -393,6 +399,7 @@ def _run_sweep(
     uniform or weighted choice, no energy), the :data:`_SWEEP_CHUNK` blocks from the
     given one on in one kernel call (:func:`_chunk_step`: the same blocks, draws and
     results); the deadline is checked between steps."""
+    retries, sweeps, order, choice, deadline = plan
     counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, revisions
     if _compiled_sweep_applies(boxes, m, order, choice, soft):
         assert m is not None
@@ -521,17 +528,14 @@ def _run_waves(
     counts: tuple[int, ...],
     m: tuple[int, ...] | None,
     rng: np.random.Generator,
+    plan: _Plan,
     *,
-    retries: int,
-    sweeps: int,
-    order: str,
-    choice: str,
-    deadline: float | None,
     workers: int,
     scheduler: str | None,
 ) -> _Counts:
     """The wave schedule (``workers >= 1``, see the module docstring); updates ``grid``
     (flat) in place after each wave."""
+    retries, sweeps, order, choice, deadline = plan
     root = int(rng.integers(2**63))
     compiled = _compiled_sweep_applies(boxes, m, order, choice, None)
     touching: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None
