@@ -160,7 +160,9 @@ def run_trials(
     jobs : int, optional
         Local worker processes (default: CPU count); ``1`` runs in this process.
     scheduler : str or distributed.Client, optional
-        Run on a Dask cluster instead.
+        Run on a Dask cluster instead: an address such as ``tcp://host:8786``, ``"local"``
+        (a local cluster of ``jobs`` processes) or a client
+        (:meth:`csplab.engine.pool.Workers.dask`).
     progress : bool
         Show a progress bar on stderr.
     """
@@ -189,11 +191,11 @@ def run_trials(
     interrupted = False
     restore = _on_sigterm_interrupt()
     workers: Workers | None = None
+    n = min(int(jobs or os.cpu_count() or 1), len(todo))
     if scheduler is not None and todo:
-        workers = Workers.dask(scheduler, purpose="--scheduler (a Dask cluster)")
+        workers = Workers.dask(scheduler, purpose="--scheduler (a Dask cluster)", local_workers=n)
         summary.executor = "dask"
-    elif (jobs or os.cpu_count() or 1) > 1 and len(todo) > 1:
-        n = min(int(jobs or os.cpu_count() or 1), len(todo))
+    elif n > 1:
         workers = Workers.local(n, start="spawn")
         summary.executor = f"{n} local processes"
     bar = _progress(len(todo), experiment, progress)
