@@ -394,59 +394,18 @@ def _run_sweep(
     soft: _Soft | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
-    ``grid`` (flat) in place. A step solves one block (:func:`_block_step`) or, with the
-    compiled kernels loaded and a plain setting (grid blocks, scan or entropy orders,
-    uniform or weighted choice, no energy), the :data:`_SWEEP_CHUNK` blocks from the
-    given one on in one kernel call (:func:`_chunk_step`: the same blocks, draws and
-    results); the deadline is checked between steps."""
+    ``grid`` (flat) in place. A step solves one block (``block_step``: Alg. 3.1 on its
+    subproblem, retried by :func:`csplab.engine.waves.solve_block`, its labels kept if
+    consistent and accepted by ``soft``) or, with the compiled kernels loaded and a plain
+    setting (grid blocks, scan or entropy orders, uniform or weighted choice, no energy),
+    the :data:`_SWEEP_CHUNK` blocks from the given one on in one kernel call
+    (:func:`_chunk_step`: the same blocks, draws and results); the deadline is checked
+    between steps."""
     retries, sweeps, order, choice, deadline = plan
     counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, revisions
-    if _compiled_sweep_applies(boxes, m, order, choice, soft):
-        assert m is not None
-        step = _chunk_step(problem, grid, boxes, m, rng, retries, order, choice, counters)
-        units = range(0, len(boxes), _SWEEP_CHUNK)
-    else:
-        step = _block_step(problem, grid, boxes, m, rng, counters, retries=retries,
-                           order=order, choice=choice, deadline=deadline, window=window,
-                           soft=soft)  # fmt: skip
-        units = range(len(boxes))
-    status: Status = "solved"
-    if soft is not None:
-        soft.start(grid, problem.shape)
-    for _sweep in range(sweeps):
-        for unit in units:
-            if (deadline is not None and time.perf_counter() > deadline) or not step(unit):
-                status = "timeout"
-                break
-        if soft is not None:
-            soft.end_sweep()
-        if status == "timeout":
-            break
-    tried, accepted, retry_count, revisions = (int(x) for x in counters)
-    return status, tried, accepted, retry_count, revisions
-
-
-def _block_step(
-    problem: Problem,
-    grid: NDArray[np.int32],
-    boxes: Sequence[NDArray[np.int64]],
-    m: tuple[int, ...] | None,
-    rng: np.random.Generator,
-    counters: NDArray[np.int64],
-    *,
-    retries: int,
-    order: str,
-    choice: str,
-    deadline: float | None,
-    window: int,
-    soft: _Soft | None,
-) -> Callable[[int], bool]:
-    """The sweep's step on block ``b``: Alg. 3.1 on its subproblem, retried
-    (:func:`csplab.engine.waves.solve_block`), its labels kept if consistent (and accepted
-    by ``soft``); ``False`` when the time ran out."""
     touching = _arc_index(problem) if len(boxes) > 1 else None
 
-    def step(b: int) -> bool:
+    def block_step(b: int) -> bool:  # False when the time ran out
         cells = boxes[b]
         if not cells.size:
             return True
@@ -461,7 +420,26 @@ def _block_step(
             counters[1] += 1
         return o.status != "timeout"
 
-    return step
+    step: Callable[[int], bool] = block_step
+    units = range(len(boxes))
+    if _compiled_sweep_applies(boxes, m, order, choice, soft):
+        assert m is not None
+        step = _chunk_step(problem, grid, boxes, m, rng, retries, order, choice, counters)
+        units = range(0, len(boxes), _SWEEP_CHUNK)
+    status: Status = "solved"
+    if soft is not None:
+        soft.start(grid, problem.shape)
+    for _sweep in range(sweeps):
+        for unit in units:
+            if (deadline is not None and time.perf_counter() > deadline) or not step(unit):
+                status = "timeout"
+                break
+        if soft is not None:
+            soft.end_sweep()
+        if status == "timeout":
+            break
+    tried, accepted, retry_count, revisions = (int(x) for x in counters)
+    return status, tried, accepted, retry_count, revisions
 
 
 _SWEEP_CHUNK = 64  # blocks per kernel call (the deadline is checked between calls)
