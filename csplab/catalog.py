@@ -45,6 +45,7 @@ from csplab.errors import InputError
 from csplab.problem import Problem, check_memory
 
 __all__ = [
+    "HEAP_ORDERS",
     "BlockArrays",
     "Code",
     "Heap",
@@ -52,6 +53,7 @@ __all__ = [
     "Run",
     "Search",
     "SupportTables",
+    "alg31_flags",
     "assign",
     "block_arrays",
     "initial_catalog",
@@ -66,6 +68,20 @@ __all__ = [
     "sweep_blocks",
     "unpack",
 ]
+
+
+#: the orders of Alg. 3.1 that take the next cell from a heap of keys (entropies, or
+#: domain sizes for min-domain)
+HEAP_ORDERS = ("min-entropy", "min-domain")
+
+
+def alg31_flags(order: str, choice: str) -> tuple[bool, bool, bool]:
+    """Alg. 3.1's ``order`` and ``choice`` as the kernels' flags ``(heap, weighted,
+    key_weighted)``: the next cell is popped from a heap, labels are drawn by weight, the
+    heap's keys are weighted entropies (min-entropy with weighted choice; min-domain (MRV)
+    keys count labels)."""
+    weighted = choice == "weighted"
+    return order in HEAP_ORDERS, weighted, weighted and order == "min-entropy"
 
 
 # ----------------------------------------------------------------------------- bitsets
@@ -460,13 +476,14 @@ def solve_block_arrays(
     block: BlockArrays,
     scan: NDArray[np.int64],
     retries: int,
-    heap: bool,
-    weighted: bool,
-    key_weighted: bool,
+    order: str,
+    choice: str,
     rng: np.random.Generator,
 ) -> tuple[NDArray[np.int32] | None, int, int]:
     """Alg. 3.1 with retries on one block (:func:`csplab._kernels.block_alg31`): the labels
-    (``None`` if every attempt failed), the retries and the queue pops spent."""
+    (``None`` if every attempt failed), the retries and the queue pops spent; ``scan`` is
+    the cell order inside the block (unused by the heap orders)."""
+    heap, weighted, key_weighted = alg31_flags(order, choice)
 
     def i64(x: NDArray[Any]) -> NDArray[np.int64]:
         return np.ascontiguousarray(x, dtype=np.int64)
@@ -476,8 +493,8 @@ def solve_block_arrays(
     nb = block.dom0.shape[0]
     lgrid = np.empty(nb, dtype=np.int32)
     counters = np.zeros(4, dtype=np.int64)
-    ok = kern.block_alg31(local, block.dom0, scan, int(retries), bool(heap), bool(weighted),
-                          bool(key_weighted), rng, lgrid, counters)  # fmt: skip
+    ok = kern.block_alg31(local, block.dom0, scan, int(retries), heap, weighted, key_weighted,
+                          rng, lgrid, counters)  # fmt: skip
     return (lgrid if ok else None), int(counters[2]), int(counters[3])
 
 
@@ -499,9 +516,8 @@ def sweep_blocks(
     span: tuple[int, int],
     scan: NDArray[np.int64],
     retries: int,
-    heap: bool,
-    weighted: bool,
-    key_weighted: bool,
+    order: str,
+    choice: str,
     rng: np.random.Generator,
     counters: NDArray[np.int64],
 ) -> None:
@@ -509,9 +525,10 @@ def sweep_blocks(
     1]]`` (sorted cells) of ``grid`` (flat, consistent, changed in place), one compiled
     kernel for the whole span: :func:`csplab._kernels.blocks_sweep`."""
     c = _compiled_for(problem)
+    heap, weighted, key_weighted = alg31_flags(order, choice)
     kern.blocks_sweep(
         c.arcs, c.packed_domains(problem), grid, bptr, bcells, int(span[0]), int(span[1]),
-        scan, int(retries), bool(heap), bool(weighted), bool(key_weighted), rng, counters,
+        scan, int(retries), heap, weighted, key_weighted, rng, counters,
     )  # fmt: skip
 
 

@@ -76,8 +76,8 @@ from __future__ import annotations
 import hashlib
 import itertools
 import time
-from collections.abc import Iterator, Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from typing import Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -545,18 +545,48 @@ def _refute_size(ndim: int) -> tuple[int, ...]:
     return {1: (8,), 2: (5, 4), 3: (3, 2, 2)}.get(ndim, (2,) * ndim)
 
 
+_R = TypeVar("_R")
+
+
 def _enumerate(
     rules: Rules, walk: _Walk, budget: int
 ) -> tuple[list[int] | None, int, set[tuple[int, ...]]]:
     """DFS over the frame's labellings; returns (failing labels or None, states, windows)."""
-    n = len(walk.cells)
-    seen: set[tuple[int, tuple[int, ...]]] = set()
+    last = len(walk.cells) - 1
     windows: set[tuple[int, ...]] = set()
-    labels: list[int] = []
-    last = n - 1
     src_q = [j for j in walk.steps[last][0] if j >= 0]
 
-    def rec(i: int) -> list[int] | None:
+    def at_last(i: int, cat: int, labels: list[int]) -> list[int] | None:
+        if i < last:
+            return None
+        windows.add((*(labels[j] for j in src_q), cat))
+        return list(labels) if cat == 0 else None
+
+    fail, states = _dfs(rules, walk, budget, at_last)
+    return fail, states, windows
+
+
+def _dfs(
+    rules: Rules,
+    walk: _Walk,
+    budget: int,
+    found: Callable[[int, int, list[int]], _R | None],
+    first: Mapping[int, int] | None = None,
+) -> tuple[_R | None, int]:
+    """Depth-first search over the labellings of ``walk``'s cells in order, memoised on the
+    labels later steps still see (``walk.key_at``); raises :class:`_Budget` past ``budget``
+    states.
+
+    At step ``i``, with ``labels`` of the cells before it and ``cat`` the bit set of the
+    labels cell ``i`` may take, ``found(i, cat, labels)`` is what the search returns, if
+    not ``None``; the search ends at the last cell. Labels are tried in increasing order,
+    ``first[i]`` (if possible) first. Returns what was found (or ``None``) and the number
+    of states visited."""
+    seen: set[tuple[int, tuple[int, ...]]] = set()
+    labels: list[int] = []
+    last = len(walk.cells) - 1
+
+    def rec(i: int) -> _R | None:
         key = (i, tuple(labels[j] for j in walk.key_at[i]))
         if key in seen:
             return None
@@ -564,10 +594,15 @@ def _enumerate(
         if len(seen) > budget:
             raise _Budget
         cat = walk.catalog(rules, i, labels)
-        if i == last:
-            windows.add((*(labels[j] for j in src_q), cat))
-            return list(labels) if cat == 0 else None
-        for b in _bits(cat):
+        res = found(i, cat, labels)
+        if res is not None or i == last:
+            return res
+        opts = list(_bits(cat))
+        want = None if first is None else first.get(i)
+        if want is not None and want in opts:
+            opts.remove(want)
+            opts.insert(0, want)
+        for b in opts:
             labels.append(b)
             res = rec(i + 1)
             labels.pop()
@@ -575,8 +610,7 @@ def _enumerate(
                 return res
         return None
 
-    fail = rec(0)
-    return fail, len(seen), windows
+    return (rec(0) if last >= 0 else None), len(seen)
 
 
 # ----------------------------------------------------------------------------- Alg. 3.6 runs
@@ -635,40 +669,16 @@ def _alg36_search(
     if stop is not None:
         cells = cells[: cells.index(stop) + 1]
     walk = _Walk(shp, cells, r)
-    n = len(cells)
-    seen: set[tuple[int, tuple[int, ...]]] = set()
-    labels: list[int] = []
 
-    def rec(i: int) -> list[list[Any]] | None:
-        if i == n:
+    def dead_end(i: int, cat: int, labels: list[int]) -> list[list[Any]] | None:
+        if cat:
             return None
-        key = (i, tuple(labels[j] for j in walk.key_at[i]))
-        if key in seen:
-            return None
-        seen.add(key)
-        if len(seen) > max_states:
-            raise _Budget
-        cat = walk.catalog(rules, i, labels)
-        if cat == 0:
-            return [[list(c), b] for c, b in zip(cells, labels, strict=False)] + [
-                [list(cells[i]), None]
-            ]
-        if stop is not None and i == n - 1:
-            return None
-        opts = list(_bits(cat))
-        want = prefer.get(cells[i])
-        if want is not None and want in opts:
-            opts.remove(want)
-            opts.insert(0, want)
-        for b in opts:
-            labels.append(b)
-            res = rec(i + 1)
-            labels.pop()
-            if res is not None:
-                return res
-        return None
+        return [[list(c), b] for c, b in zip(cells, labels, strict=False)] + [
+            [list(cells[i]), None]
+        ]
 
-    return rec(0), len(seen)
+    first = {i: prefer[c] for i, c in enumerate(cells) if c in prefer}
+    return _dfs(rules, walk, max_states, dead_end, first)
 
 
 def _realize(

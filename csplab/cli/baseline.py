@@ -7,7 +7,7 @@ import argparse
 import json
 import time
 
-from csplab.cli.common import check_output_path, load_model, model_options
+from csplab.cli.common import add_model_option, check_output_path, load_model, model_options
 from csplab.errors import InputError
 
 HELP = "run a baseline the seeds compare against (texture synthesis ...) on an example"
@@ -28,10 +28,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--size", required=True, help="output size such as 20x20 or 20x20x10")
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     p.add_argument("--out", help="output grid (.npy, .grid, .txt, .png, ...)")
-    p.add_argument(
-        "--model-option", action="append", default=[], metavar="KEY=VALUE",
-        help="option for the model file's loader (repeatable)",
-    )  # fmt: skip
+    add_model_option(p)
     seen: set[str] = set()
     for b in BASELINES.values():
         for o in b.options:

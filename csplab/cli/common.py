@@ -30,6 +30,7 @@ __all__ = [
     "COMPILING",
     "Model",
     "add_constraints_arg",
+    "add_model_option",
     "add_problem_args",
     "check_output_dir",
     "check_output_path",
@@ -335,14 +336,20 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
         "hex:even-r, hex:odd-q, hex:even-q, tri, cylinder (theta = y, periodic) or "
         "affine:A,B,C,D (default: the example's own, else square)",
     )
+    add_model_option(p)
+    p.set_defaults(_size_required=size_required)
+
+
+def add_model_option(p: argparse.ArgumentParser, of: str = "the model file") -> None:
+    """``--model-option KEY=VALUE`` (repeatable): an option for the loader ``of`` a file
+    (read by :func:`model_options`)."""
     p.add_argument(
         "--model-option",
         action="append",
         default=[],
         metavar="KEY=VALUE",
-        help=f"option for the model file's loader (repeatable): {option_help()}",
+        help=f"option for the loader of {of} (repeatable): {option_help()}",
     )
-    p.set_defaults(_size_required=size_required)
 
 
 def problem_from_args(

@@ -18,7 +18,7 @@ from csplab.cli._analysis import (
     print_verdict,
     save_witness,
 )
-from csplab.cli.common import check_output_path
+from csplab.cli.common import add_model_option, check_output_path
 from csplab.errors import InputError
 
 HELP = "prove an example infallible (Alg. 3.1 never fails) by region enumeration"
@@ -40,7 +40,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--expect-hash", help="re-check a proof: exit 3 unless the hash matches")
     p.add_argument("--out", help="save the failing run as a .png picture or .json")
     p.add_argument("--json", action="store_true", help="print the verdict as JSON")
-    p.add_argument("--model-option", action="append", default=[], metavar="KEY=VALUE")
+    add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -10,7 +10,7 @@ import argparse
 
 from csplab.analysis import to_infallible
 from csplab.cli._analysis import ORDER_HELP, load_example_model, print_verdict
-from csplab.cli.common import check_output_path
+from csplab.cli.common import add_model_option, check_output_path
 
 HELP = "split labels of a fallible example into an infallible one (Sec. 3.3.8)"
 DESCRIPTION = (
@@ -30,7 +30,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--beam", type=int, default=20, help="search width (default 20)")
     p.add_argument("--out", help="write E_I to this .grid (or any example format) file")
     p.add_argument("--json", action="store_true")
-    p.add_argument("--model-option", action="append", default=[], metavar="KEY=VALUE")
+    add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.cli.common import check_output_path, load_model, model_options
+from csplab.cli.common import add_model_option, check_output_path, load_model, model_options
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
@@ -43,10 +43,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scale", type=int, help="pixels per cell (grids)")
     p.add_argument("--empty", type=int, help="3D: the label left out (default: guessed)")
     p.add_argument("--legend", action="store_true", help="grids: add a legend object -> colour")
-    p.add_argument(
-        "--model-option", action="append", default=[], metavar="KEY=VALUE",
-        help="option for the loader of FILE (or of --tiles), as in synthesize",
-    )  # fmt: skip
+    add_model_option(p, "FILE (or of --tiles)")
 
 
 def run(args: argparse.Namespace) -> int:

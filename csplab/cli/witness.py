@@ -19,6 +19,7 @@ from csplab.cli._analysis import (
     print_verdict,
     save_witness,
 )
+from csplab.cli.common import add_model_option
 from csplab.errors import InputError
 
 HELP = "find a failing run of Alg. 3.1 (or show none exists up to a size)"
@@ -52,7 +53,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the random runs")
     p.add_argument("--out", help="save the failing run as a .png picture or .json")
     p.add_argument("--json", action="store_true")
-    p.add_argument("--model-option", action="append", default=[], metavar="KEY=VALUE")
+    add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:

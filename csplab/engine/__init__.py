@@ -11,6 +11,10 @@ module                                 what
                                        search), :func:`first_inconsistent_prefix`,
                                        :func:`catalog_at` (C(p), C*(p)),
                                        :func:`search_solutions`, drawing labels from C*
+:mod:`csplab.engine.pool`             worker processes (:class:`Workers`: a local
+                                       process pool whose workers exit with their
+                                       parent, or a Dask cluster) for the waves of
+                                       modify-in-blocks and the experiments' sweeps
 =====================================  ==============================================
 
 The arc-consistency engine (:mod:`csplab.catalog`, compiled kernels in

@@ -37,7 +37,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab import _kernels as kern
-from csplab.catalog import Propagator, reference_adjacency, reference_fixpoint
+from csplab.catalog import (
+    HEAP_ORDERS,
+    Propagator,
+    alg31_flags,
+    reference_adjacency,
+    reference_fixpoint,
+)
 from csplab.errors import InputError
 from csplab.problem import AXIS_NAMES, Problem
 from csplab.result import Result, Status
@@ -53,7 +59,6 @@ __all__ = [
 ]
 
 ORDERS = ("scanline", "random", "min-entropy", "min-domain", "scan:AXES")
-_HEAP_ORDERS = ("min-entropy", "min-domain")
 CHOICES = ("uniform", "weighted", "resemblance")
 _CHUNK = 4096
 
@@ -89,7 +94,7 @@ def run_alg31(
     n = problem.n
     perm = rng.permutation(n).astype(np.int64) if order == "random" else scan
     ustream = rng.random(n)
-    noise = rng.random(n) if order in _HEAP_ORDERS else np.zeros(n)
+    noise = rng.random(n) if order in HEAP_ORDERS else np.zeros(n)
     eng = engine if engine is not None else Propagator(problem)
     grid = np.full(n, -1, dtype=np.int32)
     stats: dict[str, Any] = {"order": order, "choice": choice}
@@ -114,10 +119,9 @@ def run_alg31(
                 time_s=time.perf_counter() - t0, stats=stats,
                 trace=np.zeros((0, 2), dtype=np.int64),
             )  # fmt: skip
-    weighted = choice == "weighted"
+    use_heap, weighted, key_weighted = alg31_flags(order, choice)
     heap: kern.Heap | None = None
-    key_weighted = weighted and order == "min-entropy"  # min-domain (MRV): label counts
-    if order in _HEAP_ORDERS:
+    if use_heap:
         pristine = engine is None and eng.c.initial is not None and not cons
         cached = eng.c.entropies.get(key_weighted) if pristine else None
         if cached is None:
@@ -192,7 +196,7 @@ def _resemblance(
             "choice='resemblance' needs a problem built from an example model "
             "(csplab.from_example); tilesets have no example to resemble"
         )
-    if order in _HEAP_ORDERS:
+    if order in HEAP_ORDERS:
         raise InputError("choice='resemblance' takes the scan orders and random, not " + order)
     perm = rng.permutation(problem.n).astype(np.int64) if order == "random" else scan
     r = run_resemblance(problem, example, rng, order=perm, window=window, context=context,
@@ -215,7 +219,7 @@ def scan_order(shape: tuple[int, ...], order: str) -> np.ndarray | None:
     n = int(np.prod(shape))
     if order == "scanline":
         return np.arange(n, dtype=np.int64)
-    if order in ("random", *_HEAP_ORDERS):
+    if order in ("random", *HEAP_ORDERS):
         return None
     if order.startswith("scan:"):
         names = order[5:]
@@ -283,7 +287,7 @@ def alg31_reference(
     scan orders and ``random``, so both return the same grid for the same seed.
     Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
     """
-    if order in _HEAP_ORDERS:
+    if order in HEAP_ORDERS:
         raise InputError("the reference Alg. 3.1 supports the scan and random orders")
     n, K = problem.n, problem.K
     scan = scan_order(problem.shape, order)

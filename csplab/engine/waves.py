@@ -24,11 +24,11 @@ not depend on which process solves which block, nor in which order. Executors:
   arrays (:class:`CompiledTask`: its catalog and internal arcs, built by a kernel in the
   parent) and one kernel call solves it (:func:`solve_compiled`), with the same generator,
   draws and outcome as :func:`solve_block` on its subproblem;
-* :class:`PoolRunner`: a local :class:`~concurrent.futures.ProcessPoolExecutor`; each task
-  carries a few blocks (:class:`BlockTask`: packed domains and the block's arcs; the
-  relations and weights, the same for every block, reach each worker once);
-* :class:`DaskRunner`: a Dask ``distributed`` cluster (``"local"``: a
-  ``distributed.LocalCluster``; the optional extra ``csplab[dask]``).
+* :class:`BlockRunner`: worker processes (:class:`csplab.engine.pool.Workers`: a local
+  process pool, or a Dask ``distributed`` cluster, ``"local"`` for a
+  ``distributed.LocalCluster``; the optional extra ``csplab[dask]``); each task carries a
+  few blocks (:class:`BlockTask`: packed domains and the block's arcs; the relations and
+  weights, the same for every block, reach each worker once).
 
 Examples
 --------
@@ -42,12 +42,8 @@ from __future__ import annotations
 
 import itertools
 import math
-import os
-import sys
-import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import FIRST_EXCEPTION, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
 from typing import Any, NamedTuple
 
@@ -57,16 +53,15 @@ from numpy.typing import NDArray
 from csplab import _interp
 from csplab.catalog import BlockArrays, SupportTables, solve_block_arrays, support_tables
 from csplab.engine.alg31 import run_alg31
-from csplab.errors import InputError
+from csplab.engine.pool import Workers
 from csplab.problem import Problem
 
 __all__ = [
     "BlockContext",
     "BlockOutcome",
+    "BlockRunner",
     "BlockTask",
     "CompiledTask",
-    "DaskRunner",
-    "PoolRunner",
     "block_rng",
     "colour_classes",
     "independent",
@@ -197,14 +192,18 @@ def solve_block(
     order: str,
     choice: str,
     deadline: float | None,
+    window: int = 1,
+    context: tuple[Any, Any, tuple[int, ...]] | None = None,
 ) -> BlockOutcome:
     """Alg. 3.1 on a block's subproblem, retried up to ``retries`` times on failure (the
-    inner loop of Alg. 3.4); ``deadline`` is a ``time.perf_counter()`` value."""
+    inner loop of Alg. 3.4); ``deadline`` is a ``time.perf_counter()`` value; ``window``
+    and ``context`` go to :func:`~csplab.engine.alg31.run_alg31` (resemblance choice)."""
     revisions = retry_count = 0
     status = "failed"
     for attempt in range(retries + 1):
         left = None if deadline is None else max(0.0, deadline - time.perf_counter())
-        r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left)
+        r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left, window=window,
+                      context=context)  # fmt: skip
         revisions += int(r.stats.get("revisions", 0))
         status = r.status
         if r.status == "solved":
@@ -258,11 +257,9 @@ def solve_compiled(
     if not _TABLES or _TABLES[0][0] is not ctx:  # once per context and process
         _TABLES[:] = [(ctx, support_tables(ctx.relations, ctx.weights))]
     assert ctx.scan is not None
-    heap = ctx.order in ("min-entropy", "min-domain")
-    weighted = ctx.choice == "weighted"
     labels, retries, pops = solve_block_arrays(
-        _TABLES[0][1], task.arrays, ctx.scan, ctx.retries, heap, weighted,
-        weighted and ctx.order == "min-entropy", block_rng(ctx.root, task.sweep, task.block),
+        _TABLES[0][1], task.arrays, ctx.scan, ctx.retries, ctx.order, ctx.choice,
+        block_rng(ctx.root, task.sweep, task.block),
     )  # fmt: skip
     status = "solved" if labels is not None else "failed"
     return BlockOutcome(task.block, labels, status, retries, pops)
@@ -325,143 +322,55 @@ def run_tasks(
     ]
 
 
-def _exit_with_parent(parent: int) -> None:
-    """Make this worker exit as soon as its parent ``parent`` dies (SIGKILL of the parent
-    leaves no chance to shut the pool down): ``PR_SET_PDEATHSIG`` on Linux, and a thread
-    polling ``os.getppid()`` everywhere (the pattern of the experiments' process pools)."""
-    import signal
-
-    try:  # Ctrl-C reaches the whole process group: the parent decides what stops
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except (ValueError, OSError):
-        pass
-    if sys.platform.startswith("linux"):
-        try:
-            import ctypes
-
-            libc = ctypes.CDLL(None, use_errno=True)
-            libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # PR_SET_PDEATHSIG
-        except (OSError, AttributeError):
-            pass
-    if os.getppid() != parent:
-        os._exit(1)
-
-    def poll() -> None:
-        while True:
-            if os.getppid() != parent:
-                os._exit(1)
-            time.sleep(0.5)
-
-    threading.Thread(target=poll, name="csplab-parent-watch", daemon=True).start()
-
-
-def _init_worker(parent: int, ctx: BlockContext) -> None:
+def _install(ctx: BlockContext) -> None:
+    """Pool initializer: the context :func:`run_tasks` uses in this worker."""
     global _CONTEXT
-    _exit_with_parent(parent)
     _CONTEXT = ctx
 
 
-class PoolRunner:
-    """Blocks on a local process pool of ``workers`` processes (fork on Linux).
+class BlockRunner:
+    """Blocks on :class:`~csplab.engine.pool.Workers`: a local pool of ``workers``
+    processes (fork on Linux; each receives the context once, at start) or, with
+    ``scheduler``, a Dask cluster (the context is scattered to every worker once).
 
     :meth:`submit` sends a few blocks as one task; :meth:`gather` waits for tasks until a
     ``timeout`` and returns the outcomes that arrived and whether all did; :meth:`close`
-    shuts the pool down (``kill=True``: now, killing running workers).
+    shuts the workers down (``kill=True``: now, killing running workers).
     """
 
-    def __init__(self, workers: int, ctx: BlockContext) -> None:
-        import multiprocessing as mp
-
-        method = "fork" if sys.platform.startswith("linux") else "spawn"
-        self.workers = workers
-        self.pool = ProcessPoolExecutor(
-            max_workers=workers, mp_context=mp.get_context(method),
-            initializer=_init_worker, initargs=(os.getpid(), ctx),
-        )  # fmt: skip
-
-    def submit(
-        self, tasks: Sequence[BlockTask | CompiledTask], wall_deadline: float | None
-    ) -> Future[Any]:
-        return self.pool.submit(run_tasks, list(tasks), wall_deadline)
-
-    def gather(
-        self, futures: Sequence[Future[Any]], timeout: float | None
-    ) -> tuple[list[BlockOutcome], bool]:
-        done, pending = wait(futures, timeout=timeout, return_when=FIRST_EXCEPTION)
-        out: list[BlockOutcome] = []
-        for f in done:
-            out.extend(f.result())  # re-raises a worker's exception
-        return out, not pending
-
-    def close(self, kill: bool = False) -> None:
-        procs = list((getattr(self.pool, "_processes", None) or {}).values())
-        self.pool.shutdown(wait=not kill, cancel_futures=True)
-        if kill:
-            for p in procs:
-                try:
-                    p.kill()
-                    p.join(timeout=5)
-                except (OSError, ValueError, AttributeError, AssertionError):
-                    pass
-
-
-class DaskRunner:
-    """Blocks on a Dask ``distributed`` cluster: ``scheduler`` is an address such as
-    ``tcp://host:8786`` or ``"local"`` (a ``LocalCluster`` of ``workers`` single-threaded
-    processes, closed by :meth:`close`). The context is scattered to every worker once."""
-
-    def __init__(self, scheduler: str, workers: int, ctx: BlockContext) -> None:
-        from csplab.deps import require
-
-        distributed: Any = require("distributed", "dask", "solver 'blocks' with scheduler=")
-        self._wait = distributed.wait
-        self.cluster: Any = None
-        if scheduler == "local":
-            self.cluster = distributed.LocalCluster(
-                n_workers=workers, threads_per_worker=1, processes=True,
-                dashboard_address=":0",
-            )  # fmt: skip
-            self.client: Any = distributed.Client(self.cluster)
-        else:
-            try:
-                self.client = distributed.Client(scheduler, timeout=30)
-            except OSError as e:
-                raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
+    def __init__(self, workers: int, ctx: BlockContext, scheduler: str | None = None) -> None:
+        self.ctx: Any = None  # a local pool's workers hold the context already
+        if scheduler is None:
+            self.workers = Workers.local(workers, initializer=_install, initargs=(ctx,))
+            return
+        self.workers = Workers.dask(
+            scheduler, purpose="solver 'blocks' with scheduler=", local_workers=workers
+        )
         try:
-            self.client.wait_for_workers(1, timeout=120)
-            self.workers = max(1, sum(self.client.nthreads().values()))
-            self.ctx = self.client.scatter(ctx, broadcast=True)
+            self.ctx = self.workers.share(ctx)
         except BaseException:
             self.close()
             raise
 
+    @property
+    def size(self) -> int:
+        """Tasks that run at once."""
+        return self.workers.size
+
     def submit(self, tasks: Sequence[BlockTask | CompiledTask], wall_deadline: float | None) -> Any:
-        return self.client.submit(run_tasks, list(tasks), wall_deadline, self.ctx, pure=False)
+        return self.workers.submit(run_tasks, list(tasks), wall_deadline, self.ctx)
 
     def gather(
         self, futures: Sequence[Any], timeout: float | None
     ) -> tuple[list[BlockOutcome], bool]:
-        try:
-            self._wait(list(futures), timeout=timeout)
-        except TimeoutError:
-            pass
+        done = self.workers.wait(futures, timeout)
         out: list[BlockOutcome] = []
-        complete = True
-        for f in futures:
-            if f.status == "finished":
-                out.extend(f.result())
-            elif f.status == "error":
-                f.result()  # re-raises the task's exception
-            else:
-                complete = False
-        return out, complete
+        for f in done:
+            out.extend(f.result())  # re-raises a worker's exception
+        return out, len(done) == len(futures)
 
     def close(self, kill: bool = False) -> None:
-        try:
-            self.client.close()
-        finally:
-            if self.cluster is not None:
-                self.cluster.close()
+        self.workers.close(kill)
 
 
 def chunk_size(blocks: int, workers: int) -> int:

@@ -19,6 +19,7 @@ Examples
 from __future__ import annotations
 
 import argparse
+import copy
 import json
 import math
 from collections.abc import Iterable, Sequence
@@ -46,7 +47,34 @@ __all__ = [
     "setting_of",
     "size_for",
     "split_solver",
+    "sweep_defaults",
 ]
+
+#: The defaults of the options most sweeps share (solver settings and the problem's
+#: boundary); an experiment's ``defaults`` start from them (:func:`sweep_defaults`).
+SWEEP_DEFAULTS: dict[str, Any] = {
+    "seed0": 0,
+    "order": "scanline",
+    "choice": "uniform",
+    "boundary": "auto",
+    "periodic": False,
+    "options": {},
+    "time_limit": None,
+}
+
+
+def sweep_defaults(*, omit: Iterable[str] = (), **own: Any) -> dict[str, Any]:
+    """An experiment's ``defaults``: :data:`SWEEP_DEFAULTS` but the keys in ``omit``,
+    then the experiment's own keys and values ``own`` (which may override them).
+
+    Examples
+    --------
+    >>> d = sweep_defaults(omit=("order", "choice"), seeds=4, boundary="none")
+    >>> d["seeds"], d["boundary"], "order" in d, d["time_limit"]
+    (4, 'none', False, None)
+    """
+    skip = set(omit)
+    return copy.deepcopy({**{k: v for k, v in SWEEP_DEFAULTS.items() if k not in skip}, **own})
 
 
 def parse_sizes(text: str | Sequence[int]) -> list[int]:

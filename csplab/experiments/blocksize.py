@@ -44,6 +44,7 @@ from csplab.experiments.base import (
     new_figure,
     outside_legend,
     save_figure,
+    sweep_defaults,
 )
 from csplab.experiments.measures import (
     objects,
@@ -104,21 +105,10 @@ class BlockSize(Experiment):
         "acceptance, retries, time, consistency and expressiveness (largest object, "
         "non-empty cells, distinct 3x3(x3) patterns vs Alg. 3.1) for block sizes 1..full"
     )
-    defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["fig3_10", "castle"],
-        "size": None,
-        "blocks": [1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, "full"],
-        "retries": 20,
-        "seeds": 20,
-        "seed0": 0,
-        "order": "scanline",
-        "choice": "uniform",
-        "boundary": "auto",
-        "periodic": False,
-        "options": {},
-        "time_limit": None,
-        "window": 3,
-    }
+    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+        examples=["fig3_10", "castle"], size=None,
+        blocks=[1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, "full"], retries=20, seeds=20, window=3,
+    )  # fmt: skip
     quick: ClassVar[dict[str, Any]] = {
         "examples": ["fig3_10"],
         "size": "12x12",

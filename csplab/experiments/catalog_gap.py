@@ -54,6 +54,7 @@ from csplab.experiments.base import (
     outside_legend,
     save_figure,
     size_for,
+    sweep_defaults,
 )
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
@@ -172,21 +173,10 @@ class CatalogGap(Experiment):
         "fraction of Alg. 3.1 steps choosing outside the exact catalog C*, first bad step vs "
         "failure step, by example and size"
     )
-    defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["fig3_5a", "fig3_6a"],
-        "sizes": "4:12:2",
-        "nz": 6,
-        "seeds": 100,
-        "seed0": 0,
-        "order": "scan:yx",
-        "choice": "uniform",
-        "boundary": "none",
-        "periodic": False,
-        "options": {},
-        "time_limit": None,
-        "oracle": "auto",
-        "per_step": True,
-    }
+    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+        examples=["fig3_5a", "fig3_6a"], sizes="4:12:2", nz=6, seeds=100, order="scan:yx",
+        boundary="none", oracle="auto", per_step=True,
+    )  # fmt: skip
     quick: ClassVar[dict[str, Any]] = {"examples": ["fig3_5a"], "sizes": "4,6", "seeds": 10}
     uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"oracle", "per_step", "nz"}
 

@@ -66,8 +66,6 @@ class ConstraintsExperiment(Fig38):
             "blocks@sweeps=4,restarts=3",
         ],
         "seeds": 4,
-        "order": "scanline",
-        "boundary": "auto",
         "time_limit": 10.0,
         "fraction": [0.05, 0.30],
     }

@@ -33,6 +33,7 @@ from csplab.experiments.base import (
     save_figure,
     setting_of,
     size_for,
+    sweep_defaults,
 )
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
@@ -46,21 +47,10 @@ class Fig38(Experiment):
     description: ClassVar[str] = (
         "success rate (95% Wilson intervals) vs nx = ny, nz fixed, one curve per example and solver"
     )
-    defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["city", "castle", "canal"],
-        "sizes": "5:50:5",
-        "nz": 10,
-        "solvers": ["catalog"],
-        "seeds": 100,
-        "seed0": 0,
-        "order": "scanline",
-        "choice": "uniform",
-        "boundary": "auto",
-        "periodic": False,
-        "options": {},
-        "time_limit": None,
-        "constraints": None,
-    }
+    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+        examples=["city", "castle", "canal"], sizes="5:50:5", nz=10, solvers=["catalog"],
+        seeds=100, constraints=None,
+    )  # fmt: skip
     quick: ClassVar[dict[str, Any]] = {
         "examples": ["castle", "line"],
         "sizes": "4,8",

@@ -33,17 +33,16 @@ Examples
 from __future__ import annotations
 
 import hashlib
-import importlib
 import json
 import os
 import sys
 import time
 from collections import Counter
 from collections.abc import Iterable, Iterator, Sequence
-from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from typing import Any
 
+from csplab.engine.pool import Workers
 from csplab.errors import CsplabError, DependencyError, InputError
 from csplab.example import ExampleModel
 from csplab.experiments.store import ResultsStore, code_label, code_revision
@@ -161,7 +160,9 @@ def run_trials(
     jobs : int, optional
         Local worker processes (default: CPU count); ``1`` runs in this process.
     scheduler : str or distributed.Client, optional
-        Run on a Dask cluster instead.
+        Run on a Dask cluster instead: an address such as ``tcp://host:8786``, ``"local"``
+        (a local cluster of ``jobs`` processes) or a client
+        (:meth:`csplab.engine.pool.Workers.dask`).
     progress : bool
         Show a progress bar on stderr.
     """
@@ -189,22 +190,25 @@ def run_trials(
     t0 = time.perf_counter()
     interrupted = False
     restore = _on_sigterm_interrupt()
-    client, own = _client(scheduler) if scheduler is not None and todo else (None, False)
+    workers: Workers | None = None
+    n = min(int(jobs or os.cpu_count() or 1), len(todo))
+    if scheduler is not None and todo:
+        workers = Workers.dask(scheduler, purpose="--scheduler (a Dask cluster)", local_workers=n)
+        summary.executor = "dask"
+    elif n > 1:
+        workers = Workers.local(n, start="spawn")
+        summary.executor = f"{n} local processes"
     bar = _progress(len(todo), experiment, progress)
+    finished = False
     try:
         if not todo:
             summary.executor = "nothing to run"
             stream: Stream = iter(())
-        elif client is not None:
-            summary.executor = "dask"
-            stream = _run_dask(todo, examples, client)
-        elif (jobs or os.cpu_count() or 1) <= 1 or len(todo) <= 1:
+        elif workers is not None:
+            stream = _run_on(workers, todo, examples)
+        else:
             summary.executor = "this process"
             stream = _run_serial(todo, examples)
-        else:
-            n = min(int(jobs or os.cpu_count() or 1), len(todo))
-            summary.executor = f"{n} local processes"
-            stream = _run_pool(todo, examples, n)
         for trial, outcome, err in stream:
             if err is not None:
                 summary.errors.append((trial, err))
@@ -217,14 +221,15 @@ def run_trials(
                 ", ".join(f"{k} {v}" for k, v in sorted(statuses.items())), refresh=False
             )
             bar.update(1)
+        finished = True
     except KeyboardInterrupt:  # Ctrl-C or SIGTERM: the stored rows stay, the run is marked
         interrupted = True
         raise
     finally:
         restore()
         bar.close()
-        if own and client is not None:
-            client.close()
+        if workers is not None:
+            workers.close(kill=not finished)
         summary.statuses = dict(statuses)
         summary.time_s = time.perf_counter() - t0
         store.finish_run(
@@ -251,43 +256,6 @@ def _on_sigterm_interrupt() -> Any:
     except (ValueError, OSError):  # not supported here
         return lambda: None
     return lambda: signal.signal(signal.SIGTERM, previous)
-
-
-def _watch_parent(parent: int) -> None:
-    """Pool initializer: the worker exits as soon as its parent process ``parent`` has
-    died (SIGKILL of the main process leaves no chance to shut the pool down)."""
-    import signal
-    import threading
-
-    try:  # Ctrl-C reaches the whole process group: the main process decides what stops
-        signal.signal(signal.SIGINT, signal.SIG_IGN)
-    except (ValueError, OSError):
-        pass
-
-    def poll() -> None:
-        while True:
-            if os.getppid() != parent:
-                os._exit(1)
-            time.sleep(0.5)
-
-    threading.Thread(target=poll, name="csplab-parent-watch", daemon=True).start()
-
-
-def _kill_workers(pool: ProcessPoolExecutor) -> None:
-    """Stop a pool now: cancel what is queued and kill the workers (a running trial
-    cannot be interrupted otherwise)."""
-    procs = list((getattr(pool, "_processes", None) or {}).values())
-    pool.shutdown(wait=False, cancel_futures=True)
-    for p in procs:
-        try:
-            p.kill()
-        except (OSError, ValueError, AttributeError):
-            pass
-    for p in procs:
-        try:
-            p.join(timeout=5)
-        except (OSError, ValueError, AssertionError):
-            pass
 
 
 def _check_dependencies(todo: Sequence[Trial]) -> None:
@@ -330,94 +298,33 @@ def _run_serial(todo: Sequence[Trial], examples: dict[str, ExampleModel]) -> Str
             yield t, out, None
 
 
-def _run_pool(todo: Sequence[Trial], examples: dict[str, ExampleModel], n: int) -> Stream:
-    import multiprocessing as mp
-
-    ctx = mp.get_context("spawn")
-    pending: dict[Future[dict[str, Any]], Trial] = {}
+def _run_on(workers: Workers, todo: Sequence[Trial], examples: dict[str, ExampleModel]) -> Stream:
+    """The trials on worker processes, at most four per worker in flight, as they finish;
+    an interruption cancels what is queued and kills the workers."""
+    shared = {h: workers.share(examples[h]) for h in sorted({t.example_hash for t in todo})}
+    pending: dict[Any, Trial] = {}
     it = iter(todo)
-    pool = ProcessPoolExecutor(
-        max_workers=n, mp_context=ctx, initializer=_watch_parent, initargs=(os.getpid(),)
-    )
-    with pool:
-        try:
 
-            def feed() -> None:
-                while len(pending) < 4 * n:
-                    t = next(it, None)
-                    if t is None:
-                        return
-                    pending[pool.submit(execute, t, examples[t.example_hash])] = t
+    def feed() -> None:
+        while len(pending) < 4 * workers.size:
+            t = next(it, None)
+            if t is None:
+                return
+            key = f"csplab-{t.experiment}-{t.key}"
+            pending[workers.submit(execute, t, shared[t.example_hash], key=key)] = t
 
+    try:
+        feed()
+        while pending:
+            for fut in workers.wait(list(pending), first=True):
+                t = pending.pop(fut)
+                e = fut.exception()
+                if e is not None:
+                    yield t, None, _describe(e)
+                else:
+                    yield t, fut.result(), None
             feed()
-            while pending:
-                finished, _ = wait(list(pending), return_when=FIRST_COMPLETED)
-                for fut in finished:
-                    t = pending.pop(fut)
-                    e = fut.exception()
-                    if e is not None:
-                        yield t, None, _describe(e)
-                    else:
-                        yield t, fut.result(), None
-                feed()
-        except BaseException:
-            for fut in pending:
-                fut.cancel()
-            _kill_workers(pool)
-            raise
-
-
-def _client(scheduler: Any) -> tuple[Any, bool]:
-    from csplab.deps import require
-
-    distributed: Any = require("distributed", "dask", "--scheduler (a Dask cluster)")
-    if isinstance(scheduler, distributed.Client):
-        return scheduler, False
-    if not isinstance(scheduler, str) or not scheduler:
-        raise InputError(f"scheduler must be an address such as tcp://host:8786, not {scheduler!r}")
-    try:
-        return distributed.Client(scheduler, timeout=30), True
-    except OSError as e:
-        raise InputError(f"cannot reach the Dask scheduler at {scheduler}: {e}") from None
-
-
-def _run_dask(todo: Sequence[Trial], examples: dict[str, ExampleModel], client: Any) -> Stream:
-    as_completed: Any = importlib.import_module("distributed").as_completed
-    try:
-        client.wait_for_workers(1, timeout=120)
-    except TimeoutError:
-        raise InputError("the Dask cluster has no workers (waited 120 s)") from None
-    hashes = sorted({t.example_hash for t in todo})
-    scattered = dict(
-        zip(hashes, client.scatter([examples[h] for h in hashes], broadcast=True), strict=True)
-    )
-    nworkers = max(1, sum(client.nthreads().values()))
-    it = iter(todo)
-    futs: dict[str, tuple[Trial, Any]] = {}
-
-    def submit() -> Any:
-        t = next(it, None)
-        if t is None:
-            return None
-        f = client.submit(
-            execute, t, scattered[t.example_hash], key=f"csplab-{t.experiment}-{t.key}",
-            pure=False,
-        )  # fmt: skip
-        futs[f.key] = (t, f)
-        return f
-
-    first = [f for f in (submit() for _ in range(4 * nworkers)) if f is not None]
-    ac = as_completed(first)
-    try:
-        for fut in ac:
-            t, _ = futs.pop(fut.key)
-            if fut.status == "error":
-                yield t, None, _describe(fut.exception())
-            else:
-                yield t, fut.result(), None
-            nxt = submit()
-            if nxt is not None:
-                ac.add(nxt)
     except BaseException:
-        client.cancel([f for _, f in futs.values()])
+        workers.cancel(list(pending))
+        workers.close(kill=True)
         raise

@@ -38,6 +38,7 @@ from csplab.experiments.base import (
     save_figure,
     setting_of,
     split_solver,
+    sweep_defaults,
 )
 from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
@@ -120,22 +121,16 @@ class SamplingBias(Experiment):
         "total variation / Jensen-Shannon distance of pooled output frequencies to the exact "
         "uniform frequencies (transfer matrices on strips), bootstrap 95% intervals"
     )
-    defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["line", "fig3_4a", "fig3_5a"],
-        "size": "16x5",
-        "solvers": [
+    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+        omit=("order", "choice"),  # the solver entries name them
+        examples=["line", "fig3_4a", "fig3_5a"], size="16x5",
+        solvers=[
             "catalog", "catalog@order=scan:yx", "catalog@order=random",
             "catalog@order=min-entropy", "catalog@choice=weighted", "blocks@block=4", "sat",
             "cpsat",
         ],
-        "seeds": 400,
-        "seed0": 0,
-        "boundary": "none",
-        "periodic": False,
-        "options": {},
-        "time_limit": None,
-        "n_boot": 500,
-    }  # fmt: skip
+        seeds=400, boundary="none", n_boot=500,
+    )  # fmt: skip
     quick: ClassVar[dict[str, Any]] = {
         "examples": ["line"],
         "size": "6x3",

@@ -34,6 +34,7 @@ from csplab.experiments.base import (
     outside_legend,
     save_figure,
     setting_of,
+    sweep_defaults,
 )
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
@@ -80,20 +81,10 @@ class Table31(Experiment):
         "k, displayed size, time for the displayed size and for 40x40x10 (Alg. 3.1 when it "
         "succeeds, else 10x10x10 blocks), plus one column per solver"
     )
-    defaults: ClassVar[dict[str, Any]] = {
-        "examples": ["city", "castle", "canal"],
-        "displayed": {},
-        "compare": "40x40x10",
-        "solvers": "installed",
-        "seeds": 5,
-        "seed0": 0,
-        "order": "scanline",
-        "choice": "uniform",
-        "boundary": "auto",
-        "periodic": False,
-        "options": {"blocks.block": 10},
-        "time_limit": 600.0,
-    }
+    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+        examples=["city", "castle", "canal"], displayed={}, compare="40x40x10",
+        solvers="installed", seeds=5, options={"blocks.block": 10}, time_limit=600.0,
+    )  # fmt: skip
     quick: ClassVar[dict[str, Any]] = {
         "examples": ["castle"],
         "displayed": {"castle": "8x8x4"},

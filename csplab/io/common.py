@@ -21,7 +21,7 @@ import os
 import re
 import stat
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Container, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -47,11 +47,13 @@ __all__ = [
     "check_file",
     "json_like",
     "load_image",
+    "neighbor_side",
     "read_bytes",
     "read_text",
     "text_lines",
     "xml_bool",
     "xml_float",
+    "xml_neighbors",
     "xml_root",
 ]
 
@@ -204,6 +206,44 @@ def xml_float(node: Node, key: str, default: float, path: object) -> float:
             f"<{node.tag}> {key}={v!r} must be a non-negative number", path=path, line=node.line
         )
     return f
+
+
+def xml_neighbors(root: Node, path: object) -> Iterator[Node]:
+    """The ``<neighbor>`` rules of a tileset's ``<neighbors>`` element (WFC, MarkovJunior)."""
+    xn = root.find("neighbors")
+    if xn is None:
+        raise FormatError(f"<{root.tag}> has no <neighbors> element", path=path, line=root.line)
+    return xn.iter("neighbor")
+
+
+def neighbor_side(
+    node: Node,
+    side: str,
+    path: object,
+    tiles: Container[str],
+    *,
+    name_first: bool,
+    forms: tuple[str, str],
+) -> tuple[str, str | None]:
+    """A ``<neighbor>``'s ``side`` attribute (``left``, ``right``, ...): one word, the tile
+    name, or two, the tile name (``name_first`` or last) and a turn; ``forms`` spells the
+    two for messages (``("name", "name k")``). Returns the tile name, one of ``tiles``,
+    and the turn (``None`` when not given)."""
+    text = node.get(side)
+    if text is None:
+        raise FormatError(f"<neighbor> has no {side!r} attribute", path=path, line=node.line)
+    parts = text.split()
+    if not 1 <= len(parts) <= 2:
+        raise FormatError(
+            f"<neighbor> {side}={text!r}: expected {forms[0]!r} or {forms[1]!r}",
+            path=path,
+            line=node.line,
+        )
+    nm = parts[0] if name_first else parts[-1]
+    if nm not in tiles:
+        raise FormatError(f"<neighbor> {side}: unknown tile {nm!r}", path=path, line=node.line)
+    turn = None if len(parts) == 1 else parts[1] if name_first else parts[0]
+    return nm, turn
 
 
 def load_image(path: Path, *, where: object = None) -> NDArray[np.uint8]:

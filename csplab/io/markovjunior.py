@@ -51,7 +51,17 @@ from numpy.typing import NDArray
 
 from csplab.errors import FormatError, InputError
 from csplab.io._xml import Node, parse_xml
-from csplab.io.common import NO, SURE, LoaderWarnings, read_bytes, xml_bool, xml_float, xml_root
+from csplab.io.common import (
+    NO,
+    SURE,
+    LoaderWarnings,
+    neighbor_side,
+    read_bytes,
+    xml_bool,
+    xml_float,
+    xml_neighbors,
+    xml_root,
+)
 from csplab.io.ruleset import RuleSet
 from csplab.io.symmetry import Group, Orientations, cube_group, expand_rules, square_group
 
@@ -106,20 +116,11 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
     if not tiles:
         raise FormatError("the tileset has no tiles", path=path, line=xtiles.line)
 
-    def ref(text: str | None, node: Node, side: str) -> tuple[int, int]:
-        if text is None:
-            raise FormatError(f"<neighbor> has no {side!r} attribute", path=path, line=node.line)
-        parts = text.split()
-        if not 1 <= len(parts) <= 2:
-            raise FormatError(
-                f"<neighbor> {side}={text!r}: expected 'tile' or 'xyz tile'",
-                path=path,
-                line=node.line,
-            )
-        nm = parts[-1]
-        if nm not in seen:
-            raise FormatError(f"<neighbor> {side}: unknown tile {nm!r}", path=path, line=node.line)
-        word = parts[0] if len(parts) == 2 else ""
+    def ref(node: Node, side: str) -> tuple[int, int]:
+        nm, turn = neighbor_side(node, side, path, seen, name_first=False,
+                                 forms=("tile", "xyz tile"))  # fmt: skip
+        word = turn or ""
+        text = node.get(side)
         if not full:
             if set(word) - {"z"}:
                 raise FormatError(
@@ -137,13 +138,10 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
         return seen[nm], g
 
     stated: list[tuple[tuple[int, int], tuple[int, int], tuple[int, int]]] = []
-    xn = root.find("neighbors")
-    if xn is None:
-        raise FormatError(f"<{root.tag}> has no <neighbors> element", path=path, line=root.line)
-    for node in xn.iter("neighbor"):
+    for node in xml_neighbors(root, path):
         if node.get("left") is not None or node.get("right") is not None:
-            a = ref(node.get("left"), node, "left")
-            b = ref(node.get("right"), node, "right")
+            a = ref(node, "left")
+            b = ref(node, "right")
             stated.append((a, b, (0, 1)))
         elif node.get("top") is not None or node.get("bottom") is not None:
             if full:
@@ -152,8 +150,8 @@ def parse_markovjunior(text: str | bytes, *, path: object = "<string>") -> RuleS
                     path=path,
                     line=node.line,
                 )
-            a = ref(node.get("bottom"), node, "bottom")
-            b = ref(node.get("top"), node, "top")
+            a = ref(node, "bottom")
+            b = ref(node, "top")
             stated.append((a, b, (2, 1)))
         else:
             raise FormatError(

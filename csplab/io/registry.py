@@ -328,6 +328,14 @@ class Format:
 _SHARED = "`../shared/anchors-data/`"
 _CONT = "csplab/examples/continuous"  # polygon examples (continuous model synthesis)
 _EMPTY6 = "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0"
+#: the labels of the mesh formats without materials or groups (OFF, STL)
+_SHELL_LABELS = Option(
+    "labels",
+    str,
+    "one",
+    "`one` label for the file or one per connected `components`",
+    choices=("one", "components"),
+)
 
 # WaveFunctionCollapse's own settings (minimum entropy, weights), for its kind of inputs
 _WFC_LIKE = (("order", "min-entropy"), ("choice", "weighted"))
@@ -677,15 +685,7 @@ FORMATS: dict[str, Format] = {
             description="OFF polyhedra (3D continuous model synthesis)",
             reader="csplab.io.meshes:read_off",
             sniffer="csplab.io.meshes:sniff_off",
-            options=(
-                Option(
-                    "labels",
-                    str,
-                    "one",
-                    "`one` label for the file or one per connected `components`",
-                    choices=("one", "components"),
-                ),
-            ),
+            options=(_SHELL_LABELS,),
             files="starting with `OFF`",
             details="`OFF`, counts, vertices, `k i1 … ik` polygon faces (colours ignored); "
             "every connected shell is a solid, validated as for `mesh-obj`",
@@ -699,15 +699,7 @@ FORMATS: dict[str, Format] = {
             description="STL polyhedra (3D continuous model synthesis)",
             reader="csplab.io.meshes:read_stl",
             sniffer="csplab.io.meshes:sniff_stl",
-            options=(
-                Option(
-                    "labels",
-                    str,
-                    "one",
-                    "`one` label for the file or one per connected `components`",
-                    choices=("one", "components"),
-                ),
-            ),
+            options=(_SHELL_LABELS,),
             files="ASCII or binary",
             details="triangles; coincident vertices are merged and adjacent coplanar "
             "triangles counted as one input polygon; every connected shell is a solid, "

@@ -58,9 +58,11 @@ from csplab.io.common import (
     NO,
     LoaderWarnings,
     load_image,
+    neighbor_side,
     read_bytes,
     xml_bool,
     xml_float,
+    xml_neighbors,
     xml_root,
 )
 from csplab.io.ruleset import RuleSet
@@ -216,27 +218,18 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
     names = [f"{nm} {k}" for nm, sym, _, _ in tiles for k in range(CARDINALITY[sym])]
     weights = [w for _, sym, w, _ in tiles for _ in range(CARDINALITY[sym])]
 
-    def ref(text: str | None, node: Node, side: str) -> int | None:
-        if text is None:
-            raise FormatError(f"<neighbor> has no {side!r} attribute", path=path, line=node.line)
-        parts = text.split()
-        if not 1 <= len(parts) <= 2:
-            raise FormatError(
-                f"<neighbor> {side}={text!r}: expected 'name' or 'name k'",
-                path=path,
-                line=node.line,
-            )
-        nm = parts[0]
-        if nm not in seen:
-            if nm in all_names:  # outside the chosen subset
-                return None
-            raise FormatError(f"<neighbor> {side}: unknown tile {nm!r}", path=path, line=node.line)
+    def ref(node: Node, side: str) -> int | None:
+        nm, turn = neighbor_side(node, side, path, all_names, name_first=True,
+                                 forms=("name", "name k"))  # fmt: skip
+        if nm not in seen:  # outside the chosen subset
+            return None
         t = seen[nm]
+        text = node.get(side)
         try:
-            k = int(parts[1]) if len(parts) == 2 else 0
+            k = int(turn) if turn is not None else 0
         except ValueError:
             raise FormatError(
-                f"<neighbor> {side}={text!r}: orientation {parts[1]!r} is not an integer",
+                f"<neighbor> {side}={text!r}: orientation {turn!r} is not an integer",
                 path=path,
                 line=node.line,
             ) from None
@@ -249,12 +242,9 @@ def _build(root: Node, *, path: object, subset: str | None, images: bool) -> Rul
         return orient.label(t, order[t][wfc_action(tiles[t][1])[0][k]])
 
     rules = []
-    xn = root.find("neighbors")
-    if xn is None:
-        raise FormatError(f"<{root.tag}> has no <neighbors> element", path=path, line=root.line)
-    for node in xn.iter("neighbor"):
-        a = ref(node.get("left"), node, "left")
-        b = ref(node.get("right"), node, "right")
+    for node in xml_neighbors(root, path):
+        a = ref(node, "left")
+        b = ref(node, "right")
         if a is not None and b is not None:
             rules.append((a, b, (0, 1)))
     if not rules:

@@ -54,7 +54,7 @@ import itertools
 import math
 import time
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -295,21 +295,19 @@ def run_blocks(
             for q in itertools.product(*starts)
         ]
     soft = _Soft(energy, float(temperature), float(cooling)) if energy is not None else None
+    plan = _Plan(retries, sweeps, order, choice, deadline)
     if workers >= 1:
         if choice == "resemblance" or soft is not None:
             raise InputError(
                 "choice='resemblance' and energy= run in the thesis' sweep (workers=0)"
             )
         status, tried, accepted, retry_count, revisions = _run_waves(
-            problem, grid, boxes, counts, None if m == (0,) else m, rng,
-            retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
+            problem, grid, boxes, counts, None if m == (0,) else m, rng, plan,
             workers=workers, scheduler=scheduler,
         )  # fmt: skip
     else:
         status, tried, accepted, retry_count, revisions = _run_sweep(
-            problem, grid, boxes, None if m == (0,) else m, rng,
-            retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
-            window=window, soft=soft,
+            problem, grid, boxes, None if m == (0,) else m, rng, plan, window=window, soft=soft,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -339,6 +337,18 @@ def run_blocks(
 
 
 _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries, revisions
+
+
+class _Plan(NamedTuple):
+    """The settings of Alg. 3.4 that the sweep and the waves share: retries per block,
+    sweeps, Alg. 3.1's order and choice, and the deadline (a ``time.perf_counter()``
+    value)."""
+
+    retries: int
+    sweeps: int
+    order: str
+    choice: str
+    deadline: float | None
 
 
 class _Soft:
@@ -381,63 +391,57 @@ def _run_sweep(
     boxes: Sequence[NDArray[np.int64]],
     m: tuple[int, ...] | None,
     rng: np.random.Generator,
+    plan: _Plan,
     *,
-    retries: int,
-    sweeps: int,
-    order: str,
-    choice: str,
-    deadline: float | None,
     window: int = 1,
     soft: _Soft | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
-    ``grid`` (flat) in place. With the compiled kernels loaded and a plain setting (grid
-    blocks, scan or entropy orders, uniform or weighted choice, no energy) the whole sweep
-    runs in one kernel (:func:`_run_sweep_compiled`)."""
-    if _compiled_sweep_applies(boxes, m, order, choice, soft):
-        return _run_sweep_compiled(
-            problem, grid, boxes, m, rng, retries=retries, sweeps=sweeps, order=order,
-            deadline=deadline, choice=choice,
-        )  # fmt: skip
+    ``grid`` (flat) in place. A step solves one block (``block_step``: Alg. 3.1 on its
+    subproblem, retried by :func:`csplab.engine.waves.solve_block`, its labels kept if
+    consistent and accepted by ``soft``) or, with the compiled kernels loaded and a plain
+    setting (grid blocks, scan or entropy orders, uniform or weighted choice, no energy),
+    the :data:`_SWEEP_CHUNK` blocks from the given one on in one kernel call
+    (:func:`_chunk_step`: the same blocks, draws and results); the deadline is checked
+    between steps."""
+    retries, sweeps, order, choice, deadline = plan
+    counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, revisions
     touching = _arc_index(problem) if len(boxes) > 1 else None
-    tried = accepted = retry_count = 0
-    revisions = 0
+
+    def block_step(b: int) -> bool:  # False when the time ran out
+        cells = boxes[b]
+        if not cells.size:
+            return True
+        arc_ids = None if touching is None else _arcs_touching(cells, *touching)
+        sub = problem.subproblem(cells, grid, shape=m, arc_ids=arc_ids)
+        ctx = (grid, cells, problem.shape) if choice == "resemblance" else None
+        o = wv.solve_block(sub, rng, 0, retries=retries, order=order, choice=choice,
+                           deadline=deadline, window=window, context=ctx)  # fmt: skip
+        counters[:] += (1, 0, o.retries, o.revisions)
+        if o.labels is not None and (soft is None or soft.accept(grid, cells, o.labels, rng)):
+            grid[cells] = o.labels
+            counters[1] += 1
+        return o.status != "timeout"
+
+    step: Callable[[int], bool] = block_step
+    units = range(len(boxes))
+    if _compiled_sweep_applies(boxes, m, order, choice, soft):
+        assert m is not None
+        step = _chunk_step(problem, grid, boxes, m, rng, retries, order, choice, counters)
+        units = range(0, len(boxes), _SWEEP_CHUNK)
     status: Status = "solved"
     if soft is not None:
         soft.start(grid, problem.shape)
     for _sweep in range(sweeps):
-        for cells in boxes:
-            if deadline is not None and time.perf_counter() > deadline:
+        for unit in units:
+            if (deadline is not None and time.perf_counter() > deadline) or not step(unit):
                 status = "timeout"
-                break
-            if not cells.size:
-                continue
-            arc_ids = None if touching is None else _arcs_touching(cells, *touching)
-            sub = problem.subproblem(cells, grid, shape=m, arc_ids=arc_ids)
-            tried += 1
-            for attempt in range(retries + 1):
-                left = None if deadline is None else max(0.0, deadline - time.perf_counter())
-                ctx = (grid, cells, problem.shape) if choice == "resemblance" else None
-                r = run_alg31(sub, rng, order=order, choice=choice, time_limit=left,
-                              window=window, context=ctx)  # fmt: skip
-                revisions += int(r.stats.get("revisions", 0))
-                if r.status == "solved":
-                    new = r.grid.reshape(-1)
-                    if soft is None or soft.accept(grid, cells, new, rng):
-                        grid[cells] = new
-                        accepted += 1
-                    break
-                if r.status == "timeout":
-                    status = "timeout"
-                    break
-                if attempt < retries:
-                    retry_count += 1
-            if status == "timeout":
                 break
         if soft is not None:
             soft.end_sweep()
         if status == "timeout":
             break
+    tried, accepted, retry_count, revisions = (int(x) for x in counters)
     return status, tried, accepted, retry_count, revisions
 
 
@@ -466,23 +470,20 @@ def _block_scan(m: tuple[int, ...], order: str) -> NDArray[np.int64]:
     return np.arange(n, dtype=np.int64) if scan is None else scan.astype(np.int64)
 
 
-def _run_sweep_compiled(
+def _chunk_step(
     problem: Problem,
     grid: NDArray[np.int32],
     boxes: Sequence[NDArray[np.int64]],
-    m: tuple[int, ...] | None,
+    m: tuple[int, ...],
     rng: np.random.Generator,
-    *,
     retries: int,
-    sweeps: int,
     order: str,
     choice: str,
-    deadline: float | None,
-) -> _Counts:
-    """:func:`_run_sweep` in one compiled kernel per :data:`_SWEEP_CHUNK` blocks
-    (:func:`csplab.catalog.sweep_blocks`): the same blocks, draws and results."""
-    assert m is not None
-    heap = order in ("min-entropy", "min-domain")
+    counters: NDArray[np.int64],
+) -> Callable[[int], bool]:
+    """The sweep's step on the :data:`_SWEEP_CHUNK` blocks from block ``a`` on in one
+    compiled kernel call (:func:`csplab.catalog.sweep_blocks`, which adds to
+    ``counters``)."""
     nb = int(np.prod(m))
     scan = _block_scan(m, order)
     sizes = np.array([b.size for b in boxes], dtype=np.int64)
@@ -491,22 +492,14 @@ def _run_sweep_compiled(
     bcells = np.concatenate(list(boxes)).astype(np.int64) if boxes else np.zeros(0, np.int64)
     if np.any((sizes != nb) & (sizes > 0)):
         raise AssertionError("grid blocks all have the block's shape")
-    weighted = choice == "weighted"
-    key_weighted = weighted and order == "min-entropy"
-    counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, queue pops
-    status: Status = "solved"
-    for _sweep in range(sweeps):
-        for a in range(0, len(boxes), _SWEEP_CHUNK):
-            if deadline is not None and time.perf_counter() > deadline:
-                status = "timeout"
-                break
-            span = (a, min(a + _SWEEP_CHUNK, len(boxes)))
-            sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, heap, weighted,
-                         key_weighted, rng, counters)  # fmt: skip
-        if status == "timeout":
-            break
-    tried, accepted, retry_count, revisions = (int(x) for x in counters)
-    return status, tried, accepted, retry_count, revisions
+
+    def step(a: int) -> bool:
+        span = (a, min(a + _SWEEP_CHUNK, len(boxes)))
+        sweep_blocks(problem, grid, bptr, bcells, span, scan, retries, order, choice, rng,
+                     counters)  # fmt: skip
+        return True
+
+    return step
 
 
 def _run_waves(
@@ -516,17 +509,14 @@ def _run_waves(
     counts: tuple[int, ...],
     m: tuple[int, ...] | None,
     rng: np.random.Generator,
+    plan: _Plan,
     *,
-    retries: int,
-    sweeps: int,
-    order: str,
-    choice: str,
-    deadline: float | None,
     workers: int,
     scheduler: str | None,
 ) -> _Counts:
     """The wave schedule (``workers >= 1``, see the module docstring); updates ``grid``
     (flat) in place after each wave."""
+    retries, sweeps, order, choice, deadline = plan
     root = int(rng.integers(2**63))
     compiled = _compiled_sweep_applies(boxes, m, order, choice, None)
     touching: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None
@@ -544,11 +534,9 @@ def _run_waves(
     scan = _block_scan(m, order) if compiled and m is not None else None
     ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root,
                           size=problem.n * problem.K, compiled=compiled, scan=scan)  # fmt: skip
-    runner: wv.PoolRunner | wv.DaskRunner | None = None
-    if scheduler is not None:
-        runner = wv.DaskRunner(scheduler, workers, ctx)
-    elif workers > 1:
-        runner = wv.PoolRunner(workers, ctx)
+    runner: wv.BlockRunner | None = None
+    if scheduler is not None or workers > 1:
+        runner = wv.BlockRunner(workers, ctx, scheduler)
     tried = accepted = retry_count = revisions = 0
     status: Status = "solved"
     stopped = False  # a wave did not finish in time: its workers are stopped
@@ -583,7 +571,7 @@ def _run_waves(
                             )
                         )
                 else:
-                    size = wv.chunk_size(len(wave), runner.workers)
+                    size = wv.chunk_size(len(wave), runner.size)
                     wall = (
                         None if deadline is None else time.time() + deadline - time.perf_counter()
                     )
