@@ -215,6 +215,7 @@ def run_blocks(
     energy: Energy | None = None,
     temperature: float = 1.0,
     cooling: float = 1.0,
+    exact: str = "none",
 ) -> Result:
     """Alg. 3.4 (see the module docstring).
 
@@ -238,6 +239,11 @@ def run_blocks(
         Soft constraints (2007 paper Sec. 4.2, :mod:`csplab.soft`): a consistent new block
         is kept with probability ``min(1, exp(-(E(M') - E(M)) / T))``; ``T`` starts at
         ``temperature`` and is multiplied by ``cooling`` after each sweep.
+    exact : {"none", "sat", "backtrack"}
+        Exact block completion: a block whose Alg. 3.1 runs all fail is solved by this
+        exact solver on the block's subproblem (its border fixed); when that proves the
+        block has no labels fitting its border, it keeps its labels as before. Runs the
+        thesis' sweep in Python (``workers=0``).
 
     Returns
     -------
@@ -293,9 +299,9 @@ def run_blocks(
     deadline = None if time_limit is None else t0 + float(time_limit)
     soft = _Soft(energy, float(temperature), float(cooling)) if energy is not None else None
     if workers >= 1:
-        if choice == "resemblance" or soft is not None:
+        if choice == "resemblance" or soft is not None or exact != "none":
             raise InputError(
-                "choice='resemblance' and energy= run in the thesis' sweep (workers=0)"
+                "choice='resemblance', energy= and exact= run in the thesis' sweep (workers=0)"
             )
         status, tried, accepted, retry_count, revisions = _run_waves(
             problem, grid, boxes, counts, None if m == (0,) else m, rng,
@@ -303,10 +309,11 @@ def run_blocks(
             workers=workers, scheduler=scheduler,
         )  # fmt: skip
     else:
+        completion = _Exact(exact) if exact != "none" else None
         status, tried, accepted, retry_count, revisions = _run_sweep(
             problem, grid, boxes, None if m == (0,) else m, rng,
             retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
-            window=window, soft=soft,
+            window=window, soft=soft, completion=completion,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -330,12 +337,47 @@ def run_blocks(
                      temperature=soft.T0, cooling=soft.cooling)  # fmt: skip
     if repair is not None:
         stats["breaches"] = repair(out)
+    if exact != "none":
+        stats["exact"] = exact
+        if workers == 0 and completion is not None:
+            stats["exact_blocks"] = completion.solved
+            stats["exact_refuted"] = completion.refuted
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return Result(status, out, "blocks", time_s=time.perf_counter() - t0, stats=stats)
 
 
 _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries, revisions
+
+
+class _Exact:
+    """Exact block completion: an exact solver on a block's subproblem (its border fixed),
+    seeded by one number drawn from the sweep's generator (deterministic for a seed)."""
+
+    def __init__(self, solver: str) -> None:
+        self.solver = solver
+        self.solved = 0  # blocks completed exactly
+        self.refuted = 0  # blocks proved to have no labels fitting their border
+
+    def __call__(
+        self, sub: Problem, rng: np.random.Generator, left: float | None
+    ) -> tuple[NDArray[np.int32] | None, bool]:
+        """The block's new labels (flat) or ``None``, and whether the time ran out."""
+        from csplab.solvers import solver_class
+
+        if left is not None and left <= 0:
+            return None, True
+        seed = int(rng.integers(2**62))
+        opts: dict[str, Any] = {} if left is None else {"time_limit": left}
+        r = solver_class(self.solver)().solve(
+            sub, rng=np.random.default_rng(seed), seed=seed, **opts
+        )
+        if r.status == "solved" and sub.is_solution(r.grid):
+            self.solved += 1
+            return np.asarray(r.grid, dtype=np.int32).reshape(-1), False
+        if r.status == "unsat":
+            self.refuted += 1
+        return None, r.status == "timeout"
 
 
 class _Soft:
@@ -386,12 +428,13 @@ def _run_sweep(
     deadline: float | None,
     window: int = 1,
     soft: _Soft | None = None,
+    completion: _Exact | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
     ``grid`` (flat) in place. With the compiled kernels loaded and a plain setting (grid
     blocks, scan or entropy orders, uniform or weighted choice, no energy) the whole sweep
     runs in one kernel (:func:`_run_sweep_compiled`)."""
-    if _compiled_sweep_applies(boxes, m, order, choice, soft):
+    if completion is None and _compiled_sweep_applies(boxes, m, order, choice, soft):
         return _run_sweep_compiled(
             problem, grid, boxes, m, rng, retries=retries, sweeps=sweeps, order=order,
             deadline=deadline, choice=choice,
@@ -429,6 +472,17 @@ def _run_sweep(
                     break
                 if attempt < retries:
                     retry_count += 1
+            else:  # every Alg. 3.1 run failed: complete the block exactly, if asked
+                if completion is not None:
+                    left = None if deadline is None else deadline - time.perf_counter()
+                    labels, timed_out = completion(sub, rng, left)
+                    if timed_out:
+                        status = "timeout"
+                    elif labels is not None and (
+                        soft is None or soft.accept(grid, cells, labels, rng)
+                    ):
+                        grid[cells] = labels
+                        accepted += 1
             if status == "timeout":
                 break
         if soft is not None:
@@ -774,6 +828,9 @@ class BlocksSolver(Solver):
                convert=_positive),
         Option("cooling", float, 1.0, "T is multiplied by this after each sweep (0 < c <= 1)",
                convert=_positive),
+        Option("exact", str, "none", "exact block completion: a block whose retries all fail "
+               "is solved by sat or backtrack with its border fixed (none: Alg. 3.4's restore)",
+               values=("none", "sat", "backtrack")),
     )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:
