@@ -35,8 +35,6 @@ import argparse
 import contextlib
 import io
 import json
-import subprocess
-import sys
 import time
 from collections import Counter
 from pathlib import Path
@@ -73,6 +71,7 @@ FILES = [
     ("tiny_debroglie.json", DATA / "tiny_debroglie.json", []),
     ("tiny_poms.json", DATA / "tiny_poms.json", []),
     ("wfc_index/within.xml", DATA / "wfc_index" / "within.xml", ["--size", "12x12"]),
+    ("wfc_index/beyond.xml", DATA / "wfc_index" / "beyond.xml", ["--size", "12x12"]),
     ("tiny_polygons.json", DATA / "tiny_polygons.json", ["--size", "10x10"]),
     ("tiny.svg", DATA / "tiny.svg", ["--size", "10x10"]),
     ("tiny_mesh.obj", DATA / "tiny_mesh.obj", ["--size", "6x6x6"]),
@@ -86,16 +85,11 @@ FILES = [
 
 
 def builtin_kinds() -> list[tuple[str, str]]:
-    """(name, kind) of every built-in example, read from ``csplab info``."""
-    out = subprocess.run([sys.executable, "-m", "csplab", "info"], capture_output=True,
-                         text=True, check=True).stdout  # fmt: skip
-    rows = out.split("built-in examples:", 1)[1].split("file formats", 1)[0].splitlines()
+    """(name, kind) of every built-in example (as ``csplab info`` lists them)."""
+    from csplab.examples import example_info
+
     found = []
-    for row in rows:
-        parts = row.split(None, 1)
-        if len(parts) < 2 or row[:1] != " " or row[2:3] == " ":
-            continue
-        name, text = parts
+    for name, text in example_info():
         kind = "grid2"
         if text.startswith("polygons:"):
             kind = "polygons"
@@ -148,15 +142,39 @@ def run_gadgets(signs: str, seed: int) -> tuple[str, float]:
     return "not solved", dt
 
 
-def run_one(args: list[str], seed: int) -> tuple[str, float]:
-    """The outcome of one ``csplab synthesize`` (in this process) and its wall time."""
+def is_grid(args: list[str]) -> bool:
+    """Whether the model of ``args`` is a grid model (not a continuous one)."""
+    import warnings
+
+    from csplab.continuous.model import PolygonModel
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.io import load_model
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return not isinstance(load_model(args[0]), PolygonModel | PolyhedralModel)
+
+
+def run_one(args: list[str], seed: int, grid: bool = True) -> tuple[str, float]:
+    """The outcome of one ``csplab synthesize`` (in this process) and its wall time; a
+    grid model's output is written and checked again with ``csplab check`` (a continuous
+    model's JSON has the checker's Eq. 4.1 violations of the output polygons)."""
+    import tempfile
+
     from csplab.cli import main
 
     buf, err = io.StringIO(), io.StringIO()
-    t0 = time.perf_counter()
-    with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(err):
-        code = main(["synthesize", *args, "--seed", str(seed), "--json"])
-    dt = time.perf_counter() - t0
+    with tempfile.TemporaryDirectory() as tmp:
+        out = str(Path(tmp) / "out.npy")
+        t0 = time.perf_counter()
+        with contextlib.redirect_stdout(buf), contextlib.redirect_stderr(err):
+            code = main(["synthesize", *args, "--seed", str(seed), "--json",
+                         *(["--out", out] if grid else [])])  # fmt: skip
+        dt = time.perf_counter() - t0
+        if code == 0 and grid:
+            with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(err):
+                if main(["check", args[0], out, *args[1:]]) != 0:
+                    return "INVALID (csplab check)", dt
     try:
         d = json.loads(buf.getvalue().strip().splitlines()[-1])
     except (json.JSONDecodeError, IndexError):
@@ -164,8 +182,11 @@ def run_one(args: list[str], seed: int) -> tuple[str, float]:
     if code == 0:
         bad = d.get("violations", d.get("stats", {}).get("violations", 0))
         return ("solved" if not bad else "INVALID"), dt
+    if code == 1 and d.get("status") == "unsat":
+        proof = d.get("proof") or d.get("stats", {}).get("proof")
+        return ("unsat" if proof else "unsat without a proof"), dt
     if code == 1:
-        return ("unsat" if d.get("status") == "unsat" else "not solved"), dt
+        return "not solved", dt
     return f"error {code}: {err.getvalue().strip()[:80]}", dt
 
 
@@ -214,6 +235,7 @@ def main() -> None:
     for label, args in [*cases(), *((g, []) for g in GADGETS)]:
         if only and not any(label.startswith(o) for o in only):
             continue
+        grid = label not in GADGETS and is_grid(args)
         tally: Counter[str] = Counter()
         failing: list[str] = []
         total = 0.0
@@ -221,7 +243,7 @@ def main() -> None:
             if label in GADGETS:
                 outcome, dt = run_gadgets(GADGETS[label], s)
             else:
-                outcome, dt = run_one(args, s)
+                outcome, dt = run_one(args, s, grid)
             total += dt
             key = outcome if outcome in ("solved", "unsat", "not solved") else "error"
             tally[key] += 1

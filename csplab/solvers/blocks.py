@@ -800,7 +800,9 @@ class BlocksSolver(Solver):
         "starts from a trivial solution (empty space, or ground under empty space) or `init=`; "
         "`block=10`, `retries=20`; the output is always consistent; global constraints: a "
         "block that breaks them more is rejected, so `sweeps` repair the model (`failed` "
-        "if one is still broken); soft constraints by Metropolis (`energy=`)"
+        "if one is still broken); soft constraints by Metropolis (`energy=`); "
+        '`exact="sat"` completes a block whose retries all fail exactly, its border fixed '
+        "(how the default chain finishes a model too large for SAT)"
     )
     options = (
         Option("block", object, 10, "block size per axis (an int or one per axis, e.g. 10x10x4)",
