@@ -333,7 +333,7 @@ def solve(
         assert fallback is not None
         res = chain.finish(
             problem, fallback, res, solver=solver, seed=_derived_seed(seed, attempt, gen),
-            attempts=attempt, t0=t0, options=options,
+            attempts=attempt, t0=t0, time_limit=limit, options=options,
         )  # fmt: skip
     elapsed = time.perf_counter() - t0
     if "fallback_from" not in res.stats:
@@ -341,7 +341,7 @@ def solve(
     res.seed = seed
     res.time_s = elapsed if attempt > 1 or chained else (res.time_s or elapsed)
     res.problem = problem
-    if restarts and not chained:
+    if restarts and "fallback_from" not in res.stats:
         res.stats["attempts"] = attempt
         if attempt_seed is not None:
             res.stats["attempt_seed"] = attempt_seed

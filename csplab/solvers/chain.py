@@ -103,12 +103,15 @@ def finish(
     seed: int,
     attempts: int,
     t0: float,
+    time_limit: float | None,
     options: dict[str, Any],
 ) -> Result:
     """Run the fallback solver on ``problem`` after ``gave_up`` (the incomplete solver
-    ``solver``'s last result, ``failed``), with what is left of ``options['time_limit']``
-    (measured from ``t0``), seeded with ``seed``; the result says which solver produced
-    it. With no time left, ``gave_up`` is returned as a ``timeout``."""
+    ``solver``'s last result, ``failed``), with what is left of ``time_limit`` (the
+    whole call's, measured from ``t0``), seeded with ``seed``; ``options`` are the
+    incomplete solver's (their ``choice`` carries over where the exact solver has it).
+    The result says which solver produced it. With no time left, ``gave_up`` is returned
+    as a ``timeout``."""
     from csplab.rng import make_rng
     from csplab.solvers import solver_class
 
@@ -116,10 +119,9 @@ def finish(
     target = exact_solver(problem, fallback, name)
     cls = solver_class(target)
     opts: dict[str, Any] = {}
-    limit = options.get("time_limit")
     spent = time.perf_counter() - t0
-    if limit is not None:
-        left = float(limit) - spent
+    if time_limit is not None:
+        left = float(time_limit) - spent
         if left <= 0:
             gave_up.status = "timeout"
             gave_up.stats["fallback"] = f"{target} (no time left)"

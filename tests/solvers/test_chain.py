@@ -63,7 +63,11 @@ def test_blocks_without_a_starting_model_falls_back_or_raises() -> None:
 def test_no_time_left_is_a_timeout_not_a_verdict() -> None:
     big = Problem.from_example(load_example("fig3_1b"), (41, 41), periodic=True)
     r = solve(big, "catalog", rng=1, restarts=10**6, time_limit=0.05, fallback="sat")
-    assert r.status == "timeout" and "proof" not in r.stats
+    assert r.status == "timeout" and "proof" not in r.stats and r.time_s < 1.0
+    assert r.solver == "catalog" and r.stats["attempts"] > 1
+    # with time left, the fallback runs within what remains of the same budget
+    r = solve(ODD, "catalog", rng=1, restarts=3, time_limit=30.0, fallback="sat")
+    assert r.status == "unsat" and r.time_s < 30.0
 
 
 def test_auto_uses_backtrack_without_python_sat(monkeypatch: pytest.MonkeyPatch) -> None:
