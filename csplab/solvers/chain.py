@@ -6,21 +6,21 @@ reports ``failed``, the same problem, with the same global constraints, goes to 
 solver for the time that is left. Its answer is the answer: ``solved`` (checked with
 :meth:`Problem.violations`), ``unsat`` with the exact solver's proof, or ``timeout``.
 
-============  =======================================================================
-fallback      what runs after the incomplete solver gave up
-============  =======================================================================
-``None``      nothing (``"none"``): the run is the incomplete solver's alone, as the
-              thesis' experiments measure it (the default of :func:`solve`)
-``"auto"``    ``sat`` where python-sat is installed, else ``backtrack``; a problem
-              too large for the SAT encoding (more than :data:`SAT_CELL_LABELS` cell
-              labels) goes to ``blocks`` with exact block completion instead (the
-              command line's default)
-``"sat"``     the SAT solver (:mod:`csplab.solvers.sat`)
-``"backtrack"``  MAC search (:mod:`csplab.solvers.backtrack`)
-============  =======================================================================
+=================  ==================================================================
+fallback           what runs after the incomplete solver gave up
+=================  ==================================================================
+``None``           nothing (also ``"none"``): the run is the incomplete solver's alone,
+                   as the thesis' experiments measure it (the default of :func:`solve`)
+``"auto"``         ``sat`` where python-sat is installed, else ``backtrack``; a problem
+                   too large for the SAT encoding (more than :data:`SAT_CELL_LABELS`
+                   cell labels) goes to ``blocks`` with exact block completion instead
+                   (the command line's default)
+``"sat"``          the SAT solver (:mod:`csplab.solvers.sat`)
+``"backtrack"``    MAC search (:mod:`csplab.solvers.backtrack`)
+=================  ==================================================================
 
 The fallback draws its randomness from the seed of the attempt after the last restart
-(:func:`_derived_seed` of the user's seed), so the whole call repeats for a seed, and the
+(``csplab.solvers._derived_seed`` of the user's seed), so the whole call repeats for a seed, and the
 result's ``attempt_seed`` reruns the fallback alone. The result names the solver that
 produced it (``Result.solver``) and says in its stats which solver gave up
 (``fallback_from``), after how many ``attempts`` and seconds (``gave_up_s``).
