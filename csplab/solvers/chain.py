@@ -20,8 +20,8 @@ fallback           what runs after the incomplete solver gave up
 =================  ==================================================================
 
 The fallback draws its randomness from the seed of the attempt after the last restart
-(``csplab.solvers._derived_seed`` of the user's seed), so the whole call repeats for a seed, and the
-result's ``attempt_seed`` reruns the fallback alone. The result names the solver that
+(``csplab.solvers._derived_seed`` of the user's seed), so the whole call repeats for a
+seed, and the result's ``attempt_seed`` reruns the fallback alone. The result names the solver that
 produced it (``Result.solver``) and says in its stats which solver gave up
 (``fallback_from``), after how many ``attempts`` and seconds (``gave_up_s``).
 
