@@ -96,8 +96,13 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
     settings["restarts"] = restarts
+    from csplab.cli.synthesize import explain, fallback_setting, not_written, outcome
+
+    if not cls.complete:
+        settings["fallback"] = fallback_setting(args.fallback)
+    fallback = None if cls.complete or args.fallback == "none" else args.fallback
     common = dict(solver=args.solver, rng=args.seed, spacing=args.spacing, snap=args.snap,
-                  boundary=boundary, restarts=restarts)  # fmt: skip
+                  boundary=boundary, restarts=restarts, fallback=fallback)  # fmt: skip
     cons = user_constraints(args, example)
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
@@ -136,18 +141,24 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
             violations=len(s.violations), polygons=polys,
             solids=len(s.model.solids) if dim == 3 and s.model is not None else None,
             times={k: round(v, 6) for k, v in s.times.items()},
+            outcome=outcome(r.status) if s.ok or r.status != "solved" else "not solved",
+            proof=r.stats.get("proof") if r.status == "unsat" else None,
         )  # fmt: skip
         print(json.dumps(d))
     else:
         what = "edge directions" if dim == 2 else "face orientations"
         unit = "spacings" if dim == 2 else "plane spacings"
+        said = outcome(r.status) if s.ok or r.status != "solved" else "not solved"
         print(
-            f"{r.status}: {example.name or args.model} {'x'.join(map(str, size))} {unit} of "
+            f"{said}: {example.name or args.model} {'x'.join(map(str, size))} {unit} of "
             f"{spacing:g} ({fams} {what}, {A.n_vertices} vertices, {A.n_edges} "
             f"edges, K={P.K}) with {r.solver} in {r.time_s:.3f} s, seed {r.seed}"
         )
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
-        keys = [k for k in r.stats if k not in ("order", "choice")]
+        for line in explain(r):
+            print(line)
+        keys = [k for k in r.stats if k not in ("order", "choice", "proof", "fallback_from",
+                                                "gave_up_s", "reason")]  # fmt: skip
         if keys:
             print("  " + ", ".join(f"{k}={r.stats[k]}" for k in keys))
         if s.model is not None:
@@ -164,8 +175,9 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         if wrote:
             print(f"  wrote {wrote}")
         elif args.out:
-            print(f"  not written: {args.out} (no solution)", file=sys.stderr)
-        if r.status == "failed" and not cls.complete and cls.name != "blocks":
+            print(not_written(args.out, r.status).replace(
+                "; --out-partial writes the partial grid", ""), file=sys.stderr)  # fmt: skip
+        if r.status == "failed" and fallback is None and not cls.complete and cls.name != "blocks":
             hint = (
                 "  hint: --solver blocks modifies the model in parts (Fig. 4.23) and always "
                 "returns a consistent model; an exact solver (sat) decides"

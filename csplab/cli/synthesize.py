@@ -25,9 +25,11 @@ HELP = "synthesize a model from an example"
 DESCRIPTION = (
     "Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 "
     "or any registered solver); for a polygon example (.json, .svg), continuous model "
-    "synthesis in a WxH region of line spacings, written as .json, .svg or .png. Exit 0 "
-    "when solved, 1 when the algorithm failed or the problem is unsatisfiable, 2 on bad "
-    "input."
+    "synthesis in a WxH region of line spacings, written as .json, .svg or .png. An "
+    "incomplete solver (catalog, blocks) that gives up after its --restarts is followed by "
+    "an exact one (--fallback), so a default run ends solved, or 'unsat' with the exact "
+    "solver's proof, or 'not solved' when the time ran out. Exit 0 when solved, 1 when not "
+    "solved or unsat (the message and --json say which), 2 on bad input."
 )
 
 
@@ -65,6 +67,17 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="run an incomplete solver again, with a fresh derived seed, up to N times while "
         "it fails (default 10, as WaveFunctionCollapse per output; Merrell's code retries "
         "20 times per block; 0: one run, as the thesis' experiments)",
+    )
+    from csplab.solvers.chain import FALLBACKS
+
+    p.add_argument(
+        "--fallback",
+        choices=FALLBACKS,
+        default="auto",
+        help="after an incomplete solver gave up on every restart, finish with an exact "
+        "solver for the time left: auto (default: sat where python-sat is installed, else "
+        "backtrack; modify in blocks with exact block completion for a model too large for "
+        "SAT), sat, backtrack, or none (the incomplete solver's run alone, as the thesis)",
     )
     p.add_argument(
         "--spacing",
@@ -109,6 +122,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     add_constraints_arg(p)
     p.add_argument("--json", action="store_true", help="print status, time and stats as JSON")
+
+
+def solver_complete(spec: str) -> bool:
+    """Whether the solver of ``spec`` (``name[:backend]``) is complete (needs no fallback)."""
+    from csplab.solvers import solver_class
+
+    return bool(solver_class(spec.partition(":")[0]).complete)
 
 
 def _options(args: argparse.Namespace) -> dict[str, Any]:
@@ -162,9 +182,63 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
             origin = "solver default" if suggested else sources.get("*", "solver default")
             settings[key] = f"{o.default} ({origin})"
     settings["restarts"] = 0 if cls.complete else args.restarts
+    if not cls.complete:
+        settings["fallback"] = fallback_setting(args.fallback)
     if cls.takes("progress"):
         opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
     return settings
+
+
+#: stats the lines of :func:`explain` say in words
+_EXPLAINED = ("proof", "fallback_from", "gave_up_s", "reason")
+
+
+def fallback_setting(fallback: str) -> str:
+    """The settings line's ``fallback`` entry: the solver ``--fallback`` names, and where
+    it came from."""
+    if fallback != "auto":
+        return f"{fallback} (given)"
+    from csplab.deps import available
+
+    return f"{'sat' if available('pysat') else 'backtrack'} (auto)"
+
+
+def outcome(status: str) -> str:
+    """What the user is told: ``solved``, ``unsat`` (an exact solver's proof) or ``not
+    solved`` (every solver gave up, or the time ran out)."""
+    return status if status in ("solved", "unsat") else "not solved"
+
+
+def explain(result: Any) -> list[str]:
+    """The lines after the first that say how the result came about: which solver gave up
+    before the fallback, the proof of an ``unsat``, why a run is ``not solved``."""
+    st = result.stats
+    lines = []
+    if "fallback_from" in st:
+        n = st.get("attempts", 1)
+        lines.append(
+            f"  {st['fallback_from']} gave up after {n} attempt{'s' * (n != 1)} "
+            f"({st.get('gave_up_s', 0.0):.3f} s); {result.solver} took over"
+            + (" (too large for SAT: modify in blocks, exact block completion)"
+               if result.solver == "blocks" and st["fallback_from"] != "blocks" else "")
+        )  # fmt: skip
+    if result.status == "unsat":
+        lines.append(f"  proof: {st.get('proof', 'refuted by ' + result.solver)}")
+    elif result.status == "timeout":
+        lines.append("  not solved: the time limit ran out (--time-limit); satisfiability "
+                     "is not decided")  # fmt: skip
+    elif result.status == "failed":
+        why = st.get("reason") or "the incomplete solver gave up"
+        lines.append(f"  not solved: {why}; this says nothing about satisfiability "
+                     "(--fallback sat or backtrack decides)")  # fmt: skip
+    return lines
+
+
+def not_written(out: str, status: str) -> str:
+    """The stderr line when ``--out`` is not written."""
+    if status == "unsat":
+        return f"  not written: {out} (no solution exists: unsat, proof above)"
+    return f"  not written: {out} (not solved; --out-partial writes the partial grid)"
 
 
 def run(args: argparse.Namespace) -> int:
@@ -191,7 +265,9 @@ def run(args: argparse.Namespace) -> int:
         check_output_path(args.out, "--out")  # an unwritable folder: fail before the work
     if out_format is not None and args.out_partial and not out_format.partial:
         raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
-    result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"], **opts)
+    fallback = None if solver_complete(args.solver) or args.fallback == "none" else args.fallback
+    result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
+                   fallback=fallback, **opts)  # fmt: skip
     wrote = None
     if out_format is not None and (result.ok or args.out_partial):
         per = problem.meta.get("periodic", False)
@@ -207,21 +283,25 @@ def run(args: argparse.Namespace) -> int:
         d["out"] = wrote
         d["format"] = example.meta.get("format")
         d["settings"] = settings
+        d["outcome"] = outcome(result.status)
+        d["proof"] = result.stats.get("proof") if result.status == "unsat" else None
         print(json.dumps(d))
     else:
         size = "x".join(map(str, problem.shape))
         msg = (
-            f"{result.status}: {example.name or args.model} {size} (K={problem.K}) with "
-            f"{result.solver} in {result.time_s:.3f} s, seed {result.seed}"
+            f"{outcome(result.status)}: {example.name or args.model} {size} (K={problem.K}) "
+            f"with {result.solver} in {result.time_s:.3f} s, seed {result.seed}"
         )
         print(msg)
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
+        for line in explain(result):
+            print(line)
         if problem.meta.get("boundary_rule"):
             print(f"  boundary {problem.meta['boundary_rule']}")
-        keys = [k for k in result.stats if k not in ("order", "choice")]
+        keys = [k for k in result.stats if k not in ("order", "choice", *_EXPLAINED)]
         if keys:
             print("  " + ", ".join(f"{k}={result.stats[k]}" for k in keys))
-        if result.status == "failed" and problem.constraints:
+        if result.status == "failed" and problem.constraints and fallback is None:
             from csplab.solvers import solver_class
 
             if solver_class(result.solver.partition(":")[0]).constraints != "exact":
@@ -231,8 +311,5 @@ def run(args: argparse.Namespace) -> int:
             unset = int((result.grid < 0).sum())
             print(f"  wrote {wrote}" + (f" (partial: {unset} cells unassigned)" if unset else ""))
         elif args.out:
-            print(
-                f"  not written: {args.out} (no solution; --out-partial writes the partial grid)",
-                file=sys.stderr,
-            )
+            print(not_written(args.out, result.status), file=sys.stderr)
     return 0 if result.ok else 1

@@ -512,18 +512,28 @@ class Experiment:
 
     def solver_params(self, config: dict[str, Any], entry: str) -> tuple[str, dict[str, Any]]:
         """``(solver spec, params)`` for a solver entry: params hold the ``options``, the
-        ``restarts`` of :func:`csplab.solvers.solve` (``catalog@restarts=20``) and, for
+        ``restarts`` of :func:`csplab.solvers.solve` (``catalog@restarts=20``), its
+        ``fallback`` (``catalog@restarts=10,fallback=sat``; none unless asked, so the
+        experiments measure single solvers) and, for
         entries with ``@`` options, the entry as ``label``."""
         spec, extra = split_solver(entry)
         opts = self.solver_options(config, spec)
         restarts = extra.pop("restarts", None)  # solve(..., restarts=N), not a solver option
+        fallback = extra.pop("fallback", None)  # solve(..., fallback=...): only when asked
         opts.update(extra)
         params: dict[str, Any] = {"options": opts}
         if restarts is not None:
             if isinstance(restarts, bool) or not isinstance(restarts, int) or restarts < 0:
                 raise InputError(f"solver entry {entry!r}: restarts must be an integer >= 0")
             params["restarts"] = restarts
-        if extra or restarts is not None:
+        if fallback is not None:
+            from csplab.solvers.chain import check_fallback
+
+            try:
+                params["fallback"] = check_fallback(str(fallback))
+            except InputError as e:
+                raise InputError(f"solver entry {entry!r}: {e}") from None
+        if extra or restarts is not None or fallback is not None:
             params["label"] = entry
         return spec, params
 

@@ -231,7 +231,9 @@ def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict
     from csplab.solvers import solve
 
     restarts = int(trial.params.get("restarts", 0))
-    r = solve(problem, trial.solver, rng=trial.seed, restarts=restarts, **trial.options)
+    fallback = trial.params.get("fallback")  # none unless the solver entry asks for one
+    r = solve(problem, trial.solver, rng=trial.seed, restarts=restarts, fallback=fallback,
+              **trial.options)  # fmt: skip
     stats = kept_stats(r.stats)
     stats["grid"] = grid_digest(r.grid)
     return {"status": r.status, "time_s": float(r.time_s), "stats": stats}

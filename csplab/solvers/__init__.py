@@ -35,7 +35,13 @@ from typing import Any
 import numpy as np
 
 from csplab.deps import available
-from csplab.errors import CsplabError, DependencyError, InputError, UnknownSolverError
+from csplab.errors import (
+    CsplabError,
+    DependencyError,
+    InputError,
+    NoTrivialSolutionError,
+    UnknownSolverError,
+)
 from csplab.problem import Problem
 from csplab.result import STATUSES, Result
 from csplab.rng import RngLike, make_rng
@@ -233,6 +239,7 @@ def solve(
     rng: RngLike = None,
     *,
     restarts: int = 0,
+    fallback: str | None = None,
     **options: Any,
 ) -> Result:
     """Solve ``problem`` with the named solver.
@@ -252,6 +259,14 @@ def solve(
         measure single runs (0, the default here). The result's stats say ``attempts`` and,
         after a restart, the ``attempt_seed`` that reproduces the returned run alone.
         ``time_limit`` covers all attempts.
+    fallback : {None, "auto", "sat", "backtrack", "none"}
+        What finishes the problem when an incomplete solver still reports ``failed`` after
+        its restarts (:mod:`csplab.solvers.chain`): ``None`` (the default, as the thesis'
+        experiments: the incomplete solver's run is the result) or an exact solver, run on
+        the same problem for the time that is left, seeded from ``rng``; ``"auto"`` is
+        ``sat`` where installed, else ``backtrack``, and modify in blocks with exact block
+        completion for a problem too large for SAT. The result's ``solver`` is the one that
+        produced it; its stats say ``fallback_from``.
     **options
         Solver options (``order=``, ``time_limit=``, ``block=`` ...).
 
@@ -276,6 +291,9 @@ def solve(
         raise InputError(f"solve() needs a Problem, got {type(problem).__name__}")
     if isinstance(restarts, bool) or not isinstance(restarts, int) or restarts < 0:
         raise InputError(f"restarts must be a non-negative integer, not {restarts!r}")
+    from csplab.solvers import chain
+
+    fallback = chain.check_fallback(fallback)
     cls, backend = get_solver(solver)
     gen, seed = make_rng(rng)
     t0 = time.perf_counter()
@@ -283,7 +301,16 @@ def solve(
     attempt_seed: int | None = None
     attempt = 0
     while True:
-        res = cls().solve(problem, rng=gen, seed=seed, backend=backend, **options)
+        try:
+            res = cls().solve(problem, rng=gen, seed=seed, backend=backend, **options)
+        except NoTrivialSolutionError as e:
+            if fallback is None or cls.complete:
+                raise
+            # modify in blocks found no starting model (the same on every attempt): it gave up
+            res = Result("failed", np.full(problem.shape, -1, dtype=np.int32), cls.name,
+                         stats={"reason": str(e).splitlines()[0]})  # fmt: skip
+            attempt += 1
+            break
         attempt += 1
         if res.status not in STATUSES:
             raise CsplabError(f"solver {solver!r} returned unknown status {res.status!r}")
@@ -302,12 +329,20 @@ def solve(
             options = {**options, "time_limit": left}
         attempt_seed = _derived_seed(seed, attempt, gen)
         gen = make_rng(attempt_seed)[0]
+    chained = fallback is not None and res.status == "failed" and not cls.complete
+    if chained:
+        assert fallback is not None
+        res = chain.finish(
+            problem, fallback, res, solver=solver, seed=_derived_seed(seed, attempt, gen),
+            attempts=attempt, t0=t0, time_limit=limit, options=options,
+        )  # fmt: skip
     elapsed = time.perf_counter() - t0
-    res.solver = solver
+    if "fallback_from" not in res.stats:
+        res.solver = solver
     res.seed = seed
-    res.time_s = elapsed if attempt > 1 else (res.time_s or elapsed)
+    res.time_s = elapsed if attempt > 1 or chained else (res.time_s or elapsed)
     res.problem = problem
-    if restarts:
+    if restarts and "fallback_from" not in res.stats:
         res.stats["attempts"] = attempt
         if attempt_seed is not None:
             res.stats["attempt_seed"] = attempt_seed
@@ -315,7 +350,7 @@ def solve(
         v = problem.violations(res.grid)
         if len(v):
             raise CsplabError(
-                f"solver {solver!r} returned a grid that is not a solution "
+                f"solver {res.solver!r} returned a grid that is not a solution "
                 f"(a bug in csplab, please report):\n{v.describe()}"
             )
         res.stats.setdefault("violations", 0)

@@ -215,6 +215,7 @@ def run_blocks(
     energy: Energy | None = None,
     temperature: float = 1.0,
     cooling: float = 1.0,
+    exact: str = "none",
 ) -> tuple[Status, NDArray[np.int32], dict[str, Any]]:
     """Alg. 3.4 (see the module docstring): the engine of :class:`BlocksSolver`.
 
@@ -240,6 +241,11 @@ def run_blocks(
         Soft constraints (2007 paper Sec. 4.2, :mod:`csplab.soft`): a consistent new block
         is kept with probability ``min(1, exp(-(E(M') - E(M)) / T))``; ``T`` starts at
         ``temperature`` and is multiplied by ``cooling`` after each sweep.
+    exact : {"none", "sat", "backtrack"}
+        Exact block completion: a block whose Alg. 3.1 runs all fail is solved by this
+        exact solver on the block's subproblem (its border fixed); when that proves the
+        block has no labels fitting its border, it keeps its labels as before. Runs the
+        thesis' sweep in Python (``workers=0``).
 
     Returns
     -------
@@ -297,17 +303,19 @@ def run_blocks(
     soft = _Soft(energy, float(temperature), float(cooling)) if energy is not None else None
     plan = _Plan(retries, sweeps, order, choice, deadline)
     if workers >= 1:
-        if choice == "resemblance" or soft is not None:
+        if choice == "resemblance" or soft is not None or exact != "none":
             raise InputError(
-                "choice='resemblance' and energy= run in the thesis' sweep (workers=0)"
+                "choice='resemblance', energy= and exact= run in the thesis' sweep (workers=0)"
             )
         status, tried, accepted, retry_count, revisions = _run_waves(
             problem, grid, boxes, counts, None if m == (0,) else m, rng, plan,
             workers=workers, scheduler=scheduler,
         )  # fmt: skip
     else:
+        completion = _Exact(exact) if exact != "none" else None
         status, tried, accepted, retry_count, revisions = _run_sweep(
             problem, grid, boxes, None if m == (0,) else m, rng, plan, window=window, soft=soft,
+            completion=completion,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -331,6 +339,11 @@ def run_blocks(
                      temperature=soft.T0, cooling=soft.cooling)  # fmt: skip
     if repair is not None:
         stats["breaches"] = repair(out)
+    if exact != "none":
+        stats["exact"] = exact
+        if workers == 0 and completion is not None:
+            stats["exact_blocks"] = completion.solved
+            stats["exact_refuted"] = completion.refuted
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return status, out, stats
@@ -349,6 +362,36 @@ class _Plan(NamedTuple):
     order: str
     choice: str
     deadline: float | None
+
+
+class _Exact:
+    """Exact block completion: an exact solver on a block's subproblem (its border fixed),
+    seeded by one number drawn from the sweep's generator (deterministic for a seed)."""
+
+    def __init__(self, solver: str) -> None:
+        self.solver = solver
+        self.solved = 0  # blocks completed exactly
+        self.refuted = 0  # blocks proved to have no labels fitting their border
+
+    def __call__(
+        self, sub: Problem, rng: np.random.Generator, left: float | None
+    ) -> tuple[NDArray[np.int32] | None, bool]:
+        """The block's new labels (flat) or ``None``, and whether the time ran out."""
+        from csplab.solvers import solver_class
+
+        if left is not None and left <= 0:
+            return None, True
+        seed = int(rng.integers(2**62))
+        opts: dict[str, Any] = {} if left is None else {"time_limit": left}
+        r = solver_class(self.solver)().solve(
+            sub, rng=np.random.default_rng(seed), seed=seed, **opts
+        )
+        if r.status == "solved" and sub.is_solution(r.grid):
+            self.solved += 1
+            return np.asarray(r.grid, dtype=np.int32).reshape(-1), False
+        if r.status == "unsat":
+            self.refuted += 1
+        return None, r.status == "timeout"
 
 
 class _Soft:
@@ -395,6 +438,7 @@ def _run_sweep(
     *,
     window: int = 1,
     soft: _Soft | None = None,
+    completion: _Exact | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
     ``grid`` (flat) in place. A step solves one block (``block_step``: Alg. 3.1 on its
@@ -418,14 +462,21 @@ def _run_sweep(
         o = wv.solve_block(sub, rng, 0, retries=retries, order=order, choice=choice,
                            deadline=deadline, window=window, context=ctx)  # fmt: skip
         counters[:] += (1, 0, o.retries, o.revisions)
-        if o.labels is not None and (soft is None or soft.accept(grid, cells, o.labels, rng)):
-            grid[cells] = o.labels
+        labels = o.labels
+        if labels is None and o.status != "timeout" and completion is not None:
+            # every Alg. 3.1 run failed: complete the block exactly
+            left = None if deadline is None else deadline - time.perf_counter()
+            labels, timed_out = completion(sub, rng, left)
+            if timed_out:
+                return False
+        if labels is not None and (soft is None or soft.accept(grid, cells, labels, rng)):
+            grid[cells] = labels
             counters[1] += 1
         return o.status != "timeout"
 
     step: Callable[[int], bool] = block_step
     units = range(len(boxes))
-    if _compiled_sweep_applies(boxes, m, order, choice, soft):
+    if completion is None and _compiled_sweep_applies(boxes, m, order, choice, soft):
         assert m is not None
         step = _chunk_step(problem, grid, boxes, m, rng, retries, order, choice, counters)
         units = range(0, len(boxes), _SWEEP_CHUNK)
@@ -737,7 +788,9 @@ class BlocksSolver(Solver):
         "starts from a trivial solution (empty space, or ground under empty space) or `init=`; "
         "`block=10`, `retries=20`; the output is always consistent; global constraints: a "
         "block that breaks them more is rejected, so `sweeps` repair the model (`failed` "
-        "if one is still broken); soft constraints by Metropolis (`energy=`)"
+        "if one is still broken); soft constraints by Metropolis (`energy=`); "
+        '`exact="sat"` completes a block whose retries all fail exactly, its border fixed '
+        "(how the default chain finishes a model too large for SAT)"
     )
     options = (
         Option("block", object, 10, "block size per axis (an int or one per axis, e.g. 10x10x4)",
@@ -765,6 +818,9 @@ class BlocksSolver(Solver):
                convert=_positive),
         Option("cooling", float, 1.0, "T is multiplied by this after each sweep (0 < c <= 1)",
                convert=_positive),
+        Option("exact", str, "none", "exact block completion: a block whose retries all fail "
+               "is solved by sat or backtrack with its border fixed (none: Alg. 3.4's restore)",
+               values=("none", "sat", "backtrack")),
     )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:

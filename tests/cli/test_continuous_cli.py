@@ -82,9 +82,20 @@ def test_file_example_spacing_and_boundary(
 
 
 def test_a_failed_run_hints_at_blocks(capsys: pytest.CaptureFixture[str]) -> None:
-    code, _, err = run(capsys, "synthesize", "fallible", "--size", "40x40", "--seed", "1",
-                       "--restarts", "0")  # fmt: skip
+    code, out, err = run(capsys, "synthesize", "fallible", "--size", "40x40", "--seed", "1",
+                         "--restarts", "0", "--fallback", "none")  # fmt: skip
     assert code == 1 and "--solver blocks" in err
+    assert out.startswith("not solved:") and "says nothing about satisfiability" in out
+
+
+def test_the_default_chain_finishes_a_failed_continuous_run(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code, out, _ = run(capsys, "synthesize", "fallible", "--size", "40x40", "--seed", "1",
+                       "--restarts", "0", "--json")  # fmt: skip
+    d = json.loads(out)
+    assert code == 0 and d["outcome"] == "solved" and d["violations"] == 0
+    assert d["solver"] == "sat" and d["stats"]["fallback_from"] == "catalog"
 
 
 @pytest.mark.parametrize(

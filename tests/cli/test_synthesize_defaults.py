@@ -21,9 +21,10 @@ def _run(capsys, *argv):
 
 
 def test_restarts_turn_a_failed_first_run_into_a_result(capsys):
-    code, out, _ = _run(capsys, *FALLIBLE, "--restarts", "0", "--json")
+    code, out, _ = _run(capsys, *FALLIBLE, "--restarts", "0", "--fallback", "none", "--json")
     d = json.loads(out)
     assert code == 1 and d["status"] == "failed" and d["settings"]["restarts"] == 0
+    assert d["outcome"] == "not solved" and d["proof"] is None
     code, out, _ = _run(capsys, *FALLIBLE, "--json")  # default: 10 restarts
     d = json.loads(out)
     assert code == 0 and d["status"] == "solved" and d["settings"]["restarts"] == 10
@@ -72,13 +73,49 @@ def test_a_files_own_heuristic_wins():
 
 def test_failed_runs_write_nothing_unless_asked(capsys, tmp_path):
     out = tmp_path / "g.npy"
-    code, _, err = _run(capsys, *FALLIBLE, "--restarts", "0", "--out", out)
+    alone = ("--restarts", "0", "--fallback", "none")  # the incomplete solver's run alone
+    code, stdout, err = _run(capsys, *FALLIBLE, *alone, "--out", out)
     assert code == 1 and not out.exists() and "--out-partial" in err
-    code, stdout, _ = _run(capsys, *FALLIBLE, "--restarts", "0", "--out", out, "--out-partial")
+    assert stdout.startswith("not solved:") and "not solved" in err and "unsat" not in err
+    code, stdout, _ = _run(capsys, *FALLIBLE, *alone, "--out", out, "--out-partial")
     g = np.load(out)
     assert code == 1 and (g < 0).any() and "partial" in stdout
     code, _, err = _run(capsys, *FALLIBLE, "--out", tmp_path / "g.txt", "--out-partial")
     assert code == 2 and "cannot hold unassigned cells" in err and not (tmp_path / "g.txt").exists()
+
+
+def test_the_default_chain_solves_what_the_incomplete_solver_gave_up_on(capsys, tmp_path):
+    out = tmp_path / "g.npy"
+    code, stdout, _ = _run(capsys, *FALLIBLE, "--restarts", "0", "--out", out)
+    assert code == 0 and out.exists() and stdout.startswith("solved:")
+    assert "catalog gave up after 1 attempt" in stdout and "fallback=sat (auto)" in stdout
+    code, stdout, _ = _run(capsys, *FALLIBLE, "--restarts", "0", "--json")
+    d = json.loads(stdout)
+    assert d["solver"] == "sat" and d["stats"]["fallback_from"] == "catalog"
+    # the fallback alone, from the recorded seed: the same grid
+    seed = d["stats"]["attempt_seed"]
+    code2, _, _ = _run(capsys, "synthesize", "fig3_5a", "--size", "8x8", "--solver", "sat",
+                       "--seed", seed, "--out", tmp_path / "h.npy")  # fmt: skip
+    assert code2 == 0 and (np.load(out) == np.load(tmp_path / "h.npy")).all()
+
+
+def test_unsat_says_so_with_the_proof_and_not_solved_says_it_decides_nothing(capsys, tmp_path):
+    odd = ["synthesize", "fig3_1b", "--size", "5x5", "--periodic", "--seed", "1"]
+    code, stdout, err = _run(capsys, *odd, "--out", tmp_path / "g.npy")
+    assert code == 1 and stdout.startswith("unsat:") and "  proof: refutation by" in stdout
+    assert "no solution exists" in err and not (tmp_path / "g.npy").exists()
+    code, stdout, _ = _run(capsys, *odd, "--json")
+    d = json.loads(stdout)
+    assert (d["status"], d["outcome"], d["solver"]) == ("unsat", "unsat", "sat")
+    assert d["proof"].startswith("refutation by")
+    code, stdout, _ = _run(capsys, *odd, "--fallback", "backtrack", "--json")
+    d = json.loads(stdout)
+    assert code == 1 and d["outcome"] == "unsat" and d["proof"].startswith("search tree exhausted")
+    code, stdout, _ = _run(capsys, *odd, "--fallback", "none")
+    assert code == 1 and stdout.startswith("not solved:") and "proof" not in stdout
+    code, stdout, _ = _run(capsys, *odd, "--fallback", "none", "--json")
+    d = json.loads(stdout)
+    assert (d["status"], d["outcome"], d["proof"]) == ("failed", "not solved", None)
 
 
 def test_an_unwritable_output_is_refused_before_the_work(capsys, tmp_path):
