@@ -66,7 +66,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=10,
         help="run an incomplete solver again, with a fresh derived seed, up to N times while "
         "it fails (default 10, as WaveFunctionCollapse per output; Merrell's code retries "
-        "20 times per block; 0: one run, as the thesis' experiments)",
+        "20 times per block; 0: one run, as the thesis' experiments); then --fallback",
     )
     from csplab.solvers.chain import FALLBACKS
 
