@@ -66,7 +66,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=10,
         help="run an incomplete solver again, with a fresh derived seed, up to N times while "
         "it fails (default 10, as WaveFunctionCollapse per output; Merrell's code retries "
-        "20 times per block; 0: one run, as the thesis' experiments)",
+        "20 times per block; 0: one run, as the thesis' experiments); then --fallback",
     )
     from csplab.solvers.chain import FALLBACKS
 
@@ -218,7 +218,9 @@ def explain(result: Any) -> list[str]:
         n = st.get("attempts", 1)
         lines.append(
             f"  {st['fallback_from']} gave up after {n} attempt{'s' * (n != 1)} "
-            f"({st.get('gave_up_s', 0.0):.3f} s); {result.solver} took over"
+            f"({st.get('gave_up_s', 0.0):.3f} s"
+            + (f": {st['reason']}" if result.status != "failed" and st.get("reason") else "")
+            + f"); {result.solver} took over"
             + (" (too large for SAT: modify in blocks, exact block completion)"
                if result.solver == "blocks" and st["fallback_from"] != "blocks" else "")
         )  # fmt: skip

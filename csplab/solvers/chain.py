@@ -144,6 +144,8 @@ def finish(
             res.status = "failed"
             res.stats["broken"] = list(broken)
     res.solver = target
+    if "reason" in gave_up.stats:  # why the incomplete solver gave up without a run
+        res.stats["reason"] = gave_up.stats["reason"]
     res.stats.update(
         fallback=target, fallback_from=name, attempts=attempts, gave_up_s=spent,
         attempt_seed=seed,

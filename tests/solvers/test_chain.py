@@ -58,6 +58,7 @@ def test_blocks_without_a_starting_model_falls_back_or_raises() -> None:
         solve(ODD, "blocks", rng=1)
     r = solve(ODD, "blocks", rng=1, fallback="auto")
     assert r.status == "unsat" and r.stats["fallback_from"] == "blocks"
+    assert r.stats["reason"].startswith("modify-in-blocks needs a consistent starting model")
 
 
 def test_no_time_left_is_a_timeout_not_a_verdict() -> None:
