@@ -166,8 +166,17 @@ def _option_info(o: Option) -> dict[str, Any]:
 
 
 def available_solvers() -> list[dict[str, Any]]:
-    """Per solver: name, description, completeness, options, dependencies and whether they
-    are installed (and its backends when they are)."""
+    """What every registered solver declares, and whether it can run here.
+
+    Returns
+    -------
+    list of dict
+        One dict per registered solver, in registry order: ``name``, ``description``,
+        ``complete``, ``constraints``, ``requires``, ``extra``, ``installed`` and
+        ``options`` (name, type, default, doc, and values or minimum where declared),
+        plus ``backends`` when the solver has backends and is installed. A solver whose
+        module cannot be imported is ``{"name", "installed": False, "error"}``.
+    """
     out = []
     for name in solver_names():
         try:
