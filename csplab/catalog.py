@@ -557,6 +557,7 @@ def propagate(
     Parameters
     ----------
     problem : Problem
+        The problem whose arcs are propagated.
     catalog : bool array ``(n, K)`` or ``(*shape, K)``
         Not modified.
     changed : array of cell indices, optional
@@ -569,6 +570,11 @@ def propagate(
         The largest arc-consistent catalog inside the given one.
     ok : bool
         ``False`` if some cell lost every label (a wipe-out); the catalog is then partial.
+
+    Raises
+    ------
+    InputError
+        When ``catalog`` has neither shape ``(n, K)`` nor ``(*shape, K)``.
     """
     eng = Propagator(problem, domains=catalog, propagate_initial=False)
     eng.propagate(changed)
@@ -594,6 +600,28 @@ def propagate_reference(
     """Slow, literal Alg. 3.2/3.3 (a stack of cells, statement 3.6 per neighbour).
 
     Same contract as :func:`propagate`; used to test the compiled kernel.
+
+    Parameters
+    ----------
+    problem : Problem
+        The problem whose arcs are propagated.
+    catalog : bool array ``(n, K)`` or ``(*shape, K)``
+        Not modified.
+    changed : array of cell indices, optional
+        Cells whose entries were removed since the catalog was last consistent (default:
+        all cells). Propagation starts from these.
+
+    Returns
+    -------
+    catalog : bool array ``(n, K)``
+        The largest arc-consistent catalog inside the given one.
+    ok : bool
+        ``False`` if some cell lost every label (a wipe-out); the catalog is then partial.
+
+    Raises
+    ------
+    InputError
+        When ``catalog`` has neither shape ``(n, K)`` nor ``(*shape, K)``.
     """
     C = _check_catalog(problem, catalog).copy()
     adj = reference_adjacency(problem)

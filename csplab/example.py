@@ -127,6 +127,12 @@ class ExampleModel:
         Merrell-format file, so it can be written back).
     num_labels : int, optional
         Force ``K`` larger than ``max label + 1`` (labels that never occur).
+
+    Raises
+    ------
+    InputError
+        When the labels are not integers, negative, too large, empty, or not 1 to 4
+        dimensional, or ``names``, ``weights`` or ``num_labels`` do not fit ``K``.
     """
 
     labels: NDArray[np.int32]
@@ -202,18 +208,32 @@ class ExampleModel:
 
     @property
     def ndim(self) -> int:
+        """Number of dimensions of the label grid (1 to 4)."""
         return int(self.labels.ndim)
 
     @property
     def shape(self) -> tuple[int, ...]:
+        """Shape of the label grid."""
         return tuple(int(s) for s in self.labels.shape)
 
     def counts(self) -> NDArray[np.int64]:
-        """How often each label occurs in the example, shape ``(K,)``."""
+        """How often each label occurs in the example.
+
+        Returns
+        -------
+        ndarray of int64, shape ``(K,)``
+            The number of cells with each label.
+        """
         return np.bincount(self.labels.ravel(), minlength=self.K).astype(np.int64)
 
     def label_weights(self) -> NDArray[np.float64]:
-        """Per-label weights: the given ``weights`` or else the label frequencies."""
+        """Per-label weights: the given ``weights`` or else the label frequencies.
+
+        Returns
+        -------
+        ndarray of float64, shape ``(K,)``
+            A fresh array of the weights.
+        """
         if self.weights is not None:
             return np.array(self.weights, dtype=np.float64)
         return self.counts().astype(np.float64)
@@ -225,11 +245,23 @@ class ExampleModel:
         return str(self.meta.get("topology", "square"))
 
     def transitions(self) -> NDArray[np.bool_]:
-        """Transition matrices ``T[d, b, c]`` of Eq. 3.2, shape ``(ndim, K, K)``.
+        """Transition matrices ``T[d, b, c]`` of Eq. 3.2.
 
         Only for examples on square grids (and cylinders, affine grids): a hexagonal or
         triangular example has other relations (:meth:`csplab.topology.Topology.learn`),
-        and a tool that reads axis transitions refuses it with one line."""
+        and a tool that reads axis transitions refuses it with one line.
+
+        Returns
+        -------
+        ndarray of bool, shape ``(ndim, K, K)``
+            ``T[d, b, c]``: some cell labelled ``b`` has a ``+1`` neighbour along axis ``d``
+            labelled ``c``.
+
+        Raises
+        ------
+        InputError
+            When the example is on a hexagonal or triangular grid.
+        """
         if self.topology.startswith(("hex", "tri")):
             raise InputError(
                 f"{self.name or 'the example'} is on a {self.topology} grid: this tool works "
@@ -238,19 +270,49 @@ class ExampleModel:
         return pair_transitions(self.labels, self.K)
 
     def file_labels(self, grid: ArrayLike | None = None) -> NDArray[np.int64]:
-        """``grid`` (default: the example's labels) with the file's label ids: the inverse
-        of the compaction of sparse ids (``meta["label_ids"]``); ``-1`` stays ``-1``."""
+        """A label grid with the file's label ids: the inverse of the compaction of sparse ids.
+
+        Parameters
+        ----------
+        grid : array_like of int, optional
+            Labels in this model's ids (default: the example's own labels); ``-1`` stays
+            ``-1``.
+
+        Returns
+        -------
+        ndarray of int64
+            ``grid`` mapped through ``meta["label_ids"]``, or ``grid`` itself when the
+            example was not compacted.
+        """
         g = self.labels if grid is None else grid
         return file_labels(g, self.meta)
 
     def label_name(self, b: int) -> str:
-        """Name of label ``b`` (its number when the example has no names)."""
+        """Name of label ``b``.
+
+        Parameters
+        ----------
+        b : int
+            A label index.
+
+        Returns
+        -------
+        str
+            The label's name, or its number when the example has no name for it.
+        """
         if self.names is not None and 0 <= b < len(self.names):
             return self.names[b]
         return str(b)
 
     def hash(self) -> str:
-        """A stable content hash (labels, K, names, weights) for result stores."""
+        """A stable content hash (labels, K, names, weights) for result stores.
+
+        Returns
+        -------
+        str
+            The first 16 hex digits of a SHA-256 over shape, ``K``, labels, names, weights
+            and the file's label ids.
+        """
         import hashlib
 
         h = hashlib.sha256()

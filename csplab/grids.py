@@ -214,9 +214,13 @@ def from_example(
     ``topology`` (:mod:`csplab.topology`) reads the example and builds the output on that
     grid (default: the example's own, ``example.meta["topology"]``, else square).
 
+    Labels that never occur in the example are excluded from every cell (a model
+    consistent with E only uses pieces of E, even in a cell without neighbours).
+
     Parameters
     ----------
     example : ExampleModel
+        The example model ``E`` whose adjacent label pairs define the relations.
     shape : sequence of int or str
         Output size, e.g. ``(40, 40, 10)`` or ``"40x40x10"``. It may omit trailing axes
         along which the example has extent 1 (a 2D size for an ``nz = 1`` model).
@@ -243,9 +247,30 @@ def from_example(
         was used.
     mask : bool array ``(*shape, K)`` (or broadcastable)
         Per-cell allowed labels (large-scale constraints, Sec. 3.5.3).
+    topology : str, optional
+        The grid to read the example on and build the output on: ``"square"``,
+        ``"hex:odd-r"`` (and the other hexagonal layouts), ``"tri"``, ``"cylinder"`` or
+        ``"affine:A,B,C,D"`` (default: the example's ``meta["topology"]``, else square).
+        An explicit square topology reads any example along its axes.
 
-    Labels that never occur in the example are excluded from every cell (a model
-    consistent with E only uses pieces of E, even in a cell without neighbours).
+    Returns
+    -------
+    Problem
+        The problem: one relation per axis (or per topology direction) with its arcs, the
+        restricted domains (each ``fixed``/``boundary``/``mask`` restriction recorded in
+        ``problem.unary``), the example's label weights and names, and ``meta`` with the
+        example, its hash and (for ``boundary="auto"``) ``"boundary_rule"``.
+
+    Raises
+    ------
+    InputError
+        When ``shape`` cannot be parsed or does not fit the example's dimensions,
+        ``boundary`` is an unknown string, ``topology`` is unknown, a hexagonal or
+        triangular example gets a size of other dimensions, a hexagonal or triangular
+        output is periodic, or ``fixed``, ``boundary`` or ``mask`` do not fit the output.
+    MemoryLimitError
+        When the problem would not fit in the available memory (one line with the
+        estimate, before anything large is allocated).
     """
     shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
     shp = _match_ndim(shp, example.shape)

@@ -96,6 +96,20 @@ class Violations:
     unassigned (negative), out of range or not in the cell's domain; ``constraints`` holds
     one line per broken constraint of ``problem.constraints`` (checked on complete grids).
     ``len()`` is the total.
+
+    Parameters
+    ----------
+    arcs : ndarray of int64
+        Indices into ``problem.arcs`` of the violated arcs.
+    cells : ndarray of int64
+        Flat indices of the cells whose label is unassigned, out of range or outside their
+        domain.
+    problem : Problem
+        The checked problem (for naming cells, labels and relations in :meth:`describe`).
+    grid : ndarray of int64
+        The checked labelling, flattened.
+    constraints : tuple of str, optional
+        One message per broken global constraint.
     """
 
     arcs: NDArray[np.int64]
@@ -111,7 +125,19 @@ class Violations:
         return len(self) > 0
 
     def describe(self, limit: int = 10) -> str:
-        """Human-readable list of the first ``limit`` violations."""
+        """Human-readable list of the first ``limit`` violations.
+
+        Parameters
+        ----------
+        limit : int, optional
+            At most this many out-of-domain cells and this many violated arcs are listed
+            (after a one-line summary with the totals and every broken constraint).
+
+        Returns
+        -------
+        str
+            The summary line followed by one indented line per listed violation.
+        """
         P, lab = self.problem, self.grid
         lines = [f"{self.arcs.size} violated arcs, {self.cells.size} cells outside their domain"]
         if self.constraints:
@@ -140,6 +166,7 @@ class Problem:
     domains : array_like of bool, shape ``(n, K)`` or ``(*shape, K)``
         Allowed labels per cell (after all unary restrictions).
     relations : array_like of bool, shape ``(R, K, K)``
+        The allowed label pairs of each relation (``R[a, b]``: ``b`` may follow ``a``).
     arcs : array_like of int, shape ``(A, 3)``
         ``(src, dst, relation)``: ``relations[r, label[src], label[dst]]`` must hold.
     weights : array_like of float, optional
@@ -163,6 +190,14 @@ class Problem:
     constraints : sequence of Constraint, optional
         Global constraints beside the arcs (:mod:`csplab.constraints`: count, connected,
         mirror/rotate, separation, max-run), checked by :meth:`violations`.
+
+    Raises
+    ------
+    InputError
+        When the shape has a non-positive extent, or ``relations``, ``domains``, ``arcs``,
+        ``weights``, ``names``, ``relation_names`` or ``positions`` do not fit each other
+        (wrong shape, arc endpoints outside the grid, unknown relation ids, negative or
+        non-finite weights), or a global constraint does not fit the problem.
 
     Notes
     -----
@@ -268,6 +303,7 @@ class Problem:
 
     @property
     def ndim(self) -> int:
+        """Number of grid axes (``len(shape)``)."""
         return len(self.shape)
 
     @property
@@ -285,17 +321,56 @@ class Problem:
 
     # ------------------------------------------------------------------ naming helpers
     def coords(self, cell: int) -> tuple[int, ...]:
-        """Grid coordinates of a flat cell index."""
+        """Grid coordinates of a flat cell index.
+
+        Parameters
+        ----------
+        cell : int
+            A flat cell index ``0..n-1`` (C order over ``shape``).
+
+        Returns
+        -------
+        tuple of int
+            The cell's coordinates, one per axis.
+        """
         return tuple(int(i) for i in np.unravel_index(int(cell), self.shape))
 
     def cell(self, coords: Sequence[int]) -> int:
-        """Flat index of grid coordinates."""
+        """Flat index of grid coordinates.
+
+        Parameters
+        ----------
+        coords : sequence of int
+            One coordinate per axis.
+
+        Returns
+        -------
+        int
+            The flat cell index (C order over ``shape``).
+
+        Raises
+        ------
+        InputError
+            When ``coords`` lie outside the grid.
+        """
         try:
             return int(np.ravel_multi_index(tuple(int(c) for c in coords), self.shape))
         except ValueError:
             raise InputError(f"cell {tuple(coords)} is outside the grid {self.shape}") from None
 
     def label_name(self, b: int | None) -> str:
+        """Name of label ``b`` for messages.
+
+        Parameters
+        ----------
+        b : int or None
+            A label index; ``None`` stands for an unknown label.
+
+        Returns
+        -------
+        str
+            The label's name from ``names``, else its number; ``"?"`` for ``None``.
+        """
         if b is None:
             return "?"
         if self.names is not None and 0 <= b < len(self.names):
@@ -303,6 +378,18 @@ class Problem:
         return str(b)
 
     def relation_name(self, r: int) -> str:
+        """Name of relation ``r`` for messages.
+
+        Parameters
+        ----------
+        r : int
+            A relation index ``0..R-1``.
+
+        Returns
+        -------
+        str
+            The name from ``relation_names``, else ``"R<r>"``.
+        """
         if self.relation_names is not None:
             return self.relation_names[r]
         return f"R{r}"
@@ -320,7 +407,24 @@ class Problem:
         """Every violated arc and every cell whose label is not in its domain.
 
         Unassigned cells (negative labels) and labels outside ``0..K-1`` count as
-        out-of-domain cells; arcs touching them count as violated.
+        out-of-domain cells; arcs touching them count as violated. Global constraints are
+        checked only when every label is in range.
+
+        Parameters
+        ----------
+        grid : array_like of int
+            A labelling of shape ``shape`` or ``(n,)``.
+
+        Returns
+        -------
+        Violations
+            The violated arcs, out-of-domain cells and broken constraints (empty, and false,
+            for a solution).
+
+        Raises
+        ------
+        InputError
+            When ``grid`` has the wrong shape or does not hold integers.
         """
         lab = self._flat_grid(grid)
         K = self.K
@@ -341,7 +445,23 @@ class Problem:
         )
 
     def is_solution(self, grid: ArrayLike) -> bool:
-        """``True`` iff ``grid`` is complete and violates nothing."""
+        """Whether ``grid`` is a solution: complete, and violating nothing.
+
+        Parameters
+        ----------
+        grid : array_like of int
+            A labelling of shape ``shape`` or ``(n,)``.
+
+        Returns
+        -------
+        bool
+            ``True`` iff :meth:`violations` finds nothing.
+
+        Raises
+        ------
+        InputError
+            When ``grid`` has the wrong shape or does not hold integers.
+        """
         return len(self.violations(grid)) == 0
 
     # ------------------------------------------------------------------ derived data
@@ -355,7 +475,22 @@ class Problem:
         return out.reshape(self.shape)
 
     def neighbours(self, cell: int) -> Iterator[tuple[int, int, bool]]:
-        """Yield ``(other, relation, forward)`` for each arc touching ``cell``."""
+        """Yield ``(other, relation, forward)`` for each arc touching ``cell``.
+
+        Parameters
+        ----------
+        cell : int
+            A flat cell index.
+
+        Yields
+        ------
+        other : int
+            The cell at the arc's other end.
+        relation : int
+            The arc's relation index.
+        forward : bool
+            ``True`` if ``cell`` is the arc's source, ``False`` if it is its destination.
+        """
         a = self.arcs
         for i in np.flatnonzero(a[:, 0] == cell):
             yield int(a[i, 1]), int(a[i, 2]), True
@@ -366,8 +501,23 @@ class Problem:
     def restrict(
         self, allowed: ArrayLike, *, kind: UnaryKind = "domain", key: Any = None
     ) -> Problem:
-        """A copy with domains intersected with ``allowed`` (``(n, K)`` or ``(*shape, K)``),
-        recorded as one unary restriction."""
+        """A copy with domains intersected with ``allowed``, recorded as one unary restriction.
+
+        Parameters
+        ----------
+        allowed : array_like of bool
+            Allowed labels per cell, shape ``(n, K)`` or ``(*shape, K)`` or broadcastable
+            to ``(*shape, K)``.
+        kind : {"domain", "fixed", "boundary", "mask"}, optional
+            The kind of the recorded :class:`Unary`.
+        key : object, optional
+            What names the restriction in explanations (coordinates, a face ...).
+
+        Returns
+        -------
+        Problem
+            The restricted copy; ``self`` is unchanged.
+        """
         al = np.broadcast_to(np.asarray(allowed, dtype=bool), (*self.shape, self.K))
         al = al.reshape(self.n, self.K)
         cells = np.flatnonzero(~al.all(axis=1)).astype(np.int64)
@@ -387,33 +537,100 @@ class Problem:
         return Problem(**args)
 
     def with_constraints(self, extra: Sequence[Constraint]) -> Problem:
-        """A copy with more global constraints (:mod:`csplab.constraints`)."""
+        """A copy with more global constraints (:mod:`csplab.constraints`).
+
+        Parameters
+        ----------
+        extra : sequence of Constraint
+            Constraints added after the existing ones.
+
+        Returns
+        -------
+        Problem
+            The copy; ``self`` is unchanged.
+
+        Raises
+        ------
+        InputError
+            When a constraint does not fit the problem (its own validation).
+        """
         return self._replace(constraints=(*self.constraints, *extra))
 
     def without_constraints(self) -> Problem:
-        """A copy without global constraints (what the arcs and domains alone say)."""
+        """A copy without global constraints (what the arcs and domains alone say).
+
+        Returns
+        -------
+        Problem
+            The copy; ``self`` is unchanged.
+        """
         return self._replace(constraints=())
 
     def require_no_constraints(self, what: str) -> None:
-        """One :class:`InputError` line when ``what`` cannot take global constraints."""
+        """Refuse global constraints: for solvers and tools that cannot handle them.
+
+        Parameters
+        ----------
+        what : str
+            The refusing tool, named in the message (e.g. ``"counting"``).
+
+        Raises
+        ------
+        InputError
+            One line naming ``what`` and the constraint kinds, when the problem has any
+            global constraint.
+        """
         if self.constraints:
             kinds = ", ".join(sorted({c.kind for c in self.constraints}))
             raise InputError(f"{what} does not handle global constraints ({kinds}); drop them")
 
     def with_unary(self, extra: Sequence[Unary]) -> Problem:
-        """A copy with more unary restrictions (each remembered, for explanations)."""
+        """A copy with more unary restrictions (each remembered, for explanations).
+
+        Parameters
+        ----------
+        extra : sequence of Unary
+            The restrictions; each intersects the domains of its cells with its labels.
+
+        Returns
+        -------
+        Problem
+            The restricted copy; ``self`` is unchanged.
+        """
         dom = self.domains.copy()
         for u in extra:
             dom[u.cells] &= u.allowed
         return self._replace(domains=dom, unary=(*self.unary, *extra))
 
     def with_mask(self, mask: ArrayLike) -> Problem:
-        """A copy with per-cell allowed labels ``mask`` (bool ``(*shape, K)`` or
-        broadcastable), recorded as one ``mask`` restriction (Sec. 3.5.3)."""
+        """A copy with per-cell allowed labels, recorded as one ``mask`` restriction (Sec. 3.5.3).
+
+        Parameters
+        ----------
+        mask : array_like of bool
+            Allowed labels per cell, shape ``(*shape, K)`` or broadcastable to it.
+
+        Returns
+        -------
+        Problem
+            The masked copy; ``self`` is unchanged.
+        """
         return self.restrict(mask, kind="mask")
 
     def without_unary(self, keep: Sequence[int] = ()) -> Problem:
-        """A copy with only the unary restrictions whose indices are in ``keep``."""
+        """A copy with only the unary restrictions whose indices are in ``keep``.
+
+        Parameters
+        ----------
+        keep : sequence of int, optional
+            Indices into :attr:`unary` of the restrictions to keep (default: none, so the
+            domains become ``base_domains``).
+
+        Returns
+        -------
+        Problem
+            The copy; ``self`` is unchanged.
+        """
         kept = [self.unary[i] for i in keep]
         dom = self.base_domains.copy()
         for u in kept:
@@ -423,8 +640,30 @@ class Problem:
     def add_arcs(
         self, relation: ArrayLike, src: ArrayLike, dst: ArrayLike, name: str | None = None
     ) -> Problem:
-        """A copy with one more relation and arcs ``src[i] -> dst[i]`` carrying it
-        (symmetry pairs, diagonal or distance-2 neighbours ...)."""
+        """A copy with one more relation and arcs ``src[i] -> dst[i]`` carrying it.
+
+        For symmetry pairs, diagonal or distance-2 neighbours, and anything else binary.
+
+        Parameters
+        ----------
+        relation : array_like of bool, shape ``(K, K)``
+            The allowed label pairs of the new relation.
+        src, dst : array_like of int
+            Flat cell indices of the new arcs' sources and destinations (same length).
+        name : str, optional
+            The new relation's name (default ``"R<index>"`` when any relation is named).
+
+        Returns
+        -------
+        Problem
+            The copy; ``self`` is unchanged.
+
+        Raises
+        ------
+        InputError
+            When ``relation`` is not ``(K, K)``, ``src`` and ``dst`` differ in length, or an
+            endpoint is not a cell.
+        """
         R = np.asarray(relation, dtype=bool)
         if R.shape != (self.K, self.K):
             raise InputError(f"relation must have shape ({self.K}, {self.K}), got {R.shape}")
@@ -458,6 +697,28 @@ class Problem:
         outside cells are dropped. ``shape`` gives the sub-grid's shape (default: flat).
         ``arc_ids`` (sorted) may name a subset of the arcs that contains every arc touching
         ``cells`` (a speed-up for many small blocks; the result is the same).
+
+        Parameters
+        ----------
+        cells : array_like of int
+            Flat indices of the sub-problem's cells, in its cell order.
+        grid : array_like of int
+            Labels of the whole problem (shape ``shape`` or ``(n,)``); negative = unlabelled.
+        shape : sequence of int, optional
+            The sub-problem's grid shape (default ``(len(cells),)``).
+        arc_ids : array_like of int, optional
+            Sorted indices of a superset of the arcs touching ``cells``.
+
+        Returns
+        -------
+        Problem
+            The sub-problem, without unary records and global constraints; its ``meta``
+            has ``"subproblem_of"`` set to this problem's shape.
+
+        Raises
+        ------
+        InputError
+            When ``grid`` has the wrong shape or does not hold integers.
         """
         idx = np.asarray(cells, dtype=np.int64).ravel()
         g = np.asarray(grid)

@@ -48,7 +48,9 @@ def _jsonable(x: Any) -> Any:
 class Result:
     """Outcome of one solver run.
 
-    Attributes
+    The parameters are kept as attributes of the same names.
+
+    Parameters
     ----------
     status : {"solved", "failed", "unsat", "timeout"}
         ``solved``: ``grid`` is a solution (checked with :meth:`Problem.violations`).
@@ -66,6 +68,8 @@ class Result:
         Solver-specific, JSON-serialisable figures.
     trace : int array ``(steps, 2)`` or None
         ``(cell, label)`` per assignment for the catalog algorithms.
+    problem : Problem or None
+        The solved problem, for rendering (label names, model, periodicity, topology).
     """
 
     status: Status
@@ -79,10 +83,18 @@ class Result:
 
     @property
     def ok(self) -> bool:
+        """Whether the run solved the problem (``status == "solved"``)."""
         return self.status == "solved"
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-serialisable summary (without the grid)."""
+        """JSON-serialisable summary (without the grid).
+
+        Returns
+        -------
+        dict
+            ``status``, ``solver``, ``seed``, ``time_s`` (rounded to microseconds),
+            ``shape`` (the grid's) and ``stats`` (numpy values made plain).
+        """
         return {
             "status": self.status,
             "solver": self.solver,
@@ -93,6 +105,13 @@ class Result:
         }
 
     def to_json(self) -> str:
+        """The summary :meth:`to_dict` as a JSON string.
+
+        Returns
+        -------
+        str
+            One line of JSON.
+        """
         return json.dumps(self.to_dict())
 
     def __repr__(self) -> str:
@@ -116,7 +135,10 @@ class Result:
 class Verdict:
     """Outcome of an analysis tool.
 
-    Attributes
+    The parameters are kept as attributes of the same names; a verdict is true iff
+    ``holds`` is ``True``.
+
+    Parameters
     ----------
     holds : bool or None
         ``True``: the property was proven. ``False``: refuted (see ``witness``).
@@ -138,6 +160,14 @@ class Verdict:
         return bool(self.holds)
 
     def to_dict(self) -> dict[str, Any]:
+        """JSON-serialisable form of the verdict.
+
+        Returns
+        -------
+        dict
+            ``holds``, ``message``, ``stats`` and ``witness`` (plain data when the witness
+            is a dict, sequence or array, else its ``repr``).
+        """
         w = self.witness
         return {
             "holds": self.holds,

@@ -65,7 +65,13 @@ ALIASES: dict[str, str] = {
 
 
 def example_names() -> list[str]:
-    """Names of the built-in examples."""
+    """Names of the built-in grid examples.
+
+    Returns
+    -------
+    list of str
+        The names :func:`load_example` takes (without the aliases), in catalogue order.
+    """
     return list(EXAMPLES)
 
 
@@ -82,7 +88,23 @@ def example_info() -> list[tuple[str, str]]:
 
 
 def load_example(name: str) -> ExampleModel:
-    """Load a built-in example by name (or alias such as ``"E1"``)."""
+    """Load a built-in grid example by name.
+
+    Parameters
+    ----------
+    name : str
+        A name of :func:`example_names` or an alias such as ``"E1"`` or ``"checkerboard"``.
+
+    Returns
+    -------
+    ExampleModel
+        The example, named by its canonical name.
+
+    Raises
+    ------
+    InputError
+        When ``name`` is neither a built-in example nor an alias (the message lists them).
+    """
     key = ALIASES.get(name, name)
     if key not in EXAMPLES:
         raise InputError(f"unknown example {name!r}; built-in examples: {', '.join(EXAMPLES)}")

@@ -4,7 +4,7 @@ The examples reconstruct the small inputs of the thesis' Chapter 4 (continuous m
 synthesis). Each JSON file in ``csplab/examples/continuous/`` has the keys ``"name"``,
 ``"description"`` (which figure it stands for, what the text pins down and what was chosen)
 and ``"polygons"`` (the :class:`~csplab.continuous.model.PolygonModel` schema). The measured
-properties (Alg. 3.1 success rates) are checked by ``tests/test_continuous_examples.py``.
+properties (Alg. 3.1 success rates) are checked by ``tests/examples/test_continuous_examples.py``.
 
 Examples
 --------

@@ -7,7 +7,7 @@ Synthesis": Table 1, Fig. 1, 8-13). Each is a Wavefront OBJ file in
 (:mod:`csplab.examples.build_continuous3d`); its header comment says which figure it stands
 for, what the paper pins down and what was chosen. Every solid is an ``o`` group with
 ``usemtl label_N`` (its label). That each synthesizes with ``catalog``, ``blocks`` and
-``sat`` without violations is checked by ``tests/test_continuous3d_examples.py``; sizes and
+``sat`` without violations is checked by ``tests/examples/test_continuous3d_examples.py``; sizes and
 times against Table 1 are printed by ``benchmarks/bench_continuous3d.py``.
 
 Examples

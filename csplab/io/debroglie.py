@@ -71,7 +71,31 @@ def sniff(head: bytes) -> int:
 
 
 def read_debroglie(path: str | Path, *, strict: bool = False) -> RuleSet:
-    """Read a DeBroglie JSON config (see the module docstring)."""
+    """Read a DeBroglie JSON config (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file to read; a ``src`` sample is looked up next to it.
+    strict : bool, optional
+        Make unsupported constraints errors instead of warnings.
+
+    Returns
+    -------
+    RuleSet
+        The tiles with their adjacencies expanded over the symmetry group, weights, the
+        output size and periodicity, ``border``/``fixedTile`` constraints as domain
+        operations and the supported global constraints; unsupported parts are listed in
+        ``meta["warnings"]`` (each also a :class:`UserWarning` naming the file).
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid config (JSON errors, an
+        unsupported model type, unknown tiles, a malformed adjacency or constraint, and with
+        ``strict`` an unsupported constraint).
+    """
     p = Path(path)
     return parse_debroglie(read_bytes(p), path=p, strict=strict)
 

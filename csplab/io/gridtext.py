@@ -235,7 +235,27 @@ def sniff(head: bytes) -> int:
 
 
 def read_grid(path: str | Path) -> ExampleModel:
-    """Read a grid-format file."""
+    """Read a csplab grid-format file (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to read.
+
+    Returns
+    -------
+    ExampleModel
+        The labels indexed ``[x, y, ...]`` with the header's names, weights and topology,
+        named by the ``name:`` header or else the file's stem.
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid grid file (a duplicate or late
+        header, a token that is neither an integer nor a label name, ragged rows or slices, a
+        ``shape:`` that does not fit the data ...).
+    """
     p = Path(path)
     return parse_grid(read_text(p), path=p, name=p.stem)
 
@@ -297,8 +317,22 @@ def grid_safe_names(names: Sequence[str]) -> list[str]:
 
 
 def write_output(out: Output, path: Path) -> None:
-    """The grid (no unassigned cells) in the grid format; label names are made
-    :func:`grid_safe_names`."""
+    """The grid (no unassigned cells) in the grid format.
+
+    Label names are made :func:`grid_safe_names` (tokens of the format).
+
+    Parameters
+    ----------
+    out : Output
+        The grid to write, with its model's names, meta and weights.
+    path : Path
+        The file to write (overwritten).
+
+    Raises
+    ------
+    InputError
+        When the grid has unassigned (negative) cells.
+    """
     ex = out.to_example()
     if ex.names is not None:
         safe = grid_safe_names(ex.names)

@@ -76,7 +76,29 @@ def sniff(head: bytes) -> int:
 
 
 def read_markovjunior(path: str | Path) -> RuleSet:
-    """Read a MarkovJunior tileset XML file (see the module docstring)."""
+    """Read a MarkovJunior tileset XML file (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The XML file to read; the tiles' ``.vox`` files are looked up in a folder named
+        after it.
+
+    Returns
+    -------
+    RuleSet
+        One label per distinct tile orientation, the rules expanded over the cube's (or,
+        without ``fullSymmetry``, the square's) symmetry group, the weights and, when the
+        ``.vox`` files are there, the tiles' voxels; inferred symmetries are reported in
+        ``meta["warnings"]`` (each also a :class:`UserWarning` naming the file).
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid tileset (no ``<tiles>``, a
+        neighbour naming an unknown tile or turn, a bad attribute or ``.vox`` file ...).
+    """
     p = Path(path)
     return parse_markovjunior(read_bytes(p), path=p)
 

@@ -127,7 +127,26 @@ def parse_merrell(text: str, *, path: object = "<string>", name: str = "") -> Ex
 
 
 def read_merrell(path: str | Path) -> ExampleModel:
-    """Read a Merrell-format file."""
+    """Read a Merrell-format file (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to read.
+
+    Returns
+    -------
+    ExampleModel
+        The labels, shape ``(nx, ny, nz)``, named after the file's stem; ``meta`` keeps the
+        three header lines, the size line and the trailer, so it can be written back.
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid Merrell-format file (a size line
+        of three positive integers, then exactly ``nx*ny*nz`` non-negative integer labels).
+    """
     p = Path(path)
     return parse_merrell(read_text(p), path=p, name=p.stem)
 
@@ -172,6 +191,20 @@ def write_output(out: Output, path: Path) -> None:
     A result of an example read from Merrell's format (``out.model``) gets that example's
     trailing label -> object table verbatim, as Merrell's program writes it: his 3DS Max
     and Blender loaders read the labels up to it.
+
+    Parameters
+    ----------
+    out : Output
+        The grid to write, with its model's names, meta and the model whose trailer is kept.
+    path : Path
+        The file to write (overwritten).
+
+    Raises
+    ------
+    FormatError
+        When the grid has more than 3 dimensions.
+    InputError
+        When the grid has unassigned (negative) cells.
 
     Examples
     --------

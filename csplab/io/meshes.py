@@ -280,6 +280,21 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
         The ``.obj`` file (its ``.mtl`` is not needed).
     labels : {"auto", "materials", "groups", "components", "one"}
         What makes a label.
+
+    Returns
+    -------
+    PolyhedralModel
+        The solids (edge-connected shells with one label and group), named after the file.
+
+    Raises
+    ------
+    FormatError
+        Naming the file and line for syntax (a bad vertex, face or label comment, a
+        binary file, one larger than :data:`~csplab.io.common.MAX_FILE_BYTES`).
+    InputError
+        Naming the file for a bad ``labels`` value, and the file and the solid or face for
+        geometry (no faces; a zero-area face, an open, non-manifold or inconsistently wound
+        solid ...).
     """
     p = Path(path)
     if labels not in ("auto", "materials", "groups", "components", "one"):
@@ -366,8 +381,31 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
 
 # ---------------------------------------------------------------------------- OFF in
 def read_off(path: str | Path, labels: str = "one") -> PolyhedralModel:
-    """A polyhedral model from an OFF file (``OFF``, counts, vertices, ``k i1 ... ik``
-    faces; colours and comments ignored); ``labels`` is ``one`` or ``components``."""
+    """A polyhedral model from an OFF file.
+
+    ``OFF``, the counts, the vertices, then ``k i1 ... ik`` faces; colours and comments
+    are ignored. Every connected shell is a solid.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.off`` file.
+    labels : {"one", "components"}
+        One label for the file, or one per connected component (1, 2, ... in file order).
+
+    Returns
+    -------
+    PolyhedralModel
+        The solids, named after the file.
+
+    Raises
+    ------
+    FormatError
+        Naming the file and line for syntax (no ``OFF``, bad counts, vertices or faces).
+    InputError
+        Naming the file for a bad ``labels`` value, and the file and the solid or face for
+        geometry.
+    """
     p = Path(path)
     by = _labels_option(p, labels)
     rows: list[tuple[int, list[str]]] = []
@@ -430,9 +468,32 @@ _STL_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)", re.IGNORECASE)
 
 
 def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
-    """A polyhedral model from an STL file, ASCII or binary (triangles; coincident
-    vertices are merged, adjacent coplanar triangles make one polygon); ``labels`` is
-    ``one`` or ``components``."""
+    """A polyhedral model from an STL file, ASCII or binary.
+
+    Coincident vertices are merged and adjacent coplanar triangles make one polygon; every
+    connected shell is a solid.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.stl`` file.
+    labels : {"one", "components"}
+        One label for the file, or one per connected component (1, 2, ... in file order).
+
+    Returns
+    -------
+    PolyhedralModel
+        The solids, named after the file.
+
+    Raises
+    ------
+    FormatError
+        Naming the file for syntax (a bad vertex, not 3 vertices per facet, a truncated
+        binary file).
+    InputError
+        Naming the file for a bad ``labels`` value, no triangles, and the solid or face
+        for geometry.
+    """
     p = Path(path)
     by = _labels_option(p, labels)
     data = read_bytes(p)
@@ -481,8 +542,23 @@ def _colours(model: PolyhedralModel) -> dict[int, tuple[int, int, int]]:
 
 
 def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
-    """Write ``model`` as OBJ + MTL (the ``.mtl`` next to it, same stem; both atomic):
-    one ``o solid_I`` per solid with ``usemtl label_N`` and its polygons, exact numbers."""
+    """Write ``model`` as OBJ + MTL (the ``.mtl`` next to it, same stem; both atomic).
+
+    One ``o solid_I`` per solid with ``usemtl label_N`` and its polygons, exact numbers, so
+    the file reads back as the same model.
+
+    Parameters
+    ----------
+    model : PolyhedralModel
+        The solids to write.
+    path : str or Path
+        The ``.obj`` file; the ``.mtl`` with one material per label goes next to it.
+
+    Raises
+    ------
+    InputError
+        Naming the file when it cannot be written.
+    """
     p = Path(path)
     mtl = p.with_suffix(".mtl")
     cols = _colours(model)
@@ -507,9 +583,25 @@ def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
 
 # ---------------------------------------------------------------------------- PNG out
 def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -> None:
-    """A shaded view of ``model`` as a PNG (atomically; matplotlib, no display needed):
-    the solids in their label colours (those of :func:`write_obj_model`), lit from the
+    """A shaded view of ``model`` as a PNG (atomically; matplotlib, no display needed).
+
+    The solids in their label colours (those of :func:`write_obj_model`), lit from the
     viewer's upper left, equal aspect, ``size_px`` pixels square.
+
+    Parameters
+    ----------
+    model : PolyhedralModel
+        The solids to draw.
+    path : str or Path
+        The ``.png`` file (written to a temporary file in the same folder, then renamed).
+    size_px : int, optional
+        The picture's side in pixels, 16 to 8192.
+
+    Raises
+    ------
+    InputError
+        When ``size_px`` is not an integer from 16 to 8192, or naming the file when it
+        cannot be written.
 
     Examples
     --------

@@ -48,7 +48,24 @@ def load_int_array(path: str | Path) -> NDArray[np.integer[Any]]:
 
 
 def read_npy(path: str | Path) -> ExampleModel:
-    """An example model from an ``.npy`` int array (no pickles)."""
+    """An example model from an ``.npy`` int array (no pickles).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.npy`` file to read.
+
+    Returns
+    -------
+    ExampleModel
+        The array's labels (indexed ``[x, y, z]``), named after the file's stem.
+
+    Raises
+    ------
+    FormatError
+        Naming the file when it is not a readable ``.npy`` array, does not hold integers, or
+        is not a valid example (negative labels, more than 4 dimensions, empty ...).
+    """
     p = Path(path)
     arr = load_int_array(p)
     try:
@@ -58,6 +75,16 @@ def read_npy(path: str | Path) -> ExampleModel:
 
 
 def write_output(out: Output, path: Path) -> None:
-    """The grid as an int32 array (int64 when the file's label ids need it)."""
+    """The grid as an int32 array (int64 when the file's label ids need it).
+
+    Unassigned cells are written as ``-1``.
+
+    Parameters
+    ----------
+    out : Output
+        The grid to write, with its model's names, meta (its file's label ids are written).
+    path : Path
+        The file to write (overwritten).
+    """
     g = out.file_grid()
     np.save(path, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)

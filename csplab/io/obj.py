@@ -202,7 +202,23 @@ def write_obj(
 
 
 def write_output(out: Output, path: Path) -> None:
-    """The grid as a mesh (a rule set's voxel tiles composited, or its pieces placed)."""
+    """The grid as a Wavefront mesh (a rule set's voxel tiles composited, or its pieces placed).
+
+    A ``.mtl`` file with one material per label is written next to ``path``.
+
+    Parameters
+    ----------
+    out : Output
+        The grid to write, with its model (voxel tiles), names, colours, empty-space label and
+        pieces.
+    path : Path
+        The file to write (overwritten).
+
+    Raises
+    ------
+    InputError
+        When the grid is not 2D or 3D.
+    """
     out = out.tile_voxels()
     write_obj(
         out.grid, path, empty=out.empty, colors=out.colors, names=out.names, pieces=out.pieces

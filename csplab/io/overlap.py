@@ -295,8 +295,42 @@ class OverlapModel(RuleSet):
         periodic_input: bool = True,
         ground: bool | str = "false",
     ) -> OverlapModel:
-        """The overlapping model of a picture; colours are numbered in order of first
-        appearance (rows from the top), the picture's ``y`` axis is turned to point up."""
+        """The overlapping model of a picture (WaveFunctionCollapse's overlapping model).
+
+        Colours are numbered in order of first appearance (rows from the top); the
+        picture's ``y`` axis is turned to point up.
+
+        Parameters
+        ----------
+        path : str or Path
+            The sample picture (PNG), at most 256x256 pixels.
+        N : int, optional
+            The pattern width, 1 to 8.
+        symmetry : int, optional
+            1 to 8: how many of a pattern's 8 images (turns, mirrors) are added.
+        periodic_input : bool, optional
+            Whether the sample wraps around (patterns across its edges are read too).
+        ground : bool or str, optional
+            2D, symmetry 1 or 2: ``True``/``"true"`` is WaveFunctionCollapse's rule (its
+            ground pattern fills the bottom and nowhere else; periodic outputs),
+            ``"bottom"`` keeps the bottom row of cells to patterns of the sample's bottom
+            row, ``False``/``"false"`` adds no rule (see the module docstring).
+
+        Returns
+        -------
+        OverlapModel
+            One label per distinct pattern, with the patterns, their counts as weights, the
+            colours and the overlap relations; named after the file's stem.
+
+        Raises
+        ------
+        InputError
+            When ``ground`` is not one of the values above.
+        FormatError
+            Naming the file when it cannot be read as a picture, is larger than 256x256, or
+            the options do not fit it (``N`` or ``symmetry`` out of range, a pattern wider
+            than a non-periodic sample, ``ground`` with a 3D sample or symmetry above 2).
+        """
         p = Path(path)
         ground_rule(ground)  # a bad value is the option's error, not the file's
         img = load_image(p)

@@ -26,8 +26,18 @@ __all__ = ["write_output"]
 
 
 def write_output(out: Output, path: Path) -> None:
-    """A picture of the grid: the rule set's own (tile pictures, voxels, the overlapping
-    model's colours) or one colour per label."""
+    """A PNG picture of the grid.
+
+    The rule set's own picture (tile pictures, voxels, the overlapping model's colours) when
+    ``out.model`` is a rule set, else one colour per label (3D: an isometric view).
+
+    Parameters
+    ----------
+    out : Output
+        The grid to write, with its model's names, meta, colours and topology.
+    path : Path
+        The file to write (overwritten).
+    """
     from csplab.io.ruleset import RuleSet
 
     if isinstance(out.model, RuleSet):

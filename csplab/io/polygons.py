@@ -149,8 +149,28 @@ def _model(
 
 # ---------------------------------------------------------------------------- JSON
 def read_polygons_json(path: str | Path) -> PolygonModel:
-    """A polygon model from a JSON file (the schema of the module docstring); its name is
-    the file's stem unless the file has a ``"name"``.
+    """A polygon model from a JSON file (the schema of the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file to read.
+
+    Returns
+    -------
+    PolygonModel
+        The polygons with their labels and holes (extra keys kept); its name is the file's
+        stem unless the file has a ``"name"``.
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not valid JSON.
+    InputError
+        One line naming the file and the polygon when the data do not make a polygon model
+        (a missing key, a bad label, a ring of fewer than 3 distinct points, an invalid
+        polygon ...).
 
     Examples
     --------
@@ -186,8 +206,23 @@ def _pts(ring: Sequence[tuple[float, float]]) -> str:
 
 
 def write_polygons_json(model: PolygonModel, path: str | Path) -> None:
-    """Write ``model`` as JSON (atomically): top-level keys one per line, one polygon per
-    line, numbers exact (so the file reads back as the same model)."""
+    """Write ``model`` as JSON (atomically).
+
+    Top-level keys one per line, one polygon per line, numbers exact (so the file reads
+    back as the same model).
+
+    Parameters
+    ----------
+    model : PolygonModel
+        The polygons (may be empty).
+    path : str or Path
+        The ``.json`` file (written to a temporary file in the same folder, then renamed).
+
+    Raises
+    ------
+    InputError
+        Naming the file when it cannot be written.
+    """
     p = Path(path)
     d = model.to_json()
     lines = [f"  {json.dumps(k)}: {json.dumps(v)}," for k, v in d.items() if k != "polygons"]
@@ -469,6 +504,26 @@ def _walk(root: Node, path: Path) -> Iterator[tuple[Node, Matrix, str | None, st
 def read_svg(path: str | Path) -> PolygonModel:
     """A polygon model from the shapes of an SVG file (see the module docstring).
 
+    Parameters
+    ----------
+    path : str or Path
+        The ``.svg`` file to read.
+
+    Returns
+    -------
+    PolygonModel
+        One polygon per closed shape (holes by nesting), labelled by ``data-label`` or by
+        fill colour (the colours kept in ``meta["colors"]``), ``y`` pointing up.
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES`, is not XML or its root is not ``<svg>``.
+    InputError
+        One line naming the file and the element when a shape cannot be read (curves,
+        arcs, circles, a bad ``transform``, an invalid polygon ...).
+
     Examples
     --------
     >>> import tempfile, pathlib
@@ -649,8 +704,25 @@ def _escape(text: str) -> str:
 
 # ---------------------------------------------------------------------------- PNG out
 def write_png(model: PolygonModel, path: str | Path, *, size_px: int = 512) -> None:
-    """Draw ``model`` as a PNG (atomically): the longer side ``size_px`` pixels, equal
-    aspect, ``y`` up, the label colours of :func:`write_svg` on white, label 0 not drawn.
+    """Draw ``model`` as a PNG (atomically).
+
+    The longer side is ``size_px`` pixels, equal aspect, ``y`` up, the label colours of
+    :func:`write_svg` on white, label 0 not drawn.
+
+    Parameters
+    ----------
+    model : PolygonModel
+        The polygons to draw.
+    path : str or Path
+        The ``.png`` file (written to a temporary file in the same folder, then renamed).
+    size_px : int, optional
+        Pixels of the longer side, 8 to 16384.
+
+    Raises
+    ------
+    InputError
+        When ``size_px`` is not an integer from 8 to 16384, or naming the file when it
+        cannot be written.
 
     Examples
     --------

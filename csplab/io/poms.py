@@ -79,7 +79,32 @@ def sniff(head: bytes) -> int:
 
 
 def read_poms(path: str | Path, *, up: Literal["auto", "y", "z"] = "auto") -> RuleSet:
-    """Read a POMS JSON config (see the module docstring)."""
+    """Read a POMS JSON config (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The JSON file to read; a ``tileset`` image is looked up next to it.
+    up : {"auto", "y", "z"}, optional
+        For 3D configs: ``"y"`` reads them ``y``-up (POMS ``(x, y, z)`` becomes csplab's
+        ``(x, -z, y)``), ``"z"`` keeps the axes, ``"auto"`` is ``"y"`` when the config has
+        an ``objMap``.
+
+    Returns
+    -------
+    RuleSet
+        The tiles with their rules, weights and names, the default output size, the
+        boundary conditions and constraints as domain operations, and the pieces or tile
+        pictures; unsupported parts are listed in ``meta["warnings"]`` (each also a
+        :class:`UserWarning` naming the file).
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid POMS config (not a JSON object,
+        no rules, a rule, size, boundary condition or constraint of the wrong form ...).
+    """
     p = Path(path)
     return parse_poms(read_bytes(p), path=p, up=up)
 

@@ -53,7 +53,27 @@ def sniff(head: bytes) -> int:
 
 
 def read_tmx(path: str | Path) -> ExampleModel:
-    """Read a Tiled map (see the module docstring)."""
+    """Read a Tiled map (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.tmx`` file to read.
+
+    Returns
+    -------
+    ExampleModel
+        The first tile layer's compacted tile ids (``y`` up), named ``gid N`` (``empty`` for
+        0); a hexagonal map is on a hexagonal grid (``meta["topology"]``).
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a supported map (root ``<map>``,
+        orthogonal or hexagonal, finite, a tile layer with csv or base64 data of ``width * height``
+        ids).
+    """
     p = Path(path)
     return parse_tmx(read_bytes(p), path=p)
 

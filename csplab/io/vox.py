@@ -200,9 +200,28 @@ def read_vox(path: str | Path) -> VoxModel:
 
 
 def read_vox_example(path: str | Path) -> Any:
-    """A voxel model as an :class:`~csplab.example.ExampleModel`: label 0 is empty space,
-    labels ``1, 2, ...`` the colour indices in use (their palette colours are kept in
-    ``meta["colors"]``, ``meta["empty"]`` is 0 and the names are ``"c<index>"``)."""
+    """A voxel model as an :class:`~csplab.example.ExampleModel`.
+
+    Label 0 is empty space, labels ``1, 2, ...`` the colour indices in use.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.vox`` file to read (its first model).
+
+    Returns
+    -------
+    ExampleModel
+        The labels ``[x, y, z]`` (``z`` up) named ``"empty"`` and ``"c<index>"``, with
+        the palette colours in ``meta["colors"]`` and ``meta["empty"] = 0``.
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid MagicaVoxel file (no ``VOX``
+        magic, a damaged chunk, no model ...).
+    """
     from csplab.example import ExampleModel
 
     vox = read_vox(path)
@@ -224,7 +243,25 @@ def read_vox_example(path: str | Path) -> Any:
 
 
 def write_output(out: Output, path: Path) -> None:
-    """The grid as a voxel model (a rule set's voxel tiles composited when they fit)."""
+    """The grid as a MagicaVoxel model (a rule set's voxel tiles composited when they fit).
+
+    Label ``b`` is colour index ``b + 1``; unassigned and empty-space cells are left out.
+    When the composited tile voxels exceed 256 per axis, one voxel per cell is written
+    with a :class:`UserWarning`.
+
+    Parameters
+    ----------
+    out : Output
+        The grid to write, with its model (voxel tiles), colours and empty-space label.
+    path : Path
+        The file to write (overwritten).
+
+    Raises
+    ------
+    InputError
+        When the grid is not 2D or 3D, has more than 256 cells along an axis or more than
+        255 labels.
+    """
     vox = out.tile_voxels()
     if vox is not out and max(vox.grid.shape) > MAX_SIDE:
         import warnings

@@ -140,7 +140,31 @@ def sniff(head: bytes) -> int:
 
 
 def read_wfc(path: str | Path, *, subset: str | None = None, images: bool = True) -> RuleSet:
-    """Read a WaveFunctionCollapse simple-tiled XML tileset (see the module docstring)."""
+    """Read a WaveFunctionCollapse simple-tiled XML tileset (see the module docstring).
+
+    Parameters
+    ----------
+    path : str or Path
+        The XML file to read; tile images are looked up next to it.
+    subset : str, optional
+        Use only the tiles of this ``<subset>`` (default: every tile).
+    images : bool, optional
+        Read the tile pictures (for PNG output); ``False`` reads the rules alone.
+
+    Returns
+    -------
+    RuleSet
+        One label per tile orientation (``"name k"``), the ``+x`` rules expanded over the
+        square's symmetry group, the tiles' weights and pictures; ``meta["warnings"]``
+        lists what was skipped (each also a :class:`UserWarning` naming the file).
+
+    Raises
+    ------
+    FormatError
+        Naming the file (and the line, where there is one) when it cannot be read, is larger than
+        :data:`~csplab.io.common.MAX_FILE_BYTES` or is not a valid tileset (no ``<tiles>``, an
+        unknown symmetry, tile or subset, a neighbour naming an unknown tile, a bad attribute ...).
+    """
     p = Path(path)
     return parse_wfc(read_bytes(p), path=p, subset=subset, images=images)
 

@@ -166,8 +166,17 @@ def _option_info(o: Option) -> dict[str, Any]:
 
 
 def available_solvers() -> list[dict[str, Any]]:
-    """Per solver: name, description, completeness, options, dependencies and whether they
-    are installed (and its backends when they are)."""
+    """What every registered solver declares, and whether it can run here.
+
+    Returns
+    -------
+    list of dict
+        One dict per registered solver, in registry order: ``name``, ``description``,
+        ``complete``, ``constraints``, ``requires``, ``extra``, ``installed`` and
+        ``options`` (name, type, default, doc, and values or minimum where declared),
+        plus ``backends`` when the solver has backends and is installed. A solver whose
+        module cannot be imported is ``{"name", "installed": False, "error"}``.
+    """
     out = []
     for name in solver_names():
         try:
@@ -247,6 +256,7 @@ def solve(
     Parameters
     ----------
     problem : Problem
+        The problem to solve (:func:`csplab.from_example`, :mod:`csplab.grids`).
     solver : str
         ``"catalog"``, ``"blocks"``, ... or ``"name:backend"``.
     rng : int, numpy.random.Generator or None
@@ -274,6 +284,22 @@ def solve(
     -------
     Result
         A ``solved`` grid is always checked with :meth:`Problem.violations`.
+
+    Raises
+    ------
+    InputError
+        When ``problem`` is not a :class:`Problem`, ``restarts`` is not a non-negative
+        integer, ``fallback`` is unknown, or an option is unknown or invalid for the solver.
+    UnknownSolverError
+        When ``solver`` names no registered solver.
+    DependencyError
+        When the solver needs an optional package that is not installed (the message names
+        the pip extra).
+    NoTrivialSolutionError
+        When modify in blocks finds no consistent starting model and there is no
+        ``fallback``.
+    CsplabError
+        When a solver returns an unknown status or a grid that is not a solution (a bug).
 
     Examples
     --------

@@ -376,17 +376,59 @@ class Solver(ABC):
 
     @classmethod
     def option(cls, name: str) -> Option | None:
-        """The declaration of option ``name`` (``None`` if the solver has none)."""
+        """The declaration of option ``name``.
+
+        Parameters
+        ----------
+        name : str
+            An option name such as ``"order"`` or ``"time_limit"``.
+
+        Returns
+        -------
+        Option or None
+            The declaration, or ``None`` if the solver has no such option.
+        """
         return next((o for o in cls.options if o.name == name), None)
 
     @classmethod
     def takes(cls, name: str) -> bool:
-        """Whether the solver has option ``name``."""
+        """Whether the solver has option ``name``.
+
+        Parameters
+        ----------
+        name : str
+            An option name such as ``"order"`` or ``"time_limit"``.
+
+        Returns
+        -------
+        bool
+            ``True`` iff :attr:`options` declares it.
+        """
         return cls.option(name) is not None
 
     @classmethod
     def validate(cls, options: Mapping[str, Any], backend: str | None = None) -> dict[str, Any]:
-        """Every declared option, converted and checked, defaults filled in."""
+        """Every declared option, converted and checked, defaults filled in.
+
+        Parameters
+        ----------
+        options : mapping
+            Option values by name (strings from the command line are converted).
+        backend : str, optional
+            The backend of a ``name:backend`` solver spec, if any.
+
+        Returns
+        -------
+        dict
+            One entry per declared option, in declaration order.
+
+        Raises
+        ------
+        InputError
+            When a backend is given to a solver without backends, an option is unknown
+            (the message lists the known ones) or a value is invalid (the message names
+            the solver and the option).
+        """
         if backend is not None and cls.backends is None:
             raise InputError(f"solver {cls.name!r} has no backends (got {backend!r})")
         known = {o.name for o in cls.options}
@@ -410,14 +452,51 @@ class Solver(ABC):
         backend: str | None = None,
         **options: Any,
     ) -> Result:
-        """Validate ``options`` against the declaration, then :meth:`run`."""
+        """Validate ``options`` against the declaration, then :meth:`run`.
+
+        Parameters
+        ----------
+        problem : Problem
+            The problem to solve.
+        rng : numpy.random.Generator
+            The randomness of the run.
+        seed : int or None
+            The seed ``rng`` was made from, recorded in the result.
+        backend : str, optional
+            The backend of a ``name:backend`` solver spec, if any.
+        **options
+            The solver's declared options (:attr:`options`).
+
+        Returns
+        -------
+        Result
+            The solver's result (``solved``, ``failed``, ``unsat`` or ``timeout``).
+
+        Raises
+        ------
+        InputError
+            When an option or the backend is invalid (see :meth:`validate`).
+        """
         call = Call(rng, seed, backend, self.validate(options, backend))
         return self.run(problem, call)
 
     @abstractmethod
     def run(self, problem: Problem, call: Call) -> Result:
-        """Solve ``problem``; ``call`` holds the randomness, the backend, every declared
-        option, validated, and the deadline. Every exit returns :meth:`result`."""
+        """Solve ``problem``; every exit returns :meth:`result`.
+
+        Parameters
+        ----------
+        problem : Problem
+            The problem to solve.
+        call : Call
+            The randomness, the backend, every declared option (validated) and the
+            deadline.
+
+        Returns
+        -------
+        Result
+            The outcome, made by :meth:`result`.
+        """
 
     def result(
         self,
@@ -456,6 +535,12 @@ class Solver(ABC):
         Returns
         -------
         Result
+            The result of this solver, its time measured from ``call.t0``.
+
+        Raises
+        ------
+        CsplabError
+            When ``status`` is ``"unsat"`` without a proof (a bug of the solver).
         """
         if proof is not None:
             stats["proof"] = proof

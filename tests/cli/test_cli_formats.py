@@ -9,8 +9,7 @@ import pytest
 from csplab.cli import main
 from csplab.io.obj import read_obj
 from csplab.io.vox import read_vox
-
-from .io._helpers import DATA, anchor, installed_solvers
+from tests.io._helpers import DATA, anchor, installed_solvers
 
 
 def run(capsys, *argv):
