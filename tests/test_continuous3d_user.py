@@ -12,8 +12,9 @@ from pathlib import Path
 
 import pytest
 
+from csplab.continuous.check3d import user_violations3
 from csplab.continuous.synthesis import synthesize3
-from csplab.continuous.user3d import parse_user_constraints, read_user_constraints, user_violations3
+from csplab.continuous.user3d import parse_user_constraints, read_user_constraints
 from csplab.errors import InputError
 from tests._meshes import box as _box
 

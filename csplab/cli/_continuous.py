@@ -191,8 +191,8 @@ def check(args: argparse.Namespace, example: Any) -> int:
         cons = user_constraints(args, example)
         if cons is not None:
             from csplab.continuous.check import Violations
+            from csplab.continuous.check3d import user_violations3
             from csplab.continuous.space import Lattice3
-            from csplab.continuous.user3d import user_violations3
 
             lat = Lattice3.of_model(example)
             origin = [float(x) for x in lat.origin]

@@ -13,8 +13,9 @@ the two polygon sets only, independently of the arrangement and the CSP that pro
    polygon is left of its rings, every other side is label 0). Points on an edge between
    nodes look like the two rays of that edge; points off the boundaries like their label.
 3. Neighbourhoods are compared in reduced form (rays whose sides differ, each with the label
-   after it; see :func:`csplab.continuous.csp.reduce_signature`); a node or node-side of an
-   edge of ``M`` whose neighbourhood never occurs in ``E`` is a violation.
+   after it, :func:`reduced`; the checker's own, written apart from the CSP's states); a
+   node or node-side of an edge of ``M`` whose neighbourhood never occurs in ``E`` is a
+   violation.
 
 Coordinates are floats; two points are one node if they agree to ``1e-9`` of the models'
 extent. Polygons with the same label are merged first (touching same-label pieces are one
@@ -48,13 +49,34 @@ import numpy as np
 import shapely
 from shapely.geometry.polygon import orient
 
-from csplab.continuous.csp import Signature, reduce_signature
 from csplab.continuous.model import Polygon, PolygonModel
 
-__all__ = ["Defect", "Violations", "neighbourhoods", "violations"]
+__all__ = ["Defect", "Violations", "neighbourhoods", "reduced", "violations"]
+
+#: a reduced neighbourhood: ``(ray, label after it)`` pairs, or ``((-1, label),)``
+Signature = tuple[tuple[int, int], ...]
 
 ANGLE_TOL = 1e-7
 _FOREIGN = 1 << 20  # ray ids of directions the example does not have start here
+
+
+def reduced(rays: list[int], sectors: list[int]) -> Signature:
+    """The reduced form of a neighbourhood: the rays (in angular order) whose sector label
+    ``sectors[i]`` (counter-clockwise after ``rays[i]``) differs from the one before, each
+    with that label; a neighbourhood of one label everywhere is ``((-1, label),)``.
+
+    >>> reduced([0, 1, 2, 3], [1, 1, 0, 0])
+    ((0, 1), (2, 0))
+    >>> reduced([0, 2], [5, 5])
+    ((-1, 5),)
+    """
+    pairs = list(zip(rays, sectors, strict=True))
+    changes = tuple(
+        (int(r), int(b))
+        for (r, b), (_, prev) in zip(pairs, pairs[-1:] + pairs[:-1], strict=True)
+        if b != prev
+    )
+    return changes or ((-1, int(sectors[0]) if sectors else 0),)
 
 
 @dataclass(frozen=True)
@@ -250,14 +272,14 @@ def neighbourhoods(
             if len(cand) > 1:
                 defects.append(Defect("label", n.point, f"labels {sorted(cand)} overlap here"))
             sect.append(min(cand) if cand else 0)
-        vsig.setdefault(reduce_signature(rays, sect), n.point)
+        vsig.setdefault(reduced(rays, sect), n.point)
         for i, r in enumerate(rays):
             after, before = sect[i], sect[i - 1]
             if r >= _FOREIGN:
                 continue  # reported once per edge by violations()
             f = r % F
             L, R = (after, before) if r < F else (before, after)
-            esig.setdefault(reduce_signature([f, F + f], [L, R]), n.point)
+            esig.setdefault(reduced([f, F + f], [L, R]), n.point)
     return vsig, esig, defects
 
 

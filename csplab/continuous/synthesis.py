@@ -138,9 +138,8 @@ def synthesize3(
     """
     from dataclasses import replace
 
-    from csplab.continuous.check3d import violations3
+    from csplab.continuous.check3d import user_violations3, violations3
     from csplab.continuous.csp3d import ContinuousCSP3
-    from csplab.continuous.user3d import user_violations3
     from csplab.rng import make_rng
 
     t0 = time.perf_counter()
