@@ -8,6 +8,8 @@ import sys
 from typing import Any
 
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.continuous.user3d import UserConstraints3
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 
@@ -26,7 +28,9 @@ def region(args: argparse.Namespace, dim: int = 2) -> tuple[int, ...]:
     return tuple(shp)
 
 
-def boundary_label(args: argparse.Namespace, example: Any) -> Any:
+def boundary_label(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel
+) -> int | dict[str, int]:
     """``--boundary``: the label outside the region (default 0, empty space); for a
     polyhedral example also per face, e.g. ``z-=1`` (a ground below)."""
     b = args.boundary
@@ -66,11 +70,15 @@ def polygon_output(path: str | None, flag: str = "--out", gives: Any = "PolygonM
     return fmt
 
 
-def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> int:
+def synthesize(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel, opts: dict[str, Any]
+) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
+    from csplab.continuous.csp import ContinuousCSP
+    from csplab.continuous.csp3d import ContinuousCSP3
+    from csplab.continuous.synthesis import Synthesis, synthesize3
     from csplab.continuous.synthesis import synthesize as run2
-    from csplab.continuous.synthesis import synthesize3
     from csplab.solvers import solver_class
 
     dim = 2 if isinstance(example, PolygonModel) else 3
@@ -108,7 +116,8 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
             common["progress"] = True  # the cut loop's rounds, once it takes over 2 s
         if not cls.complete or cons.connected:
             common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
-    if dim == 2:
+    s: Synthesis[ContinuousCSP, PolygonModel] | Synthesis[ContinuousCSP3, PolyhedralModel]
+    if isinstance(example, PolygonModel):
         settings["lines"] = args.lines
         s = run2(example, size, lines=args.lines, **common, **opts)
     else:
@@ -121,20 +130,17 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     A = csp.arrangement
     spacing = float(csp.lattice.spacing)
     fams = int((~A.boundary_only).sum())
-    if s.model is None:
-        polys = None
-    elif dim == 2:
-        polys = len(s.model)
-    else:
-        polys = s.model.n_polygons
+    out = s.model
+    polys = None if out is None else out.n_polygons
+    n_solids = len(out.solids) if isinstance(out, PolyhedralModel) else None
     if args.json:
         d = r.to_dict()
         d.update(
             example=example.name, out=wrote, format="polygons" if dim == 2 else "polyhedra",
             settings=settings, size=list(size), spacing=spacing, vertices=A.n_vertices,
-            edges=A.n_edges, families=(A.dirs if dim == 2 else A.normals).tolist(),
+            edges=A.n_edges, families=A.family_vectors.tolist(),
             violations=len(s.violations), polygons=polys,
-            solids=len(s.model.solids) if dim == 3 and s.model is not None else None,
+            solids=n_solids,
             times={k: round(v, 6) for k, v in s.times.items()},
         )  # fmt: skip
         print(json.dumps(d))
@@ -151,8 +157,8 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         if keys:
             print("  " + ", ".join(f"{k}={r.stats[k]}" for k in keys))
         if s.model is not None:
-            made = f"{polys} polygons" if dim == 2 else (
-                f"{len(s.model.solids)} solids of {polys} polygons")  # fmt: skip
+            made = f"{polys} polygons" if n_solids is None else (
+                f"{n_solids} solids of {polys} polygons")  # fmt: skip
             on = "polygons" if dim == 2 else "solids"
             print(
                 f"  {made}, labels {list(s.model.labels)}; "
@@ -174,12 +180,11 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     return 0 if s.ok else 1
 
 
-def check(args: argparse.Namespace, example: Any) -> int:
+def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> int:
     """``csplab check EXAMPLE.json OUT.json`` (or ``EXAMPLE.obj OUT.obj``): violations of
     Eq. 4.1."""
     from csplab.cli.common import load_model
     from csplab.continuous.check import violations
-    from csplab.continuous.polyhedra import PolyhedralModel
 
     out = load_model(args.grid)
     if isinstance(example, PolyhedralModel):
@@ -219,7 +224,9 @@ def check(args: argparse.Namespace, example: Any) -> int:
     return 0 if len(v) == 0 else 1
 
 
-def user_constraints(args: argparse.Namespace, example: Any) -> Any:
+def user_constraints(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel
+) -> UserConstraints3 | None:
     """The ``--constraints`` files merged (:mod:`csplab.continuous.user3d`), or ``None``."""
     if not getattr(args, "constraints", None):
         return None
@@ -233,13 +240,13 @@ def user_constraints(args: argparse.Namespace, example: Any) -> Any:
     return out
 
 
-def cons_summary(c: Any) -> list[str]:
+def cons_summary(c: UserConstraints3) -> list[str]:
     """One phrase per kind of user constraint."""
     out = []
     if c.dimensional:
         out.append("dimensional " + " ".join(f"{b}:{list(n)}" for b, n in c.dimensional))
     if c.allowed:
-        out.append(f"large-scale {len(c.allowed)} label(s) in voxels {list(c.voxel)}")
+        out.append(f"large-scale {len(c.allowed)} label(s) in voxels {list(c.voxel or ())}")
     if c.connected:
         out.append(f"connected {list(c.connected)}")
     return out

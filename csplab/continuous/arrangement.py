@@ -308,6 +308,11 @@ class Arrangement:
 
     # ------------------------------------------------------------------ sizes
     @property
+    def family_vectors(self) -> NDArray[np.int64]:
+        """The vector naming each family: its edge direction (2D; a face normal in 3D)."""
+        return self.dirs
+
+    @property
     def n_vertices(self) -> int:
         return int(self.X.size)
 

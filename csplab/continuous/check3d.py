@@ -44,6 +44,7 @@ from numpy.typing import NDArray
 
 from csplab.continuous._geom import point_labels, points_on_segments
 from csplab.continuous.check import Defect, Violations
+from csplab.continuous.polyhedra import PolyhedralModel, Solid
 
 if TYPE_CHECKING:  # the constraints' data only: the checker reads them, as given
     from csplab.continuous.user3d import UserConstraints3
@@ -52,16 +53,16 @@ __all__ = ["cone_cells", "user_violations3", "violations3"]
 
 ANGLE_TOL = 1e-7
 # per model (immutable), its polygons' normals and points: computed once per check
-_POLYGON_ARRAYS: weakref.WeakKeyDictionary[Any, tuple[NDArray[np.float64], NDArray[np.float64]]] = (
-    weakref.WeakKeyDictionary()
-)
+_POLYGON_ARRAYS: weakref.WeakKeyDictionary[
+    PolyhedralModel | _Joined, tuple[NDArray[np.float64], NDArray[np.float64]]
+] = weakref.WeakKeyDictionary()
 
 
 class _Joined:
     """Solids of a model plus the frame of outside labels (no validation: the frame touches
     the model on the region's faces by construction)."""
 
-    def __init__(self, solids: list[Any], model: Any) -> None:
+    def __init__(self, solids: list[Solid], model: PolyhedralModel) -> None:
         self.solids = solids
         self.labels = tuple(sorted({int(s.label) for s in solids}))
         self.bounds = model.bounds if len(model.solids) else (0.0,) * 6
@@ -69,6 +70,10 @@ class _Joined:
     @property
     def n_polygons(self) -> int:
         return sum(len(s.polygons) for s in self.solids)
+
+
+#: what the checker reads: a model, or a model with the frame of outside labels
+Solids = PolyhedralModel | _Joined
 
 
 def cone_cells(normals: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
@@ -140,7 +145,7 @@ def cone_cells(normals: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[
     return keys, dirs
 
 
-def _polygon_arrays(model: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _polygon_arrays(model: Solids) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit normal and one point (a triangle's centre) of every polygon of every solid,
     ``(n, 3)`` each, from the triangles grouped by polygon (cached on the model)."""
     cached = _POLYGON_ARRAYS.get(model)
@@ -167,7 +172,7 @@ def _polygon_arrays(model: Any) -> tuple[NDArray[np.float64], NDArray[np.float64
     return n, c
 
 
-def _families(example: Any, tol: float) -> NDArray[np.float64]:
+def _families(example: PolyhedralModel, tol: float) -> NDArray[np.float64]:
     fams: list[NDArray[np.float64]] = []
     for n in _polygon_arrays(example)[0]:
         if not any(abs(abs(float(n @ f)) - 1) <= tol for f in fams):
@@ -176,12 +181,12 @@ def _families(example: Any, tol: float) -> NDArray[np.float64]:
     return np.array(fams)
 
 
-def _triangles(model: Any) -> list[tuple[int, NDArray[np.float64]]]:
+def _triangles(model: Solids) -> list[tuple[int, NDArray[np.float64]]]:
     return [(int(s.label), np.asarray(s.vertices, dtype=np.float64)[np.asarray(s.faces)])
             for s in model.solids]  # fmt: skip
 
 
-def _samples(model: Any, dense: int) -> NDArray[np.float64]:
+def _samples(model: Solids, dense: int) -> NDArray[np.float64]:
     """Points where ``model``'s neighbourhoods are taken: vertices, edge pieces, triangles
     (``dense`` > 1: that many points along each edge and a grid on each triangle)."""
     pts = [np.asarray(s.vertices, dtype=np.float64) for s in model.solids]
@@ -302,7 +307,7 @@ def _labelings(
     return out
 
 
-def _plane_offsets(models: list[Any], normals: NDArray[np.float64],
+def _plane_offsets(models: list[Solids], normals: NDArray[np.float64],
                    tol: float) -> list[NDArray[np.float64]]:  # fmt: skip
     """Per family, the offsets ``n . x`` of the models' faces of that orientation."""
     out: list[list[NDArray[np.float64]]] = [[] for _ in normals]
@@ -341,8 +346,8 @@ def _frame(region: tuple[float, ...], outside: Mapping[str, int]) -> list[dict[s
 
 
 def violations3(
-    example: Any,
-    model: Any,
+    example: PolyhedralModel,
+    model: PolyhedralModel,
     *,
     angle_tol: float = ANGLE_TOL,
     region: tuple[float, float, float, float, float, float] | None = None,
@@ -354,24 +359,23 @@ def violations3(
     z1``): only points in it are checked; outside it is empty space, or the labels
     ``outside`` gives per face (``{"z-": 1}``: a ground below)."""
     defects: list[Defect] = []
+    solids: Solids = model
     if region is not None and outside and any(outside.values()):
-        from csplab.continuous.polyhedra import PolyhedralModel
-
         frame = PolyhedralModel(_frame(tuple(region), outside), merge_coplanar=False)
-        model = _Joined([*model.solids, *frame.solids], model)
+        solids = _Joined([*model.solids, *frame.solids], model)
     fams = _families(example, angle_tol)
-    for b in model.labels:
+    for b in solids.labels:
         if b not in example.labels:
             defects.append(Defect("label", (math.nan, math.nan),
                                   f"label {b} does not occur in the example"))  # fmt: skip
-    pn, pc = _polygon_arrays(model)
+    pn, pc = _polygon_arrays(solids)
     off_family = (np.abs(np.abs(pn @ fams.T) - 1) > angle_tol).all(axis=1)
     for i in np.flatnonzero(off_family).tolist():
         n, c = pn[i], pc[i].tolist()
         where = tuple(round(x, 6) for x in c)
         msg = f"a face with normal {np.round(n, 6)} at {where}, an orientation the example"
         defects.append(Defect("direction", (c[0], c[1]), msg + " does not have"))
-    if any(d.kind == "direction" for d in defects) or not len(model.solids):
+    if any(d.kind == "direction" for d in defects) or not len(solids.solids):
         return Violations(defects)
     # every family plus the axes, so that at least three independent normals exist
     N = np.concatenate([fams, np.eye(3)])
@@ -382,22 +386,22 @@ def violations3(
     N = N[keep]
     cells = cone_cells(N)
     dirs = cells[1]
-    lo = np.minimum(np.array(example.bounds[:3]), np.array(model.bounds[:3]))
-    hi = np.maximum(np.array(example.bounds[3:]), np.array(model.bounds[3:]))
+    lo = np.minimum(np.array(example.bounds[:3]), np.array(solids.bounds[:3]))
+    hi = np.maximum(np.array(example.bounds[3:]), np.array(solids.bounds[3:]))
     scale = float(max(1.0, (hi - lo).max()))
     eps = 1e-5 * scale
-    E_tris, M_tris = _triangles(example), _triangles(model)
+    E_tris, M_tris = _triangles(example), _triangles(solids)
     e_pts = _samples(example, dense)
     e_planes = _plane_offsets([example], N, angle_tol)
     allowed = {tuple(r) for r in _labelings(e_pts, cells, E_tris, e_planes, N, eps).tolist()}
     allowed |= {(b,) * len(dirs) for b in (0, *example.labels)}
-    m_pts = _samples(model, 1)
+    m_pts = _samples(solids, 1)
     if region is not None:
         r = np.asarray(region, dtype=np.float64)
         t = 1e-9 * scale
         m_pts = m_pts[((m_pts >= r[:3] - t) & (m_pts <= r[3:] + t)).all(axis=1)]
     seen: set[tuple[int, ...]] = set()
-    m_planes = _plane_offsets([model], N, angle_tol)
+    m_planes = _plane_offsets([solids], N, angle_tol)
     m_arr = _labelings(m_pts, cells, M_tris, m_planes, N, eps)
     # each distinct neighbourhood once, at its first point (in the points' order)
     rows = np.ascontiguousarray(m_arr.astype(np.int32))
@@ -418,7 +422,7 @@ def violations3(
 
 # ----------------------------------------------------------------------------- user constraints
 def user_violations3(
-    model: Any,
+    model: PolyhedralModel,
     c: UserConstraints3,
     *,
     origin: Sequence[float],
@@ -453,7 +457,7 @@ def user_violations3(
     return out
 
 
-def _touching_groups(solids: list[Any]) -> int:
+def _touching_groups(solids: list[Solid]) -> int:
     """Groups of solids whose closures meet at a common vertex."""
     if len(solids) <= 1:
         return len(solids)
@@ -470,7 +474,9 @@ def _touching_groups(solids: list[Any]) -> int:
     return len(np.unique(comp))
 
 
-def _large_scale(model: Any, c: UserConstraints3, o: NDArray[np.float64], s: float) -> list[Defect]:
+def _large_scale(
+    model: PolyhedralModel, c: UserConstraints3, o: NDArray[np.float64], s: float
+) -> list[Defect]:
     """Solids of a large-scale label meeting a voxel not allowed for it (manifold3d
     intersection volume above 1e-9 of the voxel)."""
     import manifold3d as man

@@ -32,14 +32,16 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
+import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous._geom import labels_at
+from csplab.continuous.polyhedra import PolyhedralModel, Solid
 from csplab.continuous.space import Arrangement3, Lattice3
+from csplab.continuous.user3d import UserConstraints3
 from csplab.errors import InputError
 from csplab.problem import Problem
 
@@ -74,7 +76,7 @@ def _groups(signs: NDArray[np.int8], fams: NDArray[np.int64]) -> tuple[NDArray[n
 
 
 def _triangles(
-    model: Any, lattice: Lattice3, shift: float
+    model: PolyhedralModel, lattice: Lattice3, shift: float
 ) -> list[tuple[int, NDArray[np.float64]]]:
     """Each solid's triangles in lattice units (plus ``shift``), with its label."""
     out = []
@@ -119,7 +121,9 @@ def _local_labels(
     return out
 
 
-def example_signatures3(example: Any, lattice: Lattice3, index: dict[int, int]) -> set[Labeling]:
+def example_signatures3(
+    example: PolyhedralModel, lattice: Lattice3, index: dict[int, int]
+) -> set[Labeling]:
     """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
     of the central cells: vertices and edges of its own arrangement (its bounding box plus
     one spacing), the faces next to those edges, and the solid interiors."""
@@ -183,13 +187,13 @@ class ContinuousCSP3:
 
     def __init__(
         self,
-        example: Any,
+        example: PolyhedralModel,
         size: Sequence[int],
         *,
         spacing: float | None = None,
         snap: bool = False,
         boundary: int | Mapping[str, int] = 0,
-        constraints: Any = None,
+        constraints: UserConstraints3 | None = None,
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
@@ -225,7 +229,9 @@ class ContinuousCSP3:
                     ]
             return out
 
-        def states(fams: NDArray[np.int64], sides: int) -> tuple[list[Labeling], Any]:
+        def states(
+            fams: NDArray[np.int64], sides: int
+        ) -> tuple[list[Labeling], tuple[NDArray[np.int64], int, NDArray[np.int64]]]:
             g, ng = _groups(signs, fams)
             rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
             local = sig[:, rep]  # (nsig, ng)
@@ -353,7 +359,7 @@ class ContinuousCSP3:
             self.problem = self.problem.restrict(keep, key="user constraints (Sec. 4.6)")
             self.problem.meta["constraints"] = constraints.source
 
-    def model(self, grid: ArrayLike, *, name: str = "") -> Any:
+    def model(self, grid: ArrayLike, *, name: str = "") -> PolyhedralModel:
         """The output solids of a solution: on every plane the regions between two
         different labels are traced from the vertex states (every vertex kept, so that the
         surface is watertight), triangulated (constrained Delaunay) and given to the label
@@ -376,7 +382,7 @@ class ContinuousCSP3:
         rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
         return int((sig == sig[:, rep][:, g]).all(axis=1).sum())
 
-    def encode(self, model: Any) -> NDArray[np.int32]:
+    def encode(self, model: PolyhedralModel) -> NDArray[np.int32]:
         """The assignment that a polyhedral model lying on the planes describes (point
         location around every vertex and edge); -1 where a neighbourhood is not a state."""
         A = self.arrangement
@@ -457,10 +463,9 @@ def _trace(
     return rings
 
 
-def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Any:
+def _model3(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> PolyhedralModel:
     """See :meth:`ContinuousCSP3.model`."""
     from csplab.continuous._geom import triangulate_rings
-    from csplab.continuous.polyhedra import PolyhedralModel
 
     A = self.arrangement
     N = A.normals
@@ -683,7 +688,12 @@ def _clockwise(
 
 
 def _triangulated(
-    XYZ: NDArray[np.int64], rings: list[list[int]], axes: list[int], earclip: Any
+    XYZ: NDArray[np.int64],
+    rings: list[list[int]],
+    axes: list[int],
+    earclip: Callable[
+        [NDArray[np.int64], NDArray[np.int64]], tuple[NDArray[np.int64], NDArray[np.bool_]]
+    ],
 ) -> tuple[list[list[int]], list[int], list[list[int]]]:
     """Polygons (the rings), each triangle's polygon, and the triangles (vertex ids,
     counter-clockwise like their ring): ear clipping on the integer coordinates with the
@@ -713,8 +723,6 @@ def _cdt(
 ) -> list[list[int]]:  # fmt: skip
     """Constrained Delaunay triangles (vertex ids, counter-clockwise in ``e1, e2``) of the
     region bounded by ``rings`` (counter-clockwise shells, clockwise holes)."""
-    import shapely
-
     uv = {v: (float(xyz[v] @ e1), float(xyz[v] @ e2)) for r in rings for v in r}
     key = {(round(x, 7), round(y, 7)): v for v, (x, y) in uv.items()}
     out = []
@@ -731,13 +739,11 @@ def _cdt(
 def _solids(
     polys: list[list[int]], owner: list[int], tris: list[list[int]], labels: list[int],
     world: NDArray[np.float64], names: Sequence[int],
-) -> list[Any]:  # fmt: skip
+) -> list[Solid]:  # fmt: skip
     """Polygons of one label split into closed surfaces (connected through shared edges),
     each a :class:`~csplab.continuous.polyhedra.Solid` with its own vertex numbering."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
-
-    from csplab.continuous.polyhedra import Solid
 
     if not polys:
         return []
@@ -781,7 +787,7 @@ def _solids(
     return out
 
 
-def _rings_to_polygons(rings: list[list[tuple[float, float]]]) -> list[Any]:
+def _rings_to_polygons(rings: list[list[tuple[float, float]]]) -> list[shapely.Polygon]:
     """Shapely polygons from counter-clockwise shells and clockwise holes."""
     from shapely.geometry import Polygon as SP
 

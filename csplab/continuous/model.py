@@ -220,6 +220,11 @@ class PolygonModel:
         return np.concatenate([np.asarray(r, dtype=np.float64)
                                for p in self.polygons for r in p.rings()])  # fmt: skip
 
+    @property
+    def n_polygons(self) -> int:
+        """The number of polygons (as :attr:`PolyhedralModel.n_polygons` counts faces)."""
+        return len(self.polygons)
+
     def __len__(self) -> int:
         return len(self.polygons)
 

@@ -43,13 +43,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from fractions import Fraction
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from csplab.continuous.arrangement import gcd_fractions, rational
 from csplab.errors import InputError
+
+if TYPE_CHECKING:
+    from csplab.continuous.polyhedra import PolyhedralModel
 
 __all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells", "primitive3"]
 
@@ -154,7 +157,7 @@ class Lattice3:
 
     @classmethod
     def of_model(
-        cls, example: Any, spacing: float | None = None, *, snap: bool = False
+        cls, example: PolyhedralModel, spacing: float | None = None, *, snap: bool = False
     ) -> Lattice3:
         """:meth:`of` the vertices and polygons of a polyhedral model (its ``source`` named
         in errors)."""
@@ -363,6 +366,11 @@ class Arrangement3:
         e = np.stack([np.concatenate(src), np.concatenate(dst), np.concatenate(lid)], axis=1)
         e = np.unique(e, axis=0)  # a line in three or more planes comes from several pairs
         self.edge_src, self.edge_dst, self.edge_line = e[:, 0], e[:, 1], e[:, 2]
+
+    @property
+    def family_vectors(self) -> NDArray[np.int64]:
+        """The vector naming each family: its face normal (3D; an edge direction in 2D)."""
+        return self.normals
 
     @property
     def n_vertices(self) -> int:

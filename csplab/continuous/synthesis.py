@@ -22,7 +22,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, Generic, TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -34,18 +34,27 @@ from csplab.result import Result
 from csplab.rng import RngLike
 from csplab.solvers import solve
 
+if TYPE_CHECKING:
+    from csplab.continuous.csp3d import ContinuousCSP3
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.continuous.user3d import UserConstraints3
+
 __all__ = ["Synthesis", "synthesize", "synthesize3"]
 
 
+CSP = TypeVar("CSP")
+Model = TypeVar("Model")
+
+
 @dataclass
-class Synthesis:
+class Synthesis(Generic[CSP, Model]):
     """What :func:`synthesize` returns: the solver's ``result`` (its grid holds the CSP
     values), the ``csp``, the output ``model`` (``None`` unless solved), the checker's
     ``violations`` of it, and the time of each phase in seconds (``times``)."""
 
     result: Result
-    csp: Any
-    model: Any
+    csp: CSP
+    model: Model | None
     violations: Violations
     times: dict[str, float] = field(default_factory=dict)
 
@@ -67,7 +76,7 @@ def synthesize(
     restarts: int = 0,
     check: bool = True,
     **options: Any,
-) -> Synthesis:
+) -> Synthesis[ContinuousCSP, PolygonModel]:
     """Continuous model synthesis of ``example`` in a ``W x H`` region (line spacings).
 
     Parameters
@@ -103,7 +112,7 @@ def synthesize(
 
 
 def synthesize3(
-    example: Any,
+    example: PolyhedralModel,
     size: Sequence[int],
     *,
     solver: str = "catalog",
@@ -113,10 +122,10 @@ def synthesize3(
     boundary: int | dict[str, int] = 0,
     restarts: int = 0,
     check: bool = True,
-    constraints: Any = None,
+    constraints: UserConstraints3 | None = None,
     progress: bool = False,
     **options: Any,
-) -> Synthesis:
+) -> Synthesis[ContinuousCSP3, PolyhedralModel]:
     """Continuous model synthesis in 3D of a polyhedral ``example`` in an ``A x B x C``
     box of plane spacings (:class:`~csplab.continuous.csp3d.ContinuousCSP3`); the output
     solids are checked with :func:`~csplab.continuous.check3d.violations3`. Parameters as
@@ -196,7 +205,7 @@ def _touches(states: list[tuple[int, ...]], outside: NDArray[np.int64], b: int) 
 
 
 def connected_sat(
-    csp: Any, labels: Sequence[int], solver: str = "sat", *, rng: RngLike = None,
+    csp: ContinuousCSP3, labels: Sequence[int], solver: str = "sat", *, rng: RngLike = None,
     time_limit: float | None = None, progress: bool = False,
 ) -> Result:  # fmt: skip
     """Exact connectivity (thesis Sec. 4.6.2) with the SAT oracle: a lazy cut loop.
