@@ -8,7 +8,8 @@ import pytest
 
 from csplab.continuous._geom import labels_at
 from csplab.continuous.csp3d import ContinuousCSP3
-from csplab.continuous.space import Arrangement3, Lattice3, central_cells
+from csplab.continuous.lattice import Lattice
+from csplab.continuous.space import Arrangement3, central_cells
 from csplab.errors import InputError
 from csplab.solvers import solve
 from tests._meshes import box as _box
@@ -71,7 +72,7 @@ def test_every_lattice_point_meets_every_family() -> None:
     pyr = {"label": 1, "vertices": [[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0], [1, 1, 1]],
            "faces": [[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]}  # fmt: skip
     E = polyhedra.PolyhedralModel([pyr])
-    lat = Lattice3.of(np.array(pyr["vertices"], dtype=float), pyr["faces"])
+    lat = Lattice.of_points(np.array(pyr["vertices"], dtype=float), pyr["faces"])
     assert len(lat.normals) == 5
     A = Arrangement3(lat, (4, 4, 3))
     lattice_pts = (A.X % A.D == 0) & (A.Y % A.D == 0) & (A.Z % A.D == 0)

@@ -1,7 +1,8 @@
 """User-defined constraints of continuous model synthesis in 3D (thesis Sec. 4.6):
 dimensional and large-scale constraints restrict the CSP (every solver honours them),
-connectivity is exact with sat (a cut loop) and retried otherwise; the checker
-(user_violations3) catches each planted breach."""
+connectivity is the grid solvers' Connected constraint on the CSP's problem (exact with sat,
+cpsat and asp, propagated by catalog); the checker (user_violations3) catches each planted
+breach."""
 
 from __future__ import annotations
 
@@ -63,11 +64,14 @@ def test_large_scale_keeps_labels_in_their_voxels(solver: str) -> None:
     assert [x.kind for x in d] == ["large-scale"]
 
 
-def test_connected_exact_with_sat_and_the_breach_is_found() -> None:
+@pytest.mark.parametrize("solver", ["sat", "asp"])  # cpsat: exact too, minutes here
+def test_connected_exact_with_sat_and_the_breach_is_found(solver: str) -> None:
+    pytest.importorskip({"sat": "pysat", "asp": "clingo"}[solver])
     c = _c({"type": "connected", "labels": [1]})
-    s = synthesize3(E, (6, 6, 3), solver="sat", rng=2, constraints=c)
+    s = synthesize3(E, (6, 6, 3), solver=solver, rng=2, constraints=c)
     assert s.result.status == "solved" and s.model is not None and len(s.violations) == 0
-    assert s.result.stats["rounds"] >= 1
+    (con,) = s.csp.problem.constraints  # one global constraint, seen by the solver
+    assert con.kind == "connected" and con.check(s.csp.problem, s.result.grid) is None
     two = polyhedra.PolyhedralModel([_box(1, [0, 0, 0], [2, 2, 2]), _box(1, [4, 4, 0], [6, 6, 2])])
     d = user_violations3(two, c, origin=ORIGIN, spacing=2.0)
     assert [x.kind for x in d] == ["connected"] and "2 separate groups" in d[0].detail
@@ -80,10 +84,11 @@ def test_connected_exact_with_sat_and_the_breach_is_found() -> None:
     assert labels.count(1) == 1  # exactly one group of label 1
 
 
-def test_incomplete_solvers_never_report_solved_with_a_broken_constraint() -> None:
+@pytest.mark.parametrize("solver", ["catalog", "blocks"])
+def test_incomplete_solvers_never_report_solved_with_a_broken_constraint(solver: str) -> None:
     c = _c({"type": "connected", "labels": [1]})
     for seed in range(3):
-        s = synthesize3(E, (8, 8, 3), solver="catalog", rng=seed, restarts=2, constraints=c)
+        s = synthesize3(E, (8, 8, 3), solver=solver, rng=seed, restarts=2, constraints=c)
         broken = user_violations3(s.model, c, origin=ORIGIN, spacing=2.0) if s.model else []
         assert (s.result.status == "solved") == (s.model is not None and not broken)
         if broken:

@@ -112,10 +112,6 @@ def synthesize(
     if cons is not None:
         common["constraints"] = cons
         settings["constraints"] = ", ".join(cons_summary(cons))
-        if cons.connected and cls.name == "sat":
-            common["progress"] = True  # the cut loop's rounds, once it takes over 2 s
-        if not cls.complete or cons.connected:
-            common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
     s: Synthesis[ContinuousCSP, PolygonModel] | Synthesis[ContinuousCSP3, PolyhedralModel]
     if isinstance(example, PolygonModel):
         settings["lines"] = args.lines
@@ -197,9 +193,9 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         if cons is not None:
             from csplab.continuous.check import Violations
             from csplab.continuous.check3d import user_violations3
-            from csplab.continuous.space import Lattice3
+            from csplab.continuous.lattice import Lattice
 
-            lat = Lattice3.of_model(example)
+            lat = Lattice.of_model(example)
             origin = [float(x) for x in lat.origin]
             extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
             v3 = Violations([*v3, *extra])

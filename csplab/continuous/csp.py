@@ -132,8 +132,8 @@ def example_signatures(
 ) -> set[Signature]:
     """Every reduced neighbourhood of ``example`` (labels compacted by ``label_index``),
     from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b))."""
-    lo = lattice.to_lattice(np.array([example.bounds[:2]]))[0]
-    hi = lattice.to_lattice(np.array([example.bounds[2:]]))[0]
+    lo = np.rint(lattice.to_lattice(np.array([example.bounds[:2]]))[0]).astype(np.int64)
+    hi = np.rint(lattice.to_lattice(np.array([example.bounds[2:]]))[0]).astype(np.int64)
     A = Arrangement(lattice, int(hi[0] - lo[0]) + 2, int(hi[1] - lo[1]) + 2)
     s = float(lattice.spacing)
     o = np.array([float(lattice.origin[0]), float(lattice.origin[1])])
@@ -201,12 +201,7 @@ class ContinuousCSP:
         if not example.polygons:
             raise InputError(f"{example.source}: an example needs at least one polygon")
         self.example = example
-        self.lattice = lattice or Lattice.of(
-            [r for p in example.polygons for r in p.rings()],
-            spacing,
-            snap=snap,
-            where=example.source,
-        )
+        self.lattice = lattice or Lattice.of_model(example, spacing, snap=snap)
         if self.lattice.snapped:
             example = _snapped(example, self.lattice)
             self.example = example
@@ -479,7 +474,7 @@ def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
     """The example with every vertex rounded onto ``lattice``."""
 
     def snap(r: Sequence[tuple[float, float]]) -> list[list[float]]:
-        uv = lattice.to_lattice(np.asarray(r, dtype=np.float64)).astype(np.float64)
+        uv = np.rint(lattice.to_lattice(np.asarray(r, dtype=np.float64)))
         return lattice.to_world(uv).tolist()  # type: ignore[no-any-return]
 
     polys = [

@@ -221,6 +221,18 @@ class PolyhedralModel:
         """The object labels used (sorted; 0 is implicit everywhere else)."""
         return tuple(sorted({s.label for s in self.solids}))
 
+    def indexed_faces(self) -> tuple[NDArray[np.float64], list[list[int]]]:
+        """Every solid's vertices ``(n, 3)`` one after another and every polygon as a list
+        of indices into them (as :meth:`PolygonModel.indexed_faces
+        <csplab.continuous.model.PolygonModel.indexed_faces>` gives rings)."""
+        pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in self.solids])
+        polys: list[list[int]] = []
+        base = 0
+        for s in self.solids:
+            polys += [[base + int(i) for i in p] for p in s.polygons]
+            base += len(s.vertices)
+        return pts, polys
+
     @property
     def n_polygons(self) -> int:
         """The number of input polygons (faces; adjacent coplanar triangles merged)."""

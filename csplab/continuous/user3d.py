@@ -18,10 +18,11 @@ Three kinds, read from the constraints file shared with the grid constraints
     Sec. 4.6.2: the objects of each of these labels form exactly one connected group
     (closures meeting at least at a point; an output without the label breaks it: there is
     no group, like the thesis' single seed grown into a road network). The thesis grows
-    objects from a seed;
-    csplab **checks** the output and, for every solver, runs again with a fresh derived seed
-    while the output is disconnected (``restarts``), and never reports ``solved`` for a
-    disconnected output: it is enforced by retrying, not encoded.
+    objects from a seed; csplab makes it one global constraint on the CSP's problem, the
+    grid solvers' :class:`~csplab.constraints.Connected` over the variables that touch the
+    label (:meth:`~csplab.continuous.csp3d.ContinuousCSP3.connected`): **exact** in ``sat``,
+    ``cpsat`` and ``asp``, propagated by ``catalog``, ``backtrack`` and the other
+    propagating solvers, checked (a breach is ``failed``, so ``restarts`` retry) by the rest.
 
 :func:`csplab.continuous.check3d.user_violations3` checks all three on the output solids
 alone (the truth, as :func:`~csplab.continuous.check3d.violations3` is for Eq. 4.1): a solid
@@ -49,7 +50,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.space import primitive3
+from csplab.continuous.lattice import primitive3
 from csplab.errors import InputError
 
 if TYPE_CHECKING:  # the CSP these constraints restrict (it imports this module)
@@ -66,7 +67,8 @@ __all__ = [
 KINDS3: dict[str, str] = {
     "dimensional": "exact for every solver (vertex and edge states removed)",
     "large-scale": "exact for every solver (vertex and edge states removed)",
-    "connected": "checked on the output; every solver retries with a fresh seed while broken",
+    "connected": "a global constraint (csplab.constraints.Connected): exact in sat, cpsat and "
+    "asp, propagated or checked by the others",
 }
 _AXES = {"x": (1, 0, 0), "y": (0, 1, 0), "z": (0, 0, 1)}
 
