@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from csplab.continuous.check3d import user_violations3
-from csplab.continuous.synthesis import synthesize3
+from csplab.continuous.synthesis import synthesize
 from csplab.continuous.user3d import parse_user_constraints, read_user_constraints
 from csplab.errors import InputError
 from tests._meshes import box as _box
@@ -35,7 +35,7 @@ def _c(*items: dict[str, object]) -> object:
 @pytest.mark.parametrize("solver", ["catalog", "sat", "blocks"])
 def test_dimensional_objects_are_one_spacing_thick(solver: str) -> None:
     c = _c({"type": "dimensional", "labels": [1], "normals": ["z"]})
-    s = synthesize3(E, (6, 6, 4), solver=solver, rng=3, restarts=5, constraints=c)
+    s = synthesize(E, (6, 6, 4), solver=solver, rng=3, restarts=5, constraints=c)
     assert s.ok and s.model is not None and len(s.violations) == 0
     assert s.model.solids, "an empty output would say nothing"
     for sol in s.model.solids:  # spacing 2 (the box's side): every solid 2 high
@@ -54,7 +54,7 @@ def test_dimensional_breach_is_found() -> None:
 @pytest.mark.parametrize("solver", ["catalog", "sat"])
 def test_large_scale_keeps_labels_in_their_voxels(solver: str) -> None:
     c = _c({"type": "large-scale", "voxel": [3, 3, 4], "allowed": {"1": [[0, 0, 0], [1, 1, 0]]}})
-    s = synthesize3(E, (6, 6, 4), solver=solver, rng=1, restarts=5, constraints=c)
+    s = synthesize(E, (6, 6, 4), solver=solver, rng=1, restarts=5, constraints=c)
     assert s.ok and s.model is not None and len(s.violations) == 0
     for sol in s.model.solids:  # voxels of 3 spacings = 6 units: [0, 6) or [6, 12) squared
         lo, hi = sol.vertices.min(axis=0), sol.vertices.max(axis=0)
@@ -68,7 +68,7 @@ def test_large_scale_keeps_labels_in_their_voxels(solver: str) -> None:
 def test_connected_exact_with_sat_and_the_breach_is_found(solver: str) -> None:
     pytest.importorskip({"sat": "pysat", "asp": "clingo"}[solver])
     c = _c({"type": "connected", "labels": [1]})
-    s = synthesize3(E, (6, 6, 3), solver=solver, rng=2, constraints=c)
+    s = synthesize(E, (6, 6, 3), solver=solver, rng=2, constraints=c)
     assert s.result.status == "solved" and s.model is not None and len(s.violations) == 0
     (con,) = s.csp.problem.constraints  # one global constraint, seen by the solver
     assert con.kind == "connected" and con.check(s.csp.problem, s.result.grid) is None
@@ -88,7 +88,7 @@ def test_connected_exact_with_sat_and_the_breach_is_found(solver: str) -> None:
 def test_incomplete_solvers_never_report_solved_with_a_broken_constraint(solver: str) -> None:
     c = _c({"type": "connected", "labels": [1]})
     for seed in range(3):
-        s = synthesize3(E, (8, 8, 3), solver=solver, rng=seed, restarts=2, constraints=c)
+        s = synthesize(E, (8, 8, 3), solver=solver, rng=seed, restarts=2, constraints=c)
         broken = user_violations3(s.model, c, origin=ORIGIN, spacing=2.0) if s.model else []
         assert (s.result.status == "solved") == (s.model is not None and not broken)
         if broken:
@@ -115,7 +115,7 @@ def test_unknown_normal_and_label_name_the_file(tmp_path: Path) -> None:
     f.write_text(json.dumps({"constraints": [{"type": "dimensional", "labels": [1],
                                               "normals": [[1, 1, 0]]}]}))  # fmt: skip
     with pytest.raises(InputError, match="not a plane family"):
-        synthesize3(E, (4, 4, 2), constraints=read_user_constraints(f))
+        synthesize(E, (4, 4, 2), constraints=read_user_constraints(f))
     f.write_text("{")
     with pytest.raises(InputError, match=r"c\.json: line 1: not JSON"):
         read_user_constraints(f)

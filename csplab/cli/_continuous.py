@@ -75,13 +75,10 @@ def synthesize(
 ) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
-    from csplab.continuous.csp import ContinuousCSP
-    from csplab.continuous.csp3d import ContinuousCSP3
-    from csplab.continuous.synthesis import Synthesis, synthesize3
-    from csplab.continuous.synthesis import synthesize as run2
+    from csplab.continuous.synthesis import synthesize as run
     from csplab.solvers import solver_class
 
-    dim = 2 if isinstance(example, PolygonModel) else 3
+    dim = example.ndim
 
     if args.periodic:
         raise InputError("--periodic: continuous models are not periodic")
@@ -93,7 +90,7 @@ def synthesize(
         raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
     size = region(args, dim)
     boundary = boundary_label(args, example)
-    fmt = polygon_output(args.out, gives="PolygonModel" if dim == 2 else "PolyhedralModel")
+    fmt = polygon_output(args.out, gives=type(example).__name__)
     cls = solver_class(args.solver.partition(":")[0])
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
@@ -110,14 +107,10 @@ def synthesize(
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
     if cons is not None:
-        common["constraints"] = cons
         settings["constraints"] = ", ".join(cons_summary(cons))
-    s: Synthesis[ContinuousCSP, PolygonModel] | Synthesis[ContinuousCSP3, PolyhedralModel]
-    if isinstance(example, PolygonModel):
+    if dim == 2:
         settings["lines"] = args.lines
-        s = run2(example, size, lines=args.lines, **common, **opts)
-    else:
-        s = synthesize3(example, size, **common, **opts)
+    s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
     if fmt is not None and s.model is not None:
@@ -128,7 +121,7 @@ def synthesize(
     fams = int((~A.boundary_only).sum())
     out = s.model
     polys = None if out is None else out.n_polygons
-    n_solids = len(out.solids) if isinstance(out, PolyhedralModel) else None
+    n_solids = len(out) if out is not None and out.ndim == 3 else None
     if args.json:
         d = r.to_dict()
         d.update(
@@ -178,42 +171,27 @@ def synthesize(
 
 def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> int:
     """``csplab check EXAMPLE.json OUT.json`` (or ``EXAMPLE.obj OUT.obj``): violations of
-    Eq. 4.1."""
+    Eq. 4.1 (and of the user constraints of thesis Sec. 4.6 on solids)."""
     from csplab.cli.common import load_model
     from csplab.continuous.check import violations
+    from csplab.continuous.check3d import user_violations3
+    from csplab.continuous.defects import Violations
+    from csplab.continuous.lattice import Lattice
 
     out = load_model(args.grid)
-    if isinstance(example, PolyhedralModel):
-        from csplab.continuous.check3d import violations3
-
-        if not isinstance(out, PolyhedralModel):
-            raise InputError(f"{args.grid} is not a polyhedral model (the example {args.model} is)")
-        v3 = violations3(example, out)
-        cons = user_constraints(args, example)
-        if cons is not None:
-            from csplab.continuous.check import Violations
-            from csplab.continuous.check3d import user_violations3
-            from csplab.continuous.lattice import Lattice
-
-            lat = Lattice.of_model(example)
-            origin = [float(x) for x in lat.origin]
-            extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
-            v3 = Violations([*v3, *extra])
-        if args.json:
-            print(json.dumps({"violations": len(v3), **v3.counts(), "solids": len(out.solids)}))
-        else:
-            print(f"{len(v3)} violations in {args.grid} ({len(out.solids)} solids, labels "
-                  f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
-            if len(v3):
-                print(v3.describe(args.limit))
-        return 0 if len(v3) == 0 else 1
-    if not isinstance(out, PolygonModel):
-        raise InputError(f"{args.grid} is not a polygon model (the example {args.model} is)")
+    if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
+        raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
     v = violations(example, out)
+    cons = user_constraints(args, example) if isinstance(out, PolyhedralModel) else None
+    if cons is not None and isinstance(out, PolyhedralModel):
+        lat = Lattice.of_model(example)
+        origin = [float(x) for x in lat.origin]
+        extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
+        v = Violations([*v, *extra])
     if args.json:
-        print(json.dumps({"violations": len(v), **v.counts(), "polygons": len(out)}))
+        print(json.dumps({"violations": len(v), **v.counts(), out.parts: len(out)}))
     else:
-        print(f"{len(v)} violations in {args.grid} ({len(out)} polygons, labels "
+        print(f"{len(v)} violations in {args.grid} ({len(out)} {out.parts}, labels "
               f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
         if len(v):
             print(v.describe(args.limit))

@@ -43,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.continuous._geom import point_labels, points_on_segments
-from csplab.continuous.check import Defect, Violations
+from csplab.continuous.defects import Defect, Violations
 from csplab.continuous.polyhedra import PolyhedralModel, Solid
 
 if TYPE_CHECKING:  # the constraints' data only: the checker reads them, as given

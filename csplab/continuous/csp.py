@@ -42,19 +42,28 @@ True
 from __future__ import annotations
 
 import bisect
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import Any, overload
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
+from csplab.continuous.csp3d import ContinuousCSP3
 from csplab.continuous.model import Polygon, PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.continuous.user3d import UserConstraints3
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["ContinuousCSP", "Signature", "example_signatures", "reduce_signature"]
+__all__ = [
+    "ContinuousCSP",
+    "Signature",
+    "continuous_csp",
+    "example_signatures",
+    "reduce_signature",
+]
 
 Signature = tuple[tuple[int, int], ...]
 _EPS = 1e-6  # offset (in lattice units / D) of the sample points beside an edge
@@ -483,3 +492,57 @@ def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
         for p in example.polygons
     ]  # fmt: skip
     return PolygonModel(polys, name=example.name, meta=example.meta, source=example.source)
+
+
+@overload
+def continuous_csp(
+    example: PolygonModel,
+    size: Sequence[int],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int | Mapping[str, int] = 0,
+    lines: str = "lattice",
+    constraints: UserConstraints3 | None = None,
+) -> ContinuousCSP: ...
+
+
+@overload
+def continuous_csp(
+    example: PolyhedralModel,
+    size: Sequence[int],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int | Mapping[str, int] = 0,
+    lines: str = "lattice",
+    constraints: UserConstraints3 | None = None,
+) -> ContinuousCSP3: ...
+
+
+def continuous_csp(
+    example: PolygonModel | PolyhedralModel,
+    size: Sequence[int],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int | Mapping[str, int] = 0,
+    lines: str = "lattice",
+    constraints: UserConstraints3 | None = None,
+) -> ContinuousCSP | ContinuousCSP3:
+    """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4) for an example of either
+    dimension: :class:`ContinuousCSP` of a polygon model in a ``W x H`` region (``lines``),
+    :class:`~csplab.continuous.csp3d.ContinuousCSP3` of a polyhedral one in ``A x B x C``
+    (``boundary`` also per face, user ``constraints`` of thesis Sec. 4.6). Both give
+    ``problem``, ``lattice``, ``arrangement``, ``labels``, ``boundary``, ``region()``,
+    ``model(grid)`` and ``encode(model)``."""
+    if isinstance(example, PolyhedralModel):
+        if lines != "lattice":
+            raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")
+        return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
+                              constraints=constraints)  # fmt: skip
+    if constraints:
+        raise InputError("polygon models (2D) take no user constraints yet")
+    if isinstance(boundary, Mapping):
+        raise InputError("a polygon model has one label outside its region, not one per face")
+    return ContinuousCSP(example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines)

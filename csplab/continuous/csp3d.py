@@ -396,6 +396,12 @@ class ContinuousCSP3:
         :class:`~csplab.continuous.polyhedra.PolyhedralModel`."""
         return surface_of(self, grid, name)
 
+    def region(self) -> tuple[float, float, float, float, float, float]:
+        """The output region ``(x0, y0, z0, x1, y1, z1)`` in the example's coordinates."""
+        lo = self.lattice.to_world(np.zeros(3)).tolist()
+        hi = self.lattice.to_world(np.array(self.arrangement.size, dtype=np.float64)).tolist()
+        return (lo[0], lo[1], lo[2], hi[0], hi[1], hi[2])
+
     def touching(self, label: int) -> NDArray[np.bool_]:
         """``(n, K)``: the values of each variable whose state has the model ``label`` in
         a group of cells inside the region (the vertex or edge touches an object of

@@ -194,6 +194,9 @@ class PolygonModel:
     # ------------------------------------------------------------------ queries
     #: continuous models are planar
     ndim = 2
+    #: what the model is made of, and its adjective (shared names with PolyhedralModel)
+    parts = "polygons"
+    kind = "polygon"
 
     @property
     def labels(self) -> tuple[int, ...]:

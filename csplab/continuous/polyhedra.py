@@ -160,6 +160,9 @@ class PolyhedralModel:
 
     #: polyhedral models are spatial
     ndim = 3
+    #: what the model is made of, and its adjective (shared names with PolygonModel)
+    parts = "solids"
+    kind = "polyhedral"
 
     def __init__(
         self,
