@@ -648,9 +648,7 @@ class Connected(Constraint):
 
     def to_json(self, problem: Problem) -> dict[str, Any]:
         if self.members is not None:
-            raise InputError(
-                f"connected {self._name(problem)}: per-cell members have no file form"
-            )
+            raise InputError(f"connected {self._name(problem)}: per-cell members have no file form")
         d: dict[str, Any] = {"type": "connected", "labels": _labels_json(problem, self.labels)}
         if len(self.cells):
             d["cells"] = [list(problem.coords(c)) for c in self.cells]

@@ -56,6 +56,7 @@ __all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice", "gcd_fractions", "
 #: as the 2008 paper spaces them; the example's corners then appear where those lines meet)
 LINES = ("lattice", "equal")
 
+
 def _lcm(a: int, b: int) -> int:
     return a * b // math.gcd(a, b)
 

@@ -231,9 +231,7 @@ class PolygonModel:
         rings = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for p in self.polygons
                  for r in p.rings()]  # fmt: skip
         starts = np.cumsum([0, *(len(r) for r in rings)]).tolist()
-        return np.concatenate(rings), [
-            list(range(a, b)) for a, b in itertools.pairwise(starts)
-        ]
+        return np.concatenate(rings), [list(range(a, b)) for a, b in itertools.pairwise(starts)]
 
     @property
     def n_polygons(self) -> int:
