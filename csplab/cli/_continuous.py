@@ -75,6 +75,7 @@ def synthesize(
 ) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
+    from csplab.continuous.lattice import PlaneArrangement
     from csplab.continuous.synthesis import synthesize as run
     from csplab.solvers import solver_class
 
@@ -116,7 +117,7 @@ def synthesize(
     if fmt is not None and s.model is not None:
         fmt.write(s.model, args.out)
         wrote = args.out
-    A = csp.arrangement
+    A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
     fams = int((~A.boundary_only).sum())
     out = s.model

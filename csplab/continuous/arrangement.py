@@ -166,6 +166,11 @@ class Arrangement:
         return self.dirs
 
     @property
+    def size(self) -> tuple[int, int]:
+        """The region ``(W, H)`` in spacings."""
+        return self.W, self.H
+
+    @property
     def n_vertices(self) -> int:
         return int(self.X.size)
 
@@ -180,14 +185,14 @@ class Arrangement:
         a = np.arctan2(self.dirs[:, 1], self.dirs[:, 0]).astype(np.float64)
         return np.concatenate([a, a + np.pi])
 
-    def vertex_xy(self) -> NDArray[np.float64]:
+    def vertex_positions(self) -> NDArray[np.float64]:
         """Vertices in lattice units, ``(n, 2)`` floats."""
         out: NDArray[np.float64] = np.stack([self.X, self.Y], axis=1) / self.D
         return out
 
-    def edge_xy(self) -> NDArray[np.float64]:
+    def edge_positions(self) -> NDArray[np.float64]:
         """Edge midpoints in lattice units."""
-        v = self.vertex_xy()
+        v = self.vertex_positions()
         out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 

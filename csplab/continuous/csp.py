@@ -104,7 +104,7 @@ def _edge_labels(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Labels left and right of each edge of ``A`` by point location in ``shapes``
     (``{label: geometry}`` in lattice units shifted by ``offset``)."""
-    mid = A.edge_xy() - np.asarray(offset)
+    mid = A.edge_positions() - np.asarray(offset)
     d = A.dirs[A.edge_family].astype(np.float64)
     nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.hypot(d[:, 0], d[:, 1])[:, None]
     eps = _EPS / A.D
@@ -285,7 +285,7 @@ class ContinuousCSP:
                     rels.append(M)
                 pos_rel[t, r] = rel_ids[k]
         # variables in scan order of their positions
-        pos = np.concatenate([A.vertex_xy(), A.edge_xy()])
+        pos = np.concatenate([A.vertex_positions(), A.edge_positions()])
         order = np.lexsort((pos[:, 1], pos[:, 0]))
         var = np.empty(nv + ne, dtype=np.int64)
         var[order] = np.arange(nv + ne)

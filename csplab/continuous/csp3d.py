@@ -137,9 +137,9 @@ def example_signatures3(
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
-    sigs |= set(_local_labels(A, A.vertex_xyz(), A.on, tris, index))
+    sigs |= set(_local_labels(A, A.vertex_positions(), A.on, tris, index))
     efam = A.edge_families()
-    edge_sigs = _local_labels(A, A.edge_xyz(), efam, tris, index)
+    edge_sigs = _local_labels(A, A.edge_positions(), efam, tris, index)
     sigs |= set(edge_sigs)
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
@@ -355,7 +355,7 @@ class ContinuousCSP3:
         dom[nv:] = np.arange(K)[None, :] < en[etype][:, None]
         # relations per (vertex type, ray, edge type)
         relation, rels = self._relation_maker(K)
-        pos = np.concatenate([A.vertex_xyz(), A.edge_xyz()])
+        pos = np.concatenate([A.vertex_positions(), A.edge_positions()])
         order = np.lexsort((pos[:, 2], pos[:, 1], pos[:, 0]))
         var = np.empty(nv + ne, dtype=np.int64)
         var[order] = np.arange(nv + ne)
@@ -466,9 +466,9 @@ class ContinuousCSP3:
                 raise InputError(f"label {b} does not occur in the example")
         tris = _triangles(model, self.lattice, 0.0)
         grid = np.full(self.problem.n, -1, dtype=np.int32)
-        for what, pts, fams_on, types, tlist, var in (
-            ("v", A.vertex_xyz(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
-            ("e", A.edge_xyz(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
+        for pts, fams_on, types, tlist, var in (
+            (A.vertex_positions(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
+            (A.edge_positions(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
         ):
             labs = _local_labels(A, pts, fams_on, tris, index)
             size = np.array(A.size, dtype=np.float64)
@@ -490,5 +490,4 @@ class ContinuousCSP3:
                             break
                 lookup = {s: j for j, s in enumerate(st)}
                 grid[var[i]] = lookup.get(tuple(local), -1)
-            del what
         return grid

@@ -30,7 +30,7 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from fractions import Fraction
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,6 +45,7 @@ __all__ = [
     "MAX_FAMILIES",
     "MAX_FAMILIES3",
     "Lattice",
+    "PlaneArrangement",
     "family_vectors",
     "gcd_fractions",
     "primitive3",
@@ -303,3 +304,45 @@ class Lattice:
             return tuple(allds), tuple(d in extra2 for d in allds)
         extra = [a for a in _AXES3 if a not in self.vectors]
         return (*self.vectors, *extra), (False,) * len(self.vectors) + (True,) * len(extra)
+
+
+class PlaneArrangement(Protocol):
+    """The arrangement protocol: what the 2D arrangement of lines
+    (:class:`~csplab.continuous.arrangement.Arrangement`) and the 3D arrangement of planes
+    (:class:`~csplab.continuous.space.Arrangement3`) both give, in lattice units: the
+    region ``size``, ``F`` families (``family_vectors``; ``boundary_only`` the axis ones
+    added for the region's sides), vertices at integer coordinates divided by ``D``, edges
+    between consecutive vertices of one line (``edge_src`` to ``edge_dst``), and which
+    region sides each vertex lies on (``on_side``: bits ``2 * axis`` low, ``2 * axis + 1``
+    high)."""
+
+    lattice: Lattice
+    F: int
+    D: int
+    boundary_only: NDArray[np.bool_]
+    edge_src: NDArray[np.int64]
+    edge_dst: NDArray[np.int64]
+
+    @property
+    def size(self) -> tuple[int, ...]: ...
+
+    @property
+    def family_vectors(self) -> NDArray[np.int64]: ...
+
+    @property
+    def n_vertices(self) -> int: ...
+
+    @property
+    def n_edges(self) -> int: ...
+
+    def vertex_positions(self) -> NDArray[np.float64]:
+        """Vertex coordinates ``(n_vertices, d)`` in lattice units."""
+        ...
+
+    def edge_positions(self) -> NDArray[np.float64]:
+        """Edge midpoints ``(n_edges, d)`` in lattice units."""
+        ...
+
+    def on_side(self) -> NDArray[np.int64]:
+        """Per vertex, the region sides it lies on (bit mask)."""
+        ...

@@ -246,14 +246,14 @@ class Arrangement3:
     def n_edges(self) -> int:
         return int(self.edge_src.size)
 
-    def vertex_xyz(self) -> NDArray[np.float64]:
+    def vertex_positions(self) -> NDArray[np.float64]:
         """Vertices in lattice units."""
         out: NDArray[np.float64] = np.stack([self.X, self.Y, self.Z], axis=1) / self.D
         return out
 
-    def edge_xyz(self) -> NDArray[np.float64]:
+    def edge_positions(self) -> NDArray[np.float64]:
         """Edge midpoints in lattice units."""
-        v = self.vertex_xyz()
+        v = self.vertex_positions()
         out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 

@@ -94,7 +94,7 @@ def surface_of(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> Polyhed
     vstate = g[self.var_vertex]
     XYZ = np.stack([A.X, A.Y, A.Z], axis=1)
     s = XYZ @ N.T
-    xyz = A.vertex_xyz()
+    xyz = A.vertex_positions()
     size = np.array(A.size, dtype=np.float64)
     efam = A.edge_families()
     # vertices whose labels all agree lie on no face (unless an object reaches the region's

@@ -223,8 +223,8 @@ def allowed_states(csp: ContinuousCSP3, c: UserConstraints3) -> NDArray[np.bool_
         dim.append((index[b], fam_of[n]))
     dom = np.array(csp.problem.domains, dtype=bool, copy=True)
     kinds = (
-        (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_xyz()),
-        (csp.edge_type, csp.etypes, csp.var_edge, A.edge_xyz()),
+        (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_positions()),
+        (csp.edge_type, csp.etypes, csp.var_edge, A.edge_positions()),
     )
     # large-scale: per label, a boolean voxel grid
     grids: list[tuple[int, NDArray[np.bool_]]] = []
