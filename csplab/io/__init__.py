@@ -106,8 +106,8 @@ def load_model(
 example 'line'
     """
     from csplab.examples import ALIASES, EXAMPLES, load_example
-    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
-    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
+    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_continuous_example
+    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES
 
     p = Path(spec)
     if p.exists():
@@ -119,18 +119,12 @@ example 'line'
                 f"model options apply to model files only, not to the built-in example {text!r}"
             )
         return load_example(text)
-    if text in CONTINUOUS_EXAMPLES:
+    if text in CONTINUOUS_EXAMPLES or text in POLYHEDRAL_EXAMPLES:
         if options:
             raise InputError(
                 f"model options apply to model files only, not to the built-in example {text!r}"
             )
-        return load_polygon_example(text)
-    if text in POLYHEDRAL_EXAMPLES:
-        if options:
-            raise InputError(
-                f"model options apply to model files only, not to the built-in example {text!r}"
-            )
-        return load_polyhedral_example(text)
+        return load_continuous_example(text)
     if p.suffix or "/" in text or "\\" in text:
         raise FormatError("no such file", path=text)
     raise InputError(
