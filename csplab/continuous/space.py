@@ -43,7 +43,7 @@ import itertools
 import math
 from collections.abc import Sequence
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
@@ -51,7 +51,15 @@ from numpy.typing import NDArray
 from csplab.continuous.lattice import MAX_FAMILIES3, Lattice, primitive3
 from csplab.errors import InputError
 
-__all__ = ["MAX_FAMILIES3", "Arrangement3", "central_cells", "primitive3"]
+if TYPE_CHECKING:  # types only: neither imports this module
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.problem import Problem
+
+__all__ = ["MAX_FAMILIES3", "Arrangement3", "States3", "central_cells", "primitive3"]
+
+#: per vertex or edge type: its families, its states (a label per group of central cells)
+#: and the group of every central cell
+TypeStates = tuple[NDArray[np.int64], list[tuple[int, ...]], NDArray[np.int64]]
 
 
 def _lcm(a: int, b: int) -> int:
@@ -281,3 +289,52 @@ class Arrangement3:
         target = np.zeros(3, dtype=np.int64)
         target[axis] = 1
         return int(np.flatnonzero((self.normals == target).all(axis=1))[0])
+
+
+class States3(Protocol):
+    """The states of the 3D CSP on an arrangement, as
+    :class:`~csplab.continuous.csp3d.ContinuousCSP3` builds them: per vertex and edge type
+    its families, states and cell groups (``vtypes``, ``etypes``), the compact label each
+    group must have outside the region or -1 (``vertex_outside``, ``edge_outside``), each
+    vertex's and edge's type and problem variable. What the user constraints
+    (:func:`~csplab.continuous.user3d.allowed_states`) and the surface tracing
+    (:func:`~csplab.continuous.surface.surface_of`) read, without importing the CSP."""
+
+    @property
+    def example(self) -> PolyhedralModel: ...
+
+    @property
+    def lattice(self) -> Lattice: ...
+
+    @property
+    def arrangement(self) -> Arrangement3: ...
+
+    @property
+    def labels(self) -> tuple[int, ...]: ...
+
+    @property
+    def problem(self) -> Problem: ...
+
+    @property
+    def vtypes(self) -> list[TypeStates]: ...
+
+    @property
+    def etypes(self) -> list[TypeStates]: ...
+
+    @property
+    def vertex_outside(self) -> list[NDArray[np.int64]]: ...
+
+    @property
+    def edge_outside(self) -> list[NDArray[np.int64]]: ...
+
+    @property
+    def vertex_type(self) -> NDArray[np.int64]: ...
+
+    @property
+    def edge_type(self) -> NDArray[np.int64]: ...
+
+    @property
+    def var_vertex(self) -> NDArray[np.int64]: ...
+
+    @property
+    def var_edge(self) -> NDArray[np.int64]: ...

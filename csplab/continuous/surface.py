@@ -13,14 +13,14 @@ one :class:`~csplab.continuous.polyhedra.Solid` each. Outputs are closed and out
 construction, so they are built with :meth:`PolyhedralModel.trusted` (the 3D tests
 re-validate them).
 
-The module reads the CSP's states; it does not build them (:mod:`csplab.continuous.csp3d`
-does, and calls :func:`surface_of` from :meth:`~ContinuousCSP3.model`).
+The module reads the CSP's states (:class:`~csplab.continuous.space.States3`); it does not
+build them (:mod:`csplab.continuous.csp3d` does, and calls :func:`surface_of` from
+:meth:`~csplab.continuous.csp3d.ContinuousCSP3.model`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 import shapely
@@ -28,10 +28,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous._geom import triangulate_rings
 from csplab.continuous.polyhedra import PolyhedralModel, Solid
+from csplab.continuous.space import States3
 from csplab.errors import InputError
-
-if TYPE_CHECKING:  # the CSP whose solution is traced (it calls this module)
-    from csplab.continuous.csp3d import ContinuousCSP3
 
 __all__ = ["surface_of"]
 
@@ -79,12 +77,12 @@ def _trace(
     return rings
 
 
-def surface_of(self: ContinuousCSP3, grid: ArrayLike, name: str = "") -> PolyhedralModel:
+def surface_of(self: States3, grid: ArrayLike, name: str = "") -> PolyhedralModel:
     """The output solids of a solution ``grid`` of ``self`` (the CSP): on every plane the
     regions between two different labels are traced from the vertex states (every vertex
     kept, so that the surface is watertight), triangulated and given to the label below
     (outward normal up) and the label above (down); each label's triangles split into
-    closed surfaces. :meth:`ContinuousCSP3.model` is this function."""
+    closed surfaces. :meth:`~csplab.continuous.csp3d.ContinuousCSP3.model` is this function."""
     A = self.arrangement
     N = A.normals
     signs, _ = A.cells

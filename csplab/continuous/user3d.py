@@ -45,16 +45,14 @@ import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from csplab.continuous.lattice import primitive3
+from csplab.continuous.space import States3
 from csplab.errors import InputError
-
-if TYPE_CHECKING:  # the CSP these constraints restrict (it imports this module)
-    from csplab.continuous.csp3d import ContinuousCSP3
 
 __all__ = [
     "KINDS3",
@@ -203,7 +201,7 @@ def read_user_constraints(
 
 
 # ----------------------------------------------------------------------------- enforcing
-def allowed_states(csp: ContinuousCSP3, c: UserConstraints3) -> NDArray[np.bool_]:
+def allowed_states(csp: States3, c: UserConstraints3) -> NDArray[np.bool_]:
     """``(n_variables, K)``: the domain of ``csp.problem`` with the dimensional and
     large-scale constraints applied (a state is removed when it breaks one)."""
     A = csp.arrangement

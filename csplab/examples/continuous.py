@@ -22,13 +22,11 @@ import json
 from importlib import resources
 
 from csplab.continuous.model import PolygonModel
-from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
 
 __all__ = [
     "CONTINUOUS_EXAMPLES",
     "continuous_example_names",
-    "load_continuous_example",
     "load_polygon_example",
 ]
 
@@ -118,23 +116,3 @@ def load_polygon_example(name: str) -> PolygonModel:
     path = resources.files(__package__ or "csplab.examples").joinpath("continuous", fname)
     data = json.loads(path.read_text(encoding="utf-8"))
     return PolygonModel.from_json(data, name=name, source=f"csplab/examples/continuous/{fname}")
-
-
-def load_continuous_example(name: str) -> PolygonModel | PolyhedralModel:
-    """A built-in continuous example of either dimension by name: a polygon model
-    (:func:`load_polygon_example`) or a polyhedral one
-    (:func:`~csplab.examples.continuous3d.load_polyhedral_example`).
-
-    >>> load_continuous_example("tetrahedron").ndim, load_continuous_example("triangle").ndim
-    (3, 2)
-    """
-    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
-
-    if name in POLYHEDRAL_EXAMPLES:
-        return load_polyhedral_example(name)
-    if name in CONTINUOUS_EXAMPLES:
-        return load_polygon_example(name)
-    raise InputError(
-        f"unknown continuous example {name!r}; built-in continuous examples: "
-        f"{', '.join([*CONTINUOUS_EXAMPLES, *POLYHEDRAL_EXAMPLES])}"
-    )

@@ -106,8 +106,8 @@ def load_model(
 example 'line'
     """
     from csplab.examples import ALIASES, EXAMPLES, load_example
-    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_continuous_example
-    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES
+    from csplab.examples.continuous import CONTINUOUS_EXAMPLES
+    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_continuous_example
 
     p = Path(spec)
     if p.exists():
