@@ -183,12 +183,13 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
     v = violations(example, out)
-    cons = user_constraints(args, example) if isinstance(out, PolyhedralModel) else None
-    if cons is not None and isinstance(out, PolyhedralModel):
-        lat = Lattice.of_model(example)
-        origin = [float(x) for x in lat.origin]
-        extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
-        v = Violations([*v, *extra])
+    if isinstance(out, PolyhedralModel):  # the user constraints of Sec. 4.6, on the solids
+        cons = user_constraints(args, example)
+        if cons is not None:
+            lat = Lattice.of_model(example)
+            origin = [float(x) for x in lat.origin]
+            extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
+            v = Violations([*v, *extra])
     if args.json:
         print(json.dumps({"violations": len(v), **v.counts(), out.parts: len(out)}))
     else:
