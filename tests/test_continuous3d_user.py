@@ -134,3 +134,20 @@ def test_cli_synthesize_and_check_with_constraints(tmp_path: Path) -> None:
     chk = [sys.executable, "-m", "csplab", "check", "houses", str(out), "--constraints", str(f)]
     r = subprocess.run(chk, capture_output=True, text=True, check=False)
     assert r.returncode == 0 and r.stdout.startswith("0 violations"), r.stdout + r.stderr
+
+
+def test_connected_on_the_csp_agrees_with_the_solids() -> None:
+    """The CSP's Connected (variables touching label 1, joined by the arcs) holds exactly
+    when the output's label-1 solids form one group (the independent check)."""
+    c = _c({"type": "connected", "labels": [1]})
+    seen = set()
+    for seed in range(8):
+        s = synthesize(E, (3, 3, 2), solver="catalog", rng=seed)
+        if s.model is None:
+            continue
+        (con,) = s.csp.connected([1])
+        on_csp = con.check(s.csp.problem, s.result.grid) is None
+        on_solids = not user_violations3(s.model, c, origin=ORIGIN, spacing=2.0)
+        assert on_csp == on_solids, seed
+        seen.add(on_csp)
+    assert seen == {True, False}, "both outcomes should occur over these seeds"
