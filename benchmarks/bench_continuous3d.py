@@ -6,7 +6,7 @@ row (input polygons, output polygons, minutes) next to csplab's: the input polyg
 (``n_polygons``), and for the region sizes searched upwards (10x10x6, 14x14x6, 20x20x8, ...
 plane spacings) until the output has at least the paper's number of polygons or a run takes
 longer than ``--cap`` seconds, the output polygons and solids and the time of each phase of
-:func:`~csplab.continuous.synthesis.synthesize3` with ``catalog`` (restarts allowed):
+:func:`~csplab.continuous.synthesis.synthesize` with ``catalog`` (restarts allowed):
 building the CSP, solving, geometry (the output solids), checking (the independent checker).
 A size whose predicted time (the last one's, scaled by the volume) is beyond twice the cap
 is not run.
@@ -57,12 +57,12 @@ def _fmt(size: tuple[int, ...]) -> str:
 
 
 def _run(name: str, size: tuple[int, ...], seed: int, solver: str = "catalog") -> Any:
-    from csplab.continuous.synthesis import synthesize3
+    from csplab.continuous.synthesis import synthesize
     from csplab.examples.continuous3d import load_polyhedral_example
 
     E = load_polyhedral_example(name)
     restarts = RESTARTS if solver == "catalog" else 0
-    return synthesize3(E, size, solver=solver, rng=seed, restarts=restarts)
+    return synthesize(E, size, solver=solver, rng=seed, restarts=restarts)
 
 
 def _memory_child(name: str) -> None:

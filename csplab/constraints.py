@@ -84,6 +84,7 @@ __all__ = [
     "MaxRun",
     "Separation",
     "Symmetric",
+    "arc_pairs",
     "constraints_json",
     "grid_edges",
     "label_mask",
@@ -167,6 +168,22 @@ def grid_edges(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], 
     )
     problem.__dict__["_grid_edges"] = out
     return out
+
+
+def arc_pairs(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
+    """The pairs of cells the problem's arcs join, as ``(lo, hi, relation)`` with
+    ``lo < hi``, each pair once (the neighbours of a problem whose cells sit at positions)."""
+    cached = problem.__dict__.get("_arc_pairs")
+    if cached is not None:
+        return cached  # type: ignore[no-any-return]
+    a = problem.arcs
+    a = a[a[:, 0] != a[:, 1]]
+    trip = np.stack([np.minimum(a[:, 0], a[:, 1]), np.maximum(a[:, 0], a[:, 1]), a[:, 2]], axis=1)
+    if len(trip):
+        trip = trip[np.sort(np.unique(trip[:, :2], axis=0, return_index=True)[1])]
+    out = tuple(np.ascontiguousarray(trip[:, i], dtype=np.int64) for i in range(3))
+    problem.__dict__["_arc_pairs"] = out
+    return out  # type: ignore[return-value]
 
 
 class ClauseContext:
@@ -442,6 +459,13 @@ class Connected(Constraint):
     ``ports`` (bool ``(K, 2 * ndim)``, faces ``x-, x+, y-, ...``) two neighbours connect
     only when both labels open the faces between them (DeBroglie's ``edgedPath``).
 
+    On a problem whose cells sit at positions (the CSP of continuous model synthesis,
+    :mod:`csplab.continuous`) the neighbours are the cells its arcs join, and ``members``
+    (bool ``(n, K)``) says which values put each cell in the set (there a value is a state,
+    and the states that touch an object differ from cell to cell); ``labels`` then only
+    name the set, and ``what`` describes it. ``nonempty``: at least one cell is in the set
+    (one component, not none: thesis Sec. 4.6.2).
+
     Solvers: the CNF adds one cut per stray component and model (two cells of different
     components, and none of the first component's neighbours, cannot all hold); the
     propagator removes the labels from cells no longer reachable from a cell that must
@@ -452,20 +476,50 @@ class Connected(Constraint):
     labels: Sequence[int]
     cells: Sequence[int] = ()
     ports: NDArray[np.bool_] | None = field(default=None, repr=False)
+    members: NDArray[np.bool_] | None = field(default=None, repr=False)
+    nonempty: bool = False
+    what: str = ""
     kind: ClassVar[str] = "connected"
 
     def validate(self, problem: Problem) -> None:
         _check_labels(self.labels, problem)
-        _need_grid(problem, "a connected constraint", square=self.ports is not None)
+        if self.members is None:
+            _need_grid(problem, "a connected constraint", square=self.ports is not None)
+        elif self.ports is not None:
+            raise InputError("connected: ports need a grid, not per-cell members")
+        elif np.shape(self.members) != (problem.n, problem.K):
+            raise InputError(f"connected: members must have shape ({problem.n}, {problem.K})")
         if any(not 0 <= c < problem.n for c in self.cells):
             raise InputError("connected: cells must be inside the grid")
         if self.ports is not None and np.shape(self.ports) != (problem.K, 2 * problem.ndim):
             raise InputError(f"connected: ports must have shape ({problem.K}, {2 * problem.ndim})")
 
+    def mask(self, problem: Problem) -> NDArray[np.bool_]:
+        """The values that put a cell in the set: ``(K,)`` for every cell alike, or the
+        per-cell ``members`` ``(n, K)``."""
+        if self.members is not None:
+            return np.asarray(self.members, dtype=bool)
+        return label_mask(self.labels, problem.K)
+
+    def edges(self, problem: Problem) -> tuple[NDArray[np.int64], ...]:
+        """The neighbour pairs ``(lo, hi, axis)``: :func:`grid_edges` on a grid, the pairs
+        of cells an arc joins (``axis``: its relation) when the cells sit at positions."""
+        if self.members is None:
+            return grid_edges(problem)
+        return arc_pairs(problem)
+
+    def active(self, problem: Problem, lab: NDArray[np.int64]) -> NDArray[np.bool_]:
+        """The cells whose label puts them in the set."""
+        if self.members is None:
+            return np.isin(lab, list(self.labels))
+        M = np.asarray(self.members, dtype=bool)
+        out: NDArray[np.bool_] = (lab >= 0) & M[np.arange(problem.n), np.clip(lab, 0, None)]
+        return out
+
     def components(self, problem: Problem, lab: NDArray[np.int64]) -> NDArray[np.int64]:
         """Component id (smallest cell) of each cell with a label in the set, -1 elsewhere."""
-        lo, hi, ax = grid_edges(problem)
-        act = np.isin(lab, list(self.labels))
+        lo, hi, ax = self.edges(problem)
+        act = self.active(problem, lab)
         on = act[lo] & act[hi]
         if self.ports is not None:
             P = np.asarray(self.ports, dtype=bool)
@@ -474,10 +528,12 @@ class Connected(Constraint):
         return kern.components(problem.n, lo[on], hi[on], act)
 
     def excess(self, problem: Problem, lab: NDArray[np.int64]) -> float:
-        """Cells of the set outside its largest component, plus ``n`` per missing given cell."""
+        """Cells of the set outside its largest component, plus ``n`` per missing given cell
+        (and for an empty set that must not be)."""
         comp = self.components(problem, lab)
         miss = sum(1 for c in self.cells if comp[c] < 0)
         ids, sizes = np.unique(comp[comp >= 0], return_counts=True)
+        miss += int(self.nonempty and not ids.size)
         return float(problem.n * miss + (sizes.sum() - sizes.max() if ids.size else 0))
 
     def check(self, problem: Problem, lab: NDArray[np.int64]) -> str | None:
@@ -485,23 +541,28 @@ class Connected(Constraint):
         miss = [c for c in self.cells if comp[c] < 0]
         if miss:
             return (
-                f"connected {_set_name(problem, self.labels)}: cell {problem.coords(miss[0])} "
+                f"connected {self._name(problem)}: cell {problem.coords(miss[0])} "
                 f"has label {problem.label_name(int(lab[miss[0]]))}, not one of the set"
             )
         k = np.unique(comp[comp >= 0]).size
         if k > 1:
-            return f"connected {_set_name(problem, self.labels)}: {k} components, not one"
+            return f"connected {self._name(problem)}: {k} components, not one"
+        if k == 0 and self.nonempty:
+            return f"connected {self._name(problem)}: no cell in the set, not one component"
         return None
 
     def propagate(self, problem: Problem, dom: NDArray[np.bool_]) -> bool:
-        S = label_mask(self.labels, problem.K)
+        S = self.mask(problem)
         if len(self.cells):
-            dom[list(self.cells)] &= S
+            cs = list(self.cells)
+            dom[cs] &= S if S.ndim == 1 else S[cs]
         can: NDArray[np.bool_] = np.asarray((dom & S).any(axis=1))
         must: NDArray[np.bool_] = np.asarray(can & ~(dom & ~S).any(axis=1))
+        if self.nonempty and not can.any():
+            return False
         if not must.any():
             return True
-        lo, hi, ax = grid_edges(problem)
+        lo, hi, ax = self.edges(problem)
         pe = can[lo] & can[hi]
         if self.ports is not None:
             P = np.asarray(self.ports, dtype=bool)
@@ -515,7 +576,7 @@ class Connected(Constraint):
             return False
         stray = can & (comp != roots[0])
         if stray.any():
-            dom[stray] &= ~S
+            dom[stray] &= ~S if S.ndim == 1 else ~S[stray]
             can &= ~stray
         keep = can[lo] & can[hi]
         lo, hi = lo[keep], hi[keep]
@@ -530,13 +591,19 @@ class Connected(Constraint):
         res = kern.separating_cells(ptr, nbr, must, int(np.flatnonzero(must)[0]))
         force = res[:, 0] & ~must
         if force.any():
-            dom[force] &= S
+            dom[force] &= S if S.ndim == 1 else S[force]
         return True
 
+    def in_set(self, ctx: ClauseContext, cell: int) -> Lit:
+        """The literal "``cell`` is in the set"."""
+        S = self.mask(ctx.problem)
+        return ctx.in_set(int(cell), S if S.ndim == 1 else S[int(cell)])
+
     def clauses(self, ctx: ClauseContext) -> None:
-        S = label_mask(self.labels, ctx.problem.K)
         for c in self.cells:
-            ctx.add([ctx.in_set(int(c), S)])
+            ctx.add([self.in_set(ctx, int(c))])
+        if self.nonempty:
+            ctx.add([self.in_set(ctx, c) for c in range(ctx.problem.n)])
 
     def cut(self, ctx: ClauseContext, lab: NDArray[np.int64]) -> None:
         P = ctx.problem
@@ -544,12 +611,12 @@ class Connected(Constraint):
         ids, sizes = np.unique(comp[comp >= 0], return_counts=True)
         if ids.size <= 1:
             return
-        S = label_mask(self.labels, P.K)
-        lo, hi, ax = grid_edges(P)
+        S = self.mask(P)
+        lo, hi, ax = self.edges(P)
         big = int(ids[np.argmax(sizes)])
-        t = ctx.in_set(big, S)
+        t = self.in_set(ctx, big)
         for cell in np.flatnonzero((comp >= 0) & (comp != big)):
-            for b in self.labels:
+            for b in self.labels if S.ndim == 1 else np.flatnonzero(S[cell]).tolist():
                 x = ctx.lit(int(cell), int(b))
                 if not isinstance(x, bool):
                     ctx.hints.append(-x)
@@ -557,11 +624,11 @@ class Connected(Constraint):
             if cid == big:
                 continue
             inside = comp == cid
-            clause: list[Lit] = [_neg(ctx.in_set(int(cid), S)), _neg(t)]
+            clause: list[Lit] = [_neg(self.in_set(ctx, int(cid))), _neg(t)]
             cross = inside[lo] != inside[hi]
             if self.ports is None:
                 out = np.unique(np.where(inside[lo[cross]], hi[cross], lo[cross]))
-                clause += [ctx.in_set(int(w), S) for w in out]
+                clause += [self.in_set(ctx, int(w)) for w in out]
             else:
                 Pt = np.asarray(self.ports, dtype=bool)
                 clause += [
@@ -570,12 +637,18 @@ class Connected(Constraint):
                 ]
             ctx.add(clause)
 
+    def _name(self, problem: Problem) -> str:
+        return self.what or _set_name(problem, self.labels)
+
     def describe(self, problem: Problem) -> str:
         at = f" through {len(self.cells)} given cells" if len(self.cells) else ""
         how = " (through open tile edges)" if self.ports is not None else ""
-        return f"connected {_set_name(problem, self.labels)}{at}{how}"
+        some = ", at least one cell" if self.nonempty else ""
+        return f"connected {self._name(problem)}{at}{how}{some}"
 
     def to_json(self, problem: Problem) -> dict[str, Any]:
+        if self.members is not None:
+            raise InputError(f"connected {self._name(problem)}: per-cell members have no file form")
         d: dict[str, Any] = {"type": "connected", "labels": _labels_json(problem, self.labels)}
         if len(self.cells):
             d["cells"] = [list(problem.coords(c)) for c in self.cells]
@@ -587,6 +660,8 @@ class Connected(Constraint):
                 ]
                 for b in self.labels
             }
+        if self.nonempty:
+            d["nonempty"] = True
         return d
 
 

@@ -8,6 +8,8 @@ import sys
 from typing import Any
 
 from csplab.continuous.model import PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.continuous.user3d import UserConstraints3
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 
@@ -26,7 +28,9 @@ def region(args: argparse.Namespace, dim: int = 2) -> tuple[int, ...]:
     return tuple(shp)
 
 
-def boundary_label(args: argparse.Namespace, example: Any) -> Any:
+def boundary_label(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel
+) -> int | dict[str, int]:
     """``--boundary``: the label outside the region (default 0, empty space); for a
     polyhedral example also per face, e.g. ``z-=1`` (a ground below)."""
     b = args.boundary
@@ -66,14 +70,16 @@ def polygon_output(path: str | None, flag: str = "--out", gives: Any = "PolygonM
     return fmt
 
 
-def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> int:
+def synthesize(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel, opts: dict[str, Any]
+) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
-    from csplab.continuous.synthesis import synthesize as run2
-    from csplab.continuous.synthesis import synthesize3
+    from csplab.continuous.lattice import PlaneArrangement
+    from csplab.continuous.synthesis import synthesize as run
     from csplab.solvers import solver_class
 
-    dim = 2 if isinstance(example, PolygonModel) else 3
+    dim = example.ndim
 
     if args.periodic:
         raise InputError("--periodic: continuous models are not periodic")
@@ -85,7 +91,7 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
     size = region(args, dim)
     boundary = boundary_label(args, example)
-    fmt = polygon_output(args.out, gives="PolygonModel" if dim == 2 else "PolyhedralModel")
+    fmt = polygon_output(args.out, gives=type(example).__name__)
     cls = solver_class(args.solver.partition(":")[0])
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
@@ -107,39 +113,29 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
     if cons is not None:
-        common["constraints"] = cons
         settings["constraints"] = ", ".join(cons_summary(cons))
-        if cons.connected and cls.name == "sat":
-            common["progress"] = True  # the cut loop's rounds, once it takes over 2 s
-        if not cls.complete or cons.connected:
-            common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
     if dim == 2:
         settings["lines"] = args.lines
-        s = run2(example, size, lines=args.lines, **common, **opts)
-    else:
-        s = synthesize3(example, size, **common, **opts)
+    s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
     if fmt is not None and s.model is not None:
         fmt.write(s.model, args.out)
         wrote = args.out
-    A = csp.arrangement
+    A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
     fams = int((~A.boundary_only).sum())
-    if s.model is None:
-        polys = None
-    elif dim == 2:
-        polys = len(s.model)
-    else:
-        polys = s.model.n_polygons
+    out = s.model
+    polys = None if out is None else out.n_polygons
+    n_solids = len(out) if out is not None and out.ndim == 3 else None
     if args.json:
         d = r.to_dict()
         d.update(
             example=example.name, out=wrote, format="polygons" if dim == 2 else "polyhedra",
             settings=settings, size=list(size), spacing=spacing, vertices=A.n_vertices,
-            edges=A.n_edges, families=(A.dirs if dim == 2 else A.normals).tolist(),
+            edges=A.n_edges, families=A.family_vectors.tolist(),
             violations=len(s.violations), polygons=polys,
-            solids=len(s.model.solids) if dim == 3 and s.model is not None else None,
+            solids=n_solids,
             times={k: round(v, 6) for k, v in s.times.items()},
             outcome=outcome(r.status) if s.ok or r.status != "solved" else "not solved",
             proof=r.stats.get("proof") if r.status == "unsat" else None,
@@ -162,8 +158,8 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         if keys:
             print("  " + ", ".join(f"{k}={r.stats[k]}" for k in keys))
         if s.model is not None:
-            made = f"{polys} polygons" if dim == 2 else (
-                f"{len(s.model.solids)} solids of {polys} polygons")  # fmt: skip
+            made = f"{polys} polygons" if n_solids is None else (
+                f"{n_solids} solids of {polys} polygons")  # fmt: skip
             on = "polygons" if dim == 2 else "solids"
             print(
                 f"  {made}, labels {list(s.model.labels)}; "
@@ -186,52 +182,39 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     return 0 if s.ok else 1
 
 
-def check(args: argparse.Namespace, example: Any) -> int:
+def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> int:
     """``csplab check EXAMPLE.json OUT.json`` (or ``EXAMPLE.obj OUT.obj``): violations of
-    Eq. 4.1."""
+    Eq. 4.1 (and of the user constraints of thesis Sec. 4.6 on solids)."""
     from csplab.cli.common import load_model
     from csplab.continuous.check import violations
-    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.continuous.check3d import user_violations3
+    from csplab.continuous.defects import Violations
+    from csplab.continuous.lattice import Lattice
 
     out = load_model(args.grid)
-    if isinstance(example, PolyhedralModel):
-        from csplab.continuous.check3d import violations3
-
-        if not isinstance(out, PolyhedralModel):
-            raise InputError(f"{args.grid} is not a polyhedral model (the example {args.model} is)")
-        v3 = violations3(example, out)
+    if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
+        raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
+    v = violations(example, out)
+    if isinstance(out, PolyhedralModel):  # the user constraints of Sec. 4.6, on the solids
         cons = user_constraints(args, example)
         if cons is not None:
-            from csplab.continuous.check import Violations
-            from csplab.continuous.space import Lattice3
-            from csplab.continuous.user3d import user_violations3
-
-            lat = Lattice3.of_model(example)
+            lat = Lattice.of_model(example)
             origin = [float(x) for x in lat.origin]
             extra = user_violations3(out, cons, origin=origin, spacing=float(lat.spacing))
-            v3 = Violations([*v3, *extra])
-        if args.json:
-            print(json.dumps({"violations": len(v3), **v3.counts(), "solids": len(out.solids)}))
-        else:
-            print(f"{len(v3)} violations in {args.grid} ({len(out.solids)} solids, labels "
-                  f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
-            if len(v3):
-                print(v3.describe(args.limit))
-        return 0 if len(v3) == 0 else 1
-    if not isinstance(out, PolygonModel):
-        raise InputError(f"{args.grid} is not a polygon model (the example {args.model} is)")
-    v = violations(example, out)
+            v = Violations([*v, *extra])
     if args.json:
-        print(json.dumps({"violations": len(v), **v.counts(), "polygons": len(out)}))
+        print(json.dumps({"violations": len(v), **v.counts(), out.parts: len(out)}))
     else:
-        print(f"{len(v)} violations in {args.grid} ({len(out)} polygons, labels "
+        print(f"{len(v)} violations in {args.grid} ({len(out)} {out.parts}, labels "
               f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
         if len(v):
             print(v.describe(args.limit))
     return 0 if len(v) == 0 else 1
 
 
-def user_constraints(args: argparse.Namespace, example: Any) -> Any:
+def user_constraints(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel
+) -> UserConstraints3 | None:
     """The ``--constraints`` files merged (:mod:`csplab.continuous.user3d`), or ``None``."""
     if not getattr(args, "constraints", None):
         return None
@@ -245,13 +228,13 @@ def user_constraints(args: argparse.Namespace, example: Any) -> Any:
     return out
 
 
-def cons_summary(c: Any) -> list[str]:
+def cons_summary(c: UserConstraints3) -> list[str]:
     """One phrase per kind of user constraint."""
     out = []
     if c.dimensional:
         out.append("dimensional " + " ".join(f"{b}:{list(n)}" for b, n in c.dimensional))
     if c.allowed:
-        out.append(f"large-scale {len(c.allowed)} label(s) in voxels {list(c.voxel)}")
+        out.append(f"large-scale {len(c.allowed)} label(s) in voxels {list(c.voxel or ())}")
     if c.connected:
         out.append(f"connected {list(c.connected)}")
     return out

@@ -357,9 +357,8 @@ def problem_from_args(
 ) -> Problem:
     """The problem for ``--size`` (or ``shape``), ``--boundary`` and ``--periodic``."""
     if isinstance(model, PolygonModel | PolyhedralModel):
-        kind = "polygon" if isinstance(model, PolygonModel) else "polyhedral"
         raise InputError(
-            f"{model.name or args.model} is a {kind} model (continuous model synthesis): "
+            f"{model.name or args.model} is a {model.kind} model (continuous model synthesis): "
             "`csplab synthesize`, `check` and `show` take it; this command takes grid "
             "examples and tilesets"
         )

@@ -1,11 +1,15 @@
-"""Continuous model synthesis in 2D (thesis Ch. 4; Merrell & Manocha, SIGGRAPH Asia 2008).
+"""Continuous model synthesis in 2D and 3D (thesis Ch. 4; Merrell & Manocha, SIGGRAPH Asia
+2008).
 
-The example is a set of labelled polygons (:class:`PolygonModel`); lines parallel to its
-edges cut the plane (:class:`Arrangement`, exact on an integer lattice); the states of the
-arrangement's vertices and edges form an ordinary binary :class:`~csplab.problem.Problem`
-(:class:`ContinuousCSP`) that every csplab solver solves; the solution becomes polygons again
-(:meth:`ContinuousCSP.model`), and :func:`violations` checks Eq. 4.1 on those polygons.
-:func:`synthesize` does all of it.
+The example is a set of labelled polygons (:class:`PolygonModel`) or solids
+(:class:`PolyhedralModel`); lines parallel to its edges (planes parallel to its faces) cut
+the space (:class:`Arrangement`, :class:`~csplab.continuous.space.Arrangement3`, exact on
+one integer :class:`Lattice`); the states of the arrangement's vertices and edges form an
+ordinary binary :class:`~csplab.problem.Problem` (:func:`continuous_csp`:
+:class:`ContinuousCSP` or :class:`~csplab.continuous.csp3d.ContinuousCSP3`) that every
+csplab solver solves; the solution becomes polygons or solids again (``csp.model``), and
+:func:`violations` checks Eq. 4.1 on them. :func:`synthesize` does all of it, in either
+dimension (Alg. 4.1 is one algorithm).
 
 Examples
 --------
@@ -25,10 +29,12 @@ from __future__ import annotations
 
 from typing import Any
 
-from csplab.continuous.arrangement import Arrangement, Lattice
+from csplab.continuous.arrangement import Arrangement
 from csplab.continuous.check import Violations, violations
-from csplab.continuous.csp import ContinuousCSP
+from csplab.continuous.csp import ContinuousCSP, continuous_csp
+from csplab.continuous.lattice import Lattice
 from csplab.continuous.model import Polygon, PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
 
 __all__ = [
     "Arrangement",
@@ -36,8 +42,10 @@ __all__ = [
     "Lattice",
     "Polygon",
     "PolygonModel",
+    "PolyhedralModel",
     "Synthesis",
     "Violations",
+    "continuous_csp",
     "synthesize",
     "violations",
 ]

@@ -1,6 +1,7 @@
 """The line arrangement of continuous model synthesis (Alg. 4.1 step 1), exact.
 
-**The lattice.** The example's vertices are put on an integer lattice: ``origin`` is the
+**The lattice** (:class:`~csplab.continuous.lattice.Lattice`, one type in 2D and 3D). The
+example's vertices are put on an integer lattice: ``origin`` is the
 lower-left corner of its bounding box and ``spacing`` the largest length ``s`` such that every
 vertex is ``origin + s * (i, j)`` for integers ``i, j`` (the example's own vertices then lie on
 lines, and stretched copies of the example are solutions; ``--spacing`` overrides it, and
@@ -38,14 +39,13 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
-from fractions import Fraction
+from collections.abc import Sequence
 from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab.continuous.lattice import MAX_FAMILIES, Lattice, gcd_fractions, rational
 from csplab.errors import InputError
 
 __all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice", "gcd_fractions", "rational"]
@@ -55,153 +55,6 @@ __all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice", "gcd_fractions", "
 #: (``k`` a multiple of the integer nearest ``|n|``: all families about one spacing apart,
 #: as the 2008 paper spaces them; the example's corners then appear where those lines meet)
 LINES = ("lattice", "equal")
-
-#: rays are bits of an int64 mask (two per family)
-MAX_FAMILIES = 31
-_DEN = 10**6  # largest denominator when reading a float coordinate as a rational
-_REL = 1e-9  # a float coordinate is that rational if within this relative distance
-_SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
-
-
-def rational(x: float) -> Fraction:
-    """A float as the nearest fraction of denominator at most 10^6 (the example's
-    coordinates are checked against it)."""
-    return Fraction(x).limit_denominator(_DEN)
-
-
-def gcd_fractions(fs: Iterable[Fraction]) -> Fraction:
-    """The largest fraction of which every ``fs`` is an integer multiple (0 if all are 0).
-
-    >>> gcd_fractions([Fraction(5, 2), Fraction(15, 2), Fraction(10)])
-    Fraction(5, 2)
-    """
-    g = Fraction(0)
-    for f in fs:
-        f = abs(f)
-        if f == 0:
-            continue
-        if g == 0:
-            g = f
-        else:
-            lcm_den = g.denominator * f.denominator // math.gcd(g.denominator, f.denominator)
-            g = Fraction(
-                math.gcd(g.numerator * (lcm_den // g.denominator),
-                         f.numerator * (lcm_den // f.denominator)),
-                lcm_den,
-            )  # fmt: skip
-    return g
-
-
-def _primitive(dx: int, dy: int) -> tuple[int, int]:
-    g = math.gcd(dx, dy)
-    dx, dy = dx // g, dy // g
-    if dy < 0 or (dy == 0 and dx < 0):
-        dx, dy = -dx, -dy
-    return dx, dy
-
-
-def _angle(d: tuple[int, int]) -> float:
-    return math.atan2(d[1], d[0])
-
-
-@dataclass(frozen=True)
-class Lattice:
-    """Origin, spacing and edge directions (integer, primitive, angle in ``[0, pi)``)
-    of an example; see the module docstring. Build with :meth:`of`."""
-
-    origin: tuple[Fraction, Fraction]
-    spacing: Fraction
-    directions: tuple[tuple[int, int], ...]
-    #: largest distance (in spacings) a vertex was moved by ``snap`` (0 when exact)
-    snapped: float = 0.0
-
-    @classmethod
-    def of(
-        cls,
-        rings: Sequence[Sequence[tuple[float, float]]],
-        spacing: float | None = None,
-        *,
-        snap: bool = False,
-        max_extent: int = 256,
-        where: str = "<model>",
-    ) -> Lattice:
-        """The lattice of a set of rings (see the module docstring).
-
-        ``max_extent`` bounds the example's size in spacings (a default spacing that is
-        tiny because coordinates share no common unit asks for ``spacing=``).
-        """
-        pts = np.concatenate([np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings])
-        lo = pts.min(axis=0)
-        if spacing is not None:
-            if not (math.isfinite(spacing) and spacing > 0):
-                raise InputError(f"spacing must be a positive number, not {spacing!r}")
-            s = rational(float(spacing))
-            origin = (rational(float(lo[0])), rational(float(lo[1])))
-        else:
-            fr = [[rational(float(v)) for v in p] for p in pts.tolist()]
-            for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
-                for v, q in zip(p, f, strict=True):
-                    if abs(float(q) - v) > _REL * max(1.0, abs(v)):
-                        raise InputError(
-                            f"{where}: vertex {i} ({p[0]:g}, {p[1]:g}) has no exact rational "
-                            "form; pass a spacing (and snap=true to round vertices onto it)"
-                        )
-            origin = (min(f[0] for f in fr), min(f[1] for f in fr))
-            s = gcd_fractions([f[a] - origin[a] for f in fr for a in (0, 1)])
-            if s == 0:
-                raise InputError(f"{where}: the example has no extent")
-        u = (pts - np.array([float(origin[0]), float(origin[1])])) / float(s)
-        iu = np.rint(u)
-        off = float(np.abs(u - iu).max()) if u.size else 0.0
-        if off > _SNAP_TOL and not snap:
-            k = int(np.abs(u - iu).max(axis=1).argmax())
-            raise InputError(
-                f"{where}: vertex ({pts[k, 0]:g}, {pts[k, 1]:g}) is {off:.3g} spacings off the "
-                f"lattice of spacing {float(s):g}; choose another spacing or snap=true"
-            )
-        ext = int(iu.max()) if iu.size else 0
-        if ext > max_extent:
-            raise InputError(
-                f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
-                f"{max_extent}); pass a larger spacing (with snap=true if vertices are off it)"
-            )
-        dirs: set[tuple[int, int]] = set()
-        start = 0
-        for r in rings:
-            m = len(r)
-            ring = iu[start : start + m].astype(np.int64)
-            start += m
-            nxt = np.roll(ring, -1, axis=0)
-            for (x0, y0), (x1, y1) in zip(ring.tolist(), nxt.tolist(), strict=True):
-                if (x0, y0) != (x1, y1):
-                    dirs.add(_primitive(x1 - x0, y1 - y0))
-        if len(dirs) > MAX_FAMILIES - 2:
-            raise InputError(
-                f"{where}: {len(dirs)} edge directions; at most {MAX_FAMILIES - 2} are supported "
-                "(use bounding shapes, Sec. 4.6.4, or a coarser spacing with snap=true)"
-            )
-        return cls(origin, s, tuple(sorted(dirs, key=_angle)), off if snap else 0.0)
-
-    def to_lattice(self, xy: NDArray[np.float64]) -> NDArray[np.int64]:
-        """World coordinates -> integer lattice coordinates (rounded)."""
-        o = np.array([float(self.origin[0]), float(self.origin[1])])
-        out: NDArray[np.int64] = np.rint(
-            (np.asarray(xy, dtype=np.float64) - o) / float(self.spacing)
-        ).astype(np.int64)
-        return out
-
-    def to_world(self, uv: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Lattice coordinates (floats) -> world coordinates."""
-        o = np.array([float(self.origin[0]), float(self.origin[1])])
-        return o + np.asarray(uv, dtype=np.float64) * float(self.spacing)
-
-    def families(self) -> tuple[tuple[tuple[int, int], ...], tuple[bool, ...]]:
-        """Directions of all line families in angular order, with the horizontal and
-        vertical ones added if missing, and which of them are boundary-only."""
-        ds = list(self.directions)
-        extra = [d for d in ((1, 0), (0, 1)) if d not in ds]
-        allds = sorted(ds + extra, key=_angle)
-        return tuple(allds), tuple(d in extra for d in allds)
 
 
 def _lcm(a: int, b: int) -> int:
@@ -308,6 +161,16 @@ class Arrangement:
 
     # ------------------------------------------------------------------ sizes
     @property
+    def family_vectors(self) -> NDArray[np.int64]:
+        """The vector naming each family: its edge direction (2D; a face normal in 3D)."""
+        return self.dirs
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """The region ``(W, H)`` in spacings."""
+        return self.W, self.H
+
+    @property
     def n_vertices(self) -> int:
         return int(self.X.size)
 
@@ -322,14 +185,14 @@ class Arrangement:
         a = np.arctan2(self.dirs[:, 1], self.dirs[:, 0]).astype(np.float64)
         return np.concatenate([a, a + np.pi])
 
-    def vertex_xy(self) -> NDArray[np.float64]:
+    def vertex_positions(self) -> NDArray[np.float64]:
         """Vertices in lattice units, ``(n, 2)`` floats."""
         out: NDArray[np.float64] = np.stack([self.X, self.Y], axis=1) / self.D
         return out
 
-    def edge_xy(self) -> NDArray[np.float64]:
+    def edge_positions(self) -> NDArray[np.float64]:
         """Edge midpoints in lattice units."""
-        v = self.vertex_xy()
+        v = self.vertex_positions()
         out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 

@@ -13,8 +13,9 @@ the two polygon sets only, independently of the arrangement and the CSP that pro
    polygon is left of its rings, every other side is label 0). Points on an edge between
    nodes look like the two rays of that edge; points off the boundaries like their label.
 3. Neighbourhoods are compared in reduced form (rays whose sides differ, each with the label
-   after it; see :func:`csplab.continuous.csp.reduce_signature`); a node or node-side of an
-   edge of ``M`` whose neighbourhood never occurs in ``E`` is a violation.
+   after it, :func:`reduced`; the checker's own, written apart from the CSP's states); a
+   node or node-side of an edge of ``M`` whose neighbourhood never occurs in ``E`` is a
+   violation.
 
 Coordinates are floats; two points are one node if they agree to ``1e-9`` of the models'
 extent. Polygons with the same label are merged first (touching same-label pieces are one
@@ -40,7 +41,7 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,57 +49,40 @@ import numpy as np
 import shapely
 from shapely.geometry.polygon import orient
 
-from csplab.continuous.csp import Signature, reduce_signature
+from csplab.continuous.check3d import violations3
+from csplab.continuous.defects import Defect, Violations
 from csplab.continuous.model import Polygon, PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.errors import InputError
 
-__all__ = ["Defect", "Violations", "neighbourhoods", "violations"]
+__all__ = ["Defect", "Violations", "neighbourhoods", "reduced", "violations", "violations2"]
+
+_FACES = ("z-", "z+", "x-", "x+", "y-", "y+")
+
+#: a reduced neighbourhood: ``(ray, label after it)`` pairs, or ``((-1, label),)``
+Signature = tuple[tuple[int, int], ...]
 
 ANGLE_TOL = 1e-7
 _FOREIGN = 1 << 20  # ray ids of directions the example does not have start here
 
 
-@dataclass(frozen=True)
-class Defect:
-    """One violation: ``kind`` is ``"direction"``, ``"edge"``, ``"vertex"`` or ``"label"``."""
+def reduced(rays: list[int], sectors: list[int]) -> Signature:
+    """The reduced form of a neighbourhood: the rays (in angular order) whose sector label
+    ``sectors[i]`` (counter-clockwise after ``rays[i]``) differs from the one before, each
+    with that label; a neighbourhood of one label everywhere is ``((-1, label),)``.
 
-    kind: str
-    point: tuple[float, float]
-    detail: str
-
-    def __str__(self) -> str:
-        x, y = self.point
-        return f"{self.kind} at ({x:.6g}, {y:.6g}): {self.detail}"
-
-
-class Violations:
-    """The defects :func:`violations` found (a sequence; empty means Eq. 4.1 holds)."""
-
-    def __init__(self, defects: list[Defect]) -> None:
-        self.defects = defects
-
-    def __len__(self) -> int:
-        return len(self.defects)
-
-    def __iter__(self) -> Iterator[Defect]:
-        return iter(self.defects)
-
-    def __getitem__(self, i: int) -> Defect:
-        return self.defects[i]
-
-    def __bool__(self) -> bool:
-        return bool(self.defects)
-
-    def counts(self) -> dict[str, int]:
-        out: dict[str, int] = {}
-        for d in self.defects:
-            out[d.kind] = out.get(d.kind, 0) + 1
-        return dict(sorted(out.items()))
-
-    def describe(self, limit: int = 10) -> str:
-        """A summary line and the first ``limit`` defects."""
-        c = ", ".join(f"{v} {k}" for k, v in self.counts().items())
-        head = f"{len(self)} violations of Eq. 4.1" + (f" ({c})" if c else "")
-        return "\n".join([head, *(f"  {d}" for d in self.defects[:limit])])
+    >>> reduced([0, 1, 2, 3], [1, 1, 0, 0])
+    ((0, 1), (2, 0))
+    >>> reduced([0, 2], [5, 5])
+    ((-1, 5),)
+    """
+    pairs = list(zip(rays, sectors, strict=True))
+    changes = tuple(
+        (int(r), int(b))
+        for (r, b), (_, prev) in zip(pairs, pairs[-1:] + pairs[:-1], strict=True)
+        if b != prev
+    )
+    return changes or ((-1, int(sectors[0]) if sectors else 0),)
 
 
 class _Families:
@@ -250,18 +234,52 @@ def neighbourhoods(
             if len(cand) > 1:
                 defects.append(Defect("label", n.point, f"labels {sorted(cand)} overlap here"))
             sect.append(min(cand) if cand else 0)
-        vsig.setdefault(reduce_signature(rays, sect), n.point)
+        vsig.setdefault(reduced(rays, sect), n.point)
         for i, r in enumerate(rays):
             after, before = sect[i], sect[i - 1]
             if r >= _FOREIGN:
                 continue  # reported once per edge by violations()
             f = r % F
             L, R = (after, before) if r < F else (before, after)
-            esig.setdefault(reduce_signature([f, F + f], [L, R]), n.point)
+            esig.setdefault(reduced([f, F + f], [L, R]), n.point)
     return vsig, esig, defects
 
 
 def violations(
+    example: PolygonModel | PolyhedralModel,
+    model: PolygonModel | PolyhedralModel,
+    *,
+    region: Sequence[float] | None = None,
+    outside: int | Mapping[str, int] = 0,
+) -> Violations:
+    """Eq. 4.1 for an output of either dimension: :func:`violations2` on polygon models,
+    :func:`~csplab.continuous.check3d.violations3` on polyhedral ones. ``region``: the
+    output region (``x0, y0, x1, y1`` or ``x0, y0, z0, x1, y1, z1``); ``outside``: the label
+    around it (in 3D also one per face, ``{"z-": 1}``).
+
+    >>> from csplab.continuous.model import PolygonModel
+    >>> E = PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [1, 0],
+    ...     [0, 1]]}]})
+    >>> len(violations(E, E))
+    0
+    """
+    if isinstance(example, PolygonModel) and isinstance(model, PolygonModel):
+        if isinstance(outside, Mapping):
+            raise InputError("a polygon model has one label outside its region, not one per face")
+        r2 = None if region is None else (region[0], region[1], region[2], region[3])
+        return violations2(example, model, region=r2, outside=outside)
+    if isinstance(example, PolyhedralModel) and isinstance(model, PolyhedralModel):
+        faces = outside if isinstance(outside, Mapping) else dict.fromkeys(_FACES, outside)
+        r3 = None if region is None else (region[0], region[1], region[2], region[3], region[4],
+                                          region[5])  # fmt: skip
+        return violations3(example, model, region=r3, outside=faces)
+    raise InputError(
+        f"{model.source} is a {model.ndim}D model and the example {example.source} a "
+        f"{example.ndim}D one"
+    )
+
+
+def violations2(
     example: PolygonModel,
     model: PolygonModel,
     *,
@@ -269,8 +287,8 @@ def violations(
     region: tuple[float, float, float, float] | None = None,
     outside: int = 0,
 ) -> Violations:
-    """Every place where ``model`` breaks Eq. 4.1 w.r.t. ``example`` (see the module
-    docstring); ``len() == 0`` means the model is a valid output.
+    """Every place where the polygon model ``model`` breaks Eq. 4.1 w.r.t. ``example``
+    (see the module docstring); ``len() == 0`` means the model is a valid output.
 
     ``region`` ``(x0, y0, x1, y1)`` and ``outside``: the model fills that rectangle and
     the plane around it has label ``outside`` (a synthesis with a boundary label other than

@@ -4,10 +4,10 @@
 that produced the output). The example's face orientations, up to sign and within
 ``angle_tol``, are its plane families; an output face of another orientation is a violation.
 A neighbourhood is written as the label in every cell of the central arrangement of all
-families' planes through the point (:func:`~csplab.continuous.space.central_cells`): the
-label just off the point in a direction inside the cell, found by the generalised winding
-number of each label's triangles. Two points are locally identical exactly when these
-labelings agree.
+families' planes through the point (:func:`cone_cells`, the checker's own enumeration,
+written apart from the CSP's): the label just off the point in a direction inside the cell,
+found by point location in each label's triangles. Two points are locally identical exactly
+when these labelings agree.
 
 The example's neighbourhoods are sampled densely (every vertex; points along every edge;
 a grid of points on every triangle), so that features that change along an edge or across a
@@ -36,30 +36,33 @@ from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Mapping
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from csplab.continuous._geom import point_labels, points_on_segments
-from csplab.continuous.check import Defect, Violations
-from csplab.continuous.space import central_cells
+from csplab.continuous.defects import Defect, Violations
+from csplab.continuous.polyhedra import PolyhedralModel, Solid
 
-__all__ = ["violations3"]
+if TYPE_CHECKING:  # the constraints' data only: the checker reads them, as given
+    from csplab.continuous.user3d import UserConstraints3
+
+__all__ = ["cone_cells", "user_violations3", "violations3"]
 
 ANGLE_TOL = 1e-7
 # per model (immutable), its polygons' normals and points: computed once per check
-_POLYGON_ARRAYS: weakref.WeakKeyDictionary[Any, tuple[NDArray[np.float64], NDArray[np.float64]]] = (
-    weakref.WeakKeyDictionary()
-)
+_POLYGON_ARRAYS: weakref.WeakKeyDictionary[
+    PolyhedralModel | _Joined, tuple[NDArray[np.float64], NDArray[np.float64]]
+] = weakref.WeakKeyDictionary()
 
 
 class _Joined:
     """Solids of a model plus the frame of outside labels (no validation: the frame touches
     the model on the region's faces by construction)."""
 
-    def __init__(self, solids: list[Any], model: Any) -> None:
+    def __init__(self, solids: list[Solid], model: PolyhedralModel) -> None:
         self.solids = solids
         self.labels = tuple(sorted({int(s.label) for s in solids}))
         self.bounds = model.bounds if len(model.solids) else (0.0,) * 6
@@ -69,7 +72,80 @@ class _Joined:
         return sum(len(s.polygons) for s in self.solids)
 
 
-def _polygon_arrays(model: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+#: what the checker reads: a model, or a model with the frame of outside labels
+Solids = PolyhedralModel | _Joined
+
+
+def cone_cells(normals: NDArray[np.float64]) -> tuple[NDArray[np.int8], NDArray[np.float64]]:
+    """The cells of the central arrangement of the planes ``n . x = 0`` (``normals``
+    ``(F, 3)`` with three independent ones; relative tolerance 1e-9): their sign vectors
+    ``(c, F)`` sorted, and a unit direction inside each.
+
+    On the unit sphere the planes are great circles and every cell is a convex polygon with
+    at least three corners. At a corner ``q`` where circles ``A`` and ``B`` bound the cell,
+    the next vertices ``p`` along ``A`` and ``r`` along ``B`` are corners of the cell too,
+    so ``p + q + r`` points into it: the candidates are these sums for every vertex, every
+    two circles through it and both ways along each; those on no circle name a cell.
+
+    >>> cone_cells(np.eye(3))[0].shape                  # the eight octants
+    (8, 3)
+    >>> len(cone_cells(np.array([[1., 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]]))[0])
+    14
+    """
+    N = np.asarray(normals, dtype=np.float64)
+    N = N / np.linalg.norm(N, axis=1)[:, None]
+    tol = 1e-9
+    verts: list[NDArray[np.float64]] = []
+    for i in range(len(N)):
+        for j in range(i + 1, len(N)):
+            c = np.cross(N[i], N[j])
+            size = float(np.linalg.norm(c))
+            if size > tol:
+                verts += [c / size, -c / size]
+    V: NDArray[np.float64] = np.zeros((0, 3))
+    if verts:
+        V = _unique_rows(np.round(np.array(verts, dtype=np.float64), 9).astype(np.float64) + 0.0)
+    on = np.abs(V @ N.T) <= tol  # (vertices, circles): which circles pass through a vertex
+    # along each circle, the vertices on it in angular order
+    nxt: dict[tuple[int, int, int], int] = {}  # (vertex, circle, +-1) -> the next vertex
+    for f in range(len(N)):
+        ids = np.flatnonzero(on[:, f])
+        if len(ids) < 2:
+            continue
+        a = np.eye(3)[int(np.argmin(np.abs(N[f])))]
+        e1 = np.cross(N[f], a)
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(N[f], e1)
+        ang = np.arctan2(V[ids] @ e2, V[ids] @ e1)
+        ring = ids[np.argsort(ang)].tolist()
+        for k, v in enumerate(ring):
+            nxt[(v, f, 1)] = ring[(k + 1) % len(ring)]
+            nxt[(v, f, -1)] = ring[k - 1]
+    cand = []
+    for q in range(len(V)):
+        circles = np.flatnonzero(on[q]).tolist()
+        for ai, A in enumerate(circles):
+            for B in circles[ai + 1 :]:
+                for sa in (1, -1):
+                    for sb in (1, -1):
+                        p, r = nxt.get((q, A, sa)), nxt.get((q, B, sb))
+                        if p is not None and r is not None:
+                            cand.append(V[p] + V[q] + V[r])
+    D = np.array(cand).reshape(-1, 3)
+    D = D[np.linalg.norm(D, axis=1) > tol]
+    D /= np.linalg.norm(D, axis=1)[:, None]
+    proj = D @ N.T
+    D = D[(np.abs(proj) > tol).all(axis=1)]
+    sg = np.sign(D @ N.T).astype(np.int8)
+    keys, inv = np.unique(sg, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    dirs = np.zeros((len(keys), 3))
+    np.add.at(dirs, inv, D)  # the mean of points of a convex cone lies in it
+    dirs /= np.linalg.norm(dirs, axis=1)[:, None]
+    return keys, dirs
+
+
+def _polygon_arrays(model: Solids) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Unit normal and one point (a triangle's centre) of every polygon of every solid,
     ``(n, 3)`` each, from the triangles grouped by polygon (cached on the model)."""
     cached = _POLYGON_ARRAYS.get(model)
@@ -96,7 +172,7 @@ def _polygon_arrays(model: Any) -> tuple[NDArray[np.float64], NDArray[np.float64
     return n, c
 
 
-def _families(example: Any, tol: float) -> NDArray[np.float64]:
+def _families(example: PolyhedralModel, tol: float) -> NDArray[np.float64]:
     fams: list[NDArray[np.float64]] = []
     for n in _polygon_arrays(example)[0]:
         if not any(abs(abs(float(n @ f)) - 1) <= tol for f in fams):
@@ -105,12 +181,12 @@ def _families(example: Any, tol: float) -> NDArray[np.float64]:
     return np.array(fams)
 
 
-def _triangles(model: Any) -> list[tuple[int, NDArray[np.float64]]]:
+def _triangles(model: Solids) -> list[tuple[int, NDArray[np.float64]]]:
     return [(int(s.label), np.asarray(s.vertices, dtype=np.float64)[np.asarray(s.faces)])
             for s in model.solids]  # fmt: skip
 
 
-def _samples(model: Any, dense: int) -> NDArray[np.float64]:
+def _samples(model: Solids, dense: int) -> NDArray[np.float64]:
     """Points where ``model``'s neighbourhoods are taken: vertices, edge pieces, triangles
     (``dense`` > 1: that many points along each edge and a grid on each triangle)."""
     pts = [np.asarray(s.vertices, dtype=np.float64) for s in model.solids]
@@ -231,7 +307,7 @@ def _labelings(
     return out
 
 
-def _plane_offsets(models: list[Any], normals: NDArray[np.float64],
+def _plane_offsets(models: list[Solids], normals: NDArray[np.float64],
                    tol: float) -> list[NDArray[np.float64]]:  # fmt: skip
     """Per family, the offsets ``n . x`` of the models' faces of that orientation."""
     out: list[list[NDArray[np.float64]]] = [[] for _ in normals]
@@ -270,8 +346,8 @@ def _frame(region: tuple[float, ...], outside: Mapping[str, int]) -> list[dict[s
 
 
 def violations3(
-    example: Any,
-    model: Any,
+    example: PolyhedralModel,
+    model: PolyhedralModel,
     *,
     angle_tol: float = ANGLE_TOL,
     region: tuple[float, float, float, float, float, float] | None = None,
@@ -283,24 +359,23 @@ def violations3(
     z1``): only points in it are checked; outside it is empty space, or the labels
     ``outside`` gives per face (``{"z-": 1}``: a ground below)."""
     defects: list[Defect] = []
+    solids: Solids = model
     if region is not None and outside and any(outside.values()):
-        from csplab.continuous.polyhedra import PolyhedralModel
-
         frame = PolyhedralModel(_frame(tuple(region), outside), merge_coplanar=False)
-        model = _Joined([*model.solids, *frame.solids], model)
+        solids = _Joined([*model.solids, *frame.solids], model)
     fams = _families(example, angle_tol)
-    for b in model.labels:
+    for b in solids.labels:
         if b not in example.labels:
             defects.append(Defect("label", (math.nan, math.nan),
                                   f"label {b} does not occur in the example"))  # fmt: skip
-    pn, pc = _polygon_arrays(model)
+    pn, pc = _polygon_arrays(solids)
     off_family = (np.abs(np.abs(pn @ fams.T) - 1) > angle_tol).all(axis=1)
     for i in np.flatnonzero(off_family).tolist():
         n, c = pn[i], pc[i].tolist()
         where = tuple(round(x, 6) for x in c)
         msg = f"a face with normal {np.round(n, 6)} at {where}, an orientation the example"
         defects.append(Defect("direction", (c[0], c[1]), msg + " does not have"))
-    if any(d.kind == "direction" for d in defects) or not len(model.solids):
+    if any(d.kind == "direction" for d in defects) or not len(solids.solids):
         return Violations(defects)
     # every family plus the axes, so that at least three independent normals exist
     N = np.concatenate([fams, np.eye(3)])
@@ -309,24 +384,24 @@ def violations3(
         if not any(abs(abs(float(n @ N[j])) - 1) <= angle_tol for j in keep):
             keep.append(i)
     N = N[keep]
-    cells = central_cells(N)
+    cells = cone_cells(N)
     dirs = cells[1]
-    lo = np.minimum(np.array(example.bounds[:3]), np.array(model.bounds[:3]))
-    hi = np.maximum(np.array(example.bounds[3:]), np.array(model.bounds[3:]))
+    lo = np.minimum(np.array(example.bounds[:3]), np.array(solids.bounds[:3]))
+    hi = np.maximum(np.array(example.bounds[3:]), np.array(solids.bounds[3:]))
     scale = float(max(1.0, (hi - lo).max()))
     eps = 1e-5 * scale
-    E_tris, M_tris = _triangles(example), _triangles(model)
+    E_tris, M_tris = _triangles(example), _triangles(solids)
     e_pts = _samples(example, dense)
     e_planes = _plane_offsets([example], N, angle_tol)
     allowed = {tuple(r) for r in _labelings(e_pts, cells, E_tris, e_planes, N, eps).tolist()}
     allowed |= {(b,) * len(dirs) for b in (0, *example.labels)}
-    m_pts = _samples(model, 1)
+    m_pts = _samples(solids, 1)
     if region is not None:
         r = np.asarray(region, dtype=np.float64)
         t = 1e-9 * scale
         m_pts = m_pts[((m_pts >= r[:3] - t) & (m_pts <= r[3:] + t)).all(axis=1)]
     seen: set[tuple[int, ...]] = set()
-    m_planes = _plane_offsets([model], N, angle_tol)
+    m_planes = _plane_offsets([solids], N, angle_tol)
     m_arr = _labelings(m_pts, cells, M_tris, m_planes, N, eps)
     # each distinct neighbourhood once, at its first point (in the points' order)
     rows = np.ascontiguousarray(m_arr.astype(np.int32))
@@ -343,3 +418,94 @@ def violations3(
                               f"(labels {sorted(set(lab))} around it) does not occur in the "
                               "example"))  # fmt: skip
     return Violations(defects)
+
+
+# ----------------------------------------------------------------------------- user constraints
+def user_violations3(
+    model: PolyhedralModel,
+    c: UserConstraints3,
+    *,
+    origin: Sequence[float],
+    spacing: float,
+) -> list[Defect]:
+    """The user constraints ``model`` breaks, from its solids alone (see the module
+    docstring); ``origin`` and ``spacing`` place the plane lattice and the voxels (the
+    region's corner and the plane spacing)."""
+    out: list[Defect] = []
+    o = np.asarray(origin, dtype=np.float64)
+    s = float(spacing)
+    tol = 1e-7
+    for b, n in c.dimensional:
+        nn = np.asarray(n, dtype=np.float64)
+        for i, sol in enumerate(model.solids):
+            if sol.label != b:
+                continue
+            k = ((np.asarray(sol.vertices) - o) / s) @ nn
+            if k.max() - k.min() > 1 + tol:
+                p = sol.vertices[int(k.argmax())]
+                out.append(Defect("dimensional", (float(p[0]), float(p[1])),
+                                  f"solid {i} (label {b}) spans {k.max() - k.min():.6g} plane "
+                                  f"spacings along {list(n)} (at most 1)"))  # fmt: skip
+    if c.allowed and c.voxel is not None:
+        out += _large_scale(model, c, o, s)
+    for b in c.connected:
+        groups = _touching_groups([sol for sol in model.solids if sol.label == b])
+        if groups != 1:
+            out.append(Defect("connected", (float("nan"), float("nan")),
+                              f"the objects of label {b} form {groups} separate groups "
+                              "(exactly one is required)"))  # fmt: skip
+    return out
+
+
+def _touching_groups(solids: list[Solid]) -> int:
+    """Groups of solids whose closures meet at a common vertex."""
+    if len(solids) <= 1:
+        return len(solids)
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    pts = np.concatenate([np.asarray(sol.vertices) for sol in solids])
+    owner = np.repeat(np.arange(len(solids)), [len(sol.vertices) for sol in solids])
+    _, inv = np.unique(np.round(pts, 9), axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    n = len(solids)
+    g = coo_matrix((np.ones(len(owner)), (owner, n + inv)), shape=(n + int(inv.max()) + 1,) * 2)
+    comp = connected_components(g, directed=False)[1][:n]
+    return len(np.unique(comp))
+
+
+def _large_scale(
+    model: PolyhedralModel, c: UserConstraints3, o: NDArray[np.float64], s: float
+) -> list[Defect]:
+    """Solids of a large-scale label meeting a voxel not allowed for it (manifold3d
+    intersection volume above 1e-9 of the voxel)."""
+    import manifold3d as man
+
+    assert c.voxel is not None
+    size = np.asarray(c.voxel, dtype=np.float64) * s
+    out: list[Defect] = []
+    for b, cells in c.allowed:
+        for i, sol in enumerate(model.solids):
+            if sol.label != b:
+                continue
+            lo = np.floor((sol.vertices.min(axis=0) - o) / size + 1e-9).astype(int)
+            hi = np.ceil((sol.vertices.max(axis=0) - o) / size - 1e-9).astype(int)
+            m = None
+            for x in range(lo[0], hi[0]):
+                for y in range(lo[1], hi[1]):
+                    for z in range(lo[2], hi[2]):
+                        if (x, y, z) in cells:
+                            continue
+                        if m is None:
+                            m = sol.to_manifold(f"solid {i}")
+                        box = man.Manifold.cube(size.tolist()).translate(
+                            (o + np.array([x, y, z]) * size).tolist()
+                        )
+                        vol = float((m ^ box).volume())
+                        if vol > 1e-9 * float(np.prod(size)):
+                            out.append(Defect("large-scale", (float(o[0] + x * size[0]),
+                                                              float(o[1] + y * size[1])),
+                                              f"solid {i} (label {b}) has volume {vol:.6g} "
+                                              f"in voxel {[x, y, z]}, where label {b} is "
+                                              "not allowed"))  # fmt: skip
+    return out

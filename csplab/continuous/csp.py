@@ -42,19 +42,28 @@ True
 from __future__ import annotations
 
 import bisect
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import Any, overload
 
 import numpy as np
 import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
+from csplab.continuous.csp3d import ContinuousCSP3
 from csplab.continuous.model import Polygon, PolygonModel
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.continuous.user3d import UserConstraints3
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["ContinuousCSP", "Signature", "example_signatures", "reduce_signature"]
+__all__ = [
+    "ContinuousCSP",
+    "Signature",
+    "continuous_csp",
+    "example_signatures",
+    "reduce_signature",
+]
 
 Signature = tuple[tuple[int, int], ...]
 _EPS = 1e-6  # offset (in lattice units / D) of the sample points beside an edge
@@ -95,7 +104,7 @@ def _edge_labels(
 ) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     """Labels left and right of each edge of ``A`` by point location in ``shapes``
     (``{label: geometry}`` in lattice units shifted by ``offset``)."""
-    mid = A.edge_xy() - np.asarray(offset)
+    mid = A.edge_positions() - np.asarray(offset)
     d = A.dirs[A.edge_family].astype(np.float64)
     nrm = np.stack([-d[:, 1], d[:, 0]], axis=1) / np.hypot(d[:, 0], d[:, 1])[:, None]
     eps = _EPS / A.D
@@ -132,8 +141,8 @@ def example_signatures(
 ) -> set[Signature]:
     """Every reduced neighbourhood of ``example`` (labels compacted by ``label_index``),
     from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b))."""
-    lo = lattice.to_lattice(np.array([example.bounds[:2]]))[0]
-    hi = lattice.to_lattice(np.array([example.bounds[2:]]))[0]
+    lo = np.rint(lattice.to_lattice(np.array([example.bounds[:2]]))[0]).astype(np.int64)
+    hi = np.rint(lattice.to_lattice(np.array([example.bounds[2:]]))[0]).astype(np.int64)
     A = Arrangement(lattice, int(hi[0] - lo[0]) + 2, int(hi[1] - lo[1]) + 2)
     s = float(lattice.spacing)
     o = np.array([float(lattice.origin[0]), float(lattice.origin[1])])
@@ -201,12 +210,7 @@ class ContinuousCSP:
         if not example.polygons:
             raise InputError(f"{example.source}: an example needs at least one polygon")
         self.example = example
-        self.lattice = lattice or Lattice.of(
-            [r for p in example.polygons for r in p.rings()],
-            spacing,
-            snap=snap,
-            where=example.source,
-        )
+        self.lattice = lattice or Lattice.of_model(example, spacing, snap=snap)
         if self.lattice.snapped:
             example = _snapped(example, self.lattice)
             self.example = example
@@ -281,7 +285,7 @@ class ContinuousCSP:
                     rels.append(M)
                 pos_rel[t, r] = rel_ids[k]
         # variables in scan order of their positions
-        pos = np.concatenate([A.vertex_xy(), A.edge_xy()])
+        pos = np.concatenate([A.vertex_positions(), A.edge_positions()])
         order = np.lexsort((pos[:, 1], pos[:, 0]))
         var = np.empty(nv + ne, dtype=np.int64)
         var[order] = np.arange(nv + ne)
@@ -479,7 +483,7 @@ def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
     """The example with every vertex rounded onto ``lattice``."""
 
     def snap(r: Sequence[tuple[float, float]]) -> list[list[float]]:
-        uv = lattice.to_lattice(np.asarray(r, dtype=np.float64)).astype(np.float64)
+        uv = np.rint(lattice.to_lattice(np.asarray(r, dtype=np.float64)))
         return lattice.to_world(uv).tolist()  # type: ignore[no-any-return]
 
     polys = [
@@ -488,3 +492,57 @@ def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
         for p in example.polygons
     ]  # fmt: skip
     return PolygonModel(polys, name=example.name, meta=example.meta, source=example.source)
+
+
+@overload
+def continuous_csp(
+    example: PolygonModel,
+    size: Sequence[int],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int | Mapping[str, int] = 0,
+    lines: str = "lattice",
+    constraints: UserConstraints3 | None = None,
+) -> ContinuousCSP: ...
+
+
+@overload
+def continuous_csp(
+    example: PolyhedralModel,
+    size: Sequence[int],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int | Mapping[str, int] = 0,
+    lines: str = "lattice",
+    constraints: UserConstraints3 | None = None,
+) -> ContinuousCSP3: ...
+
+
+def continuous_csp(
+    example: PolygonModel | PolyhedralModel,
+    size: Sequence[int],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    boundary: int | Mapping[str, int] = 0,
+    lines: str = "lattice",
+    constraints: UserConstraints3 | None = None,
+) -> ContinuousCSP | ContinuousCSP3:
+    """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4) for an example of either
+    dimension: :class:`ContinuousCSP` of a polygon model in a ``W x H`` region (``lines``),
+    :class:`~csplab.continuous.csp3d.ContinuousCSP3` of a polyhedral one in ``A x B x C``
+    (``boundary`` also per face, user ``constraints`` of thesis Sec. 4.6). Both give
+    ``problem``, ``lattice``, ``arrangement``, ``labels``, ``boundary``, ``region()``,
+    ``model(grid)`` and ``encode(model)``."""
+    if isinstance(example, PolyhedralModel):
+        if lines != "lattice":
+            raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")
+        return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
+                              constraints=constraints)  # fmt: skip
+    if constraints:
+        raise InputError("polygon models (2D) take no user constraints yet")
+    if isinstance(boundary, Mapping):
+        raise InputError("a polygon model has one label outside its region, not one per face")
+    return ContinuousCSP(example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines)

@@ -25,6 +25,7 @@ csplab.errors.InputError: bow.json: polygon 0: its boundary crosses itself (Self
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -193,6 +194,9 @@ class PolygonModel:
     # ------------------------------------------------------------------ queries
     #: continuous models are planar
     ndim = 2
+    #: what the model is made of, and its adjective (shared names with PolyhedralModel)
+    parts = "polygons"
+    kind = "polygon"
 
     @property
     def labels(self) -> tuple[int, ...]:
@@ -219,6 +223,20 @@ class PolygonModel:
         """Every ring vertex, ``(n, 2)``."""
         return np.concatenate([np.asarray(r, dtype=np.float64)
                                for p in self.polygons for r in p.rings()])  # fmt: skip
+
+    def indexed_faces(self) -> tuple[NDArray[np.float64], list[list[int]]]:
+        """Every ring vertex ``(n, 2)`` and the rings as lists of indices into them (what
+        :meth:`Lattice.of_model <csplab.continuous.lattice.Lattice.of_model>` reads, as
+        from a polyhedral model's vertices and faces)."""
+        rings = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for p in self.polygons
+                 for r in p.rings()]  # fmt: skip
+        starts = np.cumsum([0, *(len(r) for r in rings)]).tolist()
+        return np.concatenate(rings), [list(range(a, b)) for a, b in itertools.pairwise(starts)]
+
+    @property
+    def n_polygons(self) -> int:
+        """The number of polygons (as :attr:`PolyhedralModel.n_polygons` counts faces)."""
+        return len(self.polygons)
 
     def __len__(self) -> int:
         return len(self.polygons)

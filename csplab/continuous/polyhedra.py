@@ -160,6 +160,9 @@ class PolyhedralModel:
 
     #: polyhedral models are spatial
     ndim = 3
+    #: what the model is made of, and its adjective (shared names with PolygonModel)
+    parts = "solids"
+    kind = "polyhedral"
 
     def __init__(
         self,
@@ -220,6 +223,18 @@ class PolyhedralModel:
     def labels(self) -> tuple[int, ...]:
         """The object labels used (sorted; 0 is implicit everywhere else)."""
         return tuple(sorted({s.label for s in self.solids}))
+
+    def indexed_faces(self) -> tuple[NDArray[np.float64], list[list[int]]]:
+        """Every solid's vertices ``(n, 3)`` one after another and every polygon as a list
+        of indices into them (as :meth:`PolygonModel.indexed_faces
+        <csplab.continuous.model.PolygonModel.indexed_faces>` gives rings)."""
+        pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in self.solids])
+        polys: list[list[int]] = []
+        base = 0
+        for s in self.solids:
+            polys += [[base + int(i) for i in p] for p in s.polygons]
+            base += len(s.vertices)
+        return pts, polys
 
     @property
     def n_polygons(self) -> int:

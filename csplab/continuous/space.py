@@ -25,7 +25,9 @@ the Boolean expression of half-spaces, evaluated on each cell).
 Examples
 --------
 >>> tet = [[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]]
->>> lat = Lattice3.of(np.array(tet, dtype=float), [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+>>> from csplab.continuous.lattice import Lattice
+>>> lat = Lattice.of_points(np.array(tet, dtype=float), [[0, 2, 1], [0, 1, 3], [0, 3, 2],
+...     [1, 2, 3]])
 >>> lat.spacing, lat.normals
 (Fraction(4, 1), ((0, 0, 1), (0, 1, 0), (1, 0, 0), (1, 1, 1)))
 >>> A = Arrangement3(lat, (4, 4, 4))
@@ -40,149 +42,24 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
-from fractions import Fraction
 from functools import cached_property
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.arrangement import gcd_fractions, rational
+from csplab.continuous.lattice import MAX_FAMILIES3, Lattice, primitive3
 from csplab.errors import InputError
 
-__all__ = ["MAX_FAMILIES3", "Arrangement3", "Lattice3", "central_cells", "primitive3"]
+if TYPE_CHECKING:  # types only: neither imports this module
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.problem import Problem
 
-#: most plane families (the central arrangement has O(F^2) cells and a neighbourhood is a
-#: label per cell)
-MAX_FAMILIES3 = 16
-_REL = 1e-9
-_SNAP_TOL = 1e-6
-_AXES = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+__all__ = ["MAX_FAMILIES3", "Arrangement3", "States3", "central_cells", "primitive3"]
 
-
-def primitive3(v: Sequence[int]) -> tuple[int, int, int]:
-    """An integer vector divided by its gcd, its first non-zero component positive (one
-    representative per plane family)."""
-    a, b, c = (int(x) for x in v)
-    g = math.gcd(math.gcd(a, b), c)
-    a, b, c = a // g, b // g, c // g
-    first = next(x for x in (a, b, c) if x != 0)
-    if first < 0:
-        a, b, c = -a, -b, -c
-    return a, b, c
-
-
-@dataclass(frozen=True)
-class Lattice3:
-    """Origin, spacing and face normals (integer, primitive, first non-zero component
-    positive, sorted) of a 3D example; build with :meth:`of`."""
-
-    origin: tuple[Fraction, Fraction, Fraction]
-    spacing: Fraction
-    normals: tuple[tuple[int, int, int], ...]
-    snapped: float = 0.0
-
-    @classmethod
-    def of(
-        cls,
-        points: NDArray[np.float64],
-        polygons: Sequence[Sequence[int]],
-        spacing: float | None = None,
-        *,
-        snap: bool = False,
-        max_extent: int = 128,
-        where: str = "<model>",
-    ) -> Lattice3:
-        """The lattice of ``points`` (``(n, 3)``) whose faces are ``polygons`` (vertex
-        indices); see the module docstring."""
-        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-        lo = pts.min(axis=0)
-        if spacing is not None:
-            if not (math.isfinite(spacing) and spacing > 0):
-                raise InputError(f"spacing must be a positive number, not {spacing!r}")
-            s = rational(float(spacing))
-            origin = tuple(rational(float(v)) for v in lo)
-        else:
-            fr = [[rational(float(v)) for v in p] for p in pts.tolist()]
-            for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
-                for v, q in zip(p, f, strict=True):
-                    if abs(float(q) - v) > _REL * max(1.0, abs(v)):
-                        raise InputError(
-                            f"{where}: vertex {i} {tuple(p)} has no exact rational form; "
-                            "pass a spacing (and snap=true to round vertices onto it)"
-                        )
-            origin = tuple(min(f[a] for f in fr) for a in range(3))
-            s = gcd_fractions([f[a] - origin[a] for f in fr for a in range(3)])
-            if s == 0:
-                raise InputError(f"{where}: the example has no extent")
-        o = np.array([float(v) for v in origin])
-        u = (pts - o) / float(s)
-        iu = np.rint(u)
-        off = float(np.abs(u - iu).max()) if u.size else 0.0
-        if off > _SNAP_TOL and not snap:
-            k = int(np.abs(u - iu).max(axis=1).argmax())
-            raise InputError(
-                f"{where}: vertex {tuple(pts[k])} is {off:.3g} spacings off the lattice of "
-                f"spacing {float(s):g}; choose another spacing or snap=true"
-            )
-        ext = int(iu.max()) if iu.size else 0
-        if ext > max_extent:
-            raise InputError(
-                f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
-                f"{max_extent}); pass a larger spacing (with snap=true if vertices are off it)"
-            )
-        ip = iu.astype(np.int64)
-        normals: set[tuple[int, int, int]] = set()
-        for poly in polygons:
-            q = ip[list(poly)]
-            nxt = np.roll(q, -1, axis=0)
-            # Newell's normal, exact in integers (twice the area vector)
-            n = (
-                int(((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum()),
-                int(((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum()),
-                int(((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()),
-            )
-            if n != (0, 0, 0):
-                normals.add(primitive3(n))
-        if len(normals | set(_AXES)) > MAX_FAMILIES3:
-            raise InputError(
-                f"{where}: {len(normals)} face orientations; at most {MAX_FAMILIES3} planes "
-                "families are supported (use bounding shapes, Sec. 4.6.4)"
-            )
-        return cls(origin, s, tuple(sorted(normals)), off if snap else 0.0)  # type: ignore[arg-type]
-
-    @classmethod
-    def of_model(
-        cls, example: Any, spacing: float | None = None, *, snap: bool = False
-    ) -> Lattice3:
-        """:meth:`of` the vertices and polygons of a polyhedral model (its ``source`` named
-        in errors)."""
-        pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
-        polys: list[list[int]] = []
-        base = 0
-        for s in example.solids:
-            polys += [[base + int(i) for i in p] for p in s.polygons]
-            base += len(s.vertices)
-        return cls.of(pts, polys, spacing, snap=snap, where=example.source)
-
-    def to_lattice(self, xyz: NDArray[np.float64]) -> NDArray[np.float64]:
-        """World coordinates -> lattice coordinates (floats)."""
-        o = np.array([float(v) for v in self.origin])
-        out: NDArray[np.float64] = (np.asarray(xyz, dtype=np.float64) - o) / float(self.spacing)
-        return out
-
-    def to_world(self, uvw: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Lattice coordinates -> world coordinates."""
-        o = np.array([float(v) for v in self.origin])
-        out: NDArray[np.float64] = o + np.asarray(uvw, dtype=np.float64) * float(self.spacing)
-        return out
-
-    def families(self) -> tuple[tuple[tuple[int, int, int], ...], tuple[bool, ...]]:
-        """All plane families (the example's, then the missing axis ones) and which are
-        boundary-only."""
-        extra = [a for a in _AXES if a not in self.normals]
-        return (*self.normals, *extra), (False,) * len(self.normals) + (True,) * len(extra)
+#: per vertex or edge type: its families, its states (a label per group of central cells)
+#: and the group of every central cell
+TypeStates = tuple[NDArray[np.int64], list[tuple[int, ...]], NDArray[np.int64]]
 
 
 def _lcm(a: int, b: int) -> int:
@@ -290,7 +167,7 @@ class Arrangement3:
         along ``lines[edge_line]`` (a primitive integer direction).
     """
 
-    def __init__(self, lattice: Lattice3, size: Sequence[int]) -> None:
+    def __init__(self, lattice: Lattice, size: Sequence[int]) -> None:
         if len(size) != 3 or any(int(s) < 1 for s in size):
             raise InputError(f"the region must be AxBxC with positive sides, not {tuple(size)}")
         self.lattice = lattice
@@ -365,6 +242,11 @@ class Arrangement3:
         self.edge_src, self.edge_dst, self.edge_line = e[:, 0], e[:, 1], e[:, 2]
 
     @property
+    def family_vectors(self) -> NDArray[np.int64]:
+        """The vector naming each family: its face normal (3D; an edge direction in 2D)."""
+        return self.normals
+
+    @property
     def n_vertices(self) -> int:
         return int(self.X.size)
 
@@ -372,14 +254,14 @@ class Arrangement3:
     def n_edges(self) -> int:
         return int(self.edge_src.size)
 
-    def vertex_xyz(self) -> NDArray[np.float64]:
+    def vertex_positions(self) -> NDArray[np.float64]:
         """Vertices in lattice units."""
         out: NDArray[np.float64] = np.stack([self.X, self.Y, self.Z], axis=1) / self.D
         return out
 
-    def edge_xyz(self) -> NDArray[np.float64]:
+    def edge_positions(self) -> NDArray[np.float64]:
         """Edge midpoints in lattice units."""
-        v = self.vertex_xyz()
+        v = self.vertex_positions()
         out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 
@@ -407,3 +289,52 @@ class Arrangement3:
         target = np.zeros(3, dtype=np.int64)
         target[axis] = 1
         return int(np.flatnonzero((self.normals == target).all(axis=1))[0])
+
+
+class States3(Protocol):
+    """The states of the 3D CSP on an arrangement, as
+    :class:`~csplab.continuous.csp3d.ContinuousCSP3` builds them: per vertex and edge type
+    its families, states and cell groups (``vtypes``, ``etypes``), the compact label each
+    group must have outside the region or -1 (``vertex_outside``, ``edge_outside``), each
+    vertex's and edge's type and problem variable. What the user constraints
+    (:func:`~csplab.continuous.user3d.allowed_states`) and the surface tracing
+    (:func:`~csplab.continuous.surface.surface_of`) read, without importing the CSP."""
+
+    @property
+    def example(self) -> PolyhedralModel: ...
+
+    @property
+    def lattice(self) -> Lattice: ...
+
+    @property
+    def arrangement(self) -> Arrangement3: ...
+
+    @property
+    def labels(self) -> tuple[int, ...]: ...
+
+    @property
+    def problem(self) -> Problem: ...
+
+    @property
+    def vtypes(self) -> list[TypeStates]: ...
+
+    @property
+    def etypes(self) -> list[TypeStates]: ...
+
+    @property
+    def vertex_outside(self) -> list[NDArray[np.int64]]: ...
+
+    @property
+    def edge_outside(self) -> list[NDArray[np.int64]]: ...
+
+    @property
+    def vertex_type(self) -> NDArray[np.int64]: ...
+
+    @property
+    def edge_type(self) -> NDArray[np.int64]: ...
+
+    @property
+    def var_vertex(self) -> NDArray[np.int64]: ...
+
+    @property
+    def var_edge(self) -> NDArray[np.int64]: ...

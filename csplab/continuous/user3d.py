@@ -18,16 +18,18 @@ Three kinds, read from the constraints file shared with the grid constraints
     Sec. 4.6.2: the objects of each of these labels form exactly one connected group
     (closures meeting at least at a point; an output without the label breaks it: there is
     no group, like the thesis' single seed grown into a road network). The thesis grows
-    objects from a seed;
-    csplab **checks** the output and, for every solver, runs again with a fresh derived seed
-    while the output is disconnected (``restarts``), and never reports ``solved`` for a
-    disconnected output: it is enforced by retrying, not encoded.
+    objects from a seed; csplab makes it one global constraint on the CSP's problem, the
+    grid solvers' :class:`~csplab.constraints.Connected` over the variables that touch the
+    label (:meth:`~csplab.continuous.csp3d.ContinuousCSP3.connected`): **exact** in ``sat``,
+    ``cpsat`` and ``asp``, propagated by ``catalog``, ``backtrack`` and the other
+    propagating solvers, checked (a breach is ``failed``, so ``restarts`` retry) by the rest.
 
-:func:`user_violations3` checks all three on the output solids alone (the truth, as
-:func:`~csplab.continuous.check3d.violations3` is for Eq. 4.1): a solid of a dimensional
-label spanning more than one plane spacing along the normal; a solid of a large-scale
-label meeting a voxel where it is not allowed (volume of the intersection, manifold3d);
-the solids of a connected label in more than one group (solids sharing a vertex are joined).
+:func:`csplab.continuous.check3d.user_violations3` checks all three on the output solids
+alone (the truth, as :func:`~csplab.continuous.check3d.violations3` is for Eq. 4.1): a solid
+of a dimensional label spanning more than one plane spacing along the normal; a solid of a
+large-scale label meeting a voxel where it is not allowed (volume of the intersection,
+manifold3d); the solids of a connected label in more than one group (solids sharing a vertex
+are joined).
 
 Examples
 --------
@@ -40,7 +42,7 @@ Examples
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -48,8 +50,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.check import Defect
-from csplab.continuous.space import primitive3
+from csplab.continuous.lattice import primitive3
+from csplab.continuous.space import States3
 from csplab.errors import InputError
 
 __all__ = [
@@ -57,14 +59,14 @@ __all__ = [
     "UserConstraints3",
     "parse_user_constraints",
     "read_user_constraints",
-    "user_violations3",
 ]
 
 #: the constraint types of polyhedral models, and what the solvers do with each
 KINDS3: dict[str, str] = {
     "dimensional": "exact for every solver (vertex and edge states removed)",
     "large-scale": "exact for every solver (vertex and edge states removed)",
-    "connected": "checked on the output; every solver retries with a fresh seed while broken",
+    "connected": "a global constraint (csplab.constraints.Connected): exact in sat, cpsat and "
+    "asp, propagated or checked by the others",
 }
 _AXES = {"x": (1, 0, 0), "y": (0, 1, 0), "z": (0, 0, 1)}
 
@@ -199,7 +201,7 @@ def read_user_constraints(
 
 
 # ----------------------------------------------------------------------------- enforcing
-def allowed_states(csp: Any, c: UserConstraints3) -> NDArray[np.bool_]:
+def allowed_states(csp: States3, c: UserConstraints3) -> NDArray[np.bool_]:
     """``(n_variables, K)``: the domain of ``csp.problem`` with the dimensional and
     large-scale constraints applied (a state is removed when it breaks one)."""
     A = csp.arrangement
@@ -219,8 +221,8 @@ def allowed_states(csp: Any, c: UserConstraints3) -> NDArray[np.bool_]:
         dim.append((index[b], fam_of[n]))
     dom = np.array(csp.problem.domains, dtype=bool, copy=True)
     kinds = (
-        (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_xyz()),
-        (csp.edge_type, csp.etypes, csp.var_edge, A.edge_xyz()),
+        (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_positions()),
+        (csp.edge_type, csp.etypes, csp.var_edge, A.edge_positions()),
     )
     # large-scale: per label, a boolean voxel grid
     grids: list[tuple[int, NDArray[np.bool_]]] = []
@@ -266,92 +268,3 @@ def allowed_states(csp: Any, c: UserConstraints3) -> NDArray[np.bool_]:
             k = S.shape[0]
             dom[var[sel], :k] &= rows
     return dom
-
-
-# ----------------------------------------------------------------------------- checking
-def user_violations3(
-    model: Any,
-    c: UserConstraints3,
-    *,
-    origin: Sequence[float],
-    spacing: float,
-) -> list[Defect]:
-    """The user constraints ``model`` breaks, from its solids alone (see the module
-    docstring); ``origin`` and ``spacing`` place the plane lattice and the voxels (the
-    region's corner and the plane spacing)."""
-    out: list[Defect] = []
-    o = np.asarray(origin, dtype=np.float64)
-    s = float(spacing)
-    tol = 1e-7
-    for b, n in c.dimensional:
-        nn = np.asarray(n, dtype=np.float64)
-        for i, sol in enumerate(model.solids):
-            if sol.label != b:
-                continue
-            k = ((np.asarray(sol.vertices) - o) / s) @ nn
-            if k.max() - k.min() > 1 + tol:
-                p = sol.vertices[int(k.argmax())]
-                out.append(Defect("dimensional", (float(p[0]), float(p[1])),
-                                  f"solid {i} (label {b}) spans {k.max() - k.min():.6g} plane "
-                                  f"spacings along {list(n)} (at most 1)"))  # fmt: skip
-    if c.allowed and c.voxel is not None:
-        out += _large_scale(model, c, o, s)
-    for b in c.connected:
-        groups = _touching_groups([sol for sol in model.solids if sol.label == b])
-        if groups != 1:
-            out.append(Defect("connected", (float("nan"), float("nan")),
-                              f"the objects of label {b} form {groups} separate groups "
-                              "(exactly one is required)"))  # fmt: skip
-    return out
-
-
-def _touching_groups(solids: list[Any]) -> int:
-    """Groups of solids whose closures meet at a common vertex."""
-    if len(solids) <= 1:
-        return len(solids)
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    pts = np.concatenate([np.asarray(sol.vertices) for sol in solids])
-    owner = np.repeat(np.arange(len(solids)), [len(sol.vertices) for sol in solids])
-    _, inv = np.unique(np.round(pts, 9), axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
-    n = len(solids)
-    g = coo_matrix((np.ones(len(owner)), (owner, n + inv)), shape=(n + int(inv.max()) + 1,) * 2)
-    comp = connected_components(g, directed=False)[1][:n]
-    return len(np.unique(comp))
-
-
-def _large_scale(model: Any, c: UserConstraints3, o: NDArray[np.float64], s: float) -> list[Defect]:
-    """Solids of a large-scale label meeting a voxel not allowed for it (manifold3d
-    intersection volume above 1e-9 of the voxel)."""
-    import manifold3d as man
-
-    assert c.voxel is not None
-    size = np.asarray(c.voxel, dtype=np.float64) * s
-    out: list[Defect] = []
-    for b, cells in c.allowed:
-        for i, sol in enumerate(model.solids):
-            if sol.label != b:
-                continue
-            lo = np.floor((sol.vertices.min(axis=0) - o) / size + 1e-9).astype(int)
-            hi = np.ceil((sol.vertices.max(axis=0) - o) / size - 1e-9).astype(int)
-            m = None
-            for x in range(lo[0], hi[0]):
-                for y in range(lo[1], hi[1]):
-                    for z in range(lo[2], hi[2]):
-                        if (x, y, z) in cells:
-                            continue
-                        if m is None:
-                            m = sol.to_manifold(f"solid {i}")
-                        box = man.Manifold.cube(size.tolist()).translate(
-                            (o + np.array([x, y, z]) * size).tolist()
-                        )
-                        vol = float((m ^ box).volume())
-                        if vol > 1e-9 * float(np.prod(size)):
-                            out.append(Defect("large-scale", (float(o[0] + x * size[0]),
-                                                              float(o[1] + y * size[1])),
-                                              f"solid {i} (label {b}) has volume {vol:.6g} "
-                                              f"in voxel {[x, y, z]}, where label {b} is "
-                                              "not allowed"))  # fmt: skip
-    return out

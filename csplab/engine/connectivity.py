@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from csplab import _kernels as kern
-from csplab.constraints import ClauseContext, Connected, grid_edges, label_mask
+from csplab.constraints import ClauseContext, Connected
 from csplab.deps import require
 from csplab.problem import Problem
 
@@ -36,8 +36,8 @@ class _State:
     """One constraint's view: the literal "cell in the set" per cell and their values."""
 
     def __init__(self, problem: Problem, con: Connected, ctx: ClauseContext) -> None:
-        S = label_mask(con.labels, problem.K)
-        self.y: list[Any] = [ctx.in_set(c, S) for c in range(problem.n)]
+        self.lo, self.hi, _ = con.edges(problem)
+        self.y: list[Any] = [con.in_set(ctx, c) for c in range(problem.n)]
         self.val = np.zeros(problem.n, dtype=np.int8)  # 1 in, -1 out, 0 open; constants: 2/-2
         for c, y in enumerate(self.y):
             if y is True:
@@ -53,7 +53,6 @@ class ConnectivityPropagator:
     def __init__(self, problem: Problem, ctx: ClauseContext) -> None:
         self.is_lazy = False
         self.n = problem.n
-        self.lo, self.hi, _ = grid_edges(problem)
         self.states = [
             _State(problem, c, ctx)
             for c in problem.constraints
@@ -110,15 +109,16 @@ class ConnectivityPropagator:
             act = st.val > 0
             if not act.any():
                 continue
-            comp = kern.components(self.n, self.lo, self.hi, st.val > -1)
+            lo, hi = st.lo, st.hi
+            comp = kern.components(self.n, lo, hi, st.val > -1)
             s = int(np.flatnonzero(act)[0])
             R = comp == comp[s]
             bad = np.flatnonzero(act & ~R)
             todo = bad[:1] if bad.size else np.flatnonzero((st.val == 0) & ~R)
             if not todo.size:
                 continue
-            cross = R[self.lo] != R[self.hi]
-            bnd = np.unique(np.where(R[self.lo[cross]], self.hi[cross], self.lo[cross]))
+            cross = R[lo] != R[hi]
+            bnd = np.unique(np.where(R[lo[cross]], hi[cross], lo[cross]))
             base = [int(y) for y in (st.y[w] for w in bnd.tolist()) if not isinstance(y, bool)]
             ys = st.y[s]
             head = [] if ys is True else [-int(ys)]

@@ -24,7 +24,11 @@ from importlib import resources
 from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 
-__all__ = ["CONTINUOUS_EXAMPLES", "continuous_example_names", "load_polygon_example"]
+__all__ = [
+    "CONTINUOUS_EXAMPLES",
+    "continuous_example_names",
+    "load_polygon_example",
+]
 
 #: name -> (file in ``csplab/examples/continuous/``, one-line description)
 CONTINUOUS_EXAMPLES: dict[str, tuple[str, str]] = {

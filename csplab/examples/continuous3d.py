@@ -24,10 +24,17 @@ from __future__ import annotations
 
 from importlib import resources
 
+from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
+from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
 
-__all__ = ["POLYHEDRAL_EXAMPLES", "load_polyhedral_example", "polyhedral_example_names"]
+__all__ = [
+    "POLYHEDRAL_EXAMPLES",
+    "load_continuous_example",
+    "load_polyhedral_example",
+    "polyhedral_example_names",
+]
 
 #: name -> (file in ``csplab/examples/continuous3d/``, one-line description)
 POLYHEDRAL_EXAMPLES: dict[str, tuple[str, str]] = {
@@ -126,3 +133,21 @@ def load_polyhedral_example(name: str) -> PolyhedralModel:
         M = read_obj_model(path, labels="materials")
     meta = {**M.meta, "description": description}
     return PolyhedralModel(M.solids, name=name, meta=meta, source=source)
+
+
+def load_continuous_example(name: str) -> PolygonModel | PolyhedralModel:
+    """A built-in continuous example of either dimension by name: a polygon model
+    (:func:`~csplab.examples.continuous.load_polygon_example`) or a polyhedral one
+    (:func:`load_polyhedral_example`).
+
+    >>> load_continuous_example("tetrahedron").ndim, load_continuous_example("triangle").ndim
+    (3, 2)
+    """
+    if name in POLYHEDRAL_EXAMPLES:
+        return load_polyhedral_example(name)
+    if name in CONTINUOUS_EXAMPLES:
+        return load_polygon_example(name)
+    raise InputError(
+        f"unknown continuous example {name!r}; built-in continuous examples: "
+        f"{', '.join([*CONTINUOUS_EXAMPLES, *POLYHEDRAL_EXAMPLES])}"
+    )

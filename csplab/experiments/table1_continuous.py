@@ -1,7 +1,7 @@
 """Table 1 of Merrell & Manocha 2008 ("Continuous Model Synthesis"): input polygons,
 output polygons and time for each built-in polyhedral example, next to the paper's row.
 
-Each trial runs :func:`~csplab.continuous.synthesis.synthesize3` on a built-in polyhedral
+Each trial runs :func:`~csplab.continuous.synthesis.synthesize` on a built-in polyhedral
 example (:mod:`csplab.examples.continuous3d`) at the example's size (chosen so that the
 output has at least the paper's number of polygons; ``--sizes`` overrides) with each solver
 (``catalog`` with restarts, as the paper's Alg. 2 with retries, by default; any solver spec),
@@ -57,11 +57,11 @@ SIZES: dict[str, str] = {
 def measure_synthesis3(trial: Trial, example: Any, problem: Any) -> dict[str, Any]:
     """Synthesize once (``rng=trial.seed``): status, end-to-end time, phases, polygons,
     solids and violations."""
-    from csplab.continuous.synthesis import synthesize3
+    from csplab.continuous.synthesis import synthesize
 
     del problem
     p = trial.params
-    s = synthesize3(
+    s = synthesize(
         example, trial.size, solver=trial.solver, rng=trial.seed,
         restarts=int(p.get("restarts", 0)), boundary=p.get("boundary") or 0,
         **p.get("options", {}),
@@ -179,7 +179,7 @@ class Table1Continuous(Experiment):
 
     def _previews(self, config: dict[str, Any], out: Path) -> list[Path]:
         """One PNG preview per example: seed ``seed0`` with the first solver."""
-        from csplab.continuous.synthesis import synthesize3
+        from csplab.continuous.synthesis import synthesize
         from csplab.examples.continuous3d import load_polyhedral_example
         from csplab.io.meshes import write_png
 
@@ -188,7 +188,7 @@ class Table1Continuous(Experiment):
         for name in config["examples"]:
             E = load_polyhedral_example(name)
             size = parse_shape(config["sizes_3d"].get(name, "20x20x8"))
-            s = synthesize3(E, size, solver=config["solvers"][0], rng=int(config["seed0"]),
+            s = synthesize(E, size, solver=config["solvers"][0], rng=int(config["seed0"]),
                             restarts=int(config["restarts"]), check=False,
                             boundary=config["boundary"].get(name) or 0)  # fmt: skip
             if s.model is None:

@@ -317,7 +317,7 @@ def reach_rules(ctx: ClauseContext) -> tuple[bytes, NDArray[np.int64]]:
     ``edgedPath``) and ``:- y(c), not h(c)``. Stable models make ``h`` the least fixpoint,
     so the answer sets are exactly the connected grids: no cut loop. Returns the aspif
     lines and the ``h`` atoms (defined by rules, not choices)."""
-    from csplab.constraints import Connected, grid_edges, label_mask
+    from csplab.constraints import Connected
 
     P = ctx.problem
     lines: list[str] = []
@@ -325,8 +325,8 @@ def reach_rules(ctx: ClauseContext) -> tuple[bytes, NDArray[np.int64]]:
     for con in P.constraints:
         if not isinstance(con, Connected):
             continue
-        S = label_mask(con.labels, P.K)
-        y = [ctx.in_set(c, S) for c in range(P.n)]
+        S = con.mask(P)
+        y = [con.in_set(ctx, c) for c in range(P.n)]
         h = np.zeros(P.n, dtype=np.int64)
         roots = []
         for c in range(P.n):
@@ -345,7 +345,7 @@ def reach_rules(ctx: ClauseContext) -> tuple[bytes, NDArray[np.int64]]:
                 lines.append(f"1 0 0 0 2 {int(y[c])} -{h[c]}")  # :- y(c), not h(c).
         if len(roots) > 1:  # :- 2 {r(c)}.
             lines.append(f"1 0 0 1 2 {len(roots)} " + " ".join(f"{r} 1" for r in roots))
-        lo, hi, ax = grid_edges(P)
+        lo, hi, ax = con.edges(P)
         ports = None if con.ports is None else np.asarray(con.ports, dtype=bool)
         for u, v, a in zip(lo.tolist(), hi.tolist(), ax.tolist(), strict=True):
             if not (h[u] and h[v]):

@@ -8,7 +8,8 @@ import pytest
 
 from csplab.continuous._geom import labels_at
 from csplab.continuous.csp3d import ContinuousCSP3
-from csplab.continuous.space import Arrangement3, Lattice3, central_cells
+from csplab.continuous.lattice import Lattice
+from csplab.continuous.space import Arrangement3, central_cells
 from csplab.errors import InputError
 from csplab.solvers import solve
 from tests._meshes import box as _box
@@ -44,12 +45,34 @@ def test_central_cells_count() -> None:
         assert (np.sign(dirs @ np.array(normals).T) == signs).all()
 
 
+def test_the_checker_finds_the_same_cells_its_own_way() -> None:
+    """The 3D checker's cone_cells (corner triangles) and the CSP's central_cells (sector
+    bisectors) are two constructions of one set of cells: equal on random normals."""
+    from csplab.continuous.check3d import cone_cells
+
+    rng = np.random.default_rng(7)
+    for _ in range(60):
+        N = np.concatenate([rng.integers(-3, 4, size=(int(rng.integers(1, 8)), 3)), np.eye(3)])
+        keep: list[int] = []
+        for i, n in enumerate(N):
+            u = n / (np.linalg.norm(n) or 1.0)
+            if np.abs(n).sum() and all(
+                abs(abs(u @ N[j]) / np.linalg.norm(N[j]) - 1) > 1e-9 for j in keep
+            ):
+                keep.append(i)
+        N = N[keep].astype(np.int64)
+        want = {s.tobytes() for s in central_cells(N)[0]}
+        signs, dirs = cone_cells(N.astype(np.float64))
+        assert {s.tobytes() for s in signs} == want
+        assert (np.sign(dirs @ N.T) == signs).all()
+
+
 def test_every_lattice_point_meets_every_family() -> None:
     """Sec. 4.5.8 by construction: the pyramid's apex needs four planes to meet."""
     pyr = {"label": 1, "vertices": [[0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0], [1, 1, 1]],
            "faces": [[0, 3, 2, 1], [0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]]}  # fmt: skip
     E = polyhedra.PolyhedralModel([pyr])
-    lat = Lattice3.of(np.array(pyr["vertices"], dtype=float), pyr["faces"])
+    lat = Lattice.of_points(np.array(pyr["vertices"], dtype=float), pyr["faces"])
     assert len(lat.normals) == 5
     A = Arrangement3(lat, (4, 4, 3))
     lattice_pts = (A.X % A.D == 0) & (A.Y % A.D == 0) & (A.Z % A.D == 0)

@@ -13,7 +13,7 @@ import pytest
 
 from csplab.continuous.csp3d import ContinuousCSP3
 from csplab.continuous.polyhedra import PolyhedralModel
-from csplab.continuous.synthesis import synthesize3
+from csplab.continuous.synthesis import synthesize
 from csplab.errors import InputError
 from csplab.examples.build_continuous3d import EXAMPLES, write_all
 from csplab.examples.continuous3d import (
@@ -75,7 +75,7 @@ def test_tetrahedron_top_vertex_has_the_nine_states_of_fig9() -> None:
 def test_synthesizes_without_violations(name: str, solver: str) -> None:
     E = load_polyhedral_example(name)
     restarts = 5 if solver == "catalog" else 0
-    s = synthesize3(E, SIZE, solver=solver, rng=1, restarts=restarts)
+    s = synthesize(E, SIZE, solver=solver, rng=1, restarts=restarts)
     assert s.result.status == "solved"
     assert s.model is not None
     assert len(s.violations) == 0, s.violations
@@ -90,7 +90,7 @@ def test_synthesizes_without_violations(name: str, solver: str) -> None:
 
 def test_terrain_on_a_ground_layer() -> None:
     E = load_polyhedral_example("terrain")
-    s = synthesize3(E, SIZE, solver="catalog", rng=2, restarts=5, boundary={"z-": 1})
+    s = synthesize(E, SIZE, solver="catalog", rng=2, restarts=5, boundary={"z-": 1})
     assert s.ok and s.model is not None
     assert 1 in s.model.labels  # the ground continues along the bottom
 
@@ -101,5 +101,5 @@ def test_terrain_on_a_ground_layer() -> None:
 def test_synthesizes_at_the_issue_size(name: str, solver: str) -> None:
     E = load_polyhedral_example(name)
     restarts = 5 if solver == "catalog" else 0
-    s = synthesize3(E, (10, 10, 6), solver=solver, rng=3, restarts=restarts)
+    s = synthesize(E, (10, 10, 6), solver=solver, rng=3, restarts=restarts)
     assert s.ok, (s.result.status, s.violations)

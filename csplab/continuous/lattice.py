@@ -1,0 +1,348 @@
+"""The lattice and the plane families of continuous model synthesis, in 2D and 3D alike.
+
+Alg. 4.1 step 1 puts the example's vertices on an integer lattice: ``origin`` is the lower
+corner of its bounding box and ``spacing`` the largest length ``s`` such that every vertex is
+``origin + s * (i, j[, k])`` for integers (the example's own vertices then lie on the lines
+or planes, and stretched copies of the example are solutions; ``spacing=`` overrides it, and
+``snap=True`` rounds vertices that are off the lattice). Every edge direction (2D) or face
+normal (3D) is then an integer vector; vectors equal up to sign are one *family*, and its
+lines or planes are ``n . x = k`` for integers ``k`` (:mod:`~csplab.continuous.arrangement`
+in 2D, :mod:`~csplab.continuous.space` in 3D).
+
+Which families an example has is decided in one place, :func:`family_vectors`: the edge
+directions of its polygons (2D), the Newell normals of its faces (3D).
+
+Examples
+--------
+>>> lat = Lattice.of([[(0, 0), (4, 0), (2, 3)]])
+>>> lat.ndim, lat.spacing, lat.vectors
+(2, Fraction(1, 1), ((1, 0), (2, 3), (-2, 3)))
+>>> tet = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]], dtype=float)
+>>> lat = Lattice.of_points(tet, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+>>> lat.ndim, lat.spacing, lat.vectors
+(3, Fraction(4, 1), ((0, 0, 1), (0, 1, 0), (1, 0, 0), (1, 1, 1)))
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from fractions import Fraction
+from typing import TYPE_CHECKING, Protocol
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.errors import InputError
+
+if TYPE_CHECKING:
+    from csplab.continuous.model import PolygonModel
+    from csplab.continuous.polyhedra import PolyhedralModel
+
+__all__ = [
+    "MAX_FAMILIES",
+    "MAX_FAMILIES3",
+    "Lattice",
+    "PlaneArrangement",
+    "family_vectors",
+    "gcd_fractions",
+    "primitive3",
+    "rational",
+]
+
+#: most line families in 2D (rays are bits of an int64 mask, two per family)
+MAX_FAMILIES = 31
+#: most plane families in 3D (the central arrangement has O(F^2) cells and a neighbourhood
+#: is a label per cell)
+MAX_FAMILIES3 = 16
+#: the largest example, in spacings, by dimension (a default spacing that is tiny because
+#: coordinates share no common unit asks for ``spacing=``)
+MAX_EXTENT = {2: 256, 3: 128}
+_DEN = 10**6  # largest denominator when reading a float coordinate as a rational
+_REL = 1e-9  # a float coordinate is that rational if within this relative distance
+_SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
+_AXES3 = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+
+
+def rational(x: float) -> Fraction:
+    """A float as the nearest fraction of denominator at most 10^6 (the example's
+    coordinates are checked against it)."""
+    return Fraction(x).limit_denominator(_DEN)
+
+
+def gcd_fractions(fs: Iterable[Fraction]) -> Fraction:
+    """The largest fraction of which every ``fs`` is an integer multiple (0 if all are 0).
+
+    >>> gcd_fractions([Fraction(5, 2), Fraction(15, 2), Fraction(10)])
+    Fraction(5, 2)
+    """
+    g = Fraction(0)
+    for f in fs:
+        f = abs(f)
+        if f == 0:
+            continue
+        if g == 0:
+            g = f
+        else:
+            lcm_den = g.denominator * f.denominator // math.gcd(g.denominator, f.denominator)
+            g = Fraction(
+                math.gcd(g.numerator * (lcm_den // g.denominator),
+                         f.numerator * (lcm_den // f.denominator)),
+                lcm_den,
+            )  # fmt: skip
+    return g
+
+
+def _primitive2(dx: int, dy: int) -> tuple[int, int]:
+    """A direction divided by its gcd, pointing into the upper half-plane (angle in
+    ``[0, pi)``)."""
+    g = math.gcd(dx, dy)
+    dx, dy = dx // g, dy // g
+    if dy < 0 or (dy == 0 and dx < 0):
+        dx, dy = -dx, -dy
+    return dx, dy
+
+
+def angle(d: Sequence[int]) -> float:
+    """The angle of a 2D direction (families are sorted by it)."""
+    return math.atan2(d[1], d[0])
+
+
+def primitive3(v: Sequence[int]) -> tuple[int, int, int]:
+    """An integer vector divided by its gcd, its first non-zero component positive (one
+    representative per plane family)."""
+    a, b, c = (int(x) for x in v)
+    g = math.gcd(math.gcd(a, b), c)
+    a, b, c = a // g, b // g, c // g
+    first = next(x for x in (a, b, c) if x != 0)
+    if first < 0:
+        a, b, c = -a, -b, -c
+    return a, b, c
+
+
+def family_vectors(
+    ip: NDArray[np.int64], faces: Sequence[Sequence[int]], where: str = "<model>"
+) -> tuple[tuple[int, ...], ...]:
+    """The families of an example whose vertices are the integer lattice points ``ip``
+    ``(n, d)``: in 2D the primitive directions of the edges of the rings ``faces`` (each a
+    list of vertex indices, closed), sorted by angle; in 3D the primitive Newell normals of
+    the polygons ``faces``, sorted. The one place that decides the plane families."""
+    if ip.shape[1] == 2:
+        dirs: set[tuple[int, int]] = set()
+        for ring in faces:
+            q = ip[list(ring)]
+            nxt = np.roll(q, -1, axis=0)
+            for (x0, y0), (x1, y1) in zip(q.tolist(), nxt.tolist(), strict=True):
+                if (x0, y0) != (x1, y1):
+                    dirs.add(_primitive2(x1 - x0, y1 - y0))
+        if len(dirs) > MAX_FAMILIES - 2:
+            raise InputError(
+                f"{where}: {len(dirs)} edge directions; at most {MAX_FAMILIES - 2} are supported "
+                "(use bounding shapes, Sec. 4.6.4, or a coarser spacing with snap=true)"
+            )
+        return tuple(sorted(dirs, key=angle))
+    normals: set[tuple[int, int, int]] = set()
+    for poly in faces:
+        q = ip[list(poly)]
+        nxt = np.roll(q, -1, axis=0)
+        # Newell's normal, exact in integers (twice the area vector)
+        n = (
+            int(((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum()),
+            int(((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum()),
+            int(((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()),
+        )
+        if n != (0, 0, 0):
+            normals.add(primitive3(n))
+    if len(normals | set(_AXES3)) > MAX_FAMILIES3:
+        raise InputError(
+            f"{where}: {len(normals)} face orientations; at most {MAX_FAMILIES3} planes "
+            "families are supported (use bounding shapes, Sec. 4.6.4)"
+        )
+    return tuple(sorted(normals))
+
+
+def _show(p: Sequence[float]) -> str:
+    return "(" + ", ".join(f"{v:g}" for v in p) + ")"
+
+
+@dataclass(frozen=True)
+class Lattice:
+    """Origin, spacing and family vectors of an example in ``d`` = 2 or 3 dimensions (see
+    the module docstring); build with :meth:`of_model`, :meth:`of_points` or :meth:`of`.
+
+    ``vectors`` are the edge directions (2D: primitive, angle in ``[0, pi)``, in angular
+    order) or the face normals (3D: primitive, first non-zero component positive, sorted);
+    ``snapped`` is the largest distance (in spacings) a vertex was moved by ``snap`` (0 when
+    exact)."""
+
+    origin: tuple[Fraction, ...]
+    spacing: Fraction
+    vectors: tuple[tuple[int, ...], ...]
+    snapped: float = 0.0
+
+    @property
+    def ndim(self) -> int:
+        return len(self.origin)
+
+    @property
+    def directions(self) -> tuple[tuple[int, ...], ...]:
+        """The 2D name of :attr:`vectors` (edge directions)."""
+        return self.vectors
+
+    @property
+    def normals(self) -> tuple[tuple[int, ...], ...]:
+        """The 3D name of :attr:`vectors` (face normals)."""
+        return self.vectors
+
+    @classmethod
+    def of_points(
+        cls,
+        points: NDArray[np.float64],
+        faces: Sequence[Sequence[int]],
+        spacing: float | None = None,
+        *,
+        snap: bool = False,
+        max_extent: int | None = None,
+        where: str = "<model>",
+    ) -> Lattice:
+        """The lattice of ``points`` ``(n, d)`` with the rings (2D) or polygons (3D)
+        ``faces`` (vertex indices); ``max_extent`` bounds the example's size in spacings
+        (default :data:`MAX_EXTENT` of the dimension)."""
+        d = int(np.shape(points)[1])
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, d)
+        lo = pts.min(axis=0)
+        if spacing is not None:
+            if not (math.isfinite(spacing) and spacing > 0):
+                raise InputError(f"spacing must be a positive number, not {spacing!r}")
+            s = rational(float(spacing))
+            origin = tuple(rational(float(v)) for v in lo)
+        else:
+            fr = [[rational(float(v)) for v in p] for p in pts.tolist()]
+            for i, (p, f) in enumerate(zip(pts.tolist(), fr, strict=True)):
+                for v, q in zip(p, f, strict=True):
+                    if abs(float(q) - v) > _REL * max(1.0, abs(v)):
+                        raise InputError(
+                            f"{where}: vertex {i} {_show(p)} has no exact rational form; "
+                            "pass a spacing (and snap=true to round vertices onto it)"
+                        )
+            origin = tuple(min(f[a] for f in fr) for a in range(d))
+            s = gcd_fractions([f[a] - origin[a] for f in fr for a in range(d)])
+            if s == 0:
+                raise InputError(f"{where}: the example has no extent")
+        u = (pts - np.array([float(v) for v in origin])) / float(s)
+        iu = np.rint(u)
+        off = float(np.abs(u - iu).max()) if u.size else 0.0
+        if off > _SNAP_TOL and not snap:
+            k = int(np.abs(u - iu).max(axis=1).argmax())
+            raise InputError(
+                f"{where}: vertex {_show(pts[k].tolist())} is {off:.3g} spacings off the "
+                f"lattice of spacing {float(s):g}; choose another spacing or snap=true"
+            )
+        ext = int(iu.max()) if iu.size else 0
+        limit = MAX_EXTENT[d] if max_extent is None else max_extent
+        if ext > limit:
+            raise InputError(
+                f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
+                f"{limit}); pass a larger spacing (with snap=true if vertices are off it)"
+            )
+        vectors = family_vectors(iu.astype(np.int64), faces, where)
+        return cls(origin, s, vectors, off if snap else 0.0)
+
+    @classmethod
+    def of(
+        cls,
+        rings: Sequence[Sequence[tuple[float, float]]],
+        spacing: float | None = None,
+        *,
+        snap: bool = False,
+        max_extent: int | None = None,
+        where: str = "<model>",
+    ) -> Lattice:
+        """The lattice of a set of 2D rings (lists of points)."""
+        arrays = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
+        starts = np.cumsum([0, *(len(a) for a in arrays)])
+        faces = [list(range(int(a), int(b))) for a, b in itertools.pairwise(starts)]
+        pts = np.concatenate(arrays)
+        return cls.of_points(pts, faces, spacing, snap=snap, max_extent=max_extent, where=where)
+
+    @classmethod
+    def of_model(
+        cls,
+        example: PolygonModel | PolyhedralModel,
+        spacing: float | None = None,
+        *,
+        snap: bool = False,
+    ) -> Lattice:
+        """The lattice of a polygon or polyhedral model (its ``source`` named in errors),
+        from its :meth:`~csplab.continuous.model.PolygonModel.indexed_faces`."""
+        pts, faces = example.indexed_faces()
+        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source)
+
+    def to_lattice(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """World coordinates -> lattice coordinates (floats; ``np.rint`` them for the
+        nearest lattice point)."""
+        o = np.array([float(v) for v in self.origin])
+        out: NDArray[np.float64] = (np.asarray(x, dtype=np.float64) - o) / float(self.spacing)
+        return out
+
+    def to_world(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Lattice coordinates -> world coordinates."""
+        o = np.array([float(v) for v in self.origin])
+        out: NDArray[np.float64] = o + np.asarray(u, dtype=np.float64) * float(self.spacing)
+        return out
+
+    def families(self) -> tuple[tuple[tuple[int, ...], ...], tuple[bool, ...]]:
+        """All families with the axis ones the region's sides need added if missing, and
+        which of them are boundary-only: in 2D sorted by angle (so rays are numbered in
+        angular order), in 3D the example's first."""
+        if self.ndim == 2:
+            ds = list(self.vectors)
+            extra2: list[tuple[int, ...]] = [d for d in ((1, 0), (0, 1)) if d not in ds]
+            allds = sorted(ds + extra2, key=angle)
+            return tuple(allds), tuple(d in extra2 for d in allds)
+        extra = [a for a in _AXES3 if a not in self.vectors]
+        return (*self.vectors, *extra), (False,) * len(self.vectors) + (True,) * len(extra)
+
+
+class PlaneArrangement(Protocol):
+    """The arrangement protocol: what the 2D arrangement of lines
+    (:class:`~csplab.continuous.arrangement.Arrangement`) and the 3D arrangement of planes
+    (:class:`~csplab.continuous.space.Arrangement3`) both give, in lattice units: the
+    region ``size``, ``F`` families (``family_vectors``; ``boundary_only`` the axis ones
+    added for the region's sides), vertices at integer coordinates divided by ``D``, edges
+    between consecutive vertices of one line (``edge_src`` to ``edge_dst``), and which
+    region sides each vertex lies on (``on_side``: bits ``2 * axis`` low, ``2 * axis + 1``
+    high)."""
+
+    lattice: Lattice
+    F: int
+    D: int
+    boundary_only: NDArray[np.bool_]
+    edge_src: NDArray[np.int64]
+    edge_dst: NDArray[np.int64]
+
+    @property
+    def size(self) -> tuple[int, ...]: ...
+
+    @property
+    def family_vectors(self) -> NDArray[np.int64]: ...
+
+    @property
+    def n_vertices(self) -> int: ...
+
+    @property
+    def n_edges(self) -> int: ...
+
+    def vertex_positions(self) -> NDArray[np.float64]:
+        """Vertex coordinates ``(n_vertices, d)`` in lattice units."""
+        ...
+
+    def edge_positions(self) -> NDArray[np.float64]:
+        """Edge midpoints ``(n_edges, d)`` in lattice units."""
+        ...
+
+    def on_side(self) -> NDArray[np.int64]:
+        """Per vertex, the region sides it lies on (bit mask)."""
+        ...
