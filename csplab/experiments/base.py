@@ -453,6 +453,11 @@ class Experiment:
         """The trials of the sweep and the example models they use (by hash)."""
         raise NotImplementedError
 
+    def trials(self, quick: bool = False, **overrides: Any) -> list[Trial]:
+        """The trials of the sweep configured by :meth:`make_config` (``quick`` and
+        ``overrides`` as there)."""
+        return self.build(self.make_config(quick=quick, **overrides))[0]
+
     def report(
         self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path
     ) -> Report:  # pragma: no cover - abstract

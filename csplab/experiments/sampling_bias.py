@@ -12,9 +12,7 @@ is flagged *biased* when its TV interval lies entirely above the floor's interva
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("sampling_bias")
->>> cfg = exp.make_config(quick=True)
->>> trials, _ = exp.build(cfg)
+>>> trials = get_experiment("sampling_bias").trials(quick=True)
 >>> sorted({t.solver for t in trials})
 ['catalog', 'exact', 'uniform']
 """
@@ -23,7 +21,7 @@ from __future__ import annotations
 
 from collections import OrderedDict, defaultdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -115,13 +113,13 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
 
 
 class SamplingBias(Experiment):
-    name: ClassVar[str] = "sampling_bias"
-    title: ClassVar[str] = "Sampling bias: label and 2x2-pattern frequencies vs exact uniform"
-    description: ClassVar[str] = (
+    name = "sampling_bias"
+    title = "Sampling bias: label and 2x2-pattern frequencies vs exact uniform"
+    description = (
         "total variation / Jensen-Shannon distance of pooled output frequencies to the exact "
         "uniform frequencies (transfer matrices on strips), bootstrap 95% intervals"
     )
-    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+    defaults = sweep_defaults(
         omit=("order", "choice"),  # the solver entries name them
         examples=["line", "fig3_4a", "fig3_5a"], size="16x5",
         solvers=[
@@ -131,14 +129,14 @@ class SamplingBias(Experiment):
         ],
         seeds=400, boundary="none", n_boot=500,
     )  # fmt: skip
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["line"],
         "size": "6x3",
         "solvers": ["catalog"],
         "seeds": 8,
         "n_boot": 50,
     }
-    uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"n_boot", "periodic"}
+    uses = frozenset(defaults) - {"n_boot", "periodic"}
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument("--n-boot", dest="n_boot", type=int, help="bootstrap resamples (500)")
