@@ -21,7 +21,6 @@ Examples
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +28,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.example import ExampleModel
-from csplab.experiments.base import Experiment, Report, new_figure, save_figure
+from csplab.experiments.base import Experiment, Report, group_rows
+from csplab.experiments.figures import new_figure, save_figure
 from csplab.experiments.measures import dead_ends, pattern_distance
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
@@ -112,9 +112,7 @@ class Baselines(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        cell: dict[tuple[str, str, str], list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            cell[(r["example"], r["size"], r["solver"])].append(r)
+        cell = group_rows(rows, lambda r: (r["example"], r["size"], r["solver"]))
         table = []
         for (ex, size, m), rs in sorted(cell.items()):
             st = [r["stats"] for r in rs]

@@ -25,7 +25,6 @@ Examples
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -38,12 +37,11 @@ from csplab.experiments.base import (
     Report,
     background_labels,
     example_names,
+    group_rows,
     load_examples,
-    new_figure,
-    outside_legend,
-    save_figure,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.measures import (
     objects,
     pack_grid,
@@ -160,18 +158,14 @@ class BlockSize(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        by_ex: dict[str, list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            by_ex[r["example"]].append(r)
+        by_ex = group_rows(rows, lambda r: r["example"])
         names = example_names(by_ex)
         table: list[dict[str, Any]] = []
         for spec, rs in by_ex.items():
             ex = names[spec]
             ref = [r for r in rs if r["solver"] == "catalog"]
-            groups: dict[int, list[dict[str, Any]]] = defaultdict(list)
-            for r in rs:
-                if r["solver"] == "blocks":
-                    groups[int(r["params"]["options"]["block"][0])].append(r)
+            blocks = [r for r in rs if r["solver"] == "blocks"]
+            groups = group_rows(blocks, lambda r: int(r["params"]["options"]["block"][0]))
             size = [int(v) for v in rs[0]["size"].split("x")]
             whole = [r for r in rs if r["solver"] == "blocks" and _is_full(r, size)]
             # Alg. 3.1's outputs: its successful runs, and the accepted whole-model blocks

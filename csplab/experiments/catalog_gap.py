@@ -31,7 +31,6 @@ Examples
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -49,12 +48,11 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
-    new_figure,
-    outside_legend,
-    save_figure,
+    group_rows,
     size_for,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 from csplab.problem import Problem
@@ -215,10 +213,8 @@ class CatalogGap(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
         names = example_names(r["example"] for r in rows)
-        for r in rows:
-            groups[(names[r["example"]], r["size"])].append(r)
+        groups = group_rows(rows, lambda r: (names[r["example"]], r["size"]))
         table = []
         for (ex, size), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], _cells(kv[0][1]))):
             st = [r["stats"] for r in rs]

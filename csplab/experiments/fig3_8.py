@@ -26,13 +26,11 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
-    new_figure,
-    outside_legend,
-    save_figure,
     setting_of,
     size_for,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 

@@ -19,7 +19,7 @@ Examples
 
 from __future__ import annotations
 
-from collections import OrderedDict, defaultdict
+from collections import OrderedDict
 from pathlib import Path
 from typing import Any
 
@@ -31,13 +31,13 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
+    group_rows,
     load_examples,
-    new_figure,
-    save_figure,
     setting_of,
     split_solver,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, save_figure
 from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
 from csplab.experiments.trial import Trial
@@ -178,9 +178,7 @@ class SamplingBias(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        by_ex: dict[str, list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            by_ex[r["example"]].append(r)
+        by_ex = group_rows(rows, lambda r: r["example"])
         table: list[dict[str, Any]] = []
         label_rows: dict[str, dict[str, np.ndarray]] = {}
         names = example_names(by_ex)
@@ -193,10 +191,7 @@ class SamplingBias(Experiment):
                 continue
             ex_lab = np.asarray(exact["stats"]["labels"], dtype=float)
             ex_pat = {int(c): float(v) for c, v in exact["stats"]["_patterns"]}
-            settings: dict[str, list[dict[str, Any]]] = defaultdict(list)
-            for r in rs:
-                if r["solver"] != "exact":
-                    settings[setting_of(r)].append(r)
+            settings = group_rows((r for r in rs if r["solver"] != "exact"), setting_of)
             order = ["uniform"] + [s for s in settings if s != "uniform"]
             label_rows[ex] = {"exact": ex_lab / ex_lab.sum()}
             sampler = None

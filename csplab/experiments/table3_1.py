@@ -17,7 +17,6 @@ Examples
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -27,13 +26,12 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
+    group_rows,
     load_examples,
-    new_figure,
-    outside_legend,
-    save_figure,
     setting_of,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
 from csplab.grids import parse_shape
@@ -133,9 +131,7 @@ class Table31(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        cell: dict[tuple[str, str, str], list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            cell[(r["example"], r["size"], setting_of(r))].append(r)
+        cell = group_rows(rows, lambda r: (r["example"], r["size"], setting_of(r)))
         long = []
         for (ex, size, setting), rs in sorted(cell.items()):
             ok = [r for r in rs if r["status"] == "solved"]
