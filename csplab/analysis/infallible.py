@@ -83,6 +83,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab import grids
+from csplab._interp import set_bits
 from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
@@ -140,7 +141,7 @@ class Rules:
             return hit
         table = self.fwd[d] if forward else self.bwd[d]
         out = 0
-        for b in _bits(dom):
+        for b in set_bits(dom):
             out |= table[b]
         if len(self._union) < 2_000_000:
             self._union[key] = out
@@ -152,13 +153,6 @@ def _to_bits(mask: ArrayLike) -> int:
     for b in np.flatnonzero(np.asarray(mask, dtype=bool)):
         out |= 1 << int(b)
     return out
-
-
-def _bits(x: int) -> Iterator[int]:
-    while x:
-        low = x & -x
-        yield low.bit_length() - 1
-        x ^= low
 
 
 def _graph_ac(
@@ -597,7 +591,7 @@ def _dfs(
         res = found(i, cat, labels)
         if res is not None or i == last:
             return res
-        opts = list(_bits(cat))
+        opts = list(set_bits(cat))
         want = None if first is None else first.get(i)
         if want is not None and want in opts:
             opts.remove(want)

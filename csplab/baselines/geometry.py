@@ -276,23 +276,15 @@ def surface(sdf: NDArray[np.float64]) -> Any:
     return mesh
 
 
-def geometry(
-    model: Any,
-    size: Sequence[int],
-    *,
-    resolution: int = 24,
-    block: int = 8,
-    levels: int = 1,
-    rng: RngLike = None,
-) -> Any:
+def geometry(model: Any, size: Sequence[int], *, resolution: int = 24, **options: Any) -> Any:
     """:func:`geometry_synthesis` then :func:`surface`: a closed ``trimesh.Trimesh`` in the
-    example's units (one voxel of the example's field per sample)."""
+    example's units (one voxel of the example's field per sample); ``options`` are
+    :func:`geometry_synthesis`' others (``block``, ``levels``, ``rng``)."""
     from csplab.continuous.polyhedra import PolyhedralModel
 
     if not isinstance(model, PolyhedralModel):
         raise InputError("the geometry baseline takes a polyhedral model (a closed mesh)")
-    sdf = geometry_synthesis(model, size, resolution=resolution, block=block, levels=levels,
-                             rng=rng)  # fmt: skip
+    sdf = geometry_synthesis(model, size, resolution=resolution, **options)
     mesh = surface(sdf)
     b = np.array(model.bounds, dtype=np.float64)
     h = float((b[3:] - b[:3]).max()) / (resolution - 1)

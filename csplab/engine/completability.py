@@ -51,6 +51,7 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from csplab._closing import Closing
 from csplab.catalog import Propagator, propagate
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -248,7 +249,7 @@ def search_solutions(
         yield g.reshape(problem.shape)
 
 
-class SatCompletability:
+class SatCompletability(Closing):
     """Exact completability by incremental SAT (one :class:`SatOracle`, assumptions).
 
     Parameters
@@ -323,12 +324,6 @@ class SatCompletability:
     def close(self) -> None:
         if self._own:
             self.oracle.close()
-
-    def __enter__(self) -> SatCompletability:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
 
 def make_completability(

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab._closing import Closing
 from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, Encoding, amo_clauses, encode
 from csplab.constraints import ClauseContext, constraint_clauses
@@ -203,7 +204,7 @@ class _Timeout(Exception):
     """Raised inside the oracle when its deadline passes."""
 
 
-class SatOracle:
+class SatOracle(Closing):
     """An incremental SAT engine for one :class:`Problem` (see the module docstring).
 
     Parameters
@@ -538,12 +539,6 @@ class SatOracle:
 
     def close(self) -> None:
         self.solver.delete()
-
-    def __enter__(self) -> SatOracle:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
 
 def preferred_labels(

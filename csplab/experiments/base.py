@@ -22,10 +22,10 @@ import argparse
 import copy
 import json
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Hashable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 import numpy as np
 
@@ -38,12 +38,10 @@ __all__ = [
     "Report",
     "background_labels",
     "example_names",
+    "group_rows",
     "load_examples",
-    "new_figure",
-    "outside_legend",
     "parse_sizes",
     "provenance_note",
-    "save_figure",
     "setting_of",
     "size_for",
     "split_solver",
@@ -163,15 +161,23 @@ def example_names(specs: Iterable[str]) -> dict[str, str]:
     return {s: (n if len(seen[n]) == 1 else s) for s, n in names.items()}
 
 
-def outside_legend(target: Any, **kwargs: Any) -> Any:
-    """A legend to the right of the axes or figure ``target``, outside the data
-    (``save_figure`` saves with a tight bounding box, so it is kept in the picture)."""
-    kwargs.setdefault("fontsize", 8)
-    kwargs.setdefault("frameon", False)
-    kwargs.setdefault("loc", "upper left")
-    kwargs.setdefault("bbox_to_anchor", (1.02, 1))
-    kwargs.setdefault("borderaxespad", 0)
-    return target.legend(**kwargs)
+K = TypeVar("K", bound=Hashable)
+
+
+def group_rows(
+    rows: Iterable[dict[str, Any]], key: Callable[[dict[str, Any]], K]
+) -> dict[K, list[dict[str, Any]]]:
+    """Stored rows grouped by ``key(row)``, the groups in the order of their first row.
+
+    Examples
+    --------
+    >>> group_rows([{"e": "a", "t": 1}, {"e": "b", "t": 2}, {"e": "a", "t": 3}], lambda r: r["e"])
+    {'a': [{'e': 'a', 't': 1}, {'e': 'a', 't': 3}], 'b': [{'e': 'b', 't': 2}]}
+    """
+    out: dict[K, list[dict[str, Any]]] = {}
+    for r in rows:
+        out.setdefault(key(r), []).append(r)
+    return out
 
 
 def background_labels(example: ExampleModel) -> list[int]:
@@ -186,58 +192,6 @@ def background_labels(example: ExampleModel) -> list[int]:
         return sorted(set(auto_boundary(example).values()))
     except InputError:
         return [int(np.argmax(example.counts()))]
-
-
-def new_figure(
-    nrows: int = 1, ncols: int = 1, *, figsize: tuple[float, float], squeeze: bool = True
-) -> tuple[Any, Any]:
-    """A matplotlib figure and its axes (like ``plt.subplots``) without global state.
-
-    The figure gets its own Agg canvas: no ``matplotlib.use``, no pyplot figure manager,
-    no change to ``matplotlib.rcParams``, so plotting from a report leaves a notebook's
-    or another program's backend and settings as they were.
-
-    Parameters
-    ----------
-    nrows, ncols : int
-        The grid of axes.
-    figsize : (float, float)
-        Width and height in inches.
-    squeeze : bool
-        As in :meth:`matplotlib.figure.Figure.subplots`.
-
-    Returns
-    -------
-    (Figure, Axes or array of Axes)
-    """
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=figsize)
-    FigureCanvasAgg(fig)
-    return fig, fig.subplots(nrows, ncols, squeeze=squeeze)
-
-
-def save_figure(fig: Any, stem: Path) -> list[Path]:
-    """Save a matplotlib figure as ``stem.png`` and ``stem.svg`` (reproducible bytes).
-
-    The SVG hash salt (stable element ids) is set for these two saves only
-    (``matplotlib.rc_context``); the global ``rcParams`` are left unchanged.
-    """
-    import matplotlib
-
-    stem.parent.mkdir(parents=True, exist_ok=True)
-    out = []
-    with matplotlib.rc_context({"svg.hashsalt": "csplab"}):
-        for ext, meta in (("png", {"Software": None}), ("svg", {"Date": None})):
-            p = stem.with_suffix(f".{ext}")
-            fig.savefig(p, dpi=130, bbox_inches="tight", metadata=meta)
-            out.append(p)
-    if getattr(fig.canvas, "manager", None) is not None:  # a pyplot figure: release it
-        import matplotlib.pyplot as plt
-
-        plt.close(fig)
-    return out
 
 
 def provenance_note(rows: Sequence[dict[str, Any]]) -> str | None:
@@ -452,6 +406,11 @@ class Experiment:
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         """The trials of the sweep and the example models they use (by hash)."""
         raise NotImplementedError
+
+    def trials(self, quick: bool = False, **overrides: Any) -> list[Trial]:
+        """The trials of the sweep configured by :meth:`make_config` (``quick`` and
+        ``overrides`` as there)."""
+        return self.build(self.make_config(quick=quick, **overrides))[0]
 
     def report(
         self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path

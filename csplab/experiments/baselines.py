@@ -14,24 +14,22 @@ slice of 3D outputs).
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("baselines")
->>> cfg = exp.make_config(quick=True)
->>> trials, _ = exp.build(cfg)
+>>> trials = get_experiment("baselines").trials(quick=True)
 >>> sorted({t.solver for t in trials})
 ['model-synthesis', 'texture:efros-leung', 'texture:graphcut']
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from csplab.example import ExampleModel
-from csplab.experiments.base import Experiment, Report, new_figure, save_figure
+from csplab.experiments.base import Experiment, Report, group_rows
+from csplab.experiments.figures import new_figure, save_figure
 from csplab.experiments.measures import dead_ends, pattern_distance
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
@@ -76,13 +74,13 @@ def measure_baseline(trial: Trial, example: ExampleModel, problem: Any) -> dict[
 
 
 class Baselines(Experiment):
-    name: ClassVar[str] = "baselines"
-    title: ClassVar[str] = "Model synthesis against texture synthesis (Fig. 5.1/5.2)"
-    description: ClassVar[str] = (
+    name = "baselines"
+    title = "Model synthesis against texture synthesis (Fig. 5.1/5.2)"
+    description = (
         "adjacency violations, pattern-statistics distance and time of model synthesis, "
         "Efros-Leung and graph-cut texture synthesis on the same examples"
     )
-    defaults: ClassVar[dict[str, Any]] = {
+    defaults = {
         "examples": ["loops", "fig3_10", "fig3_6a", "line", "castle", "city"],
         "size": "40x40",
         "size3d": "24x24x8",
@@ -91,14 +89,14 @@ class Baselines(Experiment):
         "methods": list(METHODS),
         "options": {"efros-leung": {"window": 5}, "graphcut": {"patch": 6, "overlap": 2}},
     }
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["loops", "castle"],
         "size": "12x12",
         "size3d": "8x8x4",
         "seeds": 1,
         "options": {"efros-leung": {"window": 3}, "graphcut": {"patch": 4, "overlap": 2}},
     }
-    uses: ClassVar[frozenset[str]] = frozenset({"examples", "seeds", "seed0"})
+    uses = frozenset({"examples", "seeds", "seed0"})
 
     def build(self, config: dict[str, Any]) -> tuple[list[Trial], dict[str, ExampleModel]]:
         loaded, examples = self.load_examples({**config, "boundary": "none"})
@@ -114,9 +112,7 @@ class Baselines(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        cell: dict[tuple[str, str, str], list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            cell[(r["example"], r["size"], r["solver"])].append(r)
+        cell = group_rows(rows, lambda r: (r["example"], r["size"], r["solver"]))
         table = []
         for (ex, size, m), rs in sorted(cell.items()):
             st = [r["stats"] for r in rs]

@@ -18,18 +18,15 @@ rectangles less than a block high: the largest object's smaller side stays below
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("blocksize")
->>> cfg = exp.make_config(quick=True)
->>> trials, _ = exp.build(cfg)
+>>> trials = get_experiment("blocksize").trials(quick=True)
 >>> sorted({t.options.get("block", (0,))[0] for t in trials if t.solver == "blocks"})
 [2, 3, 4, 12]
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -40,12 +37,11 @@ from csplab.experiments.base import (
     Report,
     background_labels,
     example_names,
+    group_rows,
     load_examples,
-    new_figure,
-    outside_legend,
-    save_figure,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.measures import (
     objects,
     pack_grid,
@@ -99,23 +95,23 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
 
 
 class BlockSize(Experiment):
-    name: ClassVar[str] = "blocksize"
-    title: ClassVar[str] = "Sec. 3.3.6, Fig. 3.10: block-size trade-off of Alg. 3.4"
-    description: ClassVar[str] = (
+    name = "blocksize"
+    title = "Sec. 3.3.6, Fig. 3.10: block-size trade-off of Alg. 3.4"
+    description = (
         "acceptance, retries, time, consistency and expressiveness (largest object, "
         "non-empty cells, distinct 3x3(x3) patterns vs Alg. 3.1) for block sizes 1..full"
     )
-    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+    defaults = sweep_defaults(
         examples=["fig3_10", "castle"], size=None,
         blocks=[1, 2, 3, 4, 5, 6, 8, 10, 12, 16, 20, "full"], retries=20, seeds=20, window=3,
     )  # fmt: skip
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["fig3_10"],
         "size": "12x12",
         "blocks": [2, 3, 4, "full"],
         "seeds": 3,
     }
-    uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"blocks", "retries", "window"}
+    uses = frozenset(defaults) - {"blocks", "retries", "window"}
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument(
@@ -162,18 +158,14 @@ class BlockSize(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        by_ex: dict[str, list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            by_ex[r["example"]].append(r)
+        by_ex = group_rows(rows, lambda r: r["example"])
         names = example_names(by_ex)
         table: list[dict[str, Any]] = []
         for spec, rs in by_ex.items():
             ex = names[spec]
             ref = [r for r in rs if r["solver"] == "catalog"]
-            groups: dict[int, list[dict[str, Any]]] = defaultdict(list)
-            for r in rs:
-                if r["solver"] == "blocks":
-                    groups[int(r["params"]["options"]["block"][0])].append(r)
+            blocks = [r for r in rs if r["solver"] == "blocks"]
+            groups = group_rows(blocks, lambda r: int(r["params"]["options"]["block"][0]))
             size = [int(v) for v in rs[0]["size"].split("x")]
             whole = [r for r in rs if r["solver"] == "blocks" and _is_full(r, size)]
             # Alg. 3.1's outputs: its successful runs, and the accepted whole-model blocks

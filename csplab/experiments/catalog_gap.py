@@ -23,18 +23,16 @@ Successful runs made no bad choice (a solution proves every prefix completable).
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("catalog_gap")
->>> cfg = exp.make_config(quick=True, examples=["line"], sizes=[4], seeds=1)
->>> trials, _ = exp.build(cfg)
+>>> trials = get_experiment("catalog_gap").trials(quick=True, examples=["line"], sizes=[4],
+...                                              seeds=1)
 >>> len(trials), trials[0].params["oracle"] in ("sat", "brute")
 (1, True)
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -50,12 +48,11 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
-    new_figure,
-    outside_legend,
-    save_figure,
+    group_rows,
     size_for,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 from csplab.problem import Problem
@@ -167,18 +164,18 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
 
 
 class CatalogGap(Experiment):
-    name: ClassVar[str] = "catalog_gap"
-    title: ClassVar[str] = "Catalog gap: Alg. 3.1 choices outside C* and when failures show"
-    description: ClassVar[str] = (
+    name = "catalog_gap"
+    title = "Catalog gap: Alg. 3.1 choices outside C* and when failures show"
+    description = (
         "fraction of Alg. 3.1 steps choosing outside the exact catalog C*, first bad step vs "
         "failure step, by example and size"
     )
-    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+    defaults = sweep_defaults(
         examples=["fig3_5a", "fig3_6a"], sizes="4:12:2", nz=6, seeds=100, order="scan:yx",
         boundary="none", oracle="auto", per_step=True,
     )  # fmt: skip
-    quick: ClassVar[dict[str, Any]] = {"examples": ["fig3_5a"], "sizes": "4,6", "seeds": 10}
-    uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"oracle", "per_step", "nz"}
+    quick = {"examples": ["fig3_5a"], "sizes": "4,6", "seeds": 10}
+    uses = frozenset(defaults) - {"oracle", "per_step", "nz"}
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument("--nz", type=int, help="nz for 3D examples (default 6)")
@@ -216,10 +213,8 @@ class CatalogGap(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        groups: dict[tuple[str, str], list[dict[str, Any]]] = defaultdict(list)
         names = example_names(r["example"] for r in rows)
-        for r in rows:
-            groups[(names[r["example"]], r["size"])].append(r)
+        groups = group_rows(rows, lambda r: (names[r["example"]], r["size"]))
         table = []
         for (ex, size), rs in sorted(groups.items(), key=lambda kv: (kv[0][0], _cells(kv[0][1]))):
             st = [r["stats"] for r in rs]

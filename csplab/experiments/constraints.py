@@ -19,16 +19,14 @@ median time per size, and a figure.
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("constraints")
->>> cfg = exp.make_config(quick=True)
->>> trials, examples = exp.build(cfg)
+>>> trials = get_experiment("constraints").trials(quick=True)
 >>> sorted({c["type"] for c in trials[0].params["constraints"]})
 ['connected', 'count']
 """
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -41,13 +39,13 @@ __all__ = ["ConstraintsExperiment"]
 
 
 class ConstraintsExperiment(Fig38):
-    name: ClassVar[str] = "constraints"
-    title: ClassVar[str] = "Global constraints: success rate and time per solver"
-    description: ClassVar[str] = (
+    name = "constraints"
+    title = "Global constraints: success rate and time per solver"
+    description = (
         "success rate (95% Wilson) and median time vs nx = ny with a connectivity and a count "
         "constraint, one curve per example and solver"
     )
-    defaults: ClassVar[dict[str, Any]] = {
+    defaults = {
         **Fig38.defaults,
         "examples": [
             "tests/io/data/pipes.xml",
@@ -69,14 +67,14 @@ class ConstraintsExperiment(Fig38):
         "time_limit": 10.0,
         "fraction": [0.05, 0.30],
     }
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["loops", "city"],
         "sizes": "6",
         "nz": 4,
         "seeds": 2,
         "solvers": ["sat", "catalog@restarts=5"],
     }
-    uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"fraction"}
+    uses = frozenset(defaults) - {"fraction"}
 
     def add_arguments(self, p: Any) -> None:
         super().add_arguments(p)

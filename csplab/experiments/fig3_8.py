@@ -9,9 +9,7 @@ curve per example (and per solver when several are compared: ``catalog``, ``bloc
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("fig3_8")
->>> cfg = exp.make_config(quick=True)
->>> trials, examples = exp.build(cfg)
+>>> trials = get_experiment("fig3_8").trials(quick=True)
 >>> len(trials), sorted({t.size for t in trials})[:2]
 (12, [(4, 4), (4, 4, 4)])
 """
@@ -20,7 +18,7 @@ from __future__ import annotations
 
 from collections import defaultdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
@@ -28,13 +26,11 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
-    new_figure,
-    outside_legend,
-    save_figure,
     setting_of,
     size_for,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr, wilson
 from csplab.experiments.trial import Trial
 
@@ -42,23 +38,23 @@ __all__ = ["Fig38"]
 
 
 class Fig38(Experiment):
-    name: ClassVar[str] = "fig3_8"
-    title: ClassVar[str] = "Fig. 3.8: success rate of Alg. 3.1 versus model size"
-    description: ClassVar[str] = (
+    name = "fig3_8"
+    title = "Fig. 3.8: success rate of Alg. 3.1 versus model size"
+    description = (
         "success rate (95% Wilson intervals) vs nx = ny, nz fixed, one curve per example and solver"
     )
-    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+    defaults = sweep_defaults(
         examples=["city", "castle", "canal"], sizes="5:50:5", nz=10, solvers=["catalog"],
         seeds=100, constraints=None,
     )  # fmt: skip
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["castle", "line"],
         "sizes": "4,8",
         "nz": 4,
         "seeds": 3,
     }
-    uses: ClassVar[frozenset[str]] = frozenset(defaults)
-    tilesets: ClassVar[bool] = True
+    uses = frozenset(defaults)
+    tilesets = True
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument("--nz", type=int, help="nz for 3D examples (default 10)")

@@ -12,18 +12,16 @@ is flagged *biased* when its TV interval lies entirely above the floor's interva
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("sampling_bias")
->>> cfg = exp.make_config(quick=True)
->>> trials, _ = exp.build(cfg)
+>>> trials = get_experiment("sampling_bias").trials(quick=True)
 >>> sorted({t.solver for t in trials})
 ['catalog', 'exact', 'uniform']
 """
 
 from __future__ import annotations
 
-from collections import OrderedDict, defaultdict
+from collections import OrderedDict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 
@@ -33,13 +31,13 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
+    group_rows,
     load_examples,
-    new_figure,
-    save_figure,
     setting_of,
     split_solver,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, save_figure
 from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
 from csplab.experiments.trial import Trial
@@ -115,13 +113,13 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
 
 
 class SamplingBias(Experiment):
-    name: ClassVar[str] = "sampling_bias"
-    title: ClassVar[str] = "Sampling bias: label and 2x2-pattern frequencies vs exact uniform"
-    description: ClassVar[str] = (
+    name = "sampling_bias"
+    title = "Sampling bias: label and 2x2-pattern frequencies vs exact uniform"
+    description = (
         "total variation / Jensen-Shannon distance of pooled output frequencies to the exact "
         "uniform frequencies (transfer matrices on strips), bootstrap 95% intervals"
     )
-    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+    defaults = sweep_defaults(
         omit=("order", "choice"),  # the solver entries name them
         examples=["line", "fig3_4a", "fig3_5a"], size="16x5",
         solvers=[
@@ -131,14 +129,14 @@ class SamplingBias(Experiment):
         ],
         seeds=400, boundary="none", n_boot=500,
     )  # fmt: skip
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["line"],
         "size": "6x3",
         "solvers": ["catalog"],
         "seeds": 8,
         "n_boot": 50,
     }
-    uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"n_boot", "periodic"}
+    uses = frozenset(defaults) - {"n_boot", "periodic"}
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument("--n-boot", dest="n_boot", type=int, help="bootstrap resamples (500)")
@@ -180,9 +178,7 @@ class SamplingBias(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        by_ex: dict[str, list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            by_ex[r["example"]].append(r)
+        by_ex = group_rows(rows, lambda r: r["example"])
         table: list[dict[str, Any]] = []
         label_rows: dict[str, dict[str, np.ndarray]] = {}
         names = example_names(by_ex)
@@ -195,10 +191,7 @@ class SamplingBias(Experiment):
                 continue
             ex_lab = np.asarray(exact["stats"]["labels"], dtype=float)
             ex_pat = {int(c): float(v) for c, v in exact["stats"]["_patterns"]}
-            settings: dict[str, list[dict[str, Any]]] = defaultdict(list)
-            for r in rs:
-                if r["solver"] != "exact":
-                    settings[setting_of(r)].append(r)
+            settings = group_rows((r for r in rs if r["solver"] != "exact"), setting_of)
             order = ["uniform"] + [s for s in settings if s != "uniform"]
             label_rows[ex] = {"exact": ex_lab / ex_lab.sum()}
             sampler = None

@@ -44,6 +44,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
+from csplab._closing import Closing
 from csplab.errors import CsplabError, FormatError, InputError
 from csplab.experiments.trial import Trial
 
@@ -252,7 +253,7 @@ def _process_alive(pid: int) -> bool:
         return True
 
 
-class ResultsStore:
+class ResultsStore(Closing):
     """A SQLite file holding the trials of any number of experiments.
 
     Parameters
@@ -470,9 +471,3 @@ class ResultsStore:
 
     def close(self) -> None:
         self._db.close()
-
-    def __enter__(self) -> ResultsStore:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()

@@ -10,18 +10,15 @@ default every installed one).
 Examples
 --------
 >>> from csplab.experiments import get_experiment
->>> exp = get_experiment("table3_1")
->>> cfg = exp.make_config(quick=True)
->>> trials, _ = exp.build(cfg)
+>>> trials = get_experiment("table3_1").trials(quick=True)
 >>> sorted({(t.size, t.solver) for t in trials})
 [((6, 6, 4), 'blocks'), ((6, 6, 4), 'catalog'), ((8, 8, 4), 'blocks'), ((8, 8, 4), 'catalog')]
 """
 
 from __future__ import annotations
 
-from collections import defaultdict
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any
 
 from csplab.errors import InputError
 from csplab.example import ExampleModel
@@ -29,13 +26,12 @@ from csplab.experiments.base import (
     Experiment,
     Report,
     example_names,
+    group_rows,
     load_examples,
-    new_figure,
-    outside_legend,
-    save_figure,
     setting_of,
     sweep_defaults,
 )
+from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
 from csplab.grids import parse_shape
@@ -75,17 +71,17 @@ def _shape_2d_or_3d(example: ExampleModel, text: str) -> tuple[int, ...]:
 
 
 class Table31(Experiment):
-    name: ClassVar[str] = "table3_1"
-    title: ClassVar[str] = "Table 3.1: output size, k and computation time per example"
-    description: ClassVar[str] = (
+    name = "table3_1"
+    title = "Table 3.1: output size, k and computation time per example"
+    description = (
         "k, displayed size, time for the displayed size and for 40x40x10 (Alg. 3.1 when it "
         "succeeds, else 10x10x10 blocks), plus one column per solver"
     )
-    defaults: ClassVar[dict[str, Any]] = sweep_defaults(
+    defaults = sweep_defaults(
         examples=["city", "castle", "canal"], displayed={}, compare="40x40x10",
         solvers="installed", seeds=5, options={"blocks.block": 10}, time_limit=600.0,
     )  # fmt: skip
-    quick: ClassVar[dict[str, Any]] = {
+    quick = {
         "examples": ["castle"],
         "displayed": {"castle": "8x8x4"},
         "compare": "6x6x4",
@@ -94,7 +90,7 @@ class Table31(Experiment):
         "options": {"blocks.block": 4},
         "time_limit": 60.0,
     }
-    uses: ClassVar[frozenset[str]] = frozenset(defaults) - {"displayed", "compare"}
+    uses = frozenset(defaults) - {"displayed", "compare"}
 
     def add_arguments(self, p: Any) -> None:
         p.add_argument(
@@ -135,9 +131,7 @@ class Table31(Experiment):
 
     def report(self, rows: list[dict[str, Any]], config: dict[str, Any], out: Path) -> Report:
         rep = Report(self.name, self.title, config)
-        cell: dict[tuple[str, str, str], list[dict[str, Any]]] = defaultdict(list)
-        for r in rows:
-            cell[(r["example"], r["size"], setting_of(r))].append(r)
+        cell = group_rows(rows, lambda r: (r["example"], r["size"], setting_of(r)))
         long = []
         for (ex, size, setting), rs in sorted(cell.items()):
             ok = [r for r in rs if r["status"] == "solved"]

@@ -512,23 +512,15 @@ def _clause_records(
                 n0 += 1
         kind = keys[1] if i < nsup else keys[2]
         n1 = n0 + 2  # BoolArgumentProto: key of literals, length, literals
-        y = keys[3]
-        while y >= 128:
-            y >>= 7
-            n1 += 1
-        y = n0
-        while y >= 128:
-            y >>= 7
-            n1 += 1
+        for y in (keys[3], n0):  # the bytes of key and length beyond their first
+            while y >= 128:
+                y >>= 7
+                n1 += 1
         n2 = n1 + 2  # ConstraintProto: key of bool_or / exactly_one, length, argument
-        y = kind
-        while y >= 128:
-            y >>= 7
-            n2 += 1
-        y = n1
-        while y >= 128:
-            y >>= 7
-            n2 += 1
+        for y in (kind, n1):
+            while y >= 128:
+                y >>= 7
+                n2 += 1
         head[0] = keys[0]
         head[1] = n2
         head[2] = kind
