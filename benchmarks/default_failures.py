@@ -148,7 +148,7 @@ def is_grid(args: list[str]) -> bool:
 
     from csplab.continuous.model import PolygonModel
     from csplab.continuous.polyhedra import PolyhedralModel
-    from csplab.io import load_model
+    from csplab.examples import load_model
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

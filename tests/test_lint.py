@@ -79,5 +79,6 @@ def test_the_core_keeps_its_own_order():
         c for c in cfg["contracts"] if c["type"] == "layers" and c["layers"][0] == "csplab.examples"
     ]
     names = ("csplab.examples", "csplab.io", "csplab.grids", "csplab.catalog", "csplab.problem")
-    order = [core["layers"].index(m) for m in (*names, "csplab.errors")]
+    layers = [{m.strip() for m in layer.split("|")} for layer in core["layers"]]
+    order = [next(i for i, ms in enumerate(layers) if m in ms) for m in (*names, "csplab.errors")]
     assert order == sorted(order) and "ignore_imports" not in core

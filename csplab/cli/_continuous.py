@@ -7,6 +7,7 @@ import json
 import sys
 from typing import Any
 
+from csplab.cli.common import explain, fallback_setting, not_written, outcome
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -62,7 +63,9 @@ def polygon_output(path: str | None, flag: str = "--out", gives: Any = "PolygonM
     or None."""
     if not path:
         return None
-    from csplab.cli.common import check_output_path
+    from csplab.cli.common import (
+        check_output_path,
+    )
     from csplab.io.registry import output_format
 
     fmt = output_format(path, gives=gives)
@@ -102,8 +105,6 @@ def synthesize(
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
     settings["restarts"] = restarts
-    from csplab.cli.synthesize import explain, fallback_setting, not_written, outcome
-
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
     fallback = None if cls.complete or args.fallback == "none" else args.fallback

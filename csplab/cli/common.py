@@ -398,3 +398,57 @@ def with_constraint_files(problem: Problem, paths: Sequence[str] | None) -> Prob
 
     extra = [c for p in paths for c in read_constraints(p, problem)]
     return problem.with_constraints(extra)
+
+
+#: stats the lines of :func:`explain` say in words
+EXPLAINED_STATS = ("proof", "fallback_from", "gave_up_s", "reason")
+
+
+def fallback_setting(fallback: str) -> str:
+    """The settings line's ``fallback`` entry: the solver ``--fallback`` names, and where
+    it came from."""
+    if fallback != "auto":
+        return f"{fallback} (given)"
+    from csplab.deps import available
+
+    return f"{'sat' if available('pysat') else 'backtrack'} (auto)"
+
+
+def outcome(status: str) -> str:
+    """What the user is told: ``solved``, ``unsat`` (an exact solver's proof) or ``not
+    solved`` (every solver gave up, or the time ran out)."""
+    return status if status in ("solved", "unsat") else "not solved"
+
+
+def explain(result: Any) -> list[str]:
+    """The lines after the first that say how the result came about: which solver gave up
+    before the fallback, the proof of an ``unsat``, why a run is ``not solved``."""
+    st = result.stats
+    lines = []
+    if "fallback_from" in st:
+        n = st.get("attempts", 1)
+        lines.append(
+            f"  {st['fallback_from']} gave up after {n} attempt{'s' * (n != 1)} "
+            f"({st.get('gave_up_s', 0.0):.3f} s"
+            + (f": {st['reason']}" if result.status != "failed" and st.get("reason") else "")
+            + f"); {result.solver} took over"
+            + (" (too large for SAT: modify in blocks, exact block completion)"
+               if result.solver == "blocks" and st["fallback_from"] != "blocks" else "")
+        )  # fmt: skip
+    if result.status == "unsat":
+        lines.append(f"  proof: {st.get('proof', 'refuted by ' + result.solver)}")
+    elif result.status == "timeout":
+        lines.append("  not solved: the time limit ran out (--time-limit); satisfiability "
+                     "is not decided")  # fmt: skip
+    elif result.status == "failed":
+        why = st.get("reason") or "the incomplete solver gave up"
+        lines.append(f"  not solved: {why}; this says nothing about satisfiability "
+                     "(--fallback sat or backtrack decides)")  # fmt: skip
+    return lines
+
+
+def not_written(out: str, status: str) -> str:
+    """The stderr line when ``--out`` is not written."""
+    if status == "unsat":
+        return f"  not written: {out} (no solution exists: unsat, proof above)"
+    return f"  not written: {out} (not solved; --out-partial writes the partial grid)"

@@ -360,7 +360,7 @@ def solve(
         assert fallback is not None
         res = chain.finish(
             problem, fallback, res, solver=solver, seed=_derived_seed(seed, attempt, gen),
-            attempts=attempt, t0=t0, time_limit=limit, options=options,
+            attempts=attempt, t0=t0, time_limit=limit, options=options, lookup=solver_class,
         )  # fmt: skip
     elapsed = time.perf_counter() - t0
     if "fallback_from" not in res.stats:

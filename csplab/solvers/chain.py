@@ -41,6 +41,7 @@ Examples
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -49,6 +50,7 @@ from csplab.deps import available
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
 from csplab.result import Result
+from csplab.solvers.base import Solver
 
 __all__ = ["FALLBACKS", "SAT_CELL_LABELS", "check_fallback", "exact_solver", "finish"]
 
@@ -105,19 +107,21 @@ def finish(
     t0: float,
     time_limit: float | None,
     options: dict[str, Any],
+    lookup: Callable[[str], type[Solver]],
 ) -> Result:
     """Run the fallback solver on ``problem`` after ``gave_up`` (the incomplete solver
     ``solver``'s last result, ``failed``), with what is left of ``time_limit`` (the
     whole call's, measured from ``t0``), seeded with ``seed``; ``options`` are the
-    incomplete solver's (their ``choice`` carries over where the exact solver has it).
-    The result says which solver produced it. With no time left, ``gave_up`` is returned
-    as a ``timeout``."""
+    incomplete solver's (their ``choice`` carries over where the exact solver has it);
+    ``lookup`` finds a solver class by name (the registry's
+    :func:`csplab.solvers.solver_class`, passed in so this module never imports the package
+    that imports it). The result says which solver produced it. With no time left,
+    ``gave_up`` is returned as a ``timeout``."""
     from csplab.rng import make_rng
-    from csplab.solvers import solver_class
 
     name = solver.partition(":")[0]
     target = exact_solver(problem, fallback, name)
-    cls = solver_class(target)
+    cls = lookup(target)
     opts: dict[str, Any] = {}
     spent = time.perf_counter() - t0
     if time_limit is not None:
