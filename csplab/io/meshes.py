@@ -27,9 +27,19 @@ preview.
   with the same labels, solids, vertices and polygons.
 * PNG out (``mesh-png``): a shaded view of the solids in their label colours (matplotlib).
 
+Meshes as CAD tools write them are repaired first (:mod:`csplab.io.mesh_repair`): duplicate
+vertices merged, faces with repeated vertices dropped, zero-area sliver triangles removed by
+edge flips, inconsistent winding made consistent (and outward); one ``UserWarning`` line
+says what was repaired (the CLI prints it as ``csplab: warning: FILE: repaired ...``) and
+``meta["repaired"]`` has the counts. Files of more than
+:data:`~csplab.io.mesh_repair.MAX_FACES` faces are refused from their counts, before the
+faces are read.
+
 Every problem is one line: a :class:`~csplab.errors.FormatError` naming the file and line
-for syntax, an :class:`~csplab.errors.InputError` naming the file and the solid/face for
-geometry (:class:`~csplab.continuous.polyhedra.PolyhedralModel`).
+for syntax, an :class:`~csplab.errors.InputError` naming the file and the line, triangle or
+solid/face for geometry (non-finite or too large coordinates, a surface that crosses
+itself: :func:`~csplab.io.mesh_repair.self_intersection`, and the checks of
+:class:`~csplab.continuous.polyhedra.PolyhedralModel`).
 
 Examples
 --------
@@ -52,7 +62,8 @@ import os
 import re
 import struct
 import tempfile
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +74,15 @@ from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
 from csplab.errors import CsplabError, FormatError, InputError
 from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, read_bytes
+from csplab.io.mesh_repair import (
+    Repairs,
+    check_coordinates,
+    check_face_count,
+    flip_slivers,
+    merge_duplicates,
+    orient_shell,
+    self_intersection,
+)
 
 __all__ = [
     "read_obj_model",
@@ -77,6 +97,7 @@ __all__ = [
 
 _LABEL_NAME = re.compile(r"label[_\s-]?(\d+)", re.IGNORECASE)
 _LABEL_COMMENT = re.compile(r"#\s*csplab\s+label\s+(\S+)", re.IGNORECASE)
+_OBJ_FACE = re.compile(r"^[ \t]*f[ \t]", re.MULTILINE)
 
 
 # ---------------------------------------------------------------------------- sniffing
@@ -189,15 +210,6 @@ def _components(polys: Sequence[Sequence[int]], n_vertices: int) -> list[list[in
     return list(order.values())
 
 
-def _merged_ids(v: NDArray[np.float64], polys: list[list[int]]) -> list[list[int]]:
-    """Faces with coincident vertices given one index (for the connectivity only)."""
-    if not len(v):
-        return polys
-    _, inv = np.unique(v + 0.0, axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
-    return [[int(inv[i]) for i in p] for p in polys]
-
-
 def _solids(
     v: NDArray[np.float64],
     polys: list[list[int]],
@@ -207,15 +219,31 @@ def _solids(
     path: Path,
     fmt: str,
     by_component: bool,
+    vertex_name: Callable[[int], str] | None = None,
 ) -> PolyhedralModel:
-    """Solids (edge-connected shells of one label and group) and the model."""
-    merged = _merged_ids(v, polys)
+    """Solids (edge-connected shells of one label and group) and the model, after the
+    repairs of :mod:`csplab.io.mesh_repair` (one warning line says what was repaired;
+    ``meta["repaired"]`` has the counts)."""
+    check_coordinates(v, path, vertex_name or (lambda k: f"vertex {k}"))
+    repairs = Repairs()
+    v, polys, dups = merge_duplicates(v, polys)
+    if fmt != "stl":  # every STL triangle has its own vertices: the format, not a defect
+        repairs.duplicates = dups
+    keep = [j for j, p in enumerate(polys) if len(set(p)) >= 3]
+    if len(keep) < len(polys):
+        repairs.degenerate = len(polys) - len(keep)
+        polys = [polys[j] for j in keep]
+        labels = [labels[j] for j in keep]
+        groups = [groups[j] for j in keep]
+    scale = float(np.ptp(v, axis=0).max()) if len(v) else 1.0
     keys = list(dict.fromkeys(zip(groups, labels, strict=True)))
     solids: list[dict[str, Any]] = []
     for g, b in keys:
         idx = [j for j in range(len(polys)) if groups[j] == g and labels[j] == b]
-        for comp in _components([merged[j] for j in idx], len(v)):
-            faces = [polys[idx[c]] for c in comp]
+        mine = [polys[j] for j in idx]
+        for comp in _components(mine, len(v)):
+            faces = orient_shell(v, [mine[c] for c in comp], repairs)
+            faces = flip_slivers(v, faces, repairs, scale)
             used = sorted({i for f in faces for i in f})
             where = {old: new for new, old in enumerate(used)}
             s: dict[str, Any] = {
@@ -234,12 +262,24 @@ def _solids(
     meta: dict[str, Any] = {"format": fmt}
     if names and not by_component:
         meta["label_names"] = {str(b): n for b, n in sorted(names.items())}
+    if repairs:
+        meta["repaired"] = repairs.as_dict()
     try:
-        return PolyhedralModel(solids, name=path.stem, meta=meta, source=str(path))
+        model = PolyhedralModel(solids, name=path.stem, meta=meta, source=str(path))
     except CsplabError:
         raise
     except (ValueError, TypeError, OverflowError, IndexError, MemoryError) as e:
         raise InputError(f"{path}: cannot build the polyhedral model ({e})") from None
+    for i, solid in enumerate(model.solids):
+        hit = self_intersection(solid.vertices, solid.faces)
+        if hit is not None:
+            f1, f2 = (int(solid.face_polygon[k]) for k in hit)
+            raise InputError(
+                f"{path}: solid {i}: the surface crosses itself (faces {f1} and {f2} intersect)"
+            )
+    if repairs:
+        warnings.warn(repairs.note(path), UserWarning, stacklevel=3)
+    return model
 
 
 def _number_labels(
@@ -292,7 +332,10 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
     explicit: list[int | None] = []
     group, mat, label = "", None, None
     any_group = False
-    for n, raw in enumerate(_text(p).splitlines(), 1):
+    text = _text(p)
+    check_face_count(sum(1 for _ in _OBJ_FACE.finditer(text)), p)
+    vlines: list[int] = []
+    for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line:
             continue
@@ -316,6 +359,7 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
             except ValueError:
                 raise FormatError("a vertex needs 3 numbers", path=p, line=n) from None
             verts.append((x, y, z))
+            vlines.append(n)
         elif key == "f":
             face: list[int] = []
             for t in tok[1:]:
@@ -361,7 +405,8 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
         got, names = _number_labels([keys[j] for j in free], taken, p)
         for j, b in zip(free, got, strict=True):
             labs[j] = b
-    return _solids(v, polys, labs, groups, names, p, "mesh-obj", mode == "components")
+    return _solids(v, polys, labs, groups, names, p, "mesh-obj", mode == "components",
+                   lambda k: f"line {vlines[k]}")  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OFF in
@@ -371,10 +416,16 @@ def read_off(path: str | Path, labels: str = "one") -> PolyhedralModel:
     p = Path(path)
     by = _labels_option(p, labels)
     rows: list[tuple[int, list[str]]] = []
+    checked = False
     for n, raw in enumerate(_text(p).splitlines(), 1):
         tok = raw.split("#", 1)[0].split()
         if tok:
             rows.append((n, tok))
+            if not checked and len(rows) <= 2:  # the counts, before the body is read
+                counts = rows[-1][1][1:] if len(rows) == 1 else rows[-1][1]
+                if len(counts) >= 2 and counts[1].isdigit():
+                    check_face_count(int(counts[1]), p)
+                    checked = True
     if not rows or not rows[0][1][0].endswith("OFF"):
         raise FormatError("an OFF file starts with OFF", path=p, line=rows[0][0] if rows else 1)
     first = rows[0][1][1:]
@@ -415,7 +466,9 @@ def read_off(path: str | Path, labels: str = "one") -> PolyhedralModel:
             raise FormatError(f"a face refers to a vertex outside 0..{nv - 1}", path=p, line=n)
         polys.append(face)
     v = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
-    return _solids(v, polys, [1] * len(polys), [""] * len(polys), {}, p, "off", by)
+    vline = [n for n, _ in rest[:nv]]
+    return _solids(v, polys, [1] * len(polys), [""] * len(polys), {}, p, "off", by,
+                   lambda k: f"line {vline[k]}")  # fmt: skip
 
 
 def _labels_option(p: Path, labels: str) -> bool:
@@ -438,6 +491,7 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
     data = read_bytes(p)
     ascii_ = data.lstrip().lower().startswith(b"solid") and b"facet" in data[:4096].lower()
     if ascii_:
+        check_face_count(len(re.findall(rb"(?i)endfacet", data)), p)
         try:
             tri = np.asarray(
                 [[float(x) for x in m.groups()] for m in _STL_VERTEX.finditer(data)],
@@ -455,12 +509,14 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
             raise FormatError(
                 f"{n} triangles announced, the file holds {(len(data) - 84) // 50}", path=p
             )
+        check_face_count(n, p)
         rec = np.frombuffer(data, dtype=_STL_DTYPE, count=n, offset=84)
         tri = rec["v"].astype(np.float64).reshape(-1, 3)
     if not len(tri):
         raise InputError(f"{p}: no triangles: a polyhedral example needs closed solids")
     polys = np.arange(len(tri)).reshape(-1, 3).tolist()
-    return _solids(tri, polys, [1] * len(polys), [""] * len(polys), {}, p, "stl", by)
+    return _solids(tri, polys, [1] * len(polys), [""] * len(polys), {}, p, "stl", by,
+                   lambda k: f"triangle {k // 3}")  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OBJ out

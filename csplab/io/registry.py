@@ -662,9 +662,12 @@ FORMATS: dict[str, Format] = {
             details="in: closed, oriented solids (`v`, polygon `f`, `o`/`g`, `usemtl`); a "
             "material or group named `label_N` is label `N`, other names get 1, 2, … in "
             "order of first appearance, a `# csplab label N` comment labels the rest of its "
-            "group; a solid is one connected shell of one label and group; validated "
-            "(watertight, manifold, consistent winding, no zero-area face, different labels "
-            "do not overlap), inside-out solids are reversed with a warning; out: one "
+            "group; a solid is one connected shell of one label and group; repaired as CAD "
+            "exports need (duplicate vertices, zero-area slivers by edge flips, inconsistent "
+            "winding; one warning line says what) and validated (watertight, manifold, no "
+            "self-crossing, no zero-area face, different labels do not overlap, at most "
+            "200,000 faces, coordinates up to 1e7), inside-out solids are reversed with a "
+            "warning; out: one "
             "`o solid_I` per solid, one material `label_N` per label with its colour in the "
             "`.mtl` (`.obj` results of label grids are the `obj` format)",
             example="csplab info  # in Python: "
@@ -688,7 +691,7 @@ FORMATS: dict[str, Format] = {
             ),
             files="starting with `OFF`",
             details="`OFF`, counts, vertices, `k i1 … ik` polygon faces (colours ignored); "
-            "every connected shell is a solid, validated as for `mesh-obj`",
+            "every connected shell is a solid, repaired and validated as for `mesh-obj`",
             example="csplab info  # in Python: "
             "csplab.io.read_model('tests/io/data/tiny.off', labels='components')",
         ),
@@ -711,7 +714,7 @@ FORMATS: dict[str, Format] = {
             files="ASCII or binary",
             details="triangles; coincident vertices are merged and adjacent coplanar "
             "triangles counted as one input polygon; every connected shell is a solid, "
-            "validated as for `mesh-obj`",
+            "repaired and validated as for `mesh-obj`",
             example="csplab info  # in Python: "
             "csplab.io.read_model('tests/io/data/tiny.stl').n_polygons",
         ),

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BUILDERS", "build", "export", "sliver", "write_all"]
+__all__ = ["BUILDERS", "build", "export", "pushed_through", "sliver", "write_all"]
 
 
 def _man() -> Any:
@@ -178,6 +178,18 @@ def sliver(v: np.ndarray, f: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray
     keep = np.delete(f, j, axis=0)
     f = np.vstack([keep, [[a, c, x], [c, b, x], [a, b, c]]])
     return v, f
+
+
+def pushed_through(mesh: Any, depth: float = 1.0) -> Any:
+    """``mesh`` with its highest vertex (the one of largest ``x`` among ties) dragged to
+    ``depth`` below the bottom: the faces around it cross the bottom face (a closed,
+    consistently wound surface that intersects itself)."""
+    import trimesh
+
+    v = np.asarray(mesh.vertices, dtype=np.float64).copy()
+    k = int(np.argmax(v[:, 2] + 1e-3 * v[:, 0]))
+    v[k, 2] = float(v[:, 2].min()) - depth
+    return trimesh.Trimesh(vertices=v, faces=np.asarray(mesh.faces), process=False)
 
 
 def export(
