@@ -226,12 +226,12 @@ def _solids(
     ``meta["repaired"]`` has the counts)."""
     check_coordinates(v, path, vertex_name or (lambda k: f"vertex {k}"))
     repairs = Repairs()
-    v, polys, dups = merge_duplicates(v, polys)
-    if fmt != "stl":  # every STL triangle has its own vertices: the format, not a defect
-        repairs.duplicates = dups
+    orig = polys
+    v, polys, _ = merge_duplicates(v, polys)
     keep = [j for j, p in enumerate(polys) if len(set(p)) >= 3]
     if len(keep) < len(polys):
         repairs.degenerate = len(polys) - len(keep)
+        orig = [orig[j] for j in keep]
         polys = [polys[j] for j in keep]
         labels = [labels[j] for j in keep]
         groups = [groups[j] for j in keep]
@@ -242,6 +242,10 @@ def _solids(
         idx = [j for j in range(len(polys)) if groups[j] == g and labels[j] == b]
         mine = [polys[j] for j in idx]
         for comp in _components(mine, len(v)):
+            if fmt != "stl":  # every STL triangle has its own vertices: not a defect
+                # coincident vertices of one shell (other shells may share positions)
+                ids = {i for c in comp for i in orig[idx[c]]}
+                repairs.duplicates += len(ids) - len({i for c in comp for i in mine[c]})
             faces = orient_shell(v, [mine[c] for c in comp], repairs)
             faces = flip_slivers(v, faces, repairs, scale)
             used = sorted({i for f in faces for i in f})

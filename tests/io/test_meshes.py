@@ -209,8 +209,8 @@ REPAIRED = {
     ),
     "duplicates and a repeated vertex": (
         [([], [*cube(), *cube()], [*QUADS[1:], [0, 11, 10, 9], [0, 0, 1]])],
-        r"m\.obj: repaired 8 duplicate vertices \(merged\), 1 face with fewer than 3 distinct",
-        {"duplicate_vertices": 8, "degenerate_faces": 1},
+        r"m\.obj: repaired 3 duplicate vertices \(merged\), 1 face with fewer than 3 distinct",
+        {"duplicate_vertices": 3, "degenerate_faces": 1},
     ),
 }
 
