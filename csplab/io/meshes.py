@@ -210,6 +210,16 @@ def _components(polys: Sequence[Sequence[int]], n_vertices: int) -> list[list[in
     return list(order.values())
 
 
+def _edge_uses(polys: Sequence[Sequence[int]]) -> NDArray[np.int64]:
+    """The distinct numbers of faces that share an (undirected) edge."""
+    pairs = [(a, p[(k + 1) % len(p)]) for p in polys for k, a in enumerate(p)]
+    if not pairs:
+        return np.zeros(0, dtype=np.int64)
+    e = np.sort(np.asarray(pairs, dtype=np.int64), axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return np.unique(counts)
+
+
 def _solids(
     v: NDArray[np.float64],
     polys: list[list[int]],
@@ -241,7 +251,14 @@ def _solids(
     for g, b in keys:
         idx = [j for j in range(len(polys)) if groups[j] == g and labels[j] == b]
         mine = [polys[j] for j in idx]
-        for comp in _components(mine, len(v)):
+        comps = _components(mine, len(v))
+        if _edge_uses(mine).max(initial=0) > 2:
+            # solids that touch along an edge (or a point) share merged vertices: the
+            # file's own vertex numbers keep them apart when every shell is closed so
+            alone = _components([orig[j] for j in idx], len(v))
+            if all(_edge_uses([mine[c] for c in comp]).tolist() in ([], [2]) for comp in alone):
+                comps = alone
+        for comp in comps:
             if fmt != "stl":  # every STL triangle has its own vertices: not a defect
                 # coincident vertices of one shell (other shells may share positions)
                 ids = {i for c in comp for i in orig[idx[c]]}
@@ -623,3 +640,176 @@ def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
     _atomic_write(p, buf.getvalue())
+
+
+# ---------------------------------------------------------------------------- triangles out
+def _ear_clip(pts: NDArray[np.float64]) -> list[tuple[int, int, int]] | None:
+    """Triangles of a simple polygon (2D points, either orientation) by ear clipping that
+    keeps every vertex, flat ones included, and makes no zero-area triangle (``None`` when
+    it finds no ear)."""
+    n = len(pts)
+    x, y = pts[:, 0], pts[:, 1]
+    signed = float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum())
+    ring = list(range(n)) if signed > 0 else list(range(n))[::-1]
+    scale = float(np.ptp(pts, axis=0).max()) or 1.0
+    eps = 1e-12 * scale**2
+
+    def cross(a: int, b: int, c: int) -> float:
+        return float(
+            (pts[b, 0] - pts[a, 0]) * (pts[c, 1] - pts[a, 1])
+            - (pts[b, 1] - pts[a, 1]) * (pts[c, 0] - pts[a, 0])
+        )
+
+    out: list[tuple[int, int, int]] = []
+    while len(ring) > 3:
+        m = len(ring)
+        for k in range(m):
+            a, b, c = ring[k - 1], ring[k], ring[(k + 1) % m]
+            if cross(a, b, c) <= eps:
+                continue  # reflex or flat: not an ear
+            if any(
+                cross(a, b, q) >= -eps and cross(b, c, q) >= -eps and cross(c, a, q) >= -eps
+                for q in ring
+                if q not in (a, b, c) and not np.array_equal(pts[q], pts[b])
+            ):
+                continue  # another vertex in (or on) the ear
+            out.append((a, b, c))
+            del ring[k]
+            break
+        else:
+            return None
+    if cross(*ring) <= eps:
+        return None
+    out.append((ring[0], ring[1], ring[2]))
+    return out if signed > 0 else [(a, c, b) for a, b, c in out]
+
+
+def solid_triangles(solid: Any, where: str = "solid") -> NDArray[np.int64]:
+    """The solid's triangles, outward, with no zero-area triangle and every polygon vertex
+    kept (no T-junctions between neighbouring faces): the solid's own triangulation where
+    it has no zero-area triangle, else the polygon ear-clipped again in its plane (an
+    :class:`~csplab.errors.InputError` naming ``where`` and the polygon if that fails).
+
+    Examples
+    --------
+    >>> from csplab.continuous.polyhedra import PolyhedralModel
+    >>> cube = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+    ...         [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1], [0.5, 0, 0], [0.5, 0, 1]]
+    >>> quads = [[0, 3, 2, 1, 8], [4, 9, 5, 6, 7], [0, 8, 1, 5, 9, 4], [1, 2, 6, 5],
+    ...          [2, 3, 7, 6], [3, 0, 4, 7]]
+    >>> M = PolyhedralModel([{"label": 1, "vertices": cube, "faces": quads}])
+    >>> len(solid_triangles(M.solids[0]))  # 3 + 3 + 4 + 2 + 2 + 2
+    16
+    """
+    v, T = solid.vertices, np.asarray(solid.faces, dtype=np.int64)
+    tri = v[T]
+    area2 = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    scale = float(np.ptp(v, axis=0).max()) or 1.0
+    bad = np.unique(np.asarray(solid.face_polygon)[area2 <= 1e-12 * scale**2])
+    if not bad.size:
+        return T
+    keep = ~np.isin(solid.face_polygon, bad)
+    parts = [T[keep]]
+    for j in bad.tolist():
+        ids = np.asarray(solid.polygons[j], dtype=np.int64)
+        pts = v[ids]
+        normal = np.cross(pts - pts[0], np.roll(pts, -1, axis=0) - pts[0]).sum(axis=0)
+        axis = int(np.argmax(np.abs(normal)))
+        flat2 = np.delete(pts, axis, axis=1)
+        if normal[axis] < 0:  # keep the face's orientation in the projection
+            flat2 = flat2[:, ::-1]
+        got = _ear_clip(flat2)
+        if got is None:
+            raise InputError(
+                f"{where}: polygon {j} cannot be triangulated without zero-area triangles"
+            )
+        loc = np.asarray(got, dtype=np.int64)
+        parts.append(ids[loc])
+    return np.concatenate(parts)
+
+
+def _triangle_soup(
+    model: PolyhedralModel, path: str | Path
+) -> tuple[list[NDArray[np.float64]], list[NDArray[np.int64]]]:
+    """Per solid: its vertices and its triangles (:func:`solid_triangles`)."""
+    tris = [solid_triangles(s, f"{path}: solid {i}") for i, s in enumerate(model.solids)]
+    return [s.vertices for s in model.solids], tris
+
+
+def write_stl_model(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as a binary STL (atomically): every solid's triangles
+    (:func:`solid_triangles`: no zero-area triangle, no T-junction), outward normals,
+    float32 coordinates; STL has no labels (the ``.obj`` and ``.glb`` writers keep them)."""
+    verts, tris = _triangle_soup(model, path)
+    n = sum(len(t) for t in tris)
+    rec = np.zeros(n, dtype=_STL_DTYPE)
+    k = 0
+    for v, t in zip(verts, tris, strict=True):
+        tri = v[t]
+        nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+        rec["normal"][k : k + len(t)] = nrm
+        rec["v"][k : k + len(t)] = tri
+        k += len(t)
+    head = f"csplab polyhedral model {model.name}: {len(model)} solids".encode()[:80]
+    _atomic_write(Path(path), head.ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes())
+
+
+def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as OFF (atomically): every solid's vertices and polygons, exact
+    numbers; the solids are its connected shells (read back with ``labels=components``
+    for one label per solid: OFF has no labels)."""
+    lines: list[str] = []
+    polys: list[str] = []
+    base = 0
+    for s in model.solids:
+        lines += [f"{_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        polys += [f"{len(p)} " + " ".join(str(base + i) for i in p) for p in s.polygons]
+        base += len(s.vertices)
+    head = ["OFF", f"# csplab polyhedral model {model.name}: {len(model)} solids, labels "
+            f"{list(model.labels)}", f"{base} {len(polys)} 0"]  # fmt: skip
+    _atomic_write(Path(path), ("\n".join([*head, *lines, *polys]) + "\n").encode("utf-8"))
+
+
+def write_glb(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as binary glTF (``.glb``, atomically; trimesh): one mesh and one
+    PBR material per label (the label colours of :func:`write_obj_model`), node names
+    ``label_N``, the solids' triangles (:func:`solid_triangles`), ``y`` up as glTF wants
+    (csplab ``(x, y, z)`` -> ``(x, z, -y)``)."""
+    tm = require("trimesh", "mesh", "writing glTF")
+    cols = _colours(model)
+    scene = tm.Scene()
+    verts, tris = _triangle_soup(model, path)
+    for b in model.labels:
+        vs: list[NDArray[np.float64]] = []
+        fs: list[NDArray[np.int64]] = []
+        base = 0
+        for s, v, t in zip(model.solids, verts, tris, strict=True):
+            if s.label == b:
+                vs.append(v[:, [0, 2, 1]] * np.array([1.0, 1.0, -1.0]))
+                fs.append(t + base)
+                base += len(v)
+        mat = tm.visual.material.PBRMaterial(
+            name=f"label_{b}", baseColorFactor=[*cols[b], 255], metallicFactor=0.0,
+            roughnessFactor=0.8, doubleSided=False,
+        )  # fmt: skip
+        mesh = tm.Trimesh(vertices=np.concatenate(vs), faces=np.concatenate(fs), process=False)
+        mesh.visual = tm.visual.TextureVisuals(material=mat)
+        scene.add_geometry(mesh, node_name=f"label_{b}", geom_name=f"label_{b}")
+    data = scene.export(file_type="glb") if model.solids else _empty_glb()
+    _atomic_write(Path(path), bytes(data))
+
+
+def _empty_glb() -> bytes:
+    """A valid ``.glb`` with an empty scene (an output that is all empty space)."""
+    import json
+
+    doc = json.dumps({"asset": {"version": "2.0", "generator": "csplab"}, "scenes": [{}],
+                      "scene": 0}).encode()  # fmt: skip
+    doc += b" " * (-len(doc) % 4)
+    return (
+        b"glTF"
+        + struct.pack("<II", 2, 12 + 8 + len(doc))
+        + struct.pack("<I4s", len(doc), b"JSON")
+        + doc
+    )

@@ -33,7 +33,7 @@ def _non_manifold(tmp_path):
 
     a = cad._mesh(man.Manifold.cube((1.5, 1.5, 1.5)))
     b = cad._mesh(man.Manifold.cube((1.5, 1.5, 1.5)).translate((1.5, 1.5, 0.0)))
-    return cad.export(trimesh.util.concatenate([a, b]), tmp_path / "edge.off")
+    return cad.export(trimesh.util.concatenate([a, b]), tmp_path / "edge.stl")
 
 
 def _crossing(tmp_path):
@@ -80,7 +80,7 @@ def _million_off(tmp_path):
 
 BAD = {
     "open": (_open, r"open\.stl: solid 0: not closed \(not watertight\)"),
-    "non-manifold": (_non_manifold, r"edge\.off: solid 0: non-manifold edge"),
+    "non-manifold": (_non_manifold, r"edge\.stl: solid 0: non-manifold edge"),
     "self-intersecting": (
         _crossing,
         r"pushed\.stl: solid 0: the surface crosses itself \(faces \d+ and \d+ intersect\)",

@@ -162,10 +162,13 @@ def one_line(excinfo):
     return msg
 
 
+SHARED = {0: 2, 4: 6}  # the second cube's vertices on the first one's edge 2-6
+EDGE_PAIR = QUADS + [[SHARED.get(i, i + 8) for i in f] for f in QUADS]
+
 BAD = {
     "open box": ([([], cube(), QUADS[1:])], r"m\.obj: solid 0: not closed \(not watertight\)"),
-    "non-manifold": (
-        [([], cube() + cube((1, 1, 0)), QUADS + [[i + 8 for i in f] for f in QUADS])],
+    "non-manifold": (  # the second cube uses the first one's vertices of the shared edge
+        [([], cube() + cube((1, 1, 0)), EDGE_PAIR)],
         r"m\.obj: solid 0: non-manifold edge between vertices \d+ and \d+ \(shared by 4 faces",
     ),
     "zero-area face": (  # a sliver whose longest edge 4-5 is open on the other side
@@ -236,6 +239,14 @@ def test_inverted_solids_are_fixed_with_a_warning_or_rejected(tmp_path):
                         fix_inverted=False)  # fmt: skip
 
 
+def test_solids_touching_along_an_edge_in_one_group_stay_apart(tmp_path):
+    # each cube has its own vertices (as csplab writes OBJ and OFF): two solids, not a
+    # non-manifold one
+    text = obj_text([([], cube() + cube((1, 1, 0)), QUADS + [[i + 8 for i in f] for f in QUADS])])
+    m = read_model(write(tmp_path, "m.obj", text))
+    assert len(m.solids) == 2 and m.volume() == pytest.approx(2.0)
+
+
 def test_touching_solids_and_same_label_overlaps_are_fine():
     m = PolyhedralModel(
         [
@@ -268,7 +279,7 @@ def test_bad_files_are_one_line(tmp_path, name, text, want):
 # ---------------------------------------------------------------------------- registry, PNG
 def test_registry_keeps_grid_polygon_and_mesh_writers_apart(tmp_path):
     assert FORMATS["mesh-obj"].gives == FORMATS["off"].gives == "PolyhedralModel"
-    assert output_extensions(gives="PolyhedralModel") == [".obj", ".png"]
+    assert output_extensions(gives="PolyhedralModel") == [".obj", ".off", ".stl", ".glb", ".png"]
     assert output_format("a.obj").name == "obj" and output_format("a.png").name == "png"
     assert output_format("a.png", gives="PolygonModel").name == "polygon-png"
     assert output_format("a.obj", gives="PolyhedralModel").name == "mesh-obj"
