@@ -137,6 +137,10 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
             solids=len(s.model.solids) if dim == 3 and s.model is not None else None,
             times={k: round(v, 6) for k, v in s.times.items()},
         )  # fmt: skip
+        if dim == 3 and s.model is not None:  # figures from the geometry alone
+            from csplab.continuous.resemblance import resemblance3
+
+            d["resemblance"] = resemblance3(example, s.model).to_dict()
         print(json.dumps(d))
     else:
         what = "edge directions" if dim == 2 else "face orientations"
