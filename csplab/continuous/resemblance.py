@@ -180,27 +180,26 @@ def floating_solids(model: PolyhedralModel, ground: float | None = None) -> list
     b = model.bounds
     tol = 1e-6 * max(b[3] - b[0], b[4] - b[1], b[5] - b[2], 1e-300)
     g = float(lo.min()) if ground is None else ground
-    tris = [s.vertices[s.faces] for s in model.solids]
-    up = []
-    for T in tris:
+    ups, owners = [], []
+    for k, s in enumerate(model.solids):
+        T = s.vertices[s.faces]
         n = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
-        up.append(T[n[:, 2] > 1e-12 * np.linalg.norm(n, axis=1).clip(1e-300)])
+        T = T[n[:, 2] > 1e-12 * np.linalg.norm(n, axis=1).clip(1e-300)]  # facing upwards
+        ups.append(T)
+        owners.append(np.full(len(T), k, dtype=np.int64))
+    up = np.concatenate(ups) if ups else np.zeros((0, 3, 3))
+    owner = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+    tlo, thi = up.min(axis=1), up.max(axis=1)
     out = []
     for i, s in enumerate(model.solids):
         z0 = float(lo[i])
         if abs(z0 - g) <= tol:
             continue
         low = s.vertices[s.vertices[:, 2] <= z0 + tol]
-        rests = False
-        for j, T in enumerate(up):
-            if j == i or not len(T):
-                continue
-            zlo, zhi = T[:, :, 2].min(axis=1), T[:, :, 2].max(axis=1)
-            T = T[(zlo <= z0 + tol) & (zhi >= z0 - tol)]
-            if len(T) and any(_on_triangles(p, T, tol) for p in low):
-                rests = True
-                break
-        if not rests:
+        plo, phi = low.min(axis=0) - tol, low.max(axis=0) + tol
+        near = (owner != i) & (tlo <= phi).all(axis=1) & (thi >= plo).all(axis=1)
+        T = up[near]
+        if not (len(T) and any(_on_triangles(p, T, tol) for p in low)):
             out.append(i)
     return out
 
