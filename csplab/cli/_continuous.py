@@ -141,6 +141,10 @@ def synthesize(
             outcome=outcome(r.status) if s.ok or r.status != "solved" else "not solved",
             proof=r.stats.get("proof") if r.status == "unsat" else None,
         )  # fmt: skip
+        if isinstance(example, PolyhedralModel) and isinstance(s.model, PolyhedralModel):
+            from csplab.continuous.resemblance import resemblance3  # from the geometry alone
+
+            d["resemblance"] = resemblance3(example, s.model).to_dict()
         print(json.dumps(d))
     else:
         what = "edge directions" if dim == 2 else "face orientations"

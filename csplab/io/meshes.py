@@ -27,9 +27,19 @@ preview.
   with the same labels, solids, vertices and polygons.
 * PNG out (``mesh-png``): a shaded view of the solids in their label colours (matplotlib).
 
+Meshes as CAD tools write them are repaired first (:mod:`csplab.io.mesh_repair`): duplicate
+vertices merged, faces with repeated vertices dropped, zero-area sliver triangles removed by
+edge flips, inconsistent winding made consistent (and outward); one ``UserWarning`` line
+says what was repaired (the CLI prints it as ``csplab: warning: FILE: repaired ...``) and
+``meta["repaired"]`` has the counts. Files of more than
+:data:`~csplab.io.mesh_repair.MAX_FACES` faces are refused from their counts, before the
+faces are read.
+
 Every problem is one line: a :class:`~csplab.errors.FormatError` naming the file and line
-for syntax, an :class:`~csplab.errors.InputError` naming the file and the solid/face for
-geometry (:class:`~csplab.continuous.polyhedra.PolyhedralModel`).
+for syntax, an :class:`~csplab.errors.InputError` naming the file and the line, triangle or
+solid/face for geometry (non-finite or too large coordinates, a surface that crosses
+itself: :func:`~csplab.io.mesh_repair.self_intersection`, and the checks of
+:class:`~csplab.continuous.polyhedra.PolyhedralModel`).
 
 Examples
 --------
@@ -52,7 +62,8 @@ import os
 import re
 import struct
 import tempfile
-from collections.abc import Sequence
+import warnings
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -63,6 +74,15 @@ from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
 from csplab.errors import CsplabError, FormatError, InputError
 from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, read_bytes
+from csplab.io.mesh_repair import (
+    Repairs,
+    check_coordinates,
+    check_face_count,
+    flip_slivers,
+    merge_duplicates,
+    orient_shell,
+    self_intersection,
+)
 
 __all__ = [
     "read_obj_model",
@@ -77,6 +97,7 @@ __all__ = [
 
 _LABEL_NAME = re.compile(r"label[_\s-]?(\d+)", re.IGNORECASE)
 _LABEL_COMMENT = re.compile(r"#\s*csplab\s+label\s+(\S+)", re.IGNORECASE)
+_OBJ_FACE = re.compile(r"^[ \t]*f[ \t]", re.MULTILINE)
 
 
 # ---------------------------------------------------------------------------- sniffing
@@ -189,13 +210,14 @@ def _components(polys: Sequence[Sequence[int]], n_vertices: int) -> list[list[in
     return list(order.values())
 
 
-def _merged_ids(v: NDArray[np.float64], polys: list[list[int]]) -> list[list[int]]:
-    """Faces with coincident vertices given one index (for the connectivity only)."""
-    if not len(v):
-        return polys
-    _, inv = np.unique(v + 0.0, axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
-    return [[int(inv[i]) for i in p] for p in polys]
+def _edge_uses(polys: Sequence[Sequence[int]]) -> NDArray[np.int64]:
+    """The distinct numbers of faces that share an (undirected) edge."""
+    pairs = [(a, p[(k + 1) % len(p)]) for p in polys for k, a in enumerate(p)]
+    if not pairs:
+        return np.zeros(0, dtype=np.int64)
+    e = np.sort(np.asarray(pairs, dtype=np.int64), axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return np.unique(counts)
 
 
 def _solids(
@@ -207,15 +229,42 @@ def _solids(
     path: Path,
     fmt: str,
     by_component: bool,
+    vertex_name: Callable[[int], str] | None = None,
 ) -> PolyhedralModel:
-    """Solids (edge-connected shells of one label and group) and the model."""
-    merged = _merged_ids(v, polys)
+    """Solids (edge-connected shells of one label and group) and the model, after the
+    repairs of :mod:`csplab.io.mesh_repair` (one warning line says what was repaired;
+    ``meta["repaired"]`` has the counts)."""
+    check_coordinates(v, path, vertex_name or (lambda k: f"vertex {k}"))
+    repairs = Repairs()
+    orig = polys
+    v, polys, _ = merge_duplicates(v, polys)
+    keep = [j for j, p in enumerate(polys) if len(set(p)) >= 3]
+    if len(keep) < len(polys):
+        repairs.degenerate = len(polys) - len(keep)
+        orig = [orig[j] for j in keep]
+        polys = [polys[j] for j in keep]
+        labels = [labels[j] for j in keep]
+        groups = [groups[j] for j in keep]
+    scale = float(np.ptp(v, axis=0).max()) if len(v) else 1.0
     keys = list(dict.fromkeys(zip(groups, labels, strict=True)))
     solids: list[dict[str, Any]] = []
     for g, b in keys:
         idx = [j for j in range(len(polys)) if groups[j] == g and labels[j] == b]
-        for comp in _components([merged[j] for j in idx], len(v)):
-            faces = [polys[idx[c]] for c in comp]
+        mine = [polys[j] for j in idx]
+        comps = _components(mine, len(v))
+        if _edge_uses(mine).max(initial=0) > 2:
+            # solids that touch along an edge (or a point) share merged vertices: the
+            # file's own vertex numbers keep them apart when every shell is closed so
+            alone = _components([orig[j] for j in idx], len(v))
+            if all(_edge_uses([mine[c] for c in comp]).tolist() in ([], [2]) for comp in alone):
+                comps = alone
+        for comp in comps:
+            if fmt != "stl":  # every STL triangle has its own vertices: not a defect
+                # coincident vertices of one shell (other shells may share positions)
+                ids = {i for c in comp for i in orig[idx[c]]}
+                repairs.duplicates += len(ids) - len({i for c in comp for i in mine[c]})
+            faces = orient_shell(v, [mine[c] for c in comp], repairs)
+            faces = flip_slivers(v, faces, repairs, scale)
             used = sorted({i for f in faces for i in f})
             where = {old: new for new, old in enumerate(used)}
             s: dict[str, Any] = {
@@ -234,12 +283,24 @@ def _solids(
     meta: dict[str, Any] = {"format": fmt}
     if names and not by_component:
         meta["label_names"] = {str(b): n for b, n in sorted(names.items())}
+    if repairs:
+        meta["repaired"] = repairs.as_dict()
     try:
-        return PolyhedralModel(solids, name=path.stem, meta=meta, source=str(path))
+        model = PolyhedralModel(solids, name=path.stem, meta=meta, source=str(path))
     except CsplabError:
         raise
     except (ValueError, TypeError, OverflowError, IndexError, MemoryError) as e:
         raise InputError(f"{path}: cannot build the polyhedral model ({e})") from None
+    for i, solid in enumerate(model.solids):
+        hit = self_intersection(solid.vertices, solid.faces)
+        if hit is not None:
+            f1, f2 = (int(solid.face_polygon[k]) for k in hit)
+            raise InputError(
+                f"{path}: solid {i}: the surface crosses itself (faces {f1} and {f2} intersect)"
+            )
+    if repairs:
+        warnings.warn(repairs.note(path), UserWarning, stacklevel=3)
+    return model
 
 
 def _number_labels(
@@ -307,7 +368,10 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
     explicit: list[int | None] = []
     group, mat, label = "", None, None
     any_group = False
-    for n, raw in enumerate(_text(p).splitlines(), 1):
+    text = _text(p)
+    check_face_count(sum(1 for _ in _OBJ_FACE.finditer(text)), p)
+    vlines: list[int] = []
+    for n, raw in enumerate(text.splitlines(), 1):
         line = raw.strip()
         if not line:
             continue
@@ -331,6 +395,7 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
             except ValueError:
                 raise FormatError("a vertex needs 3 numbers", path=p, line=n) from None
             verts.append((x, y, z))
+            vlines.append(n)
         elif key == "f":
             face: list[int] = []
             for t in tok[1:]:
@@ -376,7 +441,8 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
         got, names = _number_labels([keys[j] for j in free], taken, p)
         for j, b in zip(free, got, strict=True):
             labs[j] = b
-    return _solids(v, polys, labs, groups, names, p, "mesh-obj", mode == "components")
+    return _solids(v, polys, labs, groups, names, p, "mesh-obj", mode == "components",
+                   lambda k: f"line {vlines[k]}")  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OFF in
@@ -409,10 +475,16 @@ def read_off(path: str | Path, labels: str = "one") -> PolyhedralModel:
     p = Path(path)
     by = _labels_option(p, labels)
     rows: list[tuple[int, list[str]]] = []
+    checked = False
     for n, raw in enumerate(_text(p).splitlines(), 1):
         tok = raw.split("#", 1)[0].split()
         if tok:
             rows.append((n, tok))
+            if not checked and len(rows) <= 2:  # the counts, before the body is read
+                counts = rows[-1][1][1:] if len(rows) == 1 else rows[-1][1]
+                if len(counts) >= 2 and counts[1].isdigit():
+                    check_face_count(int(counts[1]), p)
+                    checked = True
     if not rows or not rows[0][1][0].endswith("OFF"):
         raise FormatError("an OFF file starts with OFF", path=p, line=rows[0][0] if rows else 1)
     first = rows[0][1][1:]
@@ -453,7 +525,9 @@ def read_off(path: str | Path, labels: str = "one") -> PolyhedralModel:
             raise FormatError(f"a face refers to a vertex outside 0..{nv - 1}", path=p, line=n)
         polys.append(face)
     v = np.asarray(verts, dtype=np.float64).reshape(-1, 3)
-    return _solids(v, polys, [1] * len(polys), [""] * len(polys), {}, p, "off", by)
+    vline = [n for n, _ in rest[:nv]]
+    return _solids(v, polys, [1] * len(polys), [""] * len(polys), {}, p, "off", by,
+                   lambda k: f"line {vline[k]}")  # fmt: skip
 
 
 def _labels_option(p: Path, labels: str) -> bool:
@@ -499,6 +573,7 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
     data = read_bytes(p)
     ascii_ = data.lstrip().lower().startswith(b"solid") and b"facet" in data[:4096].lower()
     if ascii_:
+        check_face_count(len(re.findall(rb"(?i)endfacet", data)), p)
         try:
             tri = np.asarray(
                 [[float(x) for x in m.groups()] for m in _STL_VERTEX.finditer(data)],
@@ -516,12 +591,14 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
             raise FormatError(
                 f"{n} triangles announced, the file holds {(len(data) - 84) // 50}", path=p
             )
+        check_face_count(n, p)
         rec = np.frombuffer(data, dtype=_STL_DTYPE, count=n, offset=84)
         tri = rec["v"].astype(np.float64).reshape(-1, 3)
     if not len(tri):
         raise InputError(f"{p}: no triangles: a polyhedral example needs closed solids")
     polys = np.arange(len(tri)).reshape(-1, 3).tolist()
-    return _solids(tri, polys, [1] * len(polys), [""] * len(polys), {}, p, "stl", by)
+    return _solids(tri, polys, [1] * len(polys), [""] * len(polys), {}, p, "stl", by,
+                   lambda k: f"triangle {k // 3}")  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OBJ out
@@ -655,3 +732,176 @@ def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
     _atomic_write(p, buf.getvalue())
+
+
+# ---------------------------------------------------------------------------- triangles out
+def _ear_clip(pts: NDArray[np.float64]) -> list[tuple[int, int, int]] | None:
+    """Triangles of a simple polygon (2D points, either orientation) by ear clipping that
+    keeps every vertex, flat ones included, and makes no zero-area triangle (``None`` when
+    it finds no ear)."""
+    n = len(pts)
+    x, y = pts[:, 0], pts[:, 1]
+    signed = float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum())
+    ring = list(range(n)) if signed > 0 else list(range(n))[::-1]
+    scale = float(np.ptp(pts, axis=0).max()) or 1.0
+    eps = 1e-12 * scale**2
+
+    def cross(a: int, b: int, c: int) -> float:
+        return float(
+            (pts[b, 0] - pts[a, 0]) * (pts[c, 1] - pts[a, 1])
+            - (pts[b, 1] - pts[a, 1]) * (pts[c, 0] - pts[a, 0])
+        )
+
+    out: list[tuple[int, int, int]] = []
+    while len(ring) > 3:
+        m = len(ring)
+        for k in range(m):
+            a, b, c = ring[k - 1], ring[k], ring[(k + 1) % m]
+            if cross(a, b, c) <= eps:
+                continue  # reflex or flat: not an ear
+            if any(
+                cross(a, b, q) >= -eps and cross(b, c, q) >= -eps and cross(c, a, q) >= -eps
+                for q in ring
+                if q not in (a, b, c) and not np.array_equal(pts[q], pts[b])
+            ):
+                continue  # another vertex in (or on) the ear
+            out.append((a, b, c))
+            del ring[k]
+            break
+        else:
+            return None
+    if cross(*ring) <= eps:
+        return None
+    out.append((ring[0], ring[1], ring[2]))
+    return out if signed > 0 else [(a, c, b) for a, b, c in out]
+
+
+def solid_triangles(solid: Any, where: str = "solid") -> NDArray[np.int64]:
+    """The solid's triangles, outward, with no zero-area triangle and every polygon vertex
+    kept (no T-junctions between neighbouring faces): the solid's own triangulation where
+    it has no zero-area triangle, else the polygon ear-clipped again in its plane (an
+    :class:`~csplab.errors.InputError` naming ``where`` and the polygon if that fails).
+
+    Examples
+    --------
+    >>> from csplab.continuous.polyhedra import PolyhedralModel
+    >>> cube = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0],
+    ...         [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1], [0.5, 0, 0], [0.5, 0, 1]]
+    >>> quads = [[0, 3, 2, 1, 8], [4, 9, 5, 6, 7], [0, 8, 1, 5, 9, 4], [1, 2, 6, 5],
+    ...          [2, 3, 7, 6], [3, 0, 4, 7]]
+    >>> M = PolyhedralModel([{"label": 1, "vertices": cube, "faces": quads}])
+    >>> len(solid_triangles(M.solids[0]))  # 3 + 3 + 4 + 2 + 2 + 2
+    16
+    """
+    v, T = solid.vertices, np.asarray(solid.faces, dtype=np.int64)
+    tri = v[T]
+    area2 = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    scale = float(np.ptp(v, axis=0).max()) or 1.0
+    bad = np.unique(np.asarray(solid.face_polygon)[area2 <= 1e-12 * scale**2])
+    if not bad.size:
+        return T
+    keep = ~np.isin(solid.face_polygon, bad)
+    parts = [T[keep]]
+    for j in bad.tolist():
+        ids = np.asarray(solid.polygons[j], dtype=np.int64)
+        pts = v[ids]
+        normal = np.cross(pts - pts[0], np.roll(pts, -1, axis=0) - pts[0]).sum(axis=0)
+        axis = int(np.argmax(np.abs(normal)))
+        flat2 = np.delete(pts, axis, axis=1)
+        if normal[axis] < 0:  # keep the face's orientation in the projection
+            flat2 = flat2[:, ::-1]
+        got = _ear_clip(flat2)
+        if got is None:
+            raise InputError(
+                f"{where}: polygon {j} cannot be triangulated without zero-area triangles"
+            )
+        loc = np.asarray(got, dtype=np.int64)
+        parts.append(ids[loc])
+    return np.concatenate(parts)
+
+
+def _triangle_soup(
+    model: PolyhedralModel, path: str | Path
+) -> tuple[list[NDArray[np.float64]], list[NDArray[np.int64]]]:
+    """Per solid: its vertices and its triangles (:func:`solid_triangles`)."""
+    tris = [solid_triangles(s, f"{path}: solid {i}") for i, s in enumerate(model.solids)]
+    return [s.vertices for s in model.solids], tris
+
+
+def write_stl_model(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as a binary STL (atomically): every solid's triangles
+    (:func:`solid_triangles`: no zero-area triangle, no T-junction), outward normals,
+    float32 coordinates; STL has no labels (the ``.obj`` and ``.glb`` writers keep them)."""
+    verts, tris = _triangle_soup(model, path)
+    n = sum(len(t) for t in tris)
+    rec = np.zeros(n, dtype=_STL_DTYPE)
+    k = 0
+    for v, t in zip(verts, tris, strict=True):
+        tri = v[t]
+        nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+        rec["normal"][k : k + len(t)] = nrm
+        rec["v"][k : k + len(t)] = tri
+        k += len(t)
+    head = f"csplab polyhedral model {model.name}: {len(model)} solids".encode()[:80]
+    _atomic_write(Path(path), head.ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes())
+
+
+def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as OFF (atomically): every solid's vertices and polygons, exact
+    numbers; the solids are its connected shells (read back with ``labels=components``
+    for one label per solid: OFF has no labels)."""
+    lines: list[str] = []
+    polys: list[str] = []
+    base = 0
+    for s in model.solids:
+        lines += [f"{_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        polys += [f"{len(p)} " + " ".join(str(base + i) for i in p) for p in s.polygons]
+        base += len(s.vertices)
+    head = ["OFF", f"# csplab polyhedral model {model.name}: {len(model)} solids, labels "
+            f"{list(model.labels)}", f"{base} {len(polys)} 0"]  # fmt: skip
+    _atomic_write(Path(path), ("\n".join([*head, *lines, *polys]) + "\n").encode("utf-8"))
+
+
+def write_glb(model: PolyhedralModel, path: str | Path) -> None:
+    """Write ``model`` as binary glTF (``.glb``, atomically; trimesh): one mesh and one
+    PBR material per label (the label colours of :func:`write_obj_model`), node names
+    ``label_N``, the solids' triangles (:func:`solid_triangles`), ``y`` up as glTF wants
+    (csplab ``(x, y, z)`` -> ``(x, z, -y)``)."""
+    tm = require("trimesh", "mesh", "writing glTF")
+    cols = _colours(model)
+    scene = tm.Scene()
+    verts, tris = _triangle_soup(model, path)
+    for b in model.labels:
+        vs: list[NDArray[np.float64]] = []
+        fs: list[NDArray[np.int64]] = []
+        base = 0
+        for s, v, t in zip(model.solids, verts, tris, strict=True):
+            if s.label == b:
+                vs.append(v[:, [0, 2, 1]] * np.array([1.0, 1.0, -1.0]))
+                fs.append(t + base)
+                base += len(v)
+        mat = tm.visual.material.PBRMaterial(
+            name=f"label_{b}", baseColorFactor=[*cols[b], 255], metallicFactor=0.0,
+            roughnessFactor=0.8, doubleSided=False,
+        )  # fmt: skip
+        mesh = tm.Trimesh(vertices=np.concatenate(vs), faces=np.concatenate(fs), process=False)
+        mesh.visual = tm.visual.TextureVisuals(material=mat)
+        scene.add_geometry(mesh, node_name=f"label_{b}", geom_name=f"label_{b}")
+    data = scene.export(file_type="glb") if model.solids else _empty_glb()
+    _atomic_write(Path(path), bytes(data))
+
+
+def _empty_glb() -> bytes:
+    """A valid ``.glb`` with an empty scene (an output that is all empty space)."""
+    import json
+
+    doc = json.dumps({"asset": {"version": "2.0", "generator": "csplab"}, "scenes": [{}],
+                      "scene": 0}).encode()  # fmt: skip
+    doc += b" " * (-len(doc) % 4)
+    return (
+        b"glTF"
+        + struct.pack("<II", 2, 12 + 8 + len(doc))
+        + struct.pack("<I4s", len(doc), b"JSON")
+        + doc
+    )

@@ -35,7 +35,7 @@ Traceback (most recent call last):
 ...
 csplab.errors.InputError: unknown model format 'zip'; use merrell, grid, tiled, npy, wfc, \
 overlapping, wfc-samples, poms, debroglie, markovjunior, png, vox, obj, polygons, svg, \
-polygon-png, mesh-obj, off, stl or mesh-png
+polygon-png, mesh-obj, off, stl, glb or mesh-png
 """
 
 from __future__ import annotations
@@ -670,9 +670,12 @@ FORMATS: dict[str, Format] = {
             details="in: closed, oriented solids (`v`, polygon `f`, `o`/`g`, `usemtl`); a "
             "material or group named `label_N` is label `N`, other names get 1, 2, … in "
             "order of first appearance, a `# csplab label N` comment labels the rest of its "
-            "group; a solid is one connected shell of one label and group; validated "
-            "(watertight, manifold, consistent winding, no zero-area face, different labels "
-            "do not overlap), inside-out solids are reversed with a warning; out: one "
+            "group; a solid is one connected shell of one label and group; repaired as CAD "
+            "exports need (duplicate vertices, zero-area slivers by edge flips, inconsistent "
+            "winding; one warning line says what) and validated (watertight, manifold, no "
+            "self-crossing, no zero-area face, different labels do not overlap, at most "
+            "200,000 faces, coordinates up to 1e7), inside-out solids are reversed with a "
+            "warning; out: one "
             "`o solid_I` per solid, one material `label_N` per label with its colour in the "
             "`.mtl` (`.obj` results of label grids are the `obj` format)",
             example="csplab info  # in Python: "
@@ -682,13 +685,17 @@ FORMATS: dict[str, Format] = {
             name="off",
             extensions=(".off",),
             gives="PolyhedralModel",
+            writes="PolyhedralModel",
             description="OFF polyhedra (3D continuous model synthesis)",
             reader="csplab.io.meshes:read_off",
+            writer="csplab.io.meshes:write_off_model",
             sniffer="csplab.io.meshes:sniff_off",
             options=(_SHELL_LABELS,),
             files="starting with `OFF`",
             details="`OFF`, counts, vertices, `k i1 … ik` polygon faces (colours ignored); "
-            "every connected shell is a solid, validated as for `mesh-obj`",
+            "every connected shell is a solid, repaired and validated as for `mesh-obj`; "
+            "out: every solid's vertices and polygons, exact numbers (no labels: read back "
+            "with `labels=components`)",
             example="csplab info  # in Python: "
             "csplab.io.read_model('tests/io/data/tiny.off', labels='components')",
         ),
@@ -696,16 +703,34 @@ FORMATS: dict[str, Format] = {
             name="stl",
             extensions=(".stl",),
             gives="PolyhedralModel",
+            writes="PolyhedralModel",
             description="STL polyhedra (3D continuous model synthesis)",
             reader="csplab.io.meshes:read_stl",
+            writer="csplab.io.meshes:write_stl_model",
             sniffer="csplab.io.meshes:sniff_stl",
             options=(_SHELL_LABELS,),
             files="ASCII or binary",
             details="triangles; coincident vertices are merged and adjacent coplanar "
             "triangles counted as one input polygon; every connected shell is a solid, "
-            "validated as for `mesh-obj`",
+            "repaired and validated as for `mesh-obj`; out: binary, every solid's polygons "
+            "ear-clipped with all their vertices (no zero-area triangle, no T-junction), no "
+            "labels",
             example="csplab info  # in Python: "
             "csplab.io.read_model('tests/io/data/tiny.stl').n_polygons",
+        ),
+        Format(
+            name="glb",
+            extensions=(".glb",),
+            gives=None,
+            writes="PolyhedralModel",
+            description="binary glTF polyhedra (game engines, three.js)",
+            writer="csplab.io.meshes:write_glb",
+            details="out: one mesh and one PBR material `label_N` per label (the label "
+            "colours), the solids' triangles as for `stl` (no zero-area triangle, no "
+            "T-junction), `y` up (csplab `(x, y, z)` → `(x, z, -y)`); Godot, Unity, Unreal "
+            "and three.js load it directly",
+            example="csplab synthesize csplab/examples/continuous3d/houses.obj "
+            "--size 12x12x4 --seed 1 --out houses.glb",
         ),
         Format(
             name="mesh-png",
@@ -841,7 +866,7 @@ def output_extensions(*, gives: Gives | None = None, partial: bool | None = None
     >>> output_extensions(gives="PolygonModel")
     ['.json', '.svg', '.png']
     >>> output_extensions(gives="PolyhedralModel")
-    ['.obj', '.png']
+    ['.obj', '.off', '.stl', '.glb', '.png']
     """
     out: list[str] = []
     for f in _writers(gives):

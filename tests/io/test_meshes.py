@@ -162,21 +162,23 @@ def one_line(excinfo):
     return msg
 
 
+SHARED = {0: 2, 4: 6}  # the second cube's vertices on the first one's edge 2-6
+EDGE_PAIR = QUADS + [[SHARED.get(i, i + 8) for i in f] for f in QUADS]
+
 BAD = {
     "open box": ([([], cube(), QUADS[1:])], r"m\.obj: solid 0: not closed \(not watertight\)"),
-    "non-manifold": (
-        [([], cube() + cube((1, 1, 0)), QUADS + [[i + 8 for i in f] for f in QUADS])],
+    "non-manifold": (  # the second cube uses the first one's vertices of the shared edge
+        [([], cube() + cube((1, 1, 0)), EDGE_PAIR)],
         r"m\.obj: solid 0: non-manifold edge between vertices \d+ and \d+ \(shared by 4 faces",
     ),
-    "inconsistent winding": (
-        [([], cube(), [QUADS[0][::-1], *QUADS[1:]])],
-        r"m\.obj: solid 0: inconsistent winding: faces 0 and \d+ both run",
+    "zero-area face": (  # a sliver whose longest edge 4-5 is open on the other side
+        [([], [*cube(), [0.5, 0, 1]], [*QUADS[2:], [0, 1, 5, 8, 4], [4, 8, 5]])],
+        r"m\.obj: solid 0: face 5 has zero area",
     ),
-    "zero-area face": (  # a sliver triangle along the edge 4-5, the front face split there
-        [([], [*cube(), [0.5, 0, 1]], [*QUADS[:2], [0, 1, 5, 8, 4], *QUADS[3:], [4, 8, 5]])],
-        r"m\.obj: solid 0: face 6 has zero area",
-    ),
-    "NaN": ([([], [[float("nan"), 0, 0], *cube()[1:]], QUADS)], r"solid 0: vertex 0 .*non-finite"),
+    "NaN": ([([], [[float("nan"), 0, 0], *cube()[1:]], QUADS)],
+            r"m\.obj: line 1: a vertex with a non-finite coordinate \(nan, 0\.0, 0\.0\)"),
+    "huge": ([([], [[4e9, 0, 0], *cube()[1:]], QUADS)],
+             r"m\.obj: line 1: coordinate 4e\+09 beyond the 1e\+07 csplab reads"),
     "overlap": (
         [(["usemtl a"], cube(), QUADS), (["usemtl b"], cube((0.5, 0.5, 0.5)), QUADS)],
         r"m\.obj: solids 0 \(label 1\) and 1 \(label 2\) overlap \(volume 0\.125\)",
@@ -192,6 +194,40 @@ def test_bad_solids_are_one_line_naming_the_solid_and_face(tmp_path, case):
     one_line(e)
 
 
+REPAIRED = {
+    "inconsistent winding": (
+        [([], cube(), [QUADS[0][::-1], *QUADS[1:]])],
+        r"m\.obj: repaired 1 face wound against their neighbours \(reversed\)$",
+        {"rewound_faces": 1},
+    ),
+    "mostly inverted": (
+        [([], cube(), [*QUADS[:1], *(q[::-1] for q in QUADS[1:])])],
+        r"m\.obj: repaired 5 faces wound against their neighbours \(reversed\)$",
+        {"rewound_faces": 5},
+    ),
+    "zero-area face": (  # a sliver triangle along the edge 4-5, the front face split there
+        [([], [*cube(), [0.5, 0, 1]], [*QUADS[:2], [0, 1, 5, 8, 4], *QUADS[3:], [4, 8, 5]])],
+        r"m\.obj: repaired 1 zero-area triangle \(an edge flip each\)$",
+        {"zero_area_triangles": 1},
+    ),
+    "duplicates and a repeated vertex": (
+        [([], [*cube(), *cube()], [*QUADS[1:], [0, 11, 10, 9], [0, 0, 1]])],
+        r"m\.obj: repaired 3 duplicate vertices \(merged\), 1 face with fewer than 3 distinct",
+        {"duplicate_vertices": 3, "degenerate_faces": 1},
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(REPAIRED))
+def test_repairs_are_one_warning_line_and_recorded(tmp_path, case):
+    solids, want, counts = REPAIRED[case]
+    with pytest.warns(UserWarning, match=want) as rec:
+        m = read_model(write(tmp_path, "m.obj", obj_text(solids)))
+    assert len(rec) == 1
+    assert m.meta["repaired"] == counts
+    assert m.volume() == pytest.approx(1.0) and len(m.solids) == 1
+
+
 def test_inverted_solids_are_fixed_with_a_warning_or_rejected(tmp_path):
     inside_out = [[f[::-1] for f in QUADS]]
     p = write(tmp_path, "m.obj", obj_text([([], cube(), inside_out[0])]))
@@ -201,6 +237,14 @@ def test_inverted_solids_are_fixed_with_a_warning_or_rejected(tmp_path):
     with pytest.raises(InputError, match=r"solid 0: inverted: the faces point inwards"):
         PolyhedralModel([{"label": 1, "vertices": CUBE, "faces": inside_out[0]}],
                         fix_inverted=False)  # fmt: skip
+
+
+def test_solids_touching_along_an_edge_in_one_group_stay_apart(tmp_path):
+    # each cube has its own vertices (as csplab writes OBJ and OFF): two solids, not a
+    # non-manifold one
+    text = obj_text([([], cube() + cube((1, 1, 0)), QUADS + [[i + 8 for i in f] for f in QUADS])])
+    m = read_model(write(tmp_path, "m.obj", text))
+    assert len(m.solids) == 2 and m.volume() == pytest.approx(2.0)
 
 
 def test_touching_solids_and_same_label_overlaps_are_fine():
@@ -235,7 +279,7 @@ def test_bad_files_are_one_line(tmp_path, name, text, want):
 # ---------------------------------------------------------------------------- registry, PNG
 def test_registry_keeps_grid_polygon_and_mesh_writers_apart(tmp_path):
     assert FORMATS["mesh-obj"].gives == FORMATS["off"].gives == "PolyhedralModel"
-    assert output_extensions(gives="PolyhedralModel") == [".obj", ".png"]
+    assert output_extensions(gives="PolyhedralModel") == [".obj", ".off", ".stl", ".glb", ".png"]
     assert output_format("a.obj").name == "obj" and output_format("a.png").name == "png"
     assert output_format("a.png", gives="PolygonModel").name == "polygon-png"
     assert output_format("a.obj", gives="PolyhedralModel").name == "mesh-obj"

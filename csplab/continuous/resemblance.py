@@ -1,0 +1,237 @@
+"""How much a synthesized polyhedral model resembles its example: a few figures computed
+from the geometry alone (no planes, lattice or CSP), to read beside Eq. 4.1's violations.
+
+:func:`resemblance3` gives, for an example and an output
+(:class:`~csplab.continuous.polyhedra.PolyhedralModel`):
+
+* ``solids`` and ``example_solids``: the numbers of solids;
+* ``median_volume_ratio``: the output's median solid volume over the example's (a heap of
+  tiny boxes is far below 1);
+* ``edge_kinds``: the share of the example's edge kinds that occur in the output. An edge
+  kind is the pair of face orientations meeting at a crease (which fixes the edge's
+  direction, their cross product) and whether the crease is convex or reflex; creases are
+  taken on the union of each label's solids (manifold3d), so solids that touch make no
+  edge where they meet;
+* ``face_orientations``: the share of the example's face orientations (outward normals,
+  clustered within ``angle_tol`` radians: CAD exports differ in the 4th-6th decimal) that
+  some output face has (on the same unions);
+* ``floating`` and ``example_floating``: the solids that rest neither on the ground (the
+  model's lowest ``z``) nor on another solid: none of their lowest vertices lies on a face
+  of another solid that faces upwards. Floating solids in an output of an example without
+  any are a defect a human sees at once.
+
+Examples
+--------
+>>> from csplab.continuous.polyhedra import PolyhedralModel
+>>> def box(lo, hi):
+...     (x0, y0, z0), (x1, y1, z1) = lo, hi
+...     v = [[x0, y0, z0], [x1, y0, z0], [x1, y1, z0], [x0, y1, z0],
+...          [x0, y0, z1], [x1, y0, z1], [x1, y1, z1], [x0, y1, z1]]
+...     f = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [2, 3, 7, 6], [1, 2, 6, 5], [0, 4, 7, 3]]
+...     return {"label": 1, "vertices": v, "faces": f}
+>>> ex = PolyhedralModel([box((0, 0, 0), (2, 2, 1))])
+>>> out = PolyhedralModel([box((0, 0, 0), (2, 2, 1)), box((0, 0, 1), (1, 1, 2)),
+...                        box((5, 5, 3), (6, 6, 4))])
+>>> r = resemblance3(ex, out)
+>>> r.solids, r.floating, r.example_floating, r.face_orientations, r.edge_kinds
+(3, 1, 0, 1.0, 1.0)
+>>> r.median_volume_ratio
+0.25
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.deps import require
+
+__all__ = ["Resemblance", "edge_kinds", "floating_solids", "resemblance3"]
+
+#: normals closer than this (radians) are one face orientation
+ANGLE_TOL = 1e-3
+
+
+@dataclass(frozen=True)
+class Resemblance:
+    """The figures of :func:`resemblance3` (see the module docstring)."""
+
+    solids: int
+    example_solids: int
+    median_volume_ratio: float
+    edge_kinds: float
+    example_edge_kinds: int
+    face_orientations: float
+    example_face_orientations: int
+    floating: int
+    example_floating: int
+
+    def to_dict(self) -> dict[str, Any]:
+        """The figures as JSON-ready numbers (ratios rounded to 6 digits)."""
+        return {k: round(v, 6) if isinstance(v, float) else v for k, v in asdict(self).items()}
+
+
+# ---------------------------------------------------------------------------- orientations
+class _Normals:
+    """Unit normals clustered greedily within an angle (the first one of a cluster stands
+    for it)."""
+
+    def __init__(self, tol: float) -> None:
+        self.cos = math.cos(tol)
+        self.reps = np.zeros((0, 3))
+
+    def ids(self, normals: NDArray[np.float64], grow: bool = True) -> NDArray[np.int64]:
+        """The cluster of each normal (``-1``: none and ``grow`` is false)."""
+        out = np.full(len(normals), -1, dtype=np.int64)
+        if not len(normals):
+            return out
+        uniq, inv = np.unique(np.round(normals, 9), axis=0, return_inverse=True)
+        got = np.full(len(uniq), -1, dtype=np.int64)
+        for k, n in enumerate(uniq):
+            if len(self.reps):
+                dots = self.reps @ n
+                j = int(np.argmax(dots))
+                if dots[j] >= self.cos:
+                    got[k] = j
+                    continue
+            if grow:
+                self.reps = np.vstack([self.reps, n / np.linalg.norm(n)])
+                got[k] = len(self.reps) - 1
+        out[:] = got[inv.reshape(-1)]
+        return out
+
+
+def _unions(model: PolyhedralModel) -> list[Any]:
+    """Per label, the union of its solids as a ``trimesh.Trimesh`` (manifold3d)."""
+    man = require("manifold3d", "mesh", "resemblance figures of polyhedral models")
+    tm = require("trimesh", "mesh", "resemblance figures of polyhedral models")
+    out = []
+    for b in model.labels:
+        parts = [s.to_manifold(f"{model.source}: solid") for s in model.solids if s.label == b]
+        u = man.Manifold.batch_boolean(parts, man.OpType.Add) if len(parts) > 1 else parts[0]
+        g = u.to_mesh64()
+        v = np.asarray(g.vert_properties, dtype=np.float64)[:, :3]
+        f = np.asarray(g.tri_verts, dtype=np.int64).reshape(-1, 3)
+        if len(f):
+            out.append(tm.Trimesh(vertices=v, faces=f, process=True))
+    return out
+
+
+def edge_kinds(
+    model: PolyhedralModel, normals: _Normals, grow: bool = True
+) -> tuple[set[tuple[int, int, bool]], set[int]]:
+    """The model's edge kinds ``(orientation, orientation, convex)`` (orientations
+    sorted) and its face orientations, as clusters of ``normals`` (new ones added when
+    ``grow``; otherwise an unknown orientation is ``-1``)."""
+    kinds: set[tuple[int, int, bool]] = set()
+    faces: set[int] = set()
+    for mesh in _unions(model):
+        fn = np.asarray(mesh.face_normals, dtype=np.float64)
+        ok = np.isfinite(fn).all(axis=1) & (np.asarray(mesh.area_faces) > 0)
+        cid = np.full(len(fn), -1, dtype=np.int64)
+        cid[ok] = normals.ids(fn[ok], grow)
+        faces |= set(cid[ok].tolist())
+        adj = np.asarray(mesh.face_adjacency, dtype=np.int64).reshape(-1, 2)
+        if not len(adj):
+            continue
+        a, b = cid[adj[:, 0]], cid[adj[:, 1]]
+        convex = np.asarray(mesh.face_adjacency_convex, dtype=bool)
+        crease = (a != b) & ok[adj[:, 0]] & ok[adj[:, 1]]
+        for x, y, c in zip(a[crease].tolist(), b[crease].tolist(), convex[crease].tolist(),
+                           strict=True):  # fmt: skip
+            kinds.add((min(x, y), max(x, y), bool(c)))
+    return kinds, faces
+
+
+# ---------------------------------------------------------------------------- floating
+def _on_triangles(p: NDArray[np.float64], T: NDArray[np.float64], tol: float) -> bool:
+    """Whether point ``p`` lies within ``tol`` of any triangle of ``T`` ``(m, 3, 3)``."""
+    a, b, c = T[:, 0], T[:, 1], T[:, 2]
+    n = np.cross(b - a, c - a)
+    nn = np.linalg.norm(n, axis=1)
+    ok = nn > 0
+    a, b, c, n, nn = a[ok], b[ok], c[ok], n[ok], nn[ok]
+    dist = np.abs(((p - a) * n).sum(axis=1)) / nn
+    near = dist <= tol
+    if not near.any():
+        return False
+    a, b, c, n = a[near], b[near], c[near], n[near]
+    q = p - (((p - a) * n).sum(axis=1) / (n * n).sum(axis=1))[:, None] * n  # onto the plane
+    s = []
+    for u, w in ((a, b), (b, c), (c, a)):
+        e = w - u
+        side = (np.cross(e, q - u) * n).sum(axis=1) / np.linalg.norm(n, axis=1)
+        s.append(side / np.maximum(np.linalg.norm(e, axis=1), 1e-300) >= -tol)
+    return bool((s[0] & s[1] & s[2]).any())
+
+
+def floating_solids(model: PolyhedralModel, ground: float | None = None) -> list[int]:
+    """The indices of the solids that rest neither on the ground (``ground``, default the
+    model's lowest ``z``) nor on another solid (a face of it whose normal points upwards
+    holds one of the solid's lowest vertices), within ``1e-6`` of the model's extent."""
+    if not model.solids:
+        return []
+    lo = np.array([s.vertices[:, 2].min() for s in model.solids])
+    b = model.bounds
+    tol = 1e-6 * max(b[3] - b[0], b[4] - b[1], b[5] - b[2], 1e-300)
+    g = float(lo.min()) if ground is None else ground
+    ups, owners = [], []
+    for k, s in enumerate(model.solids):
+        T = s.vertices[s.faces]
+        n = np.cross(T[:, 1] - T[:, 0], T[:, 2] - T[:, 0])
+        T = T[n[:, 2] > 1e-12 * np.linalg.norm(n, axis=1).clip(1e-300)]  # facing upwards
+        ups.append(T)
+        owners.append(np.full(len(T), k, dtype=np.int64))
+    up = np.concatenate(ups) if ups else np.zeros((0, 3, 3))
+    owner = np.concatenate(owners) if owners else np.zeros(0, dtype=np.int64)
+    tlo, thi = up.min(axis=1), up.max(axis=1)
+    out = []
+    for i, s in enumerate(model.solids):
+        z0 = float(lo[i])
+        if abs(z0 - g) <= tol:
+            continue
+        low = s.vertices[s.vertices[:, 2] <= z0 + tol]
+        plo, phi = low.min(axis=0) - tol, low.max(axis=0) + tol
+        near = (owner != i) & (tlo <= phi).all(axis=1) & (thi >= plo).all(axis=1)
+        T = up[near]
+        if not (len(T) and any(_on_triangles(p, T, tol) for p in low)):
+            out.append(i)
+    return out
+
+
+# ---------------------------------------------------------------------------- figures
+def resemblance3(
+    example: PolyhedralModel, output: PolyhedralModel, *, angle_tol: float = ANGLE_TOL
+) -> Resemblance:
+    """The resemblance figures of ``output`` against ``example`` (module docstring).
+
+    Parameters
+    ----------
+    example, output : PolyhedralModel
+        The example and a synthesized model (any polyhedral models).
+    angle_tol : float
+        Normals closer than this many radians are one face orientation.
+    """
+    normals = _Normals(angle_tol)
+    ex_kinds, ex_faces = edge_kinds(example, normals, grow=True)
+    out_kinds, out_faces = (
+        edge_kinds(output, normals, grow=False) if output.solids else (set(), set())
+    )
+    ex_vol = float(np.median([s.volume for s in example.solids])) if example.solids else 0.0
+    out_vol = float(np.median([s.volume for s in output.solids])) if output.solids else 0.0
+    return Resemblance(
+        solids=len(output.solids),
+        example_solids=len(example.solids),
+        median_volume_ratio=out_vol / ex_vol if ex_vol > 0 else 0.0,
+        edge_kinds=len(ex_kinds & out_kinds) / len(ex_kinds) if ex_kinds else 1.0,
+        example_edge_kinds=len(ex_kinds),
+        face_orientations=len(ex_faces & out_faces) / len(ex_faces) if ex_faces else 1.0,
+        example_face_orientations=len(ex_faces),
+        floating=len(floating_solids(output)),
+        example_floating=len(floating_solids(example)),
+    )

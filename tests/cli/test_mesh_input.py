@@ -1,0 +1,128 @@
+"""Meshes as CAD tools write them through the CLI: repaired with one note, or refused with
+one line naming the file (exit 2, no traceback, nothing written)."""
+
+from __future__ import annotations
+
+import struct
+
+import numpy as np
+import pytest
+
+pytest.importorskip("trimesh")
+pytest.importorskip("manifold3d")
+
+from csplab.cli import main
+from csplab.testing import cad
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _open(tmp_path):
+    m = cad.build("bevelled")
+    m.update_faces(np.arange(len(m.faces)) != 3)
+    return cad.export(m, tmp_path / "open.stl")
+
+
+def _non_manifold(tmp_path):
+    import manifold3d as man
+    import trimesh
+
+    a = cad._mesh(man.Manifold.cube((1.5, 1.5, 1.5)))
+    b = cad._mesh(man.Manifold.cube((1.5, 1.5, 1.5)).translate((1.5, 1.5, 0.0)))
+    return cad.export(trimesh.util.concatenate([a, b]), tmp_path / "edge.stl")
+
+
+def _crossing(tmp_path):
+    return cad.export(cad.pushed_through(cad.build("chamfered")), tmp_path / "pushed.stl")
+
+
+def _nan(tmp_path):
+    p = cad.export(cad.build("tetra"), tmp_path / "nan.off")
+    lines = p.read_text().splitlines()
+    k = next(i for i, t in enumerate(lines) if len(t.split()) == 3 and i > 1)
+    lines[k] = "nan 0 0"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def _inf(tmp_path):
+    text = cad.export(cad.build("tetra"), tmp_path / "t.obj").read_text()
+    p = tmp_path / "inf.obj"
+    lines = text.splitlines()
+    k = next(i for i, t in enumerate(lines) if t.startswith("v "))
+    lines[k] = "v inf 0 0"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def _huge(tmp_path):
+    import trimesh
+
+    m = cad.build("tetra")
+    return cad.export(trimesh.Trimesh(m.vertices * 1e9, m.faces), tmp_path / "huge.stl")
+
+
+def _million(tmp_path):
+    p = tmp_path / "million.stl"
+    p.write_bytes(b"binary".ljust(80) + struct.pack("<I", 10**6) + bytes(50 * 10**6))
+    return p
+
+
+def _million_off(tmp_path):
+    p = tmp_path / "million.off"
+    p.write_text("OFF\n3 1000000 0\n0 0 0\n1 0 0\n0 1 0\n" + "3 0 1 2\n" * 10)
+    return p
+
+
+BAD = {
+    "open": (_open, r"open\.stl: solid 0: not closed \(not watertight\)"),
+    "non-manifold": (_non_manifold, r"edge\.stl: solid 0: non-manifold edge"),
+    "self-intersecting": (
+        _crossing,
+        r"pushed\.stl: solid 0: the surface crosses itself \(faces \d+ and \d+ intersect\)",
+    ),
+    "NaN": (_nan, r"nan\.off: line \d+: a vertex with a non-finite coordinate \(nan, 0\.0, 0\.0\)"),
+    "infinite": (_inf, r"inf\.obj: line \d+: a vertex with a non-finite coordinate \(inf, "),
+    "1e9": (_huge, r"huge\.stl: triangle \d+: coordinate [\d.]+e\+09 beyond the 1e\+07"),
+    "1e6 faces (stl)": (_million, r"million\.stl: 1000000 faces, more than the 200000 csplab"),
+    "1e6 faces (off)": (_million_off, r"million\.off: 1000000 faces, more than the 200000"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_meshes_are_one_line_exit_2_nothing_written(tmp_path, capsys, case):
+    make, want = BAD[case]
+    p = make(tmp_path)
+    out = tmp_path / "out.obj"
+    code, _, err = run(capsys, "synthesize", str(p), "--size", "10x10x5", "--seed", "1",
+                       "--out", str(out))  # fmt: skip
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("csplab: error: ") and str(p) in lines[0]
+    assert "Traceback" not in err
+    import re
+
+    assert re.search(want, lines[0]), lines[0]
+    assert not out.exists() and not out.with_suffix(".mtl").exists()
+
+
+@pytest.mark.parametrize("name", ["engraved", "holes", "slanted", "tetra"])
+def test_cad_exports_with_defects_are_repaired_with_one_note(tmp_path, capsys, name):
+    p = cad.export(cad.build(name), tmp_path / f"{name}.off", slivers=2, duplicate_vertices=True,
+                   flip=2, seed=5)  # fmt: skip
+    png = tmp_path / "p.png"
+    code, _, err = run(capsys, "show", str(p), "--out", str(png))
+    assert code == 0 and png.exists()
+    notes = err.strip().splitlines()
+    assert len(notes) == 1 and notes[0].startswith(f"csplab: warning: {p}: repaired ")
+    assert "2 zero-area triangles" in notes[0] and "duplicate vertices (merged)" in notes[0]
+    assert "wound against their neighbours" in notes[0]
+    from csplab.io import read_model
+
+    with pytest.warns(UserWarning):
+        m = read_model(p)
+    assert m.volume() == pytest.approx(float(cad.build(name).volume), rel=1e-6)
