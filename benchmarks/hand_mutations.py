@@ -31,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
+TIMEOUT_S = 300  # a test run that takes longer has hung: the mutation is killed
 
 
 @dataclass(frozen=True)
@@ -163,7 +164,11 @@ def _pytest(cwd: Path, tests: tuple[str, ...]) -> tuple[bool, float, str]:
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
            "-p", "no:randomly", *tests]  # fmt: skip
     t0 = time.perf_counter()
-    r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False)
+    try:
+        r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False,
+                           timeout=TIMEOUT_S)  # fmt: skip
+    except subprocess.TimeoutExpired:
+        return False, time.perf_counter() - t0, f"no answer in {TIMEOUT_S} s (a hang)"
     lines = r.stdout.strip().splitlines() or [""]
     failed = [ln.split()[1] for ln in lines if ln.startswith(("FAILED ", "ERROR "))]
     tail = lines[-1] if not failed else f"{lines[-1]}: {', '.join(failed)}"
