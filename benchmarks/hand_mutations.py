@@ -77,6 +77,14 @@ MUTATIONS: tuple[Mutation, ...] = (
         "the models' vertices are not sampled",
     ),
     Mutation(
+        "check2d-no-overlap-by-shapes",
+        "csplab/continuous/check.py",
+        "            if both.area > 1e-12 * scale * scale:",
+        "            if False:",
+        ("tests/continuous/test_check_planted.py",),
+        "the 2D checker looks for overlapping labels at ring nodes only",
+    ),
+    Mutation(
         "blocks-compiled-partial-labels",
         "csplab/catalog.py",
         "return (lgrid if ok else None), int(counters[2]), int(counters[3])",
@@ -91,6 +99,14 @@ MUTATIONS: tuple[Mutation, ...] = (
         "    return BlockOutcome(block, r.grid.reshape(-1), status, retry_count, revisions)",
         ("tests/solvers/test_blocks_failing.py",),
         "an interpreted block task returns its partial labels after failing every retry",
+    ),
+    Mutation(
+        "alg31-label-draws-reversed",
+        "csplab/engine/alg31.py",
+        "    ustream = rng.random(n)\n    noise",
+        "    ustream = 1.0 - rng.random(n)\n    noise",
+        ("tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",),
+        "the compiled Alg. 3.1 draws its labels from the other end of the catalog",
     ),
     Mutation(
         "efros-leung-threshold-10",

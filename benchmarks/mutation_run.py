@@ -78,7 +78,7 @@ TARGETS: tuple[Target, ...] = (
     Target(
         "blocks.tasks",
         "csplab/engine/waves.py",
-        ("solve_block", "solve_compiled", "independent", "block_rng"),
+        ("solve_block", "solve_compiled"),
         ("tests/solvers/test_blocks_failing.py",),
     ),
     Target(

@@ -52,14 +52,15 @@ def test_a_valid_output_passes_and_the_example_passes_itself() -> None:
 
 
 def test_crossing_bars_only_edge_pieces_see() -> None:
-    """Two unit bars stacked crosswise (a single cube as the example): where the upper bar
+    """Two bars stacked crosswise (a single cube as the example): where the upper bar
     crosses the lower bar's top edges, each edge is concave, a neighbourhood no cube has.
     No vertex of either bar is there (the crossings are inside edges of both) and no
     triangle centre either (the bars are long, the crossing off their middles), so only the
     middles of the edge pieces find it."""
     E = _model(box(1, [0, 0, 0], [1, 1, 1]))
-    M = _model(box(1, [0, 1, 0], [10, 2, 1]), box(1, [4.5, -7, 1], [5.5, 3, 2]))
-    crossing_lo, crossing_hi = [4.5, 1, 1], [5.5, 2, 1]
+    # sizes that are not whole units: an edge moved by a unit lands on no other edge
+    M = _model(box(1, [0, 1, 0], [10, 2.5, 0.75]), box(1, [4.5, -7, 0.75], [6, 3, 1.5]))
+    crossing_lo, crossing_hi = [4.5, 1, 0.75], [6, 2.5, 0.75]
     # the premise: the crossing holds no vertex and no triangle centre
     assert not _inside(_vertices(M), crossing_lo, crossing_hi).any()
     assert not _inside(_triangles(M).mean(axis=1), crossing_lo, crossing_hi).any()
@@ -68,11 +69,13 @@ def test_crossing_bars_only_edge_pieces_see() -> None:
     # every defect lies on a side of the crossing, none off it
     for d in v:
         x, y = d.point
-        assert 4.5 <= x <= 5.5 and 1 <= y <= 2 and (x in (4.5, 5.5) or y in (1, 2)), d
+        assert 4.5 <= x <= 6 and 1 <= y <= 2.5 and (x in (4.5, 6) or y in (1, 2.5)), d
     # the upper bar lifted off the lower one: nothing to report
     assert (
         len(
-            violations3(E, _model(box(1, [0, 1, 0], [10, 2, 1]), box(1, [4.5, -7, 2], [5.5, 3, 3])))
+            violations3(
+                E, _model(box(1, [0, 1, 0], [10, 2.5, 0.75]), box(1, [4.5, -7, 1], [6, 3, 1.75]))
+            )
         )
         == 0
     )
