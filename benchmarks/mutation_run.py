@@ -79,7 +79,7 @@ TARGETS: tuple[Target, ...] = (
         "blocks.tasks",
         "csplab/engine/waves.py",
         ("solve_block", "solve_compiled"),
-        ("tests/solvers/test_blocks_failing.py",),
+        ("tests/engine/test_waves.py", "tests/solvers/test_blocks_failing.py"),
     ),
     Target(
         "blocks.arrays",
