@@ -131,3 +131,17 @@ def test_cubes_meeting_at_a_corner_only_vertices_see() -> None:
     )
     # an example that has such a corner accepts it
     assert len(violations3(M, M)) == 0
+
+
+def test_an_edge_split_by_a_vertex_is_sampled_piece_by_piece() -> None:
+    """A box B stands flush on the front of a slab A (the example): B's corner splits A's
+    front top edge into two pieces. In the output a bar C crosses that edge on its second
+    piece; the crossing (a concave edge) is found at the middle of that piece, not at the
+    middle of the whole edge, which is B's corner (a neighbourhood of the example)."""
+    A, B = box(1, [0, 0, 0], [4, 1, 1]), box(1, [0, 0, 1], [2, 1, 2])
+    E = _model(A, B)
+    assert len(violations3(E, E)) == 0
+    M = _model(A, B, box(1, [2.5, -7, 1], [3.5, 0.5, 1.6]))
+    v = violations3(E, M)
+    at_crossing = [d for d in v if 2.5 <= d.point[0] <= 3.5 and d.point[1] == 0]
+    assert at_crossing, v.describe()
