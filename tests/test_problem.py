@@ -141,3 +141,58 @@ def test_labels_absent_from_the_example_are_excluded():
     P = from_example(E, (1, 1))
     assert P.domains[0].tolist() == [True, False, False, True]
     assert not P.is_solution([[1]])
+
+
+def _violations_by_hand(P, g):
+    """Brute force from the definition: a cell is bad when its label is negative, >= K or
+    outside its domain; an arc is broken when an end is bad-ranged or the relation forbids
+    the pair."""
+    lab = np.asarray(g).reshape(-1)
+    cells = [c for c in range(P.n)
+             if not 0 <= lab[c] < P.K or not P.domains[c, lab[c]]]  # fmt: skip
+    arcs = []
+    for i, (s, d, r) in enumerate(P.arcs.tolist()):
+        a, b = int(lab[s]), int(lab[d])
+        if not (0 <= a < P.K and 0 <= b < P.K and P.relations[r, a, b]):
+            arcs.append(i)
+    return cells, arcs
+
+
+def test_violations_match_the_definition_on_random_grids():
+    """Random relations, domains and grids with labels from -1 to K (one past the last
+    label) on problems of 1 to 3 labels: the same cells and arcs as the definition."""
+    rng = np.random.default_rng(32)
+    for K in (1, 2, 3):
+        for _ in range(15):
+            shape = (3, 4)
+            n = 12
+            idx = np.arange(n).reshape(shape)
+            arcs = [[int(idx[i, j]), int(idx[i, j + 1]), 0] for i in range(3) for j in range(3)]
+            arcs += [[int(idx[i, j]), int(idx[i + 1, j]), 1] for i in range(2) for j in range(4)]
+            rel = rng.random((2, K, K)) < 0.6
+            dom = rng.random((n, K)) < 0.8
+            dom[np.arange(n), rng.integers(0, K, n)] = True
+            P = Problem(shape, dom, rel, arcs)
+            g = rng.integers(-1, K + 1, shape)
+            v = P.violations(g)
+            cells, broken = _violations_by_hand(P, g)
+            assert v.cells.tolist() == cells and v.arcs.tolist() == broken
+            assert len(v) == len(cells) + len(broken) and v.constraints == ()
+            assert P.is_solution(g) == (not cells and not broken)
+
+
+def test_constraints_are_checked_on_complete_grids_and_counted():
+    from csplab.constraints import Count
+
+    E = ExampleModel([[0, 1], [1, 0]])
+    P = Problem.from_example(E, (2, 2)).with_constraints([Count([1], min=3)])
+    good_arcs = np.array([[0, 1], [1, 0]])  # a solution of the arcs with two 1s
+    v = P.violations(good_arcs)
+    assert v.arcs.size == 0 and v.cells.size == 0 and len(v.constraints) == 1
+    assert "count" in v.constraints[0] and len(v) == 1 and not P.is_solution(good_arcs)
+    ok = P.with_constraints([]).without_constraints().with_constraints([Count([1], min=2)])
+    assert len(ok.violations(good_arcs)) == 0 and ok.violations(good_arcs).constraints == ()
+    # an incomplete grid: its cells are reported, the constraints are not checked yet
+    part = np.array([[0, 1], [1, -1]])
+    vp = P.violations(part)
+    assert vp.cells.tolist() == [3] and vp.constraints == ()

@@ -318,6 +318,16 @@ def violations2(
         if b not in example.labels:
             c = model.shape(b).representative_point()
             defects.append(Defect("label", (c.x, c.y), f"label {b} does not occur in the example"))
+    # two labels claiming one area: found by their shapes, not by the nodes (rings that cross
+    # inside edges, or a polygon inside another, have no node in the overlap)
+    used = model.labels
+    shapes = {b: model.shape(b) for b in used} if len(used) > 1 else {}
+    for i, a in enumerate(used):
+        for b in used[i + 1 :]:
+            both = shapes[a].intersection(shapes[b])
+            if both.area > 1e-12 * scale * scale:
+                c = both.representative_point()
+                defects.append(Defect("label", (c.x, c.y), f"labels [{a}, {b}] overlap here"))
     segs, labs = _segments(model)
     mv, me, extra = neighbourhoods(model, fams, scale, (segs, labs))
     for (ax, ay), (bx, by) in segs.tolist():

@@ -71,3 +71,18 @@ def test_multiresolution_is_closed_and_seeded_by_the_coarse_pass() -> None:
     assert not np.array_equal(one.vertices.shape, ()) and two.volume > 0
     with pytest.raises(InputError, match="levels"):
         geometry(E, (16, 16, 8), resolution=16, block=4, levels=0)
+
+
+def test_a_block_of_the_source_finds_an_identical_block() -> None:
+    """Lagae et al. Sec. 4.3: the search returns a best block; a query that is a block of
+    the source has an exact match (distance 0 at every level of its pyramid)."""
+    f = signed_distance(load_polyhedral_example("houses"), 16)
+    t = SearchTree.build(f, 4)
+    rng = np.random.default_rng(1)
+    for i in rng.choice(len(t.corners), 12, replace=False).tolist():
+        c = t.corners[i]
+        q = f[tuple(slice(a, a + 4) for a in c)]
+        b, _ = t.best(q)
+        pyr = t.pyramid(q)
+        for lvl, qq in enumerate(pyr):  # every level of the found block equals the query's
+            assert np.array_equal(t.levels[lvl][b], qq), (i, lvl)

@@ -18,3 +18,74 @@ def test_min_domain_is_mrv_whatever_the_choice():
     W = P._replace(weights=np.linspace(1, 50, P.K))
     r = solve(W, "catalog", rng=0, order="min-domain", choice="weighted")
     assert r.stats["order"] == "min-domain" and (r.status != "solved" or W.is_solution(r.grid))
+
+
+def _problems():
+    """Fixed problems where Alg. 3.1 solves, fails (loops in random order, seed 0) and is
+    unsat."""
+    import numpy as np
+
+    from csplab import ExampleModel, Problem
+    from csplab.examples import load_example
+
+    yield "fig3_10", Problem.from_example(load_example("fig3_10"), (7, 6))
+    yield "castle", Problem.from_example(load_example("castle"), (6, 6, 5), boundary="auto")
+    yield "loops", Problem.from_example(load_example("loops"), (8, 8))
+    # 0 1 2 0 1 2 ... along x with both ends fixed to 0: unsat for length 5 (4 steps)
+    P = Problem.from_example(ExampleModel(np.arange(9) % 3), (5,))
+    yield "cycle-unsat", P.with_fixed({(0,): 0, (4,): 0})
+
+
+def test_run_alg31_is_the_literal_algorithm():
+    """run_alg31 against alg31_reference (the literal Alg. 3.1 on the reference fixpoint):
+    same status and grid for the same seed, orders scanline/random/scan:AXES, uniform and
+    weighted choice; its trace is the cells in the order's sequence, each given the label
+    the grid has, and a solved grid has no violation."""
+    import numpy as np
+
+    from csplab.engine.alg31 import alg31_reference, run_alg31, scan_order
+
+    statuses = set()
+    for name, P in _problems():
+        orders = ["scanline", "random", "scan:" + "xyz"[: P.ndim][::-1]]
+        for order in orders:
+            for choice in ("uniform", "weighted"):
+                for seed in range(3):
+                    want, grid = alg31_reference(P, np.random.default_rng(seed), order=order,
+                                                 choice=choice)  # fmt: skip
+                    r = run_alg31(P, np.random.default_rng(seed), order=order, choice=choice)
+                    key = (name, order, choice, seed)
+                    assert r.status == want, key
+                    statuses.add(r.status)
+                    flat = r.grid.reshape(-1)
+                    if want == "unsat":
+                        assert len(r.trace) == 0 and r.stats.get("proof"), key
+                        continue
+                    assert np.array_equal(r.grid, grid) or want == "failed", key
+                    cells, labels = r.trace[:, 0], r.trace[:, 1]
+                    assert np.array_equal(flat[cells], labels), key
+                    assert (flat >= 0).sum() >= len(cells)
+                    scan = scan_order(P.shape, order)
+                    if scan is not None:
+                        assert np.array_equal(cells, scan[: len(cells)]), key
+                    if want == "solved":
+                        assert len(cells) == P.n and len(P.violations(r.grid)) == 0, key
+                    else:
+                        assert r.stats["fail_cell"] is not None, key
+    assert {"solved", "failed", "unsat"} <= statuses  # the premise: every outcome seen
+
+
+def test_heap_orders_visit_each_cell_once_and_solve_consistently():
+    import numpy as np
+
+    from csplab.engine.alg31 import run_alg31
+
+    for _, P in _problems():
+        for order in ("min-entropy", "min-domain"):
+            for seed in range(3):
+                r = run_alg31(P, np.random.default_rng(seed), order=order)
+                cells = r.trace[:, 0]
+                assert len(set(cells.tolist())) == len(cells)
+                if r.status == "solved":
+                    assert sorted(cells.tolist()) == list(range(P.n))
+                    assert len(P.violations(r.grid)) == 0

@@ -1,0 +1,235 @@
+"""Apply each hand mutation of issue 32, one at a time, and run the tests that must kill it.
+
+Every mutation below once passed the whole suite: a sampling of the 3D checker removed, a
+block that failed every retry handing back its partial labels, the Efros-Leung baseline
+matching loosely or not at all, the SAT oracle accepting models with several labels in a
+cell. The script copies the tracked files of the work tree to a temporary directory
+(the work tree itself is never changed), checks that the killing tests pass there
+unmutated, then applies each mutation (an exact text replacement, which must match once)
+and runs its tests: a mutation is *killed* when they fail.
+
+Usage::
+
+    python benchmarks/hand_mutations.py            # every mutation
+    python benchmarks/hand_mutations.py -k check3d # those whose id contains "check3d"
+    python benchmarks/hand_mutations.py --list
+
+The exit status is 0 when every mutation selected was killed. It takes a few minutes
+(each test run loads the compiled kernels in a fresh directory).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+TIMEOUT_S = 300  # a test run that takes longer has hung: the mutation is killed
+
+
+@dataclass(frozen=True)
+class Mutation:
+    """One hand mutation: replace ``old`` (which occurs once in ``path``) by ``new``."""
+
+    id: str
+    path: str
+    old: str
+    new: str
+    tests: tuple[str, ...]
+    what: str
+
+
+MUTATIONS: tuple[Mutation, ...] = (
+    Mutation(
+        "check3d-no-edge-pieces",
+        "csplab/continuous/check3d.py",
+        "out.append(_edge_pieces(edges[:, 0], edges[:, 1], verts))",
+        "out.append(np.zeros((0, 3)))",
+        ("tests/continuous/test_check3d_planted.py::test_crossing_bars_only_edge_pieces_see",),
+        "the output's edge pieces are not sampled",
+    ),
+    Mutation(
+        "check3d-no-triangle-centres",
+        "csplab/continuous/check3d.py",
+        "        out.append(tri.mean(axis=1))\n        # every edge once",
+        "        # every edge once",
+        (
+            "tests/continuous/test_check3d_planted.py"
+            "::test_a_box_on_part_of_a_triangle_only_triangle_centres_see",
+        ),
+        "the output's triangle centres are not sampled",
+    ),
+    Mutation(
+        "check3d-no-vertices",
+        "csplab/continuous/check3d.py",
+        "    out = [verts]\n",
+        "    out = [verts[:0]]\n",
+        (
+            "tests/continuous/test_check3d_planted.py::test_cubes_meeting_at_a_corner_only_vertices_see",
+        ),
+        "the models' vertices are not sampled",
+    ),
+    Mutation(
+        "check2d-no-overlap-by-shapes",
+        "csplab/continuous/check.py",
+        "            if both.area > 1e-12 * scale * scale:",
+        "            if False:",
+        ("tests/continuous/test_check_planted.py",),
+        "the 2D checker looks for overlapping labels at ring nodes only",
+    ),
+    Mutation(
+        "blocks-compiled-partial-labels",
+        "csplab/catalog.py",
+        "return (lgrid if ok else None), int(counters[2]), int(counters[3])",
+        "return lgrid, int(counters[2]), int(counters[3])",
+        ("tests/solvers/test_blocks_failing.py",),
+        "a compiled block task returns its partial labels after failing every retry",
+    ),
+    Mutation(
+        "blocks-interpreted-partial-labels",
+        "csplab/engine/waves.py",
+        "    return BlockOutcome(block, None, status, retry_count, revisions)",
+        "    return BlockOutcome(block, r.grid.reshape(-1), status, retry_count, revisions)",
+        ("tests/solvers/test_blocks_failing.py",),
+        "an interpreted block task returns its partial labels after failing every retry",
+    ),
+    Mutation(
+        "alg31-label-draws-reversed",
+        "csplab/engine/alg31.py",
+        "    ustream = rng.random(n)\n    noise",
+        "    ustream = 1.0 - rng.random(n)\n    noise",
+        ("tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",),
+        "the compiled Alg. 3.1 draws its labels from the other end of the catalog",
+    ),
+    Mutation(
+        "efros-leung-threshold-10",
+        "csplab/baselines/texture.py",
+        "cand = np.flatnonzero(dist <= best * (1.0 + eps))",
+        "cand = np.flatnonzero(dist <= best * 10)",
+        ("tests/baselines/test_texture_guarded.py",),
+        "Efros-Leung keeps candidates within 10 times the best distance, not 1 + eps",
+    ),
+    Mutation(
+        "efros-leung-random-position",
+        "csplab/baselines/texture.py",
+        "out[cell] = ex_lab[int(cand[gen.integers(len(cand))])]",
+        "out[cell] = ex_lab[int(gen.integers(len(ex_lab)))]",
+        ("tests/baselines/test_texture_guarded.py",),
+        "Efros-Leung copies the label of a random example position",
+    ),
+    Mutation(
+        "graphcut-seam-half-cost",
+        "csplab/baselines/texture.py",
+        "w[tuple(a)] = diff[tuple(a)] + diff[tuple(b)] + 1e-6",
+        "w[tuple(a)] = diff[tuple(a)] + 1e-6",
+        ("tests/baselines/test_texture_guarded.py",),
+        "a graph-cut seam is priced by one side's mismatch only",
+    ),
+    Mutation(
+        "geometry-search-farthest-first",
+        "csplab/baselines/geometry.py",
+        "dist = ((content - pyr[lvl + 1][None, :]) ** 2).mean(axis=1)",
+        "dist = -((content - pyr[lvl + 1][None, :]) ** 2).mean(axis=1)",
+        ("tests/baselines/test_geometry.py::test_a_block_of_the_source_finds_an_identical_block",),
+        "the block search pops the farthest node first",
+    ),
+    Mutation(
+        "sat-lazy-amo-never-refined",
+        "csplab/engine/sat.py",
+        "                if multi.size == 0:\n",
+        "                if True:\n",
+        ("tests/solvers/test_conformance_amo.py",),
+        "the SAT oracle accepts a model with several labels in a cell (lazy at-most-one)",
+    ),
+    Mutation(
+        "cnf-amo-skips-two-label-cells",
+        "csplab/cnf.py",
+        "    cand = cand[size[cand] >= 2]\n",
+        "    cand = cand[size[cand] >= 3]\n",
+        ("tests/solvers/test_conformance_amo.py",),
+        "eager at-most-one clauses leave out the cells with two labels",
+    ),
+)
+
+
+def _copy_tree(dst: Path) -> None:
+    files = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True,
+                           check=True).stdout.decode().split("\0")  # fmt: skip
+    for f in files:
+        if not f or not (ROOT / f).is_file():
+            continue
+        (dst / f).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(ROOT / f, dst / f)
+    # tests not yet committed (a work tree in progress) come along too
+    for f in (ROOT / "tests").rglob("*.py"):
+        t = dst / f.relative_to(ROOT)
+        if not t.exists():
+            t.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(f, t)
+
+
+def _pytest(cwd: Path, tests: tuple[str, ...]) -> tuple[bool, float, str]:
+    env = {**os.environ, "PYTHONPATH": str(cwd)}
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
+           "-p", "no:randomly", *tests]  # fmt: skip
+    t0 = time.perf_counter()
+    try:
+        r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False,
+                           timeout=TIMEOUT_S)  # fmt: skip
+    except subprocess.TimeoutExpired:
+        return False, time.perf_counter() - t0, f"no answer in {TIMEOUT_S} s (a hang)"
+    lines = r.stdout.strip().splitlines() or [""]
+    failed = [ln.split()[1] for ln in lines if ln.startswith(("FAILED ", "ERROR "))]
+    tail = lines[-1] if not failed else f"{lines[-1]}: {', '.join(failed)}"
+    if r.returncode not in (0, 1):  # not a test failure: an error of the run itself
+        tail = f"exit {r.returncode}: " + " | ".join(
+            (r.stdout + r.stderr).strip().splitlines()[-3:]
+        )
+    return r.returncode == 0, time.perf_counter() - t0, tail
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("-k", default="", help="only mutations whose id contains this")
+    ap.add_argument("--list", action="store_true", help="list the mutations and stop")
+    a = ap.parse_args(argv)
+    chosen = [m for m in MUTATIONS if a.k in m.id]
+    if a.list:
+        for m in chosen:
+            print(f"{m.id}: {m.what} ({m.path}) <- {', '.join(m.tests)}")
+        return 0
+    killed = 0
+    with tempfile.TemporaryDirectory(prefix="csplab-mut-") as tmp:
+        work = Path(tmp)
+        _copy_tree(work)
+        for m in chosen:
+            src = work / m.path
+            text = src.read_text()
+            if text.count(m.old) != 1:
+                print(f"{m.id}: STALE (the text to mutate occurs {text.count(m.old)} times)")
+                continue
+            ok, dt, tail = _pytest(work, m.tests)
+            if not ok:
+                print(f"{m.id}: BROKEN (the tests fail unmutated: {tail})")
+                continue
+            src.write_text(text.replace(m.old, m.new))
+            try:
+                ok, dt, tail = _pytest(work, m.tests)
+            finally:
+                src.write_text(text)
+            status = "survived" if ok else "killed"
+            killed += not ok
+            print(f"{m.id}: {status} in {dt:.0f} s by {' '.join(m.tests)} [{tail}]", flush=True)
+    print(f"{killed} of {len(chosen)} hand mutations killed")
+    return 0 if killed == len(chosen) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
