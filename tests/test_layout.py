@@ -15,6 +15,7 @@ PACKAGE = ROOT / "csplab"
 CROSS_CUTTING = {
     "test_docstrings.py",  # numpydoc sections of the public API
     "test_general_csp.py",  # Problem, solvers and tools on CSPs that are not grids
+    "test_hand_mutations.py",  # the hand mutations of issue 32 across checkers and engines
     "test_import_cycles.py",
     "test_layout.py",
     "test_lint.py",

@@ -185,7 +185,7 @@ def test_constraints_are_checked_on_complete_grids_and_counted():
     from csplab.constraints import Count
 
     E = ExampleModel([[0, 1], [1, 0]])
-    P = Problem.from_example(E, (2, 2)).with_constraints([Count([1], min=3)])
+    P = from_example(E, (2, 2)).with_constraints([Count([1], min=3)])
     good_arcs = np.array([[0, 1], [1, 0]])  # a solution of the arcs with two 1s
     v = P.violations(good_arcs)
     assert v.arcs.size == 0 and v.cells.size == 0 and len(v.constraints) == 1

@@ -11,10 +11,10 @@ import itertools
 import numpy as np
 import pytest
 
-from csplab import Problem
 from csplab.baselines.texture import _offsets, efros_leung, graphcut
 from csplab.example import ExampleModel
 from csplab.examples import load_example
+from csplab.grids import from_example
 
 
 def _el_distances(E: np.ndarray, out: np.ndarray, cell: tuple[int, ...], window: int):
@@ -61,7 +61,7 @@ def test_breaks_far_fewer_arcs_than_random_sampling(window) -> None:
     """On a structured example, Efros-Leung's output breaks far fewer adjacency arcs than
     its own cells shuffled (random sampling with exactly the same label histogram)."""
     E = load_example("fig3_10")
-    P = Problem.from_example(E, (24, 24))
+    P = from_example(E, (24, 24))
     for seed in range(3):
         g = efros_leung(E, (24, 24), window=window, rng=seed)
         shuffled = np.random.default_rng(seed).permutation(g.reshape(-1)).reshape(g.shape)

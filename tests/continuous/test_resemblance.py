@@ -12,7 +12,6 @@ from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.resemblance import floating_solids, resemblance3
 from csplab.io import read_model
 from csplab.testing import cad
-
 from tests._meshes import box
 
 

@@ -25,15 +25,16 @@ def _problems():
     unsat."""
     import numpy as np
 
-    from csplab import ExampleModel, Problem
+    from csplab import ExampleModel
     from csplab.examples import load_example
+    from csplab.grids import from_example, with_fixed
 
-    yield "fig3_10", Problem.from_example(load_example("fig3_10"), (7, 6))
-    yield "castle", Problem.from_example(load_example("castle"), (6, 6, 5), boundary="auto")
-    yield "loops", Problem.from_example(load_example("loops"), (8, 8))
+    yield "fig3_10", from_example(load_example("fig3_10"), (7, 6))
+    yield "castle", from_example(load_example("castle"), (6, 6, 5), boundary="auto")
+    yield "loops", from_example(load_example("loops"), (8, 8))
     # 0 1 2 0 1 2 ... along x with both ends fixed to 0: unsat for length 5 (4 steps)
-    P = Problem.from_example(ExampleModel(np.arange(9) % 3), (5,))
-    yield "cycle-unsat", P.with_fixed({(0,): 0, (4,): 0})
+    P = from_example(ExampleModel(np.arange(9) % 3), (5,))
+    yield "cycle-unsat", with_fixed(P, {(0,): 0, (4,): 0})
 
 
 def test_run_alg31_is_the_literal_algorithm():

@@ -17,6 +17,7 @@ import pytest
 from csplab import Problem, load_example, solve
 from csplab.deps import available
 from csplab.engine import waves as wv
+from csplab.grids import from_example
 from csplab.solvers.blocks import trivial_solution
 
 # the compiled block tasks run for grid blocks in scanline order, the interpreted ones for
@@ -27,7 +28,7 @@ OPTS: dict[str, Any] = {"block": 6, "retries": 0, "sweeps": 1}
 
 @pytest.fixture(scope="module")
 def castle() -> Problem:
-    return Problem.from_example(load_example("castle"), (24, 24, 10), boundary="auto")
+    return from_example(load_example("castle"), (24, 24, 10), boundary="auto")
 
 
 def _watched(monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, Any]]:

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from csplab import ExampleModel, Problem, load_example, solve
+from csplab.grids import from_example
 from csplab.testing.brute import count, solutions
 
 pytest.importorskip("pysat")
@@ -31,7 +32,7 @@ def _cycle(k: int, shape: tuple[int, ...]) -> Problem:
     every label true in every cell satisfies every support clause, and its lowest-label
     decoding (all 0) breaks every arc."""
     ex = np.indices((2 * k,) * len(shape)).sum(axis=0) % k
-    return Problem.from_example(ExampleModel(ex), shape)
+    return from_example(ExampleModel(ex), shape)
 
 
 FIXED = {
@@ -39,8 +40,8 @@ FIXED = {
     "cycle3-1d": _cycle(3, (7,)),
     "cycle3-2d": _cycle(3, (3, 4)),
     "cycle4-2d": _cycle(4, (3, 3)),
-    "fig3_10": Problem.from_example(load_example("fig3_10"), (3, 3)),
-    "castle": Problem.from_example(load_example("castle"), (2, 2, 2)),
+    "fig3_10": from_example(load_example("fig3_10"), (3, 3)),
+    "castle": from_example(load_example("castle"), (2, 2, 2)),
 }
 
 
