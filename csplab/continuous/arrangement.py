@@ -62,8 +62,19 @@ def _lcm(a: int, b: int) -> int:
 
 
 class Arrangement:
-    """Vertices and edges of the lines of ``lattice``'s families in ``[0, W] x [0, H]``
-    (lattice units); see the module docstring.
+    """Vertices and edges of the lines of a lattice's families in a rectangular region.
+
+    The region is ``[0, W] x [0, H]`` in lattice units; see the module docstring.
+
+    Parameters
+    ----------
+    lattice : Lattice
+        The example's lattice; its :meth:`~Lattice.families` give the line directions.
+    W, H : int
+        Width and height of the region in spacings (lattice units), each at least 1.
+    lines : {"lattice", "equal"}, default "lattice"
+        How the lines of a family are spaced (:data:`LINES`): a line through every lattice
+        point, or lines about one spacing apart in every family.
 
     Attributes
     ----------
@@ -79,6 +90,11 @@ class Arrangement:
         vertices on one line.
     ray_mask : int64 array
         Bit ``f`` (ray along ``+d_f``) and bit ``F + f`` (along ``-d_f``) of each vertex.
+
+    Raises
+    ------
+    InputError
+        When ``W`` or ``H`` is below 1, or ``lines`` is not one of :data:`LINES`.
     """
 
     def __init__(self, lattice: Lattice, W: int, H: int, *, lines: str = "lattice") -> None:
@@ -172,10 +188,12 @@ class Arrangement:
 
     @property
     def n_vertices(self) -> int:
+        """The number of arrangement vertices."""
         return int(self.X.size)
 
     @property
     def n_edges(self) -> int:
+        """The number of arrangement edges (consecutive vertices on one line)."""
         return int(self.edge_src.size)
 
     # ------------------------------------------------------------------ geometry
@@ -186,18 +204,37 @@ class Arrangement:
         return np.concatenate([a, a + np.pi])
 
     def vertex_positions(self) -> NDArray[np.float64]:
-        """Vertices in lattice units, ``(n, 2)`` floats."""
+        """Vertices in lattice units.
+
+        Returns
+        -------
+        float array ``(n_vertices, 2)``
+            The ``(x, y)`` of each vertex, ``(X, Y) / D``.
+        """
         out: NDArray[np.float64] = np.stack([self.X, self.Y], axis=1) / self.D
         return out
 
     def edge_positions(self) -> NDArray[np.float64]:
-        """Edge midpoints in lattice units."""
+        """Edge midpoints in lattice units.
+
+        Returns
+        -------
+        float array ``(n_edges, 2)``
+            The midpoint ``(x, y)`` of each edge.
+        """
         v = self.vertex_positions()
         out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 
     def on_side(self) -> NDArray[np.int64]:
-        """Per vertex, bits 1 (x=0), 2 (x=W), 4 (y=0), 8 (y=H) of the sides it lies on."""
+        """The sides of the region each vertex lies on, as bits.
+
+        Returns
+        -------
+        int64 array ``(n_vertices,)``
+            Per vertex, bits 1 (x=0), 2 (x=W), 4 (y=0) and 8 (y=H) of the sides it lies on
+            (0 for an interior vertex).
+        """
         WD, HD = self.W * self.D, self.H * self.D
         out: NDArray[np.int64] = (
             (self.X == 0) * 1 + (self.X == WD) * 2 + (self.Y == 0) * 4 + (self.Y == HD) * 8
@@ -205,9 +242,21 @@ class Arrangement:
         return out
 
     def outside_sectors(self, rays: Sequence[int], side: int) -> tuple[bool, ...]:
-        """For a vertex with ``rays`` (sorted) on the sides ``side`` (bits of
-        :meth:`on_side`), which sectors (sector ``i`` runs counter-clockwise from ray ``i``)
-        lie outside the region."""
+        """Which sectors around a vertex on the region's sides lie outside the region.
+
+        Parameters
+        ----------
+        rays : sequence of int
+            The vertex's ray numbers, sorted (so in angular order).
+        side : int
+            The sides the vertex lies on (bits of :meth:`on_side`).
+
+        Returns
+        -------
+        tuple of bool
+            One per ray: whether sector ``i`` (running counter-clockwise from ray ``i`` to the
+            next) lies outside the region.
+        """
         ang = self.ray_angles
         out = []
         m = len(rays)
@@ -224,7 +273,14 @@ class Arrangement:
         return tuple(out)
 
     def edge_outside(self) -> NDArray[np.int8]:
-        """Per edge: 0 inside, 1 if its left side is outside the region, 2 if its right."""
+        """Which side of each edge lies outside the region.
+
+        Returns
+        -------
+        int8 array ``(n_edges,)``
+            Per edge: 0 if both sides are inside, 1 if its left side is outside the region,
+            2 if its right side is.
+        """
         side = self.on_side()
         common = side[self.edge_src] & side[self.edge_dst]
         out = np.zeros(self.n_edges, dtype=np.int8)

@@ -252,11 +252,37 @@ def violations(
     region: Sequence[float] | None = None,
     outside: int | Mapping[str, int] = 0,
 ) -> Violations:
-    """Eq. 4.1 for an output of either dimension: :func:`violations2` on polygon models,
-    :func:`~csplab.continuous.check3d.violations3` on polyhedral ones. ``region``: the
-    output region (``x0, y0, x1, y1`` or ``x0, y0, z0, x1, y1, z1``); ``outside``: the label
-    around it (in 3D also one per face, ``{"z-": 1}``).
+    """Every place where an output of either dimension breaks Eq. 4.1 w.r.t. its example.
 
+    :func:`violations2` checks polygon models, :func:`~csplab.continuous.check3d.violations3`
+    polyhedral ones; both models must have the same dimension.
+
+    Parameters
+    ----------
+    example : PolygonModel or PolyhedralModel
+        The example model.
+    model : PolygonModel or PolyhedralModel
+        The output to check, of the example's dimension.
+    region : sequence of float, optional
+        The output region, ``x0, y0, x1, y1`` (2D) or ``x0, y0, z0, x1, y1, z1`` (3D); only
+        points in the closed region are checked. ``None`` (the default): the whole model.
+    outside : int or mapping of str to int, default 0
+        The label around the region; in 3D also one per face (``{"z-": 1}``, faces not
+        named being empty space, label 0).
+
+    Returns
+    -------
+    Violations
+        The defects found; empty means the model is a valid output.
+
+    Raises
+    ------
+    InputError
+        When ``outside`` is a mapping for polygon models, or the two models differ in
+        dimension.
+
+    Examples
+    --------
     >>> from csplab.continuous.model import PolygonModel
     >>> E = PolygonModel.from_json({"polygons": [{"label": 1, "points": [[0, 0], [1, 0],
     ...     [0, 1]]}]})

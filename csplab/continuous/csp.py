@@ -164,12 +164,14 @@ def example_signatures(
 
 
 class ContinuousCSP:
-    """The binary CSP of continuous model synthesis for ``example`` in a ``W x H`` region
-    (in spacings); see the module docstring.
+    """The binary CSP of continuous model synthesis for a polygon example in a 2D region.
+
+    The region is ``W x H`` line spacings; see the module docstring.
 
     Parameters
     ----------
     example : PolygonModel
+        The example; it needs at least one polygon.
     size : (int, int)
         Region ``W x H`` in line spacings.
     spacing : float, optional
@@ -181,6 +183,9 @@ class ContinuousCSP:
         The label outside the region (default 0, empty space).
     lines : {"lattice", "equal"}
         Line spacing per family (:data:`~csplab.continuous.arrangement.LINES`).
+    lattice : Lattice, optional
+        The lattice to use (``spacing`` and ``snap`` are then ignored); default: the
+        example's own, :meth:`Lattice.of_model`.
 
     Attributes
     ----------
@@ -191,6 +196,14 @@ class ContinuousCSP:
         Compact label index -> model label (index 0 is empty space).
     type_rays, type_states : lists
         Per vertex type, its rays and its allowed sector-label tuples (compact labels).
+
+    Raises
+    ------
+    InputError
+        When ``size`` is not two extents, the example has no polygon, ``boundary`` does not
+        occur in the example, or no neighbourhood of the example fits some vertex of the
+        arrangement (as ``lines="equal"`` or a boundary label may cause); the lattice and
+        the arrangement raise it for a bad ``spacing``, region or ``lines``.
     """
 
     def __init__(
@@ -320,7 +333,19 @@ class ContinuousCSP:
 
     # ------------------------------------------------------------------ queries
     def edge_states_allowed(self, family: int) -> list[tuple[int, int]]:
-        """The (left, right) model labels an inside edge of ``family`` may take."""
+        """The (left, right) model labels an inside edge of one family may take.
+
+        Parameters
+        ----------
+        family : int
+            The family's index (angular order of the arrangement's families).
+
+        Returns
+        -------
+        list of (int, int)
+            The allowed (label on the left, label on the right) pairs w.r.t. the family's
+            direction, in model labels (0 is empty space), in increasing order.
+        """
         Kl, F = self.Kl, self.arrangement.F
         return [
             (self.labels[L], self.labels[R])
@@ -330,7 +355,14 @@ class ContinuousCSP:
         ]
 
     def vertex_state_counts(self) -> dict[tuple[int, ...], int]:
-        """Allowed states per inside vertex type, keyed by its families."""
+        """The number of allowed states of each inside vertex type.
+
+        Returns
+        -------
+        dict of tuple of int to int
+            The families through an inside vertex type (each a whole line: both rays) to
+            the number of states that type may take.
+        """
         F = self.arrangement.F
         out: dict[tuple[int, ...], int] = {}
         for rays, st in zip(self.type_rays, self.type_states, strict=True):
@@ -342,14 +374,46 @@ class ContinuousCSP:
 
     # ------------------------------------------------------------------ decoding
     def edge_labels(self, grid: ArrayLike) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-        """Compact (left, right) labels of every edge in a solution ``grid``."""
+        """The compact (left, right) labels of every edge in a solution.
+
+        Parameters
+        ----------
+        grid : array_like of int
+            A value per variable of :attr:`problem` (any shape of ``n`` values).
+
+        Returns
+        -------
+        left, right : int64 arrays ``(n_edges,)``
+            Per arrangement edge, the compact label (an index into :attr:`labels`) on its
+            left and on its right w.r.t. its family's direction.
+        """
         g = np.asarray(grid, dtype=np.int64).reshape(-1)
         v = g[self.var_edge]
         return v // self.Kl, v % self.Kl
 
     def model(self, grid: ArrayLike, *, name: str = "") -> PolygonModel:
-        """The output polygons of a solution (faces merged per label, collinear vertices
-        dropped), in the example's coordinates."""
+        """The output polygons of a solution, in the example's coordinates.
+
+        Faces are merged per label and collinear vertices dropped.
+
+        Parameters
+        ----------
+        grid : array_like of int
+            A complete solution: one non-negative value per variable of :attr:`problem`.
+        name : str, default ""
+            The model's name; empty: the example's name (or ``model``) with ``-synth``.
+
+        Returns
+        -------
+        PolygonModel
+            The output; its ``meta`` records the example's name, the size and the spacing
+            (and the example's colours, if it has them).
+
+        Raises
+        ------
+        InputError
+            When ``grid`` has the wrong number of values or a negative (unassigned) one.
+        """
         A = self.arrangement
         g = np.asarray(grid, dtype=np.int64).reshape(-1)
         if g.shape != (self.problem.n,) or (g < 0).any():
@@ -413,17 +477,42 @@ class ContinuousCSP:
         return tuple(-1 if o else b for b, o in zip(st, out, strict=True))
 
     def region(self) -> tuple[float, float, float, float]:
-        """The output region ``(x0, y0, x1, y1)`` in the example's coordinates."""
+        """The output region in the example's coordinates.
+
+        Returns
+        -------
+        (float, float, float, float)
+            The region's corners ``(x0, y0, x1, y1)``.
+        """
         s, (ox, oy) = float(self.lattice.spacing), self.lattice.origin
         W, H = self.problem.meta["size"]
         return (float(ox), float(oy), float(ox) + s * W, float(oy) + s * H)
 
     # ------------------------------------------------------------------ encoding
     def encode(self, model: PolygonModel) -> NDArray[np.int32]:
-        """The CSP assignment that a model lying on the lines describes (every vertex and
-        edge valued by point location beside the edges); vertices whose neighbourhood is not
-        an allowed state get -1 and edges with disallowed label pairs keep their value, so
-        :meth:`Problem.violations` tells whether ``model`` is a solution."""
+        """The CSP assignment that a model lying on the lines describes.
+
+        Every vertex and edge is valued by point location beside the edges; vertices whose
+        neighbourhood is not an allowed state get -1 and edges with disallowed label pairs
+        keep their value, so :meth:`Problem.violations` tells whether ``model`` is a
+        solution.
+
+        Parameters
+        ----------
+        model : PolygonModel
+            A model in the example's coordinates, its edges on the arrangement's lines.
+
+        Returns
+        -------
+        int32 array ``(n,)``
+            One value per variable of :attr:`problem` (-1 for a vertex whose neighbourhood
+            is not an allowed state).
+
+        Raises
+        ------
+        InputError
+            When ``model`` has a label that does not occur in the example.
+        """
         A, lat = self.arrangement, self.lattice
         index = {b: i for i, b in enumerate(self.labels)}
         s = float(lat.spacing)
@@ -530,12 +619,46 @@ def continuous_csp(
     lines: str = "lattice",
     constraints: UserConstraints3 | None = None,
 ) -> ContinuousCSP | ContinuousCSP3:
-    """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4) for an example of either
-    dimension: :class:`ContinuousCSP` of a polygon model in a ``W x H`` region (``lines``),
+    """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4), in either dimension.
+
+    :class:`ContinuousCSP` of a polygon model in a ``W x H`` region (``lines``),
     :class:`~csplab.continuous.csp3d.ContinuousCSP3` of a polyhedral one in ``A x B x C``
     (``boundary`` also per face, user ``constraints`` of thesis Sec. 4.6). Both give
     ``problem``, ``lattice``, ``arrangement``, ``labels``, ``boundary``, ``region()``,
-    ``model(grid)`` and ``encode(model)``."""
+    ``model(grid)`` and ``encode(model)``.
+
+    Parameters
+    ----------
+    example : PolygonModel or PolyhedralModel
+        The example.
+    size : sequence of int
+        The region in line spacings: ``(W, H)`` in 2D, ``(A, B, C)`` in 3D.
+    spacing : float, optional
+        Line (plane) spacing in the example's units; default: derived from the example
+        (:class:`~csplab.continuous.lattice.Lattice`).
+    snap : bool, default False
+        Round example vertices onto the lattice of ``spacing``.
+    boundary : int or mapping of str to int, default 0
+        The label outside the region (0: empty space); in 3D also one per face
+        (``{"z-": 1}``).
+    lines : {"lattice", "equal"}, default "lattice"
+        Line spacing per family (2D only,
+        :data:`~csplab.continuous.arrangement.LINES`).
+    constraints : UserConstraints3, optional
+        User constraints of thesis Sec. 4.6 (3D only).
+
+    Returns
+    -------
+    ContinuousCSP or ContinuousCSP3
+        The CSP, of the example's dimension.
+
+    Raises
+    ------
+    InputError
+        When a 3D example gets ``lines`` other than ``"lattice"``, or a 2D one gets user
+        ``constraints`` or a per-face ``boundary``; the CSP classes raise it for a bad
+        size, example or boundary label.
+    """
     if isinstance(example, PolyhedralModel):
         if lines != "lattice":
             raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")

@@ -24,7 +24,13 @@ class Defect:
 
 
 class Violations:
-    """The defects :func:`violations` found (a sequence; empty means Eq. 4.1 holds)."""
+    """The defects :func:`violations` found (a sequence; empty means Eq. 4.1 holds).
+
+    Parameters
+    ----------
+    defects : list of Defect
+        The defects, in the order the checker found them.
+    """
 
     def __init__(self, defects: list[Defect]) -> None:
         self.defects = defects
@@ -42,13 +48,33 @@ class Violations:
         return bool(self.defects)
 
     def counts(self) -> dict[str, int]:
+        """The number of defects of each kind.
+
+        Returns
+        -------
+        dict of str to int
+            Defect kind (``"direction"``, ``"edge"``, ``"vertex"``, ``"label"``) to the
+            number of such defects, sorted by kind; kinds without defects are left out.
+        """
         out: dict[str, int] = {}
         for d in self.defects:
             out[d.kind] = out.get(d.kind, 0) + 1
         return dict(sorted(out.items()))
 
     def describe(self, limit: int = 10) -> str:
-        """A summary line and the first ``limit`` defects."""
+        """A summary line and the first ``limit`` defects, for people.
+
+        Parameters
+        ----------
+        limit : int, default 10
+            How many defects to list after the summary line.
+
+        Returns
+        -------
+        str
+            The summary line (the number of violations, by kind), then one indented line
+            per listed defect.
+        """
         c = ", ".join(f"{v} {k}" for k, v in self.counts().items())
         head = f"{len(self)} violations of Eq. 4.1" + (f" ({c})" if c else "")
         return "\n".join([head, *(f"  {d}" for d in self.defects[:limit])])

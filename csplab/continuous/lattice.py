@@ -169,13 +169,25 @@ def _show(p: Sequence[float]) -> str:
 
 @dataclass(frozen=True)
 class Lattice:
-    """Origin, spacing and family vectors of an example in ``d`` = 2 or 3 dimensions (see
-    the module docstring); build with :meth:`of_model`, :meth:`of_points` or :meth:`of`.
+    """Origin, spacing and family vectors of an example in ``d`` = 2 or 3 dimensions.
 
-    ``vectors`` are the edge directions (2D: primitive, angle in ``[0, pi)``, in angular
-    order) or the face normals (3D: primitive, first non-zero component positive, sorted);
-    ``snapped`` is the largest distance (in spacings) a vertex was moved by ``snap`` (0 when
-    exact)."""
+    See the module docstring; build one with :meth:`of_model`, :meth:`of_points` or
+    :meth:`of`.
+
+    Parameters
+    ----------
+    origin : tuple of Fraction
+        The lower corner of the example's bounding box (``d`` coordinates); lattice point
+        ``(i, j[, k])`` is at ``origin + spacing * (i, j[, k])``.
+    spacing : Fraction
+        The lattice spacing, in the example's units.
+    vectors : tuple of tuple of int
+        The family vectors: the edge directions (2D: primitive, angle in ``[0, pi)``, in
+        angular order) or the face normals (3D: primitive, first non-zero component
+        positive, sorted).
+    snapped : float, default 0.0
+        The largest distance (in spacings) a vertex was moved by ``snap`` (0 when exact).
+    """
 
     origin: tuple[Fraction, ...]
     spacing: Fraction
@@ -184,6 +196,7 @@ class Lattice:
 
     @property
     def ndim(self) -> int:
+        """The dimension ``d``, 2 or 3."""
         return len(self.origin)
 
     @property
@@ -207,9 +220,41 @@ class Lattice:
         max_extent: int | None = None,
         where: str = "<model>",
     ) -> Lattice:
-        """The lattice of ``points`` ``(n, d)`` with the rings (2D) or polygons (3D)
-        ``faces`` (vertex indices); ``max_extent`` bounds the example's size in spacings
-        (default :data:`MAX_EXTENT` of the dimension)."""
+        """The lattice of an example given as points and faces, in 2D or 3D.
+
+        Parameters
+        ----------
+        points : float array ``(n, d)``
+            The example's vertices, ``d`` = 2 or 3.
+        faces : sequence of sequence of int
+            The rings (2D, closed) or polygons (3D) of the example, as indices into
+            ``points``; their edges or normals give the families (:func:`family_vectors`).
+        spacing : float, optional
+            The spacing; default: the largest length of which every vertex coordinate,
+            less the origin's, is an integer multiple.
+        snap : bool, default False
+            Accept vertices off the lattice of ``spacing`` (they are rounded onto it;
+            :attr:`snapped` records how far).
+        max_extent : int, optional
+            The largest example size in spacings; default :data:`MAX_EXTENT` of the
+            dimension.
+        where : str, default "<model>"
+            What the example is called in error messages.
+
+        Returns
+        -------
+        Lattice
+            The example's lattice.
+
+        Raises
+        ------
+        InputError
+            When ``spacing`` is not a positive number, a vertex has no exact rational form
+            (without ``spacing``), the example has no extent, a vertex is off the lattice
+            without ``snap``, the example spans more than ``max_extent`` spacings, or it has
+            more families than are supported (:data:`MAX_FAMILIES`,
+            :data:`MAX_FAMILIES3`).
+        """
         d = int(np.shape(points)[1])
         pts = np.asarray(points, dtype=np.float64).reshape(-1, d)
         lo = pts.min(axis=0)
@@ -260,7 +305,35 @@ class Lattice:
         max_extent: int | None = None,
         where: str = "<model>",
     ) -> Lattice:
-        """The lattice of a set of 2D rings (lists of points)."""
+        """The lattice of a set of 2D rings (lists of points).
+
+        Parameters
+        ----------
+        rings : sequence of sequence of (float, float)
+            The rings, each a list of points (closed: the last joins the first).
+        spacing : float, optional
+            The spacing; default: derived, as in :meth:`of_points`.
+        snap : bool, default False
+            Round vertices that are off the lattice of ``spacing`` onto it.
+        max_extent : int, optional
+            The largest example size in spacings; default :data:`MAX_EXTENT` of 2D.
+        where : str, default "<model>"
+            What the example is called in error messages.
+
+        Returns
+        -------
+        Lattice
+            The rings' lattice (2D).
+
+        Raises
+        ------
+        InputError
+            When ``spacing`` is not a positive number, a vertex has no exact rational form
+            (without ``spacing``), the example has no extent, a vertex is off the lattice
+            without ``snap``, the example spans more than ``max_extent`` spacings, or it has
+            more families than are supported (:data:`MAX_FAMILIES`,
+            :data:`MAX_FAMILIES3`).
+        """
         arrays = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for r in rings]
         starts = np.cumsum([0, *(len(a) for a in arrays)])
         faces = [list(range(int(a), int(b))) for a, b in itertools.pairwise(starts)]
@@ -275,28 +348,81 @@ class Lattice:
         *,
         snap: bool = False,
     ) -> Lattice:
-        """The lattice of a polygon or polyhedral model (its ``source`` named in errors),
-        from its :meth:`~csplab.continuous.model.PolygonModel.indexed_faces`."""
+        """The lattice of a polygon or polyhedral model.
+
+        It is found from the model's
+        :meth:`~csplab.continuous.model.PolygonModel.indexed_faces`, by :meth:`of_points`.
+
+        Parameters
+        ----------
+        example : PolygonModel or PolyhedralModel
+            The example; its ``source`` names it in errors.
+        spacing : float, optional
+            The spacing; default: derived, as in :meth:`of_points`.
+        snap : bool, default False
+            Round vertices that are off the lattice of ``spacing`` onto it.
+
+        Returns
+        -------
+        Lattice
+            The example's lattice, of its dimension.
+
+        Raises
+        ------
+        InputError
+            As :meth:`of_points`: for a bad ``spacing``, a vertex off the lattice without
+            ``snap``, an example too large or with too many families.
+        """
         pts, faces = example.indexed_faces()
         return cls.of_points(pts, faces, spacing, snap=snap, where=example.source)
 
     def to_lattice(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
-        """World coordinates -> lattice coordinates (floats; ``np.rint`` them for the
-        nearest lattice point)."""
+        """World coordinates to lattice coordinates.
+
+        Parameters
+        ----------
+        x : float array ``(..., d)``
+            Points in the example's (world) coordinates.
+
+        Returns
+        -------
+        float array ``(..., d)``
+            The points in lattice units, ``(x - origin) / spacing`` (floats; ``np.rint``
+            them for the nearest lattice point).
+        """
         o = np.array([float(v) for v in self.origin])
         out: NDArray[np.float64] = (np.asarray(x, dtype=np.float64) - o) / float(self.spacing)
         return out
 
     def to_world(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Lattice coordinates -> world coordinates."""
+        """Lattice coordinates to world coordinates.
+
+        Parameters
+        ----------
+        u : float array ``(..., d)``
+            Points in lattice units.
+
+        Returns
+        -------
+        float array ``(..., d)``
+            The points in the example's coordinates, ``origin + u * spacing``.
+        """
         o = np.array([float(v) for v in self.origin])
         out: NDArray[np.float64] = o + np.asarray(u, dtype=np.float64) * float(self.spacing)
         return out
 
     def families(self) -> tuple[tuple[tuple[int, ...], ...], tuple[bool, ...]]:
-        """All families with the axis ones the region's sides need added if missing, and
-        which of them are boundary-only: in 2D sorted by angle (so rays are numbered in
-        angular order), in 3D the example's first."""
+        """All families, with the axis ones the region's sides need added if missing.
+
+        Returns
+        -------
+        vectors : tuple of tuple of int
+            The family vectors: in 2D sorted by angle (so rays are numbered in angular
+            order), in 3D the example's first, then the added axes.
+        boundary_only : tuple of bool
+            Per family, whether it was added for the region's sides only (the example has
+            no edge or face of it).
+        """
         if self.ndim == 2:
             ds = list(self.vectors)
             extra2: list[tuple[int, ...]] = [d for d in ((1, 0), (0, 1)) if d not in ds]

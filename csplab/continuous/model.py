@@ -82,8 +82,22 @@ def _oriented(ring: Ring, ccw: bool) -> Ring:
 
 @dataclass(frozen=True)
 class Polygon:
-    """One object: ``label >= 1``, an exterior ring (counter-clockwise) and hole rings
-    (clockwise); ``extra`` keeps any other keys of the JSON object."""
+    """One object of a polygon model: a labelled polygon, holes allowed.
+
+    A polygon is normalised and validated when a :class:`PolygonModel` is built of it, not
+    on its own.
+
+    Parameters
+    ----------
+    label : int
+        The object label, ``>= 1`` (0 is empty space).
+    points : tuple of (float, float)
+        The exterior ring, counter-clockwise, without a repeated closing point.
+    holes : tuple of rings, default ()
+        The hole rings, clockwise (the interior is on the left of every ring).
+    extra : mapping of str to Any, default {}
+        Any other keys of the JSON object, kept when written (not compared).
+    """
 
     label: int
     points: Ring
@@ -101,6 +115,14 @@ class Polygon:
         yield from self.holes
 
     def to_json(self) -> dict[str, Any]:
+        """The JSON form of the polygon, its extra keys kept.
+
+        Returns
+        -------
+        dict of str to Any
+            ``extra``'s keys, then ``label``, ``points`` (a list of ``[x, y]``) and, if
+            there are holes, ``holes`` (a list of such lists).
+        """
         d: dict[str, Any] = dict(self.extra)
         d["label"] = self.label
         d["points"] = [list(p) for p in self.points]
@@ -122,6 +144,13 @@ class PolygonModel:
         Top-level extra keys (kept when written) and provenance.
     source : str
         The file (or ``"<model>"``) named in error messages.
+
+    Raises
+    ------
+    InputError
+        When a polygon is malformed (no points, a label not an integer ``>= 1``, a ring of
+        fewer than 3 distinct finite points), a ring is flat or crosses itself, a polygon is
+        invalid, or polygons of different labels overlap.
     """
 
     def __init__(
@@ -154,7 +183,31 @@ class PolygonModel:
 
     @classmethod
     def from_json(cls, data: Any, *, name: str = "", source: str = "<model>") -> PolygonModel:
-        """From the JSON schema ``{"polygons": [{"label", "points", "holes"?}, ...]}``."""
+        """A model from its JSON form.
+
+        The schema is ``{"polygons": [{"label", "points", "holes"?}, ...]}``; other keys, of
+        each polygon and at the top level, are kept.
+
+        Parameters
+        ----------
+        data : Any
+            The parsed JSON (a mapping with a ``"polygons"`` list).
+        name : str, default ""
+            A short name for reports; default: the data's ``"name"``, if any.
+        source : str, default "<model>"
+            The file named in error messages.
+
+        Returns
+        -------
+        PolygonModel
+            The model, normalised and validated.
+
+        Raises
+        ------
+        InputError
+            When ``data`` is not a mapping with a ``"polygons"`` list, or the polygons are
+            not a valid model (see :class:`PolygonModel`).
+        """
         if not isinstance(data, Mapping) or "polygons" not in data:
             raise InputError(f'{source}: expected an object with a "polygons" list')
         polys = data["polygons"]
@@ -164,7 +217,14 @@ class PolygonModel:
         return cls(polys, name=name or str(meta.get("name", "")), meta=meta, source=source)
 
     def to_json(self) -> dict[str, Any]:
-        """The JSON form (extra keys kept)."""
+        """The JSON form of the model (extra keys kept).
+
+        Returns
+        -------
+        dict of str to Any
+            The JSON-compatible ``meta`` keys and ``"polygons"``, a list of
+            :meth:`Polygon.to_json`.
+        """
         d: dict[str, Any] = {k: v for k, v in self.meta.items() if _jsonable(v)}
         d["polygons"] = [p.to_json() for p in self.polygons]
         return d
@@ -173,7 +233,27 @@ class PolygonModel:
     def from_shapes(
         cls, shapes: Mapping[int, Any], *, name: str = "", meta: Mapping[str, Any] | None = None
     ) -> PolygonModel:
-        """From ``{label: shapely (Multi)Polygon}``; empty geometries are skipped."""
+        """A model from shapely geometries per label; empty geometries are skipped.
+
+        Parameters
+        ----------
+        shapes : mapping of int to shapely geometry
+            ``{label: Polygon or MultiPolygon}``, labels ``>= 1``.
+        name : str, default ""
+            A short name for reports.
+        meta : mapping of str to Any, optional
+            Top-level extra keys and provenance.
+
+        Returns
+        -------
+        PolygonModel
+            One polygon per (part of a) geometry, by increasing label.
+
+        Raises
+        ------
+        InputError
+            When the geometries are not a valid model (see :class:`PolygonModel`).
+        """
         polys: list[Polygon] = []
         for label in sorted(shapes):
             for g in getattr(shapes[label], "geoms", [shapes[label]]):
@@ -204,11 +284,33 @@ class PolygonModel:
         return tuple(sorted({p.label for p in self.polygons}))
 
     def shape(self, label: int) -> Any:
-        """The union of the polygons with ``label`` (a shapely geometry)."""
+        """The union of the polygons of one label.
+
+        Parameters
+        ----------
+        label : int
+            The object label.
+
+        Returns
+        -------
+        shapely geometry
+            The union of the polygons with ``label`` (empty if there are none).
+        """
         return shapely.union_all([p.shape for p in self.polygons if p.label == label])
 
     def area(self, label: int | None = None) -> float:
-        """Area of one label (or of all objects)."""
+        """The area of one label, or of all objects.
+
+        Parameters
+        ----------
+        label : int, optional
+            The object label; ``None`` (the default): all labels.
+
+        Returns
+        -------
+        float
+            The area (overlapping polygons of one label counted once).
+        """
         labs = self.labels if label is None else (label,)
         return float(sum(self.shape(b).area for b in labs))
 
@@ -220,14 +322,29 @@ class PolygonModel:
                 float(a[:, 1].max()))  # fmt: skip
 
     def points(self) -> NDArray[np.float64]:
-        """Every ring vertex, ``(n, 2)``."""
+        """Every ring vertex of the model.
+
+        Returns
+        -------
+        float array ``(n, 2)``
+            The vertices of every ring (exterior then holes), polygon by polygon.
+        """
         return np.concatenate([np.asarray(r, dtype=np.float64)
                                for p in self.polygons for r in p.rings()])  # fmt: skip
 
     def indexed_faces(self) -> tuple[NDArray[np.float64], list[list[int]]]:
-        """Every ring vertex ``(n, 2)`` and the rings as lists of indices into them (what
-        :meth:`Lattice.of_model <csplab.continuous.lattice.Lattice.of_model>` reads, as
-        from a polyhedral model's vertices and faces)."""
+        """Every ring vertex and the rings as lists of indices into them.
+
+        This is what :meth:`Lattice.of_model <csplab.continuous.lattice.Lattice.of_model>`
+        reads, as from a polyhedral model's vertices and faces.
+
+        Returns
+        -------
+        points : float array ``(n, 2)``
+            Every ring vertex, as :meth:`points`.
+        rings : list of list of int
+            Each ring (exterior then holes, polygon by polygon) as indices into ``points``.
+        """
         rings = [np.asarray(r, dtype=np.float64).reshape(-1, 2) for p in self.polygons
                  for r in p.rings()]  # fmt: skip
         starts = np.cumsum([0, *(len(r) for r in rings)]).tolist()

@@ -156,6 +156,20 @@ class PolyhedralModel:
     merge_coplanar : bool
         Merge adjacent coplanar triangles into polygons when every face of a solid is a
         triangle (default).
+
+    Raises
+    ------
+    InputError
+        When a solid fails a check of the module docstring's validation (one line naming
+        the file, the solid and the face or vertex), or two solids of different labels
+        overlap.
+    DependencyError
+        When a package of the ``mesh`` extra that the checks need is missing.
+
+    Warns
+    -----
+    UserWarning
+        When an inside-out solid is reversed (``fix_inverted``).
     """
 
     #: polyhedral models are spatial
@@ -205,11 +219,28 @@ class PolyhedralModel:
         meta: Mapping[str, Any] | None = None,
         source: str = "<model>",
     ) -> PolyhedralModel:
-        """A model of solids that are closed, outward and non-overlapping by construction
-        (csplab's own synthesis outputs), built without validating them again.
+        """A model of solids known to be valid, built without validating them again.
 
-        Reading the model back from a file (or ``PolyhedralModel(model.solids)``) runs
-        every check of the module docstring; the test suite does so for synthesis outputs.
+        The solids must be closed, outward and non-overlapping by construction (csplab's
+        own synthesis outputs). Reading the model back from a file (or
+        ``PolyhedralModel(model.solids)``) runs every check of the module docstring; the
+        test suite does so for synthesis outputs.
+
+        Parameters
+        ----------
+        solids : sequence of Solid
+            The solids, used as they are.
+        name : str, default ""
+            A short name for reports.
+        meta : mapping of str to Any, optional
+            Provenance (``format``, ``label_names``, ...).
+        source : str, default "<model>"
+            The file (or ``"<model>"``) named in error messages.
+
+        Returns
+        -------
+        PolyhedralModel
+            The model of ``solids``.
         """
         self = cls.__new__(cls)
         self.name = name
@@ -225,9 +256,18 @@ class PolyhedralModel:
         return tuple(sorted({s.label for s in self.solids}))
 
     def indexed_faces(self) -> tuple[NDArray[np.float64], list[list[int]]]:
-        """Every solid's vertices ``(n, 3)`` one after another and every polygon as a list
-        of indices into them (as :meth:`PolygonModel.indexed_faces
-        <csplab.continuous.model.PolygonModel.indexed_faces>` gives rings)."""
+        """Every solid's vertices and every polygon as a list of indices into them.
+
+        This is the 3D form of :meth:`PolygonModel.indexed_faces
+        <csplab.continuous.model.PolygonModel.indexed_faces>`, which gives rings.
+
+        Returns
+        -------
+        points : float array ``(n, 3)``
+            Every solid's vertices, one solid after another.
+        polygons : list of list of int
+            Every solid's polygons (faces), as indices into ``points``.
+        """
         pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in self.solids])
         polys: list[list[int]] = []
         base = 0
@@ -243,7 +283,13 @@ class PolyhedralModel:
 
     @property
     def bounds(self) -> tuple[float, float, float, float, float, float]:
-        """``(xmin, ymin, zmin, xmax, ymax, zmax)`` over all vertices."""
+        """``(xmin, ymin, zmin, xmax, ymax, zmax)`` over all vertices.
+
+        Raises
+        ------
+        InputError
+            When the model has no solids.
+        """
         if not self.solids:
             raise InputError(f"{self.source}: the model has no solids")
         a = np.concatenate([s.vertices for s in self.solids])
@@ -252,8 +298,26 @@ class PolyhedralModel:
                 float(hi[0]), float(hi[1]), float(hi[2]))  # fmt: skip
 
     def volume(self, label: int | None = None) -> float:
-        """Volume of one label (or of all objects); same-label solids that may overlap are
-        united (manifold3d) first, so overlaps count once."""
+        """The volume of one label, or of all objects.
+
+        Same-label solids that may overlap are united (manifold3d) first, so overlaps count
+        once.
+
+        Parameters
+        ----------
+        label : int, optional
+            The object label; ``None`` (the default): all labels.
+
+        Returns
+        -------
+        float
+            The volume.
+
+        Raises
+        ------
+        DependencyError
+            When a package of the ``mesh`` extra (trimesh, manifold3d) is missing.
+        """
         labs = self.labels if label is None else (label,)
         total = 0.0
         for b in labs:
@@ -269,17 +333,46 @@ class PolyhedralModel:
         return total
 
     def labels_at(self, points: Any) -> NDArray[np.int64]:
-        """The label of the solid containing each point ``(P, 3)`` (0: empty space; points
-        on a face are ambiguous), by compiled ray casting
-        (:func:`csplab.continuous._geom.point_labels`)."""
+        """The label of the solid containing each point, by compiled ray casting.
+
+        See :func:`csplab.continuous._geom.point_labels`.
+
+        Parameters
+        ----------
+        points : array_like of float
+            Query points, ``(P, 3)`` (any shape of ``3 * P`` values); points on a face are
+            ambiguous.
+
+        Returns
+        -------
+        int64 array ``(P,)``
+            The label at each point, 0 for empty space.
+        """
         from csplab.continuous._geom import point_labels
 
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         return point_labels(pts, [(s.label, s.vertices[s.faces]) for s in self.solids])
 
     def to_trimesh(self, label: int | None = None) -> Any:
-        """The solids of ``label`` (all when ``None``) as one ``trimesh.Trimesh``
-        (concatenated, not united); :meth:`Solid.to_trimesh` gives one solid."""
+        """The solids of one label, or all, as one ``trimesh.Trimesh``.
+
+        The solids are concatenated, not united; :meth:`Solid.to_trimesh` gives one solid.
+
+        Parameters
+        ----------
+        label : int, optional
+            The object label; ``None`` (the default): all solids.
+
+        Returns
+        -------
+        trimesh.Trimesh
+            The solids' triangles (an empty mesh when there are none).
+
+        Raises
+        ------
+        DependencyError
+            When trimesh (the ``mesh`` extra) is missing.
+        """
         tm = _trimesh()
         parts = [s.to_trimesh() for s in self.solids if label is None or s.label == label]
         if not parts:
@@ -287,7 +380,14 @@ class PolyhedralModel:
         return parts[0] if len(parts) == 1 else tm.util.concatenate(parts)
 
     def to_json(self) -> dict[str, Any]:
-        """``{"solids": [...], ...meta}`` (the JSON-compatible meta keys)."""
+        """The JSON form of the model.
+
+        Returns
+        -------
+        dict of str to Any
+            The JSON-compatible ``meta`` keys and ``"solids"``, a list of
+            :meth:`Solid.to_json` (``{"label", "vertices", "faces"}`` and extra keys).
+        """
         d: dict[str, Any] = {
             k: v for k, v in self.meta.items() if isinstance(v, str | int | float | list | dict)
         }
@@ -295,8 +395,14 @@ class PolyhedralModel:
         return d
 
     def hash(self) -> str:
-        """A short content hash (labels, vertices, polygons): equal models, equal hashes
-        (what the experiment harness keys trials by)."""
+        """A short content hash of the model: equal models, equal hashes.
+
+        Returns
+        -------
+        str
+            16 hex digits of a SHA-256 of every solid's label, vertices and polygons (what
+            the experiment harness keys trials by).
+        """
         import hashlib
 
         h = hashlib.sha256(b"polyhedra")

@@ -49,9 +49,22 @@ M = TypeVar("M", PolygonModel, PolyhedralModel)
 
 @dataclass
 class Synthesis(Generic[CSP, Model]):
-    """What :func:`synthesize` returns: the solver's ``result`` (its grid holds the CSP
-    values), the ``csp``, the output ``model`` (``None`` unless solved), the checker's
-    ``violations`` of it, and the time of each phase in seconds (``times``)."""
+    """What :func:`synthesize` returns: the solver's result, the CSP, the output and its check.
+
+    Parameters
+    ----------
+    result : Result
+        The solver's result; its grid holds the CSP values.
+    csp : ContinuousCSP or ContinuousCSP3
+        The CSP that was solved.
+    model : PolygonModel or PolyhedralModel or None
+        The output model, ``None`` unless solved.
+    violations : Violations
+        The checker's violations of the output (and of the user constraints, in 3D); empty
+        when it was not checked.
+    times : dict of str to float, default {}
+        The time of each phase in seconds (``csp``, ``solve``, ``geometry``, ``check``).
+    """
 
     result: Result
     csp: CSP
@@ -61,6 +74,7 @@ class Synthesis(Generic[CSP, Model]):
 
     @property
     def ok(self) -> bool:
+        """Whether the solver succeeded and the output exists and has no violations."""
         return self.result.ok and self.model is not None and not self.violations
 
 
@@ -115,13 +129,17 @@ def synthesize(
     constraints: UserConstraints3 | None = None,
     **options: Any,
 ) -> Synthesis[Any, M]:
-    """Continuous model synthesis (Alg. 4.1) of a polygon ``example`` in a ``W x H`` region
-    of line spacings, or of a polyhedral one in an ``A x B x C`` box of plane spacings.
+    """Continuous model synthesis (Alg. 4.1) of a polygon or polyhedral example.
+
+    A polygon ``example`` is synthesized in a ``W x H`` region of line spacings, a
+    polyhedral one in an ``A x B x C`` box of plane spacings.
 
     Parameters
     ----------
     example : PolygonModel or PolyhedralModel
+        The example model.
     size : (int, int) or (int, int, int)
+        The region in line (plane) spacings, of the example's dimension.
     solver : str
         Any registered solver name (``NAME:BACKEND`` too); ``options`` go to it.
     rng : int or numpy Generator, optional
@@ -134,7 +152,30 @@ def synthesize(
         (:func:`csplab.solvers.solve`'s one restart loop; ``time_limit`` covers all).
     check : bool
         Run the checker on the output (default; it is the truth, not the CSP).
+    **options
+        Solver options (``time_limit=``, ``order=``, ``block=`` ...), passed to
+        :func:`csplab.solvers.solve`.
 
+    Returns
+    -------
+    Synthesis
+        The solver's result, the CSP, the output model (``None`` unless solved), its
+        violations and the time of each phase.
+
+    Raises
+    ------
+    InputError
+        When the CSP cannot be built (a bad size, spacing, boundary label or
+        dimension-specific argument, see :func:`~csplab.continuous.csp.continuous_csp`),
+        or :func:`csplab.solvers.solve` rejects an option.
+    UnknownSolverError
+        When ``solver`` names no registered solver.
+    DependencyError
+        When the solver, or the 3D geometry, needs an optional package that is not
+        installed.
+
+    Notes
+    -----
     The dimensional and large-scale user constraints restrict the CSP's domains;
     connectivity is a :class:`~csplab.constraints.Connected` constraint on its problem
     (exact in ``sat``, ``cpsat`` and ``asp``, propagated or checked by the others, as on

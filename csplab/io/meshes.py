@@ -829,9 +829,25 @@ def _triangle_soup(
 
 
 def write_stl_model(model: PolyhedralModel, path: str | Path) -> None:
-    """Write ``model`` as a binary STL (atomically): every solid's triangles
-    (:func:`solid_triangles`: no zero-area triangle, no T-junction), outward normals,
-    float32 coordinates; STL has no labels (the ``.obj`` and ``.glb`` writers keep them)."""
+    """Write ``model`` as a binary STL (atomically).
+
+    Every solid's triangles (:func:`solid_triangles`: no zero-area triangle, no
+    T-junction), outward normals, float32 coordinates; STL has no labels (the ``.obj`` and
+    ``.glb`` writers keep them).
+
+    Parameters
+    ----------
+    model : PolyhedralModel
+        The solids to write.
+    path : str or Path
+        The ``.stl`` file.
+
+    Raises
+    ------
+    InputError
+        Naming the file when it cannot be written, or the solid and polygon when a polygon
+        cannot be triangulated without zero-area triangles.
+    """
     verts, tris = _triangle_soup(model, path)
     n = sum(len(t) for t in tris)
     rec = np.zeros(n, dtype=_STL_DTYPE)
@@ -848,9 +864,23 @@ def write_stl_model(model: PolyhedralModel, path: str | Path) -> None:
 
 
 def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
-    """Write ``model`` as OFF (atomically): every solid's vertices and polygons, exact
-    numbers; the solids are its connected shells (read back with ``labels=components``
-    for one label per solid: OFF has no labels)."""
+    """Write ``model`` as OFF (atomically).
+
+    Every solid's vertices and polygons, exact numbers; the solids are its connected shells
+    (read back with ``labels=components`` for one label per solid: OFF has no labels).
+
+    Parameters
+    ----------
+    model : PolyhedralModel
+        The solids to write.
+    path : str or Path
+        The ``.off`` file.
+
+    Raises
+    ------
+    InputError
+        Naming the file when it cannot be written.
+    """
     lines: list[str] = []
     polys: list[str] = []
     base = 0
@@ -864,10 +894,27 @@ def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
 
 
 def write_glb(model: PolyhedralModel, path: str | Path) -> None:
-    """Write ``model`` as binary glTF (``.glb``, atomically; trimesh): one mesh and one
-    PBR material per label (the label colours of :func:`write_obj_model`), node names
-    ``label_N``, the solids' triangles (:func:`solid_triangles`), ``y`` up as glTF wants
-    (csplab ``(x, y, z)`` -> ``(x, z, -y)``)."""
+    """Write ``model`` as binary glTF (``.glb``, atomically; trimesh).
+
+    One mesh and one PBR material per label (the label colours of :func:`write_obj_model`),
+    node names ``label_N``, the solids' triangles (:func:`solid_triangles`), ``y`` up as
+    glTF wants (csplab ``(x, y, z)`` -> ``(x, z, -y)``).
+
+    Parameters
+    ----------
+    model : PolyhedralModel
+        The solids to write.
+    path : str or Path
+        The ``.glb`` file.
+
+    Raises
+    ------
+    InputError
+        Naming the file when it cannot be written, or the solid and polygon when a polygon
+        cannot be triangulated without zero-area triangles.
+    DependencyError
+        When trimesh (the ``mesh`` extra) is not installed.
+    """
     tm = require("trimesh", "mesh", "writing glTF")
     cols = _colours(model)
     scene = tm.Scene()
