@@ -45,12 +45,13 @@ a chunk depends only on the cells within ``S * (B + r)`` of it (in practice on a
 
 Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
-completion keeps its previous labels, so such a cell may stay unmet (:meth:`World.unmet`
-lists them in a rectangle). Not honoured in an infinite world (refused or not offered):
-global counts over the whole world, connectivity or paths between arbitrary far cells, and
-boundary faces on the infinite ``x``/``y`` axes (there is no outside); counts per chunk
-would need the chunk grid to coincide with every pass' blocks, which the shifted passes
-deliberately break.
+completion keeps its previous labels, so a fixed cell may stay unmet where every pass puts
+a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help). Not
+honoured in an infinite world: the global constraints of a model file (counts over the
+whole grid, connectivity, paths: dropped with a warning, :attr:`World.dropped`), boundary
+faces on the infinite ``x``/``y`` axes (there is no outside: refused), and counts per chunk
+(the chunk grid is not the blocks' lattice in every pass: a later pass' block straddles
+chunks, so a count met in one pass is not kept by the next).
 
 Examples
 --------
@@ -67,6 +68,7 @@ from __future__ import annotations
 import hashlib
 import json
 import sqlite3
+import warnings
 from collections import OrderedDict
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
@@ -210,7 +212,8 @@ class World:
         ``xs, ys`` (integer arrays of the block's ``(X, Y)`` shape); 3D: ``(X, Y, Z, K)``.
     cache_blocks, cache_chunks : int
         Sizes of the block and chunk caches (least recently used entries are forgotten:
-        memory stays flat however far one walks).
+        memory stays flat however far one walks). The block cache holds at least the
+        blocks one chunk needs from scratch (``sum((k + 2) ** 2 for k < S)``).
     store : str or Path, optional
         A SQLite file keeping generated chunks (keyed by the world's settings): a restart
         reads them instead of solving again.
@@ -259,6 +262,7 @@ class World:
         self.B = self.chunk_shape[:2]
         self.height = self.chunk_shape[2] if self.ndim == 3 else None
         self.zfaces = self._zfaces(boundary)
+        self.dropped: list[str] = []  # the model's global constraints (cannot hold)
         # the template: a block with its ring; the arcs' reach from it
         probe = self.problem(tuple(max(4, 2 * b) for b in self.B))
         self.reach = _reach(probe)
@@ -287,7 +291,10 @@ class World:
             self.seed, self.retries, order, choice, exact,
         )  # fmt: skip
         self.S = 4 * self.passes
-        self.blocks: _LRU = _LRU(int(cache_blocks))
+        # the blocks one chunk needs from scratch: about (k + 1) ** 2 at k sub-passes below
+        # the last; a smaller cache would solve blocks again and again within one chunk
+        pyramid = sum((k + 2) ** 2 for k in range(self.S))
+        self.blocks: _LRU = _LRU(max(int(cache_blocks), pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
         self.stats: dict[str, int] = {"alg31": 0, "exact": 0, "kept": 0, "stored": 0}
         self.key = self._key()
@@ -341,14 +348,24 @@ class World:
             per = (periodic, periodic, False)
         m = self.model
         if isinstance(m, ExampleModel):
-            return from_example(m, shp, periodic=per, boundary=self.zfaces or "none")
-        if hasattr(m, "problem"):
-            P: Problem = m.problem(shp, periodic=per, boundary=self.zfaces or "none")
-            return P
-        raise InputError(
-            f"{getattr(m, 'name', None) or type(m).__name__} is not a grid model: a world "
-            "takes grid examples, tilesets and overlapping samples"
-        )
+            P = from_example(m, shp, periodic=per, boundary=self.zfaces or "none")
+        elif hasattr(m, "problem"):
+            P = m.problem(shp, periodic=per, boundary=self.zfaces or "none")
+        else:
+            raise InputError(
+                f"{getattr(m, 'name', None) or type(m).__name__} is not a grid model: a world "
+                "takes grid examples, tilesets and overlapping samples"
+            )
+        if P.constraints:  # global constraints of the file: they cannot hold (module doc)
+            if not self.dropped:
+                self.dropped = [type(c).__name__ for c in P.constraints]
+                warnings.warn(
+                    f"a world cannot honour the model's global constraints "
+                    f"({', '.join(self.dropped)}): dropped",
+                    stacklevel=3,
+                )
+            P = P.without_constraints()
+        return P
 
     def _start(self) -> NDArray[np.int32]:
         """``M0``: a consistent periodic tile (checked on the template's window)."""
@@ -410,9 +427,7 @@ class World:
     def _block_rect(self, s: int, b: tuple[int, int]) -> Rect:
         q, _ = self._pass_colour(s)
         off = self._offset(q)
-        return tuple(  # type: ignore[return-value]
-            (off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2)
-        )
+        return tuple((off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2))
 
     # -- state ----------------------------------------------------------------------------
     def _state(self, s: int, rect: Rect) -> NDArray[np.int32]:
@@ -424,9 +439,9 @@ class World:
                 br = self._block_rect(t, b)
                 lo = [max(br[a][0], rect[a][0]) for a in range(2)]
                 hi = [min(br[a][1], rect[a][1]) for a in range(2)]
-                out[lo[0] - rect[0][0] : hi[0] - rect[0][0], lo[1] - rect[1][0] : hi[1] - rect[1][0]] = lab[
-                    lo[0] - br[0][0] : hi[0] - br[0][0], lo[1] - br[1][0] : hi[1] - br[1][0]
-                ]
+                out[
+                    lo[0] - rect[0][0] : hi[0] - rect[0][0], lo[1] - rect[1][0] : hi[1] - rect[1][0]
+                ] = lab[lo[0] - br[0][0] : hi[0] - br[0][0], lo[1] - br[1][0] : hi[1] - br[1][0]]
         return out
 
     def _window(self, s: int, b: tuple[int, int]) -> Rect:
@@ -446,7 +461,7 @@ class World:
             if x0 <= k[0] < x1 and y0 <= k[1] < y1:
                 cell = (k[0] - x0, k[1] - y0, *k[2:])
                 al[cell] = False
-                al[cell + (v,)] = True
+                al[(*cell, v)] = True
                 hit = True
         return al if (hit or self.mask is not None) else None
 
@@ -475,7 +490,7 @@ class World:
             rects = rects + new
             if len(rects) > 64:  # merge into the bounding box (a superset: correct)
                 rects = [tuple((min(r[a][0] for r in rects), max(r[a][1] for r in rects))
-                               for a in range(2))]  # type: ignore[list-item]  # fmt: skip
+                               for a in range(2))]  # fmt: skip
         pool = self._workers()
         for s in range(1, self.S + 1):
             todo = sorted(b for b in need[s] if (s, b) not in self.blocks)
