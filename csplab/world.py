@@ -571,24 +571,36 @@ class World:
             self._db.commit()
         return arr.copy()
 
-    def region(self, xs: tuple[int, int], ys: tuple[int, int]) -> NDArray[np.int32]:
+    def region(
+        self, xs: tuple[int, int], ys: tuple[int, int], *, progress: bool = False
+    ) -> NDArray[np.int32]:
         """The labels of cells ``[x0, x1) x [y0, y1)`` (3D: the whole height), stitched
-        from chunks."""
+        from chunks; ``progress``: a bar on stderr (after 2 s) counting chunks."""
+        from csplab.progress import progress_bar
+
         (x0, x1), (y0, y1) = (int(xs[0]), int(xs[1])), (int(ys[0]), int(ys[1]))
         if x1 <= x0 or y1 <= y0:
             raise InputError(f"empty region {xs}, {ys}")
         X, Y = self.B
         out = np.empty((x1 - x0, y1 - y0, *self._bshape[2:]), dtype=np.int32)
-        if self.workers >= 2:
-            self._prefetch(((x0, x1), (y0, y1)))
-        for i in range(x0 // X, (x1 - 1) // X + 1):
-            for j in range(y0 // Y, (y1 - 1) // Y + 1):
-                c = self.chunk(i, j)
-                lo = (max(x0, i * X), max(y0, j * Y))
-                hi = (min(x1, (i + 1) * X), min(y1, (j + 1) * Y))
-                out[lo[0] - x0 : hi[0] - x0, lo[1] - y0 : hi[1] - y0] = c[
-                    lo[0] - i * X : hi[0] - i * X, lo[1] - j * Y : hi[1] - j * Y
-                ]
+        rows = range(x0 // X, (x1 - 1) // X + 1)
+        cols = range(y0 // Y, (y1 - 1) // Y + 1)
+
+        def chunks() -> Iterable[tuple[int, int]]:
+            for i in rows:
+                if self.workers >= 2:  # a row of chunks at a time on the workers
+                    self._prefetch(((i * X, (i + 1) * X), (cols[0] * Y, (cols[-1] + 1) * Y)))
+                for j in cols:
+                    yield i, j
+
+        for i, j in progress_bar(chunks(), total=len(rows) * len(cols), desc="chunks",
+                                 enabled=progress, unit="chunk"):  # fmt: skip
+            c = self.chunk(i, j)
+            lo = (max(x0, i * X), max(y0, j * Y))
+            hi = (min(x1, (i + 1) * X), min(y1, (j + 1) * Y))
+            out[lo[0] - x0 : hi[0] - x0, lo[1] - y0 : hi[1] - y0] = c[
+                lo[0] - i * X : hi[0] - i * X, lo[1] - j * Y : hi[1] - j * Y
+            ]
         return out
 
     def chunks_in(self, xs: tuple[int, int], ys: tuple[int, int]) -> Iterable[tuple[int, int]]:
