@@ -82,7 +82,7 @@ from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
 from csplab.problem import Problem
-from csplab.solvers.blocks import _Exact, trivial_solution
+from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
 __all__ = ["MAX_PERIOD", "World"]
 
@@ -137,7 +137,7 @@ class _BlockSolver:
         how = "alg31"
         labels = o.labels
         if labels is None and self.exact != "none" and not (~sub.domains.any(axis=1)).any():
-            labels, _ = _Exact(self.exact)(sub, rng, None)
+            labels, _ = ExactCompletion(self.exact)(sub, rng, None)
             how = "exact"
         if labels is None:
             old = window.reshape(-1)[self.inner]
