@@ -204,7 +204,8 @@ class World:
     exact : {"sat", "backtrack", "none"}
         Exact completion of a block that Alg. 3.1 cannot complete.
     order, choice : str
-        Alg. 3.1's cell order and label choice inside a block.
+        Alg. 3.1's cell order and label choice inside a block (the thesis': ``scanline``,
+        ``uniform``).
     fixed : mapping ``{(x, y[, z]): label}``, optional
         Cells fixed in world coordinates.
     mask : callable, optional
@@ -233,7 +234,7 @@ class World:
         retries: int = 20,
         exact: str = "sat",
         order: str = "scanline",
-        choice: str = "weighted",
+        choice: str = "uniform",
         fixed: Mapping[Sequence[int], int] | None = None,
         mask: Callable[..., Any] | None = None,
         cache_blocks: int = 4096,

@@ -208,3 +208,48 @@ def test_external_rule_set_world() -> None:
     assert w.dropped == ["Connected"]  # a path constraint cannot hold on an endless plane
     g = w.region((0, 32), (0, 32))
     assert len(w.problem(g.shape).violations(g)) == 0
+
+
+def test_cli_world_writes_the_region_and_checks_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from csplab.cli import main
+
+    out = tmp_path / "w.npy"
+    argv = ["world", str(DATA / "pipes.xml"), "--chunk", "16x16", "--seed", "3",
+            "--region=-16:32,0:16", "--out", str(out), "--json"]  # fmt: skip
+    assert main(argv) == 0
+    import json
+
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["violations"] == 0 and summary["shape"] == [48, 16]
+    g = np.load(out)
+    w = World(str(DATA / "pipes.xml"), seed=3, chunk=(16, 16), order=summary["order"],
+              choice=summary["choice"])  # fmt: skip
+    assert g.tobytes() == w.region((-16, 32), (0, 16)).tobytes()  # the library's bytes
+    assert g.shape == (48, 16)
+    assert len(w.problem(g.shape).violations(g)) == 0
+    png = tmp_path / "w.png"
+    assert (
+        main(["world", "fig3_4a", "--chunk", "8x8", "--region", "0:16,0:16", "--out", str(png)])
+        == 0
+    )
+    assert png.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--region", "0:16"], "--region must be"),
+        (["--region", "5:5,0:8"], "is empty"),
+        (["--region", "0:8,0:8", "--chunk", "8x8x8", "--boundary", "x-=0"], "infinite world"),
+    ],
+)
+def test_cli_world_bad_input_exits_2(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from csplab.cli import main
+
+    assert main(["world", "fig3_4a", *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1

@@ -29,7 +29,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("model", metavar="MODEL", help="built-in example name or model file")
     p.add_argument("--chunk", default="32x32", help="chunk size XxY or XxYxZ (default 32x32)")
     p.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
-    p.add_argument("--region", required=True, help="cells X0:X1,Y0:Y1 (half-open, may be negative)")
+    p.add_argument(
+        "--region",
+        required=True,
+        help="cells X0:X1,Y0:Y1 (half-open; a negative start needs --region=-64:64,0:64)",
+    )
     kinds = ", ".join(f"{f.extensions[0]}" for f in formats(writable=True))
     p.add_argument("--out", help=f"output file, format by extension: {kinds}")
     p.add_argument(
@@ -46,8 +50,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default="sat",
         help="exact completion of a block random choice cannot complete (sat)",
     )
-    p.add_argument("--order", default="scanline", help="Alg. 3.1's cell order in a block")
-    p.add_argument("--choice", default="weighted", help="Alg. 3.1's label choice")
+    p.add_argument(
+        "--order", help="Alg. 3.1's cell order in a block (default: the model format's, else "
+        "scanline)"
+    )  # fmt: skip
+    p.add_argument(
+        "--choice", help="Alg. 3.1's label choice (default: the model format's, else uniform)"
+    )
     p.add_argument("--jobs", type=int, default=1, help="worker processes (same output)")
     p.add_argument("--store", help="SQLite file keeping generated chunks across runs")
     add_model_option(p)
@@ -84,11 +93,16 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         check_output_path(args.out, "--out")
     model = load_model(args.model, model_options(args.model_option))
+    from csplab.io.registry import synthesis_defaults
+
+    suggested, _ = synthesis_defaults(model)
+    order = args.order or suggested.get("order", "scanline")
+    choice = args.choice or suggested.get("choice", "uniform")
     t0 = time.perf_counter()
     world = World(
         model, seed=args.seed, chunk=chunk, boundary=parse_boundary(args.boundary) or "none",
-        passes=args.passes, retries=args.retries, exact=args.exact, order=args.order,
-        choice=args.choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
+        passes=args.passes, retries=args.retries, exact=args.exact, order=order,
+        choice=choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
     )  # fmt: skip
     try:
         grid = world.region(xs, ys, progress=True)
@@ -104,6 +118,8 @@ def run(args: argparse.Namespace) -> int:
         "region": [list(xs), list(ys)],
         "shape": list(grid.shape),
         "chunks": n_chunks,
+        "order": order,
+        "choice": choice,
         "blocks": dict(world.stats),
         "violations": violations,
         "dropped_constraints": world.dropped,
