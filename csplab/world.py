@@ -216,8 +216,9 @@ class World:
         memory stays flat however far one walks). The block cache holds at least the
         blocks one chunk needs from scratch (``sum((k + 2) ** 2 for k < S)``).
     store : str or Path, optional
-        A SQLite file keeping generated chunks (keyed by the world's settings): a restart
-        reads them instead of solving again.
+        A SQLite file keeping generated chunks (keyed by the model's rules, the seed and the
+        settings; a ``mask`` by its module and name): a restart reads them instead of
+        solving again.
     workers : int
         Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
         the output is the same for any number.
@@ -538,7 +539,7 @@ class World:
             h.update(np.ascontiguousarray(arr).tobytes())
         h.update(json.dumps([self.seed, self.chunk_shape, self.passes, self.retries,
                              self.exact, self.order, self.choice, self.zfaces,
-                             sorted(self.fixed.items()), self.mask is not None,
+                             sorted(self.fixed.items()), _name_of(self.mask),
                              ]).encode())  # fmt: skip
         return h.hexdigest()[:32]
 
@@ -620,6 +621,13 @@ class World:
                 if int(g[(k[0] - xs[0], k[1] - ys[0], *k[2:])]) != v:
                     out.append(k)
         return out
+
+
+def _name_of(f: Callable[..., Any] | None) -> str | None:
+    """A mask's identity in the store key: its module and qualified name."""
+    if f is None:
+        return None
+    return f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', type(f).__name__)}"
 
 
 def _reach(P: Problem) -> int:
