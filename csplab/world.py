@@ -280,6 +280,8 @@ class World:
         a = self.template.arcs
         touch = np.isin(a[:, 0], inner) | np.isin(a[:, 1], inner)
         self.K = self.template.K
+        # blocks are cached in the smallest integer type that holds the labels
+        self._small = np.int16 if self.K <= np.iinfo(np.int16).max else np.int32
         self.fixed = {tuple(int(c) for c in k): int(v) for k, v in (fixed or {}).items()}
         for k, v in self.fixed.items():
             if len(k) != self.ndim or not 0 <= v < self.K:
@@ -474,7 +476,7 @@ class World:
             win = self._state(s - 1, self._window(s, b))
             lab, how = self.solver(s, b, win, self._allowed(s, b))
             self.stats[how] += 1
-            self.blocks.put(key, lab)
+            self.blocks.put(key, lab.astype(self._small, copy=False))
         return lab  # type: ignore[no-any-return]
 
     def _prefetch(self, rect: Rect) -> None:
@@ -506,7 +508,7 @@ class World:
             results = [x for f in futures for x in f.result()]
             for b, (lab, how) in zip(todo, results, strict=True):
                 self.stats[how] += 1
-                self.blocks.put((s, b), lab)
+                self.blocks.put((s, b), lab.astype(self._small, copy=False))
 
     def _workers(self) -> Any:
         if self._pool is None:
