@@ -21,7 +21,7 @@ asserted.
 
 Usage::
 
-    python benchmarks/bench_world.py [--full] [--seed 1] [--walk 1000] [--seams 1000]
+    python benchmarks/bench_world.py [--full] [--seed 1] [--walk 1500] [--seams 1000]
         [--orders 20] [--chunks 64]
 """
 
@@ -80,7 +80,7 @@ def main() -> None:
     ap.add_argument("--full", action="store_true", help="the issue's counts (long)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--chunks", type=int, default=64, help="chunks timed per latency line")
-    ap.add_argument("--walk", type=int, default=1000, help="chunks walked for memory")
+    ap.add_argument("--walk", type=int, default=1500, help="chunks walked for memory")
     ap.add_argument("--seams", type=int, default=1024, help="chunks checked for seams")
     ap.add_argument("--orders", type=int, default=20, help="random visit orders")
     a = ap.parse_args()
@@ -102,7 +102,9 @@ def main() -> None:
     note = "" if a.walk >= 100_000 else " (issue: 10^5; --full)"
     secs = time.perf_counter() - t0
     print(f"memory after walking {a.walk} chunks{note}: {end:.0f} MB resident, {start:.0f} MB "
-          f"after the first chunk, {end - half:+.1f} MB over the second half, {secs:.0f} s "
+          f"after the first chunk, {end - half:+.1f} MB over the second half, {secs:.0f} s, "
+          f"caches {len(w.blocks)}/{w.blocks.size} blocks {len(w.chunks)}/{w.chunks.size} "
+          f"chunks "
           f"(target <= 200 MB): {verdict(end <= 200, f'{end - 200:.0f} MB over')}")  # fmt: skip
 
     # 2. 2D latencies
