@@ -20,6 +20,7 @@ from csplab.grids import from_example
 from csplab.problem import Problem, Violations
 from csplab.result import Result, Verdict
 from csplab.solvers import Solver, available_solvers, solve
+from csplab.world import World
 
 __version__ = "0.1.0"
 
@@ -31,6 +32,7 @@ __all__ = [
     "Solver",
     "Verdict",
     "Violations",
+    "World",
     "__version__",
     "available_solvers",
     "example_names",

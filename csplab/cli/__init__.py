@@ -35,6 +35,7 @@ COMMANDS: dict[str, str] = {
     "count": "csplab.cli.count",
     "experiment": "csplab.cli.experiment",
     "baseline": "csplab.cli.baseline",
+    "world": "csplab.cli.world",
 }
 
 

@@ -77,7 +77,7 @@ from csplab.solvers.base import (
     order_option,
 )
 
-__all__ = ["BlocksSolver", "block_starts", "trivial_solution"]
+__all__ = ["BlocksSolver", "ExactCompletion", "block_starts", "trivial_solution"]
 
 
 def block_starts(n: int, m: int) -> list[int]:
@@ -312,7 +312,7 @@ def run_blocks(
             workers=workers, scheduler=scheduler,
         )  # fmt: skip
     else:
-        completion = _Exact(exact) if exact != "none" else None
+        completion = ExactCompletion(exact) if exact != "none" else None
         status, tried, accepted, retry_count, revisions = _run_sweep(
             problem, grid, boxes, None if m == (0,) else m, rng, plan, window=window, soft=soft,
             completion=completion,
@@ -364,7 +364,7 @@ class _Plan(NamedTuple):
     deadline: float | None
 
 
-class _Exact:
+class ExactCompletion:
     """Exact block completion: an exact solver on a block's subproblem (its border fixed),
     seeded by one number drawn from the sweep's generator (deterministic for a seed)."""
 
@@ -438,7 +438,7 @@ def _run_sweep(
     *,
     window: int = 1,
     soft: _Soft | None = None,
-    completion: _Exact | None = None,
+    completion: ExactCompletion | None = None,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
     ``grid`` (flat) in place. A step solves one block (``block_step``: Alg. 3.1 on its

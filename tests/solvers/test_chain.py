@@ -11,7 +11,7 @@ import pytest
 from csplab import from_example, load_example, solve
 from csplab.errors import InputError
 from csplab.solvers import chain
-from csplab.solvers.blocks import _Exact
+from csplab.solvers.blocks import ExactCompletion
 
 # Fig. 3.5's example: Alg. 3.1 fails on seed 3 in the figures' scan order
 FALLIBLE = from_example(load_example("fig3_5a"), (8, 8))
@@ -132,7 +132,7 @@ def test_a_block_refuted_with_its_border_keeps_its_labels() -> None:
     grid = start.copy().reshape(-1)
     sub = P.subproblem(sub_cells, grid, shape=(3, 3))
     assert solve(sub, "sat", rng=1).status == "solved"  # a consistent border: solvable
-    completion = _Exact("sat")
+    completion = ExactCompletion("sat")
     labels, timed_out = completion(sub, np.random.default_rng(1), None)
     assert labels is not None and not timed_out and completion.solved == 1
     grid[sub_cells[0] - 1] = 1 - grid[sub_cells[0] - 1]  # break the border's parity

@@ -1,0 +1,642 @@
+"""Infinite, chunked, seed-deterministic worlds: modify in blocks on an unbounded lattice.
+
+A :class:`World` is a model that extends without end along ``x`` and ``y`` (a 3D world has
+the fixed height of its chunk, the ground and sky of the model's boundary rule on the
+``z`` faces). ``world.chunk(i, j)`` gives the labels of chunk ``(i, j)`` and
+``world.region(...)`` any rectangle; the content is a pure function of the model, the seed,
+the settings and the coordinates.
+
+Construction: modify in blocks (Merrell 2009, Alg. 3.4/3.5, Sec. 3.3.6) on the whole plane.
+
+* **State 0** is a consistent *periodic* model ``M0`` tiled over the plane: the trivial
+  solution (:func:`csplab.solvers.blocks.trivial_solution`: one label, or uniform layers
+  such as ground under empty space) of a small periodic problem, else a SAT solution of a
+  small torus; a model with no periodic solution up to :data:`MAX_PERIOD` is refused.
+* **Sub-passes** ``s = 1 .. S`` (``S = passes * 4``). Pass ``q`` lays a lattice of blocks of
+  the chunk's size ``B`` over the plane, shifted by ``q * B // passes`` per axis (so a seam
+  of one pass lies inside the blocks of another); block ``(bx, by)`` has colour
+  ``(bx mod 2, by mod 2)`` and each colour is one sub-pass. Blocks of one colour are ``B``
+  cells apart, more than the arcs' reach ``r`` (checked), so neither sees the other's
+  cells: they are independent.
+* **A block** of sub-pass ``s`` is the block's cells with the labels of state ``s - 1``
+  around it fixed (a ring of width ``r``; :meth:`Problem.subproblem`). Alg. 3.1 completes
+  it (:func:`csplab.engine.waves.solve_block`, with ``retries``) from the generator
+  ``default_rng(SeedSequence([seed, s, zig(bx), zig(by)]))``; when every run fails, exact
+  completion (SAT with the border fixed); when the border admits no completion, the block
+  keeps its labels of state ``s - 1``. State ``s`` is state ``s - 1`` with the blocks of
+  colour ``s`` replaced.
+
+Why the content does not depend on the visit order (proof sketch). By induction on ``s``:
+state 0 is a fixed function of the coordinates. A block of sub-pass ``s`` is a function of
+(seed, ``s``, its coordinates, the labels of state ``s - 1`` on the block and its ring); its
+generator is keyed by those coordinates only, never by a stream shared with other blocks,
+and the blocks of one sub-pass do not see each other's cells. So state ``s`` at any cell is
+a function of state ``s - 1`` on a bounded window, hence (induction) of the coordinates
+alone. Which chunks were generated before, by which worker, in which order, or whether a
+block was evicted and solved again changes nothing: each is recomputed from the same
+inputs. Consistency: state 0 is consistent, and a block only ever takes labels that satisfy
+every arc inside it and to its fixed ring (or keeps its old ones), so every state is
+consistent on the whole plane, and every stitched rectangle has 0 violations.
+
+Dependency neighbourhood. The final label of a cell depends on state ``s - 1`` within the
+block of sub-pass ``s`` that holds it widened by ``r``; unrolled over the ``S`` sub-passes,
+a chunk depends only on the cells within ``S * (B + r)`` of it (in practice on about
+``(2k + 1) ** 2 / 4`` blocks of the ``k``-th sub-pass below the last).
+
+Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
+restrict the domains of the blocks that hold those cells; a block whose border leaves no
+completion keeps its previous labels, so a fixed cell may stay unmet where every pass puts
+a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help). Not
+honoured in an infinite world: the global constraints of a model file (counts over the
+whole grid, connectivity, paths: dropped with a warning, :attr:`World.dropped`), boundary
+faces on the infinite ``x``/``y`` axes (there is no outside: refused), and counts per chunk
+(the chunk grid is not the blocks' lattice in every pass: a later pass' block straddles
+chunks, so a count met in one pass is not kept by the next).
+
+Examples
+--------
+>>> w = World("fig3_4a", seed=3, chunk=(8, 8))
+>>> a = w.chunk(0, 1)
+>>> a.shape, bool((World("fig3_4a", seed=3, chunk=(8, 8)).chunk(0, 1) == a).all())
+((8, 8), True)
+>>> len(w.problem((16, 16)).violations(w.region((-4, 12), (0, 16))))
+0
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sqlite3
+import warnings
+from collections import OrderedDict
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.engine import waves as wv
+from csplab.errors import InputError, NoTrivialSolutionError
+from csplab.example import ExampleModel
+from csplab.grids import from_example
+from csplab.problem import Problem
+from csplab.solvers.blocks import ExactCompletion, trivial_solution
+
+__all__ = ["MAX_PERIOD", "World"]
+
+#: largest period of the start model ``M0`` tried before a model is refused
+MAX_PERIOD = 8
+
+Rect = tuple[tuple[int, int], ...]  # ((x0, x1), (y0, y1)) half-open
+
+
+def _zig(v: int) -> int:
+    """A non-negative key for a signed coordinate (SeedSequence takes non-negative ints)."""
+    return 2 * v if v >= 0 else -2 * v - 1
+
+
+class _BlockSolver:
+    """Solve one block: a pure function of (settings, sub-pass, block, window)."""
+
+    def __init__(
+        self,
+        template: Problem,
+        inner: NDArray[np.int64],
+        arc_ids: NDArray[np.int64],
+        block_shape: tuple[int, ...],
+        seed: int,
+        retries: int,
+        order: str,
+        choice: str,
+        exact: str,
+    ) -> None:
+        self.template, self.inner, self.arc_ids = template, inner, arc_ids
+        self.block_shape, self.seed, self.retries = block_shape, seed, retries
+        self.order, self.choice, self.exact = order, choice, exact
+
+    def __call__(
+        self,
+        s: int,
+        b: tuple[int, ...],
+        window: NDArray[np.int32],
+        allowed: NDArray[np.bool_] | None,
+    ) -> tuple[NDArray[np.int32], str]:
+        """The block's labels (block shape) and how they came: ``alg31``, ``exact``,
+        ``kept``."""
+        sub = self.template.subproblem(self.inner, window, shape=self.block_shape,
+                                       arc_ids=self.arc_ids)  # fmt: skip
+        if allowed is not None:
+            sub = sub.restrict(allowed)
+        rng = np.random.default_rng(
+            np.random.SeedSequence([self.seed, s, *(_zig(int(c)) for c in b)])
+        )
+        o = wv.solve_block(sub, rng, 0, retries=self.retries, order=self.order,
+                           choice=self.choice, deadline=None)  # fmt: skip
+        how = "alg31"
+        labels = o.labels
+        if labels is None and self.exact != "none" and not (~sub.domains.any(axis=1)).any():
+            labels, _ = ExactCompletion(self.exact)(sub, rng, None)
+            how = "exact"
+        if labels is None:
+            old = window.reshape(-1)[self.inner]
+            return old.reshape(self.block_shape).astype(np.int32), "kept"
+        return np.asarray(labels, dtype=np.int32).reshape(self.block_shape), how
+
+
+_WORKER: _BlockSolver | None = None
+
+
+def _init_worker(solver: _BlockSolver) -> None:
+    global _WORKER
+    _WORKER = solver
+
+
+def _solve_task(
+    tasks: list[tuple[int, tuple[int, ...], NDArray[np.int32], NDArray[np.bool_] | None]],
+) -> list[tuple[NDArray[np.int32], str]]:
+    assert _WORKER is not None
+    return [_WORKER(*t) for t in tasks]
+
+
+class _LRU(OrderedDict[Any, Any]):
+    """A bounded mapping that forgets the least recently used entry."""
+
+    def __init__(self, size: int) -> None:
+        super().__init__()
+        self.size = size
+
+    def get_(self, key: Any) -> Any:
+        v = self.get(key)
+        if v is not None:
+            self.move_to_end(key)
+        return v
+
+    def put(self, key: Any, value: Any) -> None:
+        self[key] = value
+        self.move_to_end(key)
+        while len(self) > self.size:
+            self.popitem(last=False)
+
+
+class World:
+    """An endless chunked world of ``model`` (see the module docstring for the construction).
+
+    Parameters
+    ----------
+    model : str, ExampleModel or RuleSet
+        A built-in example name or model file (:func:`csplab.examples.load_model`), an
+        example or a rule set (tilesets and overlapping samples).
+    seed : int
+        The world's seed (any non-negative integer).
+    chunk : tuple of int
+        ``(X, Y)`` for a 2D world, ``(X, Y, Z)`` for a 3D one (``Z``: its fixed height).
+        The blocks of modify in blocks have the chunk's size in ``x`` and ``y``.
+    boundary : "auto", "none" or mapping
+        Labels of the ``z`` faces of a 3D world (``"auto"``: the rule of
+        :func:`csplab.grids.from_example`, ground below and sky above; only its ``z`` faces
+        are kept). Faces on ``x``/``y`` do not exist in an infinite world: refused.
+    passes : int
+        Passes of modify in blocks over the plane (each shifted by ``B // passes``).
+    retries : int
+        Alg. 3.1 runs per block after the first, before exact completion.
+    exact : {"sat", "backtrack", "none"}
+        Exact completion of a block that Alg. 3.1 cannot complete.
+    order, choice : str
+        Alg. 3.1's cell order and label choice inside a block (the thesis': ``scanline``,
+        ``uniform``).
+    fixed : mapping ``{(x, y[, z]): label}``, optional
+        Cells fixed in world coordinates.
+    mask : callable, optional
+        ``mask(xs, ys) -> bool array (..., K)``: the labels allowed at world cells
+        ``xs, ys`` (integer arrays of the block's ``(X, Y)`` shape); 3D: ``(X, Y, Z, K)``.
+    cache_blocks, cache_chunks : int
+        Sizes of the block and chunk caches (least recently used entries are forgotten:
+        memory stays flat however far one walks). The block cache holds at least the
+        blocks one chunk needs from scratch (``sum((k + 2) ** 2 for k < S)``).
+    store : str or Path, optional
+        A SQLite file keeping generated chunks (keyed by the model's rules, the seed and the
+        settings; a ``mask`` by its module and name): a restart reads them instead of
+        solving again.
+    workers : int
+        Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
+        the output is the same for any number.
+    """
+
+    def __init__(
+        self,
+        model: Any,
+        *,
+        seed: int = 0,
+        chunk: Sequence[int] = (32, 32),
+        boundary: Any = "auto",
+        passes: int = 2,
+        retries: int = 20,
+        exact: str = "sat",
+        order: str = "scanline",
+        choice: str = "uniform",
+        fixed: Mapping[Sequence[int], int] | None = None,
+        mask: Callable[..., Any] | None = None,
+        cache_blocks: int = 4096,
+        cache_chunks: int = 1024,
+        store: str | Path | None = None,
+        workers: int = 0,
+    ) -> None:
+        from csplab.examples import load_model
+
+        if isinstance(model, str | Path):
+            model = load_model(model)
+        self.model = model
+        self.seed = int(seed)
+        if self.seed < 0:
+            raise InputError(f"seed must be >= 0, not {seed}")
+        self.chunk_shape = tuple(int(c) for c in chunk)
+        if len(self.chunk_shape) not in (2, 3) or min(self.chunk_shape) < 1:
+            raise InputError(f"chunk must be 2 or 3 positive sizes, not {chunk!r}")
+        if passes < 1 or retries < 0 or workers < 0:
+            raise InputError("passes must be >= 1, retries >= 0 and workers >= 0")
+        if exact not in ("sat", "backtrack", "none"):
+            raise InputError(f"exact must be sat, backtrack or none, not {exact!r}")
+        self.ndim = len(self.chunk_shape)
+        self.passes, self.retries, self.exact = int(passes), int(retries), exact
+        self.order, self.choice, self.workers = order, choice, int(workers)
+        self.B = self.chunk_shape[:2]
+        self.height = self.chunk_shape[2] if self.ndim == 3 else None
+        self.zfaces = self._zfaces(boundary)
+        self.dropped: list[str] = []  # the model's global constraints (cannot hold)
+        # the template: a block with its ring; the arcs' reach from it
+        probe = self.problem(tuple(max(4, 2 * b) for b in self.B))
+        self.reach = _reach(probe)
+        if self.reach > min(self.B):
+            raise InputError(
+                f"the model's arcs reach {self.reach} cells, more than the chunk "
+                f"{self.B}: use a larger chunk"
+            )
+        r = self.reach
+        self.template = self.problem(tuple(b + 2 * r for b in self.B))
+        idx = np.arange(self.template.n, dtype=np.int64).reshape(self.template.shape)
+        inner = idx[r : r + self.B[0], r : r + self.B[1]].reshape(-1)
+        a = self.template.arcs
+        touch = np.isin(a[:, 0], inner) | np.isin(a[:, 1], inner)
+        self.K = self.template.K
+        # blocks are cached in the smallest integer type that holds the labels
+        self._small = np.int16 if self.K <= np.iinfo(np.int16).max else np.int32
+        self.fixed = {tuple(int(c) for c in k): int(v) for k, v in (fixed or {}).items()}
+        for k, v in self.fixed.items():
+            if len(k) != self.ndim or not 0 <= v < self.K:
+                raise InputError(f"fixed cell {k}: {v} is not a cell and label of this world")
+            if self.ndim == 3 and not 0 <= k[2] < self.chunk_shape[2]:
+                raise InputError(f"fixed cell {k} is outside the world's height")
+        self.mask = mask
+        self.M0 = self._start()
+        self.solver = _BlockSolver(
+            self.template, inner, np.flatnonzero(touch).astype(np.int64), self._bshape,
+            self.seed, self.retries, order, choice, exact,
+        )  # fmt: skip
+        self.S = 4 * self.passes
+        # the blocks one chunk needs from scratch: about (k + 1) ** 2 at k sub-passes below
+        # the last; a smaller cache would solve blocks again and again within one chunk
+        pyramid = sum((k + 2) ** 2 for k in range(self.S))
+        self.blocks: _LRU = _LRU(max(int(cache_blocks), pyramid))
+        self.chunks: _LRU = _LRU(int(cache_chunks))
+        self.stats: dict[str, int] = {"alg31": 0, "exact": 0, "kept": 0, "stored": 0}
+        self.key = self._key()
+        self._db: sqlite3.Connection | None = None
+        if store is not None:
+            self._db = sqlite3.connect(str(store))
+            self._db.execute(
+                "CREATE TABLE IF NOT EXISTS chunks (world TEXT, i INTEGER, j INTEGER, "
+                "data BLOB, PRIMARY KEY (world, i, j))"
+            )
+            self._db.commit()
+        self._pool: Any = None
+
+    # -- problems -------------------------------------------------------------------------
+    @property
+    def _bshape(self) -> tuple[int, ...]:
+        return self.B if self.height is None else (*self.B, self.height)
+
+    def _zfaces(self, boundary: Any) -> dict[str, int] | None:
+        if boundary in (None, "none"):
+            return None
+        if isinstance(boundary, Mapping):
+            bad = [f for f in boundary if f not in ("z-", "z+")]
+            if bad or self.ndim == 2:
+                raise InputError(
+                    f"boundary faces {bad or list(boundary)} do not exist in an infinite "
+                    "world (only z- and z+ of a 3D world)"
+                )
+            return {str(f): int(v) for f, v in boundary.items()}
+        if boundary != "auto":
+            raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
+        if self.ndim == 2:
+            return None
+        assert self.height is not None
+        if isinstance(self.model, ExampleModel):
+            P = from_example(self.model, (6, 6, self.height), boundary="auto")
+            faces = P.meta.get("boundary") or {}
+        else:
+            faces = dict(getattr(self.model, "boundary", None) or {})
+        z = {f: int(v) for f, v in faces.items() if f in ("z-", "z+")}
+        return z or None
+
+    def problem(self, shape: Sequence[int], *, periodic: bool = False) -> Problem:
+        """The model's problem on a rectangle of ``shape`` (``(X, Y)``; a 3D world adds its
+        height): no faces on ``x``/``y``, the world's ``z`` faces; ``periodic`` wraps ``x``
+        and ``y``. Check a stitched region with its :meth:`Problem.violations`."""
+        shp = tuple(int(s) for s in shape[:2])
+        per: bool | tuple[bool, ...] = periodic
+        if self.height is not None:
+            shp = (*shp, self.height)
+            per = (periodic, periodic, False)
+        m = self.model
+        if isinstance(m, ExampleModel):
+            P = from_example(m, shp, periodic=per, boundary=self.zfaces or "none")
+        elif hasattr(m, "problem"):
+            P = m.problem(shp, periodic=per, boundary=self.zfaces or "none")
+        else:
+            raise InputError(
+                f"{getattr(m, 'name', None) or type(m).__name__} is not a grid model: a world "
+                "takes grid examples, tilesets and overlapping samples"
+            )
+        if P.constraints:  # global constraints of the file: they cannot hold (module doc)
+            if not self.dropped:
+                self.dropped = [type(c).__name__ for c in P.constraints]
+                warnings.warn(
+                    f"a world cannot honour the model's global constraints "
+                    f"({', '.join(self.dropped)}): dropped",
+                    stacklevel=3,
+                )
+            P = P.without_constraints()
+        return P
+
+    def _start(self) -> NDArray[np.int32]:
+        """``M0``: a consistent periodic tile (checked on the template's window)."""
+        from csplab.solvers import solve
+
+        r = self.reach
+        for p in range(1, MAX_PERIOD + 1):
+            if p < r:
+                continue
+            P = self.problem((p, p), periodic=True)
+            tile: NDArray[np.int32] | None = None
+            try:
+                tile = trivial_solution(P, attempts=0)
+            except NoTrivialSolutionError:
+                res = solve(P, "sat", rng=self.seed)
+                if res.status == "solved":
+                    tile = np.asarray(res.grid, dtype=np.int32)
+            if tile is None:
+                continue
+            win = self._tile(tile, self._rect_of(self.template.shape, r))
+            if self.template.is_solution(win):
+                return tile
+        raise InputError(
+            f"{getattr(self.model, 'name', '') or 'this model'} has no periodic solution "
+            f"with a period up to {MAX_PERIOD}: a world needs one to start from"
+        )
+
+    def _rect_of(self, shape: Sequence[int], r: int) -> Rect:
+        return ((-r, shape[0] - r), (-r, shape[1] - r))
+
+    def _tile(self, tile: NDArray[np.int32], rect: Rect) -> NDArray[np.int32]:
+        (x0, x1), (y0, y1) = rect
+        p, q = tile.shape[0], tile.shape[1]
+        xs = np.arange(x0, x1) % p
+        ys = np.arange(y0, y1) % q
+        return np.ascontiguousarray(tile[xs[:, None], ys[None, :]], dtype=np.int32)
+
+    # -- lattice --------------------------------------------------------------------------
+    def _pass_colour(self, s: int) -> tuple[int, tuple[int, int]]:
+        q, c = divmod(s - 1, 4)
+        return q, (c >> 1, c & 1)
+
+    def _offset(self, q: int) -> tuple[int, int]:
+        return (q * self.B[0] // self.passes, q * self.B[1] // self.passes)
+
+    def _blocks_in(self, s: int, rect: Rect) -> list[tuple[int, int]]:
+        """Blocks of sub-pass ``s`` (its colour only) that meet ``rect``."""
+        q, col = self._pass_colour(s)
+        off = self._offset(q)
+        ranges = []
+        for a in range(2):
+            lo, hi = rect[a]
+            b0 = (lo - off[a]) // self.B[a]
+            b1 = (hi - 1 - off[a]) // self.B[a]
+            first = b0 + ((col[a] - b0) % 2)
+            ranges.append(range(first, b1 + 1, 2))
+        return [(bx, by) for bx in ranges[0] for by in ranges[1]]
+
+    def _block_rect(self, s: int, b: tuple[int, int]) -> Rect:
+        q, _ = self._pass_colour(s)
+        off = self._offset(q)
+        return tuple((off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2))
+
+    # -- state ----------------------------------------------------------------------------
+    def _state(self, s: int, rect: Rect) -> NDArray[np.int32]:
+        """Labels of state ``s`` on ``rect`` (blocks solved on demand)."""
+        out = self._tile(self.M0, rect)
+        for t in range(1, s + 1):
+            for b in self._blocks_in(t, rect):
+                lab = self._block(t, b)
+                br = self._block_rect(t, b)
+                lo = [max(br[a][0], rect[a][0]) for a in range(2)]
+                hi = [min(br[a][1], rect[a][1]) for a in range(2)]
+                out[
+                    lo[0] - rect[0][0] : hi[0] - rect[0][0], lo[1] - rect[1][0] : hi[1] - rect[1][0]
+                ] = lab[lo[0] - br[0][0] : hi[0] - br[0][0], lo[1] - br[1][0] : hi[1] - br[1][0]]
+        return out
+
+    def _window(self, s: int, b: tuple[int, int]) -> Rect:
+        br, r = self._block_rect(s, b), self.reach
+        return ((br[0][0] - r, br[0][1] + r), (br[1][0] - r, br[1][1] + r))
+
+    def _allowed(self, s: int, b: tuple[int, int]) -> NDArray[np.bool_] | None:
+        if not self.fixed and self.mask is None:
+            return None
+        (x0, x1), (y0, y1) = self._block_rect(s, b)
+        al = np.ones((*self._bshape, self.K), dtype=bool)
+        if self.mask is not None:
+            xs, ys = np.meshgrid(np.arange(x0, x1), np.arange(y0, y1), indexing="ij")
+            al &= np.broadcast_to(np.asarray(self.mask(xs, ys), dtype=bool), al.shape)
+        hit = False
+        for k, v in self.fixed.items():
+            if x0 <= k[0] < x1 and y0 <= k[1] < y1:
+                cell = (k[0] - x0, k[1] - y0, *k[2:])
+                al[cell] = False
+                al[(*cell, v)] = True
+                hit = True
+        return al if (hit or self.mask is not None) else None
+
+    def _block(self, s: int, b: tuple[int, int]) -> NDArray[np.int32]:
+        key = (s, b)
+        lab = self.blocks.get_(key)
+        if lab is None:
+            win = self._state(s - 1, self._window(s, b))
+            lab, how = self.solver(s, b, win, self._allowed(s, b))
+            self.stats[how] += 1
+            self.blocks.put(key, lab.astype(self._small, copy=False))
+        return lab  # type: ignore[no-any-return]
+
+    def _prefetch(self, rect: Rect) -> None:
+        """Solve the blocks ``rect`` needs, sub-pass by sub-pass, independent blocks of a
+        sub-pass on the workers (``workers >= 2``)."""
+        need: list[set[tuple[int, int]]] = [set() for _ in range(self.S + 1)]
+        rects: list[Rect] = [rect]
+        for s in range(self.S, 0, -1):
+            new: list[Rect] = []
+            for rc in rects:
+                for b in self._blocks_in(s, rc):
+                    if b not in need[s] and (s, b) not in self.blocks:
+                        need[s].add(b)
+                        new.append(self._window(s, b))
+            rects = rects + new
+            if len(rects) > 64:  # merge into the bounding box (a superset: correct)
+                rects = [tuple((min(r[a][0] for r in rects), max(r[a][1] for r in rects))
+                               for a in range(2))]  # fmt: skip
+        pool = self._workers()
+        for s in range(1, self.S + 1):
+            todo = sorted(b for b in need[s] if (s, b) not in self.blocks)
+            if not todo:
+                continue
+            tasks = [(s, b, self._state(s - 1, self._window(s, b)), self._allowed(s, b))
+                     for b in todo]  # fmt: skip
+            size = max(1, len(tasks) // (2 * pool.size))
+            futures = [pool.submit(_solve_task, tasks[i : i + size])
+                       for i in range(0, len(tasks), size)]  # fmt: skip
+            results = [x for f in futures for x in f.result()]
+            for b, (lab, how) in zip(todo, results, strict=True):
+                self.stats[how] += 1
+                self.blocks.put((s, b), lab.astype(self._small, copy=False))
+
+    def _workers(self) -> Any:
+        if self._pool is None:
+            from csplab.engine.pool import Workers
+
+            self._pool = Workers.local(self.workers, initializer=_init_worker,
+                                       initargs=(self.solver,))  # fmt: skip
+        return self._pool
+
+    def close(self) -> None:
+        """Stop the workers and close the store."""
+        if self._pool is not None:
+            self._pool.close()
+            self._pool = None
+        if self._db is not None:
+            self._db.close()
+            self._db = None
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- public ---------------------------------------------------------------------------
+    def _key(self) -> str:
+        t = self.template
+        h = hashlib.sha256()
+        for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
+            h.update(np.ascontiguousarray(arr).tobytes())
+        h.update(json.dumps([self.seed, self.chunk_shape, self.passes, self.retries,
+                             self.exact, self.order, self.choice, self.zfaces,
+                             sorted(self.fixed.items()), _name_of(self.mask),
+                             ]).encode())  # fmt: skip
+        return h.hexdigest()[:32]
+
+    def chunk(self, i: int, j: int, k: int = 0) -> NDArray[np.int32]:
+        """The labels of chunk ``(i, j)`` (cells ``[i * X, (i + 1) * X) x [j * Y, ...)``;
+        a 3D world's ``k`` must be 0: its height is one chunk)."""
+        if k != 0:
+            raise InputError("a world is one chunk high: k must be 0")
+        key = (int(i), int(j))
+        got = self.chunks.get_(key)
+        if got is not None:
+            return got.copy()  # type: ignore[no-any-return]
+        if self._db is not None:
+            row = self._db.execute(
+                "SELECT data FROM chunks WHERE world=? AND i=? AND j=?", (self.key, *key)
+            ).fetchone()
+            if row is not None:
+                arr = np.frombuffer(row[0], dtype=np.int32).reshape(self._bshape).copy()
+                self.chunks.put(key, arr)
+                self.stats["stored"] += 1
+                return arr.copy()
+        rect = ((key[0] * self.B[0], (key[0] + 1) * self.B[0]),
+                (key[1] * self.B[1], (key[1] + 1) * self.B[1]))  # fmt: skip
+        if self.workers >= 2:
+            self._prefetch(rect)
+        arr = self._state(self.S, rect)
+        self.chunks.put(key, arr)
+        if self._db is not None:
+            self._db.execute("INSERT OR REPLACE INTO chunks VALUES (?, ?, ?, ?)",
+                             (self.key, *key, arr.tobytes()))  # fmt: skip
+            self._db.commit()
+        return arr.copy()
+
+    def region(
+        self, xs: tuple[int, int], ys: tuple[int, int], *, progress: bool = False
+    ) -> NDArray[np.int32]:
+        """The labels of cells ``[x0, x1) x [y0, y1)`` (3D: the whole height), stitched
+        from chunks; ``progress``: a bar on stderr (after 2 s) counting chunks."""
+        from csplab.progress import progress_bar
+
+        (x0, x1), (y0, y1) = (int(xs[0]), int(xs[1])), (int(ys[0]), int(ys[1]))
+        if x1 <= x0 or y1 <= y0:
+            raise InputError(f"empty region {xs}, {ys}")
+        X, Y = self.B
+        out = np.empty((x1 - x0, y1 - y0, *self._bshape[2:]), dtype=np.int32)
+        rows = range(x0 // X, (x1 - 1) // X + 1)
+        cols = range(y0 // Y, (y1 - 1) // Y + 1)
+
+        def chunks() -> Iterable[tuple[int, int]]:
+            for i in rows:
+                if self.workers >= 2:  # a row of chunks at a time on the workers
+                    self._prefetch(((i * X, (i + 1) * X), (cols[0] * Y, (cols[-1] + 1) * Y)))
+                for j in cols:
+                    yield i, j
+
+        for i, j in progress_bar(chunks(), total=len(rows) * len(cols), desc="chunks",
+                                 enabled=progress, unit="chunk"):  # fmt: skip
+            c = self.chunk(i, j)
+            lo = (max(x0, i * X), max(y0, j * Y))
+            hi = (min(x1, (i + 1) * X), min(y1, (j + 1) * Y))
+            out[lo[0] - x0 : hi[0] - x0, lo[1] - y0 : hi[1] - y0] = c[
+                lo[0] - i * X : hi[0] - i * X, lo[1] - j * Y : hi[1] - j * Y
+            ]
+        return out
+
+    def chunks_in(self, xs: tuple[int, int], ys: tuple[int, int]) -> Iterable[tuple[int, int]]:
+        """The chunk coordinates a region covers (in order)."""
+        X, Y = self.B
+        for i in range(xs[0] // X, (xs[1] - 1) // X + 1):
+            for j in range(ys[0] // Y, (ys[1] - 1) // Y + 1):
+                yield i, j
+
+    def unmet(self, xs: tuple[int, int], ys: tuple[int, int]) -> list[tuple[int, ...]]:
+        """The fixed cells in the region whose label differs from the requested one."""
+        g = self.region(xs, ys)
+        out = []
+        for k, v in sorted(self.fixed.items()):
+            if xs[0] <= k[0] < xs[1] and ys[0] <= k[1] < ys[1]:
+                if int(g[(k[0] - xs[0], k[1] - ys[0], *k[2:])]) != v:
+                    out.append(k)
+        return out
+
+
+def _name_of(f: Callable[..., Any] | None) -> str | None:
+    """A mask's identity in the store key: its module and qualified name."""
+    if f is None:
+        return None
+    return f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', type(f).__name__)}"
+
+
+def _reach(P: Problem) -> int:
+    """The largest ``x``/``y`` offset of an arc of a non-periodic problem."""
+    if not len(P.arcs):
+        return 1
+    c = np.stack(np.unravel_index(P.arcs[:, :2].reshape(-1), P.shape), axis=1).reshape(
+        len(P.arcs), 2, P.ndim
+    )
+    return max(1, int(np.abs(c[:, 0, :2] - c[:, 1, :2]).max()))

@@ -1,0 +1,254 @@
+"""Infinite worlds (:mod:`csplab.world`): order independence, consistency, fallible models,
+workers, caches and the store."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from csplab.engine.alg31 import run_alg31
+from csplab.errors import InputError
+from csplab.io.ruleset import RuleSet
+from csplab.world import World
+
+DATA = Path(__file__).resolve().parent / "io" / "data"
+SHARED = next(
+    (p / "shared" / "anchors-data" for p in Path(__file__).resolve().parents[2:4]
+     if (p / "shared" / "anchors-data").is_dir()),
+    Path("/nonexistent"),
+)  # fmt: skip
+
+CHUNKS = [(i, j) for i in range(-1, 2) for j in range(-1, 2)]
+
+
+def three_colours() -> RuleSet:
+    """Proper 3-colouring of the grid: Alg. 3.1 in WFC's order (min-entropy) fails on
+    nearly every 32x32 run (a cell whose neighbours took all three colours), yet every
+    consistent border has a completion (its old labels)."""
+    R = ~np.eye(3, dtype=bool)
+    return RuleSet(np.stack([R, R]), name="three")
+
+
+_REF: dict[str, dict[tuple[int, int], np.ndarray]] = {}
+
+
+def reference(name: str, **kw: object) -> dict[tuple[int, int], np.ndarray]:
+    """The 3x3 chunks around the origin, generated in scan order (computed once)."""
+    if name not in _REF:
+        w = World(name, **kw)  # type: ignore[arg-type]
+        _REF[name] = {c: w.chunk(*c) for c in CHUNKS}
+    return _REF[name]
+
+
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(order=st.permutations(CHUNKS), cache=st.sampled_from([1, 300, 4096]))
+def test_any_visit_order_and_cache_size_gives_the_same_chunks(
+    order: list[tuple[int, int]], cache: int
+) -> None:
+    ref = reference("fig3_4a", seed=5, chunk=(8, 8))
+    w = World("fig3_4a", seed=5, chunk=(8, 8), cache_blocks=cache, cache_chunks=2)
+    for c in order:
+        assert w.chunk(*c).tobytes() == ref[c].tobytes(), c
+    # visited again after the chunks were evicted: the same bytes
+    assert w.chunk(*order[0]).tobytes() == ref[order[0]].tobytes()
+
+
+@settings(max_examples=6, deadline=None)
+@given(order=st.permutations(CHUNKS[:4]))
+def test_overlapping_sample_world_is_order_independent(order: list[tuple[int, int]]) -> None:
+    ref = reference(str(DATA / "sample.png"), seed=2, chunk=(16, 16))
+    w = World(str(DATA / "sample.png"), seed=2, chunk=(16, 16))
+    for c in order:
+        assert w.chunk(*c).tobytes() == ref[c].tobytes()
+
+
+def test_seed_changes_the_world_and_the_world_is_not_trivial() -> None:
+    a = World("fig3_4a", seed=5, chunk=(8, 8)).region((0, 24), (0, 24))
+    b = World("fig3_4a", seed=6, chunk=(8, 8)).region((0, 24), (0, 24))
+    assert a.tobytes() != b.tobytes()
+    assert len(np.unique(a)) > 2  # more than the start model's label
+
+
+@pytest.mark.parametrize(
+    "model, chunk",
+    [
+        ("fig3_4a", (8, 8)),
+        (str(DATA / "pipes.xml"), (16, 16)),
+        (str(DATA / "sample.png"), (16, 16)),
+    ],
+)
+def test_stitched_regions_have_no_violations(model: str, chunk: tuple[int, int]) -> None:
+    w = World(model, seed=1, chunk=chunk)
+    for xs, ys in [((0, 48), (0, 48)), ((-37, 5), (11, 60))]:
+        g = w.region(xs, ys)
+        assert g.shape == (xs[1] - xs[0], ys[1] - ys[0])
+        P = w.problem(g.shape)
+        assert len(P.violations(g)) == 0
+    # a region equals the chunks it is stitched from
+    X, Y = chunk
+    assert (w.region((X, 2 * X), (-Y, 0)) == w.chunk(1, -1)).all()
+
+
+def test_fallible_model_gives_a_consistent_world() -> None:
+    rs = three_colours()
+    P = rs.problem((32, 32), boundary="none")
+    fails = sum(
+        run_alg31(P, np.random.default_rng(s), order="min-entropy").status != "solved"
+        for s in range(6)
+    )
+    assert fails > 3  # single-pass Alg. 3.1 fails more often than not on a 32x32 chunk
+    w = World(rs, seed=3, chunk=(16, 16), order="min-entropy", retries=1)
+    g = w.region((-16, 32), (0, 32))
+    assert len(w.problem(g.shape).violations(g)) == 0
+    assert w.stats["exact"] > 0  # the blocks random choice could not complete
+    assert len(np.unique(g)) == 3
+    # and order independence holds for it too
+    w2 = World(rs, seed=3, chunk=(16, 16), order="min-entropy", retries=1)
+    assert w2.chunk(1, 1).tobytes() == w.chunk(1, 1).tobytes()
+
+
+def test_without_exact_completion_a_fallible_block_keeps_its_labels() -> None:
+    w = World(three_colours(), seed=3, chunk=(16, 16), order="min-entropy", retries=0,
+              exact="none")  # fmt: skip
+    g = w.region((0, 32), (0, 32))
+    assert len(w.problem(g.shape).violations(g)) == 0
+    assert w.stats["kept"] > 0
+
+
+def test_workers_give_the_same_bytes() -> None:
+    a = World("fig3_4a", seed=9, chunk=(8, 8)).region((-8, 16), (0, 16))
+    with World("fig3_4a", seed=9, chunk=(8, 8), workers=2) as w:
+        b = w.region((-8, 16), (0, 16))
+    assert a.tobytes() == b.tobytes()
+
+
+def test_restart_from_the_store_gives_the_same_bytes(tmp_path: Path) -> None:
+    db = tmp_path / "world.sqlite"
+    with World("fig3_4a", seed=4, chunk=(8, 8), store=db) as w:
+        first = {c: w.chunk(*c) for c in CHUNKS[:3]}
+        assert w.stats["stored"] == 0
+    with World("fig3_4a", seed=4, chunk=(8, 8), store=db) as w:
+        for c, a in first.items():
+            assert w.chunk(*c).tobytes() == a.tobytes()
+        assert w.stats["stored"] == 3 and w.stats["alg31"] == 0
+        # another seed shares the file but not the chunks
+    with World("fig3_4a", seed=8, chunk=(8, 8), store=db) as w:
+        w.chunk(*CHUNKS[0])
+        assert w.stats["stored"] == 0
+    fresh = World("fig3_4a", seed=4, chunk=(8, 8))
+    assert all(fresh.chunk(*c).tobytes() == a.tobytes() for c, a in first.items())
+
+
+def test_caches_are_bounded() -> None:
+    w = World("fig3_4a", seed=1, chunk=(8, 8), cache_blocks=50, cache_chunks=5)
+    assert w.blocks.size == sum((k + 2) ** 2 for k in range(8))  # raised to one chunk's
+    for i in range(40):
+        w.chunk(i, 0)
+    assert len(w.blocks) == w.blocks.size and len(w.chunks) == 5
+
+
+def test_fixed_cells_and_masks_in_world_coordinates() -> None:
+    fixed = {(3, 4): 1, (-20, 7): 2, (40, -3): 3}
+    region = ((-24, 48), (-8, 16))
+    for seed, passes, unmet in [(1, 2, []), (2, 2, [(-20, 7), (40, -3)]), (2, 4, [])]:
+        w = World("fig3_4a", seed=seed, chunk=(8, 8), fixed=fixed, passes=passes)
+        # a 2 needs a 1 below, a 3 above and empty space beside it: where every pass' block
+        # holding the cell has a border that rules this out, it stays unmet (and reported)
+        assert w.unmet(*region) == unmet
+        g = w.region(*region)
+        assert len(w.problem(g.shape).violations(g)) == 0
+        for (x, y), v in fixed.items():
+            assert (g[x + 24, y + 8] == v) == ((x, y) not in unmet)
+    assert World("fig3_4a", seed=2, chunk=(8, 8)).region(*region)[64, 5] != 3  # not by chance
+
+    def no_label_1(xs: np.ndarray, ys: np.ndarray) -> np.ndarray:
+        al = np.ones((*xs.shape, w.K), dtype=bool)
+        al[..., 1] = xs < 0  # label 1 only where x < 0
+        return al
+
+    m = World("fig3_4a", seed=2, chunk=(8, 8), mask=no_label_1)
+    g = m.region((0, 24), (0, 24))
+    assert not (g == 1).any() and len(m.problem(g.shape).violations(g)) == 0
+
+
+def test_bad_input_is_one_line() -> None:
+    with pytest.raises(InputError, match="do not exist in an infinite world"):
+        World("city", chunk=(8, 8, 8), boundary={"x-": 0})
+    with pytest.raises(InputError, match="chunk"):
+        World("fig3_4a", chunk=(8,))
+    with pytest.raises(InputError, match="k must be 0"):
+        World("fig3_4a", chunk=(8, 8)).chunk(0, 0, 1)
+    # the checkerboard with an odd period only... has period 2: accepted; a model with
+    # no periodic solution at all is refused
+    R = np.zeros((3, 3), dtype=bool)
+    R[0, 1] = R[1, 2] = True  # 0 -> 1 -> 2 -> nothing: no infinite row exists
+    with pytest.raises(InputError, match="no periodic solution"):
+        World(RuleSet(np.stack([R, R | R.T]), name="dead end"), chunk=(8, 8))
+
+
+@pytest.mark.slow
+def test_castle_3d_world() -> None:
+    w = World("castle", seed=1, chunk=(12, 12, 8))
+    g = w.region((-6, 18), (0, 24))
+    assert g.shape == (24, 24, 8)
+    assert len(w.problem(g.shape).violations(g)) == 0
+    w2 = World("castle", seed=1, chunk=(12, 12, 8))
+    assert w2.chunk(1, 1).tobytes() == w.chunk(1, 1).tobytes()
+
+
+@pytest.mark.skipif(not (SHARED / "DeBroglie").is_dir(), reason="no shared anchors-data")
+def test_external_rule_set_world() -> None:
+    with pytest.warns(UserWarning, match="cannot honour the model's global constraints"):
+        w = World(str(SHARED / "DeBroglie" / "edged_path_constraint.json"), seed=1, chunk=(16, 16))
+    assert w.dropped == ["Connected"]  # a path constraint cannot hold on an endless plane
+    g = w.region((0, 32), (0, 32))
+    assert len(w.problem(g.shape).violations(g)) == 0
+
+
+def test_cli_world_writes_the_region_and_checks_it(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from csplab.cli import main
+
+    out = tmp_path / "w.npy"
+    argv = ["world", str(DATA / "pipes.xml"), "--chunk", "16x16", "--seed", "3",
+            "--region=-16:32,0:16", "--out", str(out), "--json"]  # fmt: skip
+    assert main(argv) == 0
+    import json
+
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["violations"] == 0 and summary["shape"] == [48, 16]
+    g = np.load(out)
+    w = World(str(DATA / "pipes.xml"), seed=3, chunk=(16, 16), order=summary["order"],
+              choice=summary["choice"])  # fmt: skip
+    assert g.tobytes() == w.region((-16, 32), (0, 16)).tobytes()  # the library's bytes
+    assert g.shape == (48, 16)
+    assert len(w.problem(g.shape).violations(g)) == 0
+    png = tmp_path / "w.png"
+    assert (
+        main(["world", "fig3_4a", "--chunk", "8x8", "--region", "0:16,0:16", "--out", str(png)])
+        == 0
+    )
+    assert png.stat().st_size > 0
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--region", "0:16"], "--region must be"),
+        (["--region", "5:5,0:8"], "is empty"),
+        (["--region", "0:8,0:8", "--chunk", "8x8x8", "--boundary", "x-=0"], "infinite world"),
+    ],
+)
+def test_cli_world_bad_input_exits_2(
+    args: list[str], message: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from csplab.cli import main
+
+    assert main(["world", "fig3_4a", *args]) == 2
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1
