@@ -222,6 +222,12 @@ class World:
     workers : int
         Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
         the output is the same for any number.
+
+    Raises
+    ------
+    InputError
+        For bad settings (a chunk shape, faces on ``x``/``y``, unknown options) or a model
+        with no periodic solution to start from.
     """
 
     def __init__(
@@ -342,9 +348,28 @@ class World:
         return z or None
 
     def problem(self, shape: Sequence[int], *, periodic: bool = False) -> Problem:
-        """The model's problem on a rectangle of ``shape`` (``(X, Y)``; a 3D world adds its
-        height): no faces on ``x``/``y``, the world's ``z`` faces; ``periodic`` wraps ``x``
-        and ``y``. Check a stitched region with its :meth:`Problem.violations`."""
+        """The model's problem on a rectangle of ``shape``.
+
+        No faces on ``x``/``y``, the world's ``z`` faces. Check a stitched region with its
+        :meth:`Problem.violations`.
+
+        Parameters
+        ----------
+        shape : sequence of int
+            ``(X, Y)``; a 3D world adds its height.
+        periodic : bool
+            Wrap ``x`` and ``y``.
+
+        Returns
+        -------
+        Problem
+            The grid problem of the rectangle.
+
+        Raises
+        ------
+        InputError
+            When the model is not a grid model (an example or a rule set).
+        """
         shp = tuple(int(s) for s in shape[:2])
         per: bool | tuple[bool, ...] = periodic
         if self.height is not None:
@@ -546,8 +571,25 @@ class World:
         return h.hexdigest()[:32]
 
     def chunk(self, i: int, j: int, k: int = 0) -> NDArray[np.int32]:
-        """The labels of chunk ``(i, j)`` (cells ``[i * X, (i + 1) * X) x [j * Y, ...)``;
-        a 3D world's ``k`` must be 0: its height is one chunk)."""
+        """The labels of chunk ``(i, j)``: cells ``[i * X, (i + 1) * X) x [j * Y, ...)``.
+
+        Parameters
+        ----------
+        i, j : int
+            The chunk's coordinates (any integers).
+        k : int
+            Must be 0: a 3D world's height is one chunk.
+
+        Returns
+        -------
+        ndarray of int32
+            The chunk's labels, shape ``chunk`` (a copy: the caller may change it).
+
+        Raises
+        ------
+        InputError
+            When ``k`` is not 0.
+        """
         if k != 0:
             raise InputError("a world is one chunk high: k must be 0")
         key = (int(i), int(j))
@@ -578,8 +620,25 @@ class World:
     def region(
         self, xs: tuple[int, int], ys: tuple[int, int], *, progress: bool = False
     ) -> NDArray[np.int32]:
-        """The labels of cells ``[x0, x1) x [y0, y1)`` (3D: the whole height), stitched
-        from chunks; ``progress``: a bar on stderr (after 2 s) counting chunks."""
+        """The labels of cells ``[x0, x1) x [y0, y1)`` (3D: the whole height).
+
+        Parameters
+        ----------
+        xs, ys : tuple of int
+            ``(x0, x1)`` and ``(y0, y1)``, half-open, any integers.
+        progress : bool
+            A bar on stderr (after 2 s) counting chunks.
+
+        Returns
+        -------
+        ndarray of int32
+            The region stitched from chunks.
+
+        Raises
+        ------
+        InputError
+            When the region is empty.
+        """
         from csplab.progress import progress_bar
 
         (x0, x1), (y0, y1) = (int(xs[0]), int(xs[1])), (int(ys[0]), int(ys[1]))
@@ -608,14 +667,36 @@ class World:
         return out
 
     def chunks_in(self, xs: tuple[int, int], ys: tuple[int, int]) -> Iterable[tuple[int, int]]:
-        """The chunk coordinates a region covers (in order)."""
+        """The chunk coordinates a region covers, in order.
+
+        Parameters
+        ----------
+        xs, ys : tuple of int
+            ``(x0, x1)`` and ``(y0, y1)``, half-open.
+
+        Yields
+        ------
+        tuple of int
+            ``(i, j)`` of each chunk, row by row.
+        """
         X, Y = self.B
         for i in range(xs[0] // X, (xs[1] - 1) // X + 1):
             for j in range(ys[0] // Y, (ys[1] - 1) // Y + 1):
                 yield i, j
 
     def unmet(self, xs: tuple[int, int], ys: tuple[int, int]) -> list[tuple[int, ...]]:
-        """The fixed cells in the region whose label differs from the requested one."""
+        """The fixed cells in the region whose label differs from the requested one.
+
+        Parameters
+        ----------
+        xs, ys : tuple of int
+            ``(x0, x1)`` and ``(y0, y1)``, half-open.
+
+        Returns
+        -------
+        list of tuple of int
+            The world coordinates of those cells, sorted.
+        """
         g = self.region(xs, ys)
         out = []
         for k, v in sorted(self.fixed.items()):
