@@ -58,10 +58,8 @@ Examples
 from __future__ import annotations
 
 import io
-import os
 import re
 import struct
-import tempfile
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -73,7 +71,7 @@ from numpy.typing import NDArray
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
 from csplab.errors import CsplabError, FormatError, InputError
-from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, read_bytes
+from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, png_target, read_bytes, write_atomic
 from csplab.io.mesh_repair import (
     Repairs,
     check_coordinates,
@@ -151,29 +149,6 @@ def sniff_stl(head: bytes) -> int:
 
 
 # ---------------------------------------------------------------------------- helpers
-def _atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``."""
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
-    except OSError as e:
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def _text(path: Path) -> str:
     data = read_bytes(path)
     if b"\0" in data:
@@ -654,8 +629,8 @@ def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
         lines += [f"v {_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
         lines += ["f " + " ".join(str(base + k) for k in poly) for poly in s.polygons]
         base += len(s.vertices)
-    _atomic_write(mtl, ("\n".join(m_lines) + "\n").encode("utf-8"))
-    _atomic_write(p, ("\n".join(lines) + "\n").encode("utf-8"))
+    write_atomic(mtl, ("\n".join(m_lines) + "\n").encode("utf-8"))
+    write_atomic(p, ("\n".join(lines) + "\n").encode("utf-8"))
 
 
 # ---------------------------------------------------------------------------- PNG out
@@ -696,9 +671,7 @@ def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    if isinstance(size_px, bool) or not isinstance(size_px, int) or not 16 <= size_px <= 8192:
-        raise InputError(f"{path}: size_px must be an integer from 16 to 8192, not {size_px!r}")
-    p = Path(path)
+    p = png_target(path, size_px, 16, 8192)
     dpi = 100
     fig = Figure(figsize=(size_px / dpi, size_px / dpi), dpi=dpi)
     FigureCanvasAgg(fig)
@@ -731,7 +704,7 @@ def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -
         ax.set_box_aspect((1, 1, 1), zoom=1.3)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
-    _atomic_write(p, buf.getvalue())
+    write_atomic(p, buf.getvalue())
 
 
 # ---------------------------------------------------------------------------- triangles out
@@ -844,7 +817,7 @@ def write_stl_model(model: PolyhedralModel, path: str | Path) -> None:
         rec["v"][k : k + len(t)] = tri
         k += len(t)
     head = f"csplab polyhedral model {model.name}: {len(model)} solids".encode()[:80]
-    _atomic_write(Path(path), head.ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes())
+    write_atomic(Path(path), head.ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes())
 
 
 def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
@@ -860,7 +833,7 @@ def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
         base += len(s.vertices)
     head = ["OFF", f"# csplab polyhedral model {model.name}: {len(model)} solids, labels "
             f"{list(model.labels)}", f"{base} {len(polys)} 0"]  # fmt: skip
-    _atomic_write(Path(path), ("\n".join([*head, *lines, *polys]) + "\n").encode("utf-8"))
+    write_atomic(Path(path), ("\n".join([*head, *lines, *polys]) + "\n").encode("utf-8"))
 
 
 def write_glb(model: PolyhedralModel, path: str | Path) -> None:
@@ -889,7 +862,7 @@ def write_glb(model: PolyhedralModel, path: str | Path) -> None:
         mesh.visual = tm.visual.TextureVisuals(material=mat)
         scene.add_geometry(mesh, node_name=f"label_{b}", geom_name=f"label_{b}")
     data = scene.export(file_type="glb") if model.solids else _empty_glb()
-    _atomic_write(Path(path), bytes(data))
+    write_atomic(Path(path), bytes(data))
 
 
 def _empty_glb() -> bytes:

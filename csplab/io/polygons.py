@@ -44,9 +44,7 @@ from __future__ import annotations
 import io
 import json
 import math
-import os
 import re
-import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
@@ -59,7 +57,15 @@ from csplab.continuous.model import Polygon, PolygonModel
 from csplab.errors import FormatError, InputError
 from csplab.io._json import load_json
 from csplab.io._xml import Node, parse_xml
-from csplab.io.common import NO, SURE, json_like, read_bytes, xml_root
+from csplab.io.common import (
+    NO,
+    SURE,
+    json_like,
+    png_target,
+    read_bytes,
+    write_atomic,
+    xml_root,
+)
 
 __all__ = [
     "read_polygons_json",
@@ -100,33 +106,6 @@ def sniff_svg(head: bytes) -> int:
 
 
 # ---------------------------------------------------------------------------- files
-def _atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``."""
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
-    except OSError as e:
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def _model(
     polys: Sequence[Polygon | dict[str, Any]],
     *,
@@ -236,7 +215,7 @@ def write_polygons_json(model: PolygonModel, path: str | Path) -> None:
         polys.append("    {" + ", ".join(items) + "}")
     body = "[]" if not polys else "[\n" + ",\n".join(polys) + "\n  ]"
     text = "{\n" + "\n".join(lines) + ("\n" if lines else "") + f'  "polygons": {body}\n}}\n'
-    _atomic_write(p, text.encode("utf-8"))
+    write_atomic(p, text.encode("utf-8"))
 
 
 # ---------------------------------------------------------------------------- SVG in
@@ -695,7 +674,7 @@ def write_svg(
             f'fill-rule="evenodd" stroke="#000000" stroke-width="{_num(stroke)}"/>'
         )
     lines.append("</svg>")
-    _atomic_write(p, ("\n".join(lines) + "\n").encode("utf-8"))
+    write_atomic(p, ("\n".join(lines) + "\n").encode("utf-8"))
 
 
 def _escape(text: str) -> str:
@@ -737,9 +716,7 @@ def write_png(model: PolygonModel, path: str | Path, *, size_px: int = 512) -> N
     """
     from PIL import Image, ImageDraw
 
-    if isinstance(size_px, bool) or not isinstance(size_px, int) or not 8 <= size_px <= 16384:
-        raise InputError(f"{path}: size_px must be an integer from 8 to 16384, not {size_px!r}")
-    p = Path(path)
+    p = png_target(path, size_px, 8, 16384)
     x0, y0, x1, y1 = _bounds(model)
     span = max(x1 - x0, y1 - y0, 1e-12)
     margin = 1
@@ -764,4 +741,4 @@ def write_png(model: PolygonModel, path: str | Path, *, size_px: int = 512) -> N
         img.paste(cols[poly.label], (0, 0, w, h), mask)
     buf = io.BytesIO()
     img.save(buf, format="PNG")
-    _atomic_write(p, buf.getvalue())
+    write_atomic(p, buf.getvalue())
