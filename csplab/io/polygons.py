@@ -45,7 +45,7 @@ import io
 import json
 import math
 import re
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -281,17 +281,27 @@ def _mul(m: Matrix, n: Matrix) -> Matrix:
             a * e2 + c * f2 + e, b * e2 + d * f2 + f)  # fmt: skip
 
 
+def _matches(
+    pattern: re.Pattern[str], text: str, el: _Element, error: Callable[[int], str]
+) -> Iterator[re.Match[str]]:
+    """The matches of ``pattern`` one after another through ``text``, up to where only
+    separators (white space, commas) are left; ``el.error(error(pos))`` at anything else."""
+    pos = 0
+    while pos < len(text):
+        hit = pattern.match(text, pos)
+        if hit is None:
+            if text[pos:].strip(" ,\t\r\n") == "":
+                return
+            raise el.error(error(pos))
+        yield hit
+        pos = hit.end()
+
+
 def _transform(text: str, el: _Element) -> Matrix:
     """The matrix of an SVG ``transform`` list."""
     m = _IDENTITY
-    pos, text = 0, text.strip()
-    while pos < len(text):
-        hit = _TRANSFORM.match(text, pos)
-        if hit is None:
-            if text[pos:].strip(" ,\t\r\n") == "":
-                break
-            raise el.error(f"cannot read transform {text!r}")
-        pos = hit.end()
+    text = text.strip()
+    for hit in _matches(_TRANSFORM, text, el, lambda pos: f"cannot read transform {text!r}"):
         kind, args = hit.group(1), _numbers(hit.group(2), el, f"transform {hit.group(1)}")
         n = len(args)
         t: Matrix
@@ -323,16 +333,12 @@ def _transform(text: str, el: _Element) -> Matrix:
 
 def _path_rings(d: str, el: _Element) -> list[list[tuple[float, float]]]:
     """The subpaths of path data with straight segments only."""
-    tokens: list[str] = []
-    pos = 0
-    while pos < len(d):
-        hit = _PATH_TOKEN.match(d, pos)
-        if hit is None:
-            if d[pos:].strip(" ,\t\r\n") == "":
-                break
-            raise el.error(f"cannot read path data near {d[pos : pos + 20]!r}")
-        tokens.append(hit.group(1))
-        pos = hit.end()
+    tokens = [
+        hit.group(1)
+        for hit in _matches(
+            _PATH_TOKEN, d, el, lambda p: f"cannot read path data near {d[p : p + 20]!r}"
+        )
+    ]
     rings: list[list[tuple[float, float]]] = []
     cur: list[tuple[float, float]] = []
     x = y = 0.0
