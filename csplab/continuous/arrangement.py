@@ -45,7 +45,13 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.lattice import MAX_FAMILIES, Lattice, gcd_fractions, rational
+from csplab.continuous.lattice import (
+    MAX_FAMILIES,
+    ArrangementGraph,
+    Lattice,
+    gcd_fractions,
+    rational,
+)
 from csplab.errors import InputError
 
 __all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice", "gcd_fractions", "rational"]
@@ -61,7 +67,7 @@ def _lcm(a: int, b: int) -> int:
     return a * b // math.gcd(a, b)
 
 
-class Arrangement:
+class Arrangement(ArrangementGraph):
     """Vertices and edges of the lines of ``lattice``'s families in ``[0, W] x [0, H]``
     (lattice units); see the module docstring.
 
@@ -170,14 +176,6 @@ class Arrangement:
         """The region ``(W, H)`` in spacings."""
         return self.W, self.H
 
-    @property
-    def n_vertices(self) -> int:
-        return int(self.X.size)
-
-    @property
-    def n_edges(self) -> int:
-        return int(self.edge_src.size)
-
     # ------------------------------------------------------------------ geometry
     @cached_property
     def ray_angles(self) -> NDArray[np.float64]:
@@ -188,12 +186,6 @@ class Arrangement:
     def vertex_positions(self) -> NDArray[np.float64]:
         """Vertices in lattice units, ``(n, 2)`` floats."""
         out: NDArray[np.float64] = np.stack([self.X, self.Y], axis=1) / self.D
-        return out
-
-    def edge_positions(self) -> NDArray[np.float64]:
-        """Edge midpoints in lattice units."""
-        v = self.vertex_positions()
-        out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 
     def on_side(self) -> NDArray[np.int64]:
