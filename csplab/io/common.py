@@ -170,6 +170,16 @@ def write_atomic(path: Path, data: bytes) -> None:
         raise
 
 
+def exact_text(x: float) -> str:
+    """Shortest exact text of a float (integral values without ``.0``), for the model
+    writers."""
+    if x == 0:
+        return "0"
+    if x.is_integer() and abs(x) < 2**53:
+        return str(int(x))
+    return repr(x)
+
+
 def png_target(path: str | Path, size_px: int, smallest: int, largest: int) -> Path:
     """``path`` for a PNG writer, once ``size_px`` is checked to be an integer from
     ``smallest`` to ``largest`` (else an :class:`~csplab.errors.InputError`)."""

@@ -71,7 +71,16 @@ from numpy.typing import NDArray
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
 from csplab.errors import CsplabError, FormatError, InputError
-from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, png_target, read_bytes, write_atomic
+from csplab.io.common import (
+    KIND,
+    NO,
+    PLAUSIBLE,
+    SURE,
+    exact_text,
+    png_target,
+    read_bytes,
+    write_atomic,
+)
 from csplab.io.mesh_repair import (
     Repairs,
     check_coordinates,
@@ -577,15 +586,6 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
 
 
 # ---------------------------------------------------------------------------- OBJ out
-def _num(x: float) -> str:
-    """Shortest exact text of a float (integral values without ``.0``)."""
-    if x == 0:
-        return "0"
-    if x.is_integer() and abs(x) < 2**53:
-        return str(int(x))
-    return repr(x)
-
-
 def _colours(model: PolyhedralModel) -> dict[int, tuple[int, int, int]]:
     from csplab.render import palette
 
@@ -626,7 +626,9 @@ def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
     base = 1
     for i, s in enumerate(model.solids):
         lines += [f"o solid_{i}", f"usemtl label_{s.label}"]
-        lines += [f"v {_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        lines += [
+            f"v {exact_text(x)} {exact_text(y)} {exact_text(z)}" for x, y, z in s.vertices.tolist()
+        ]
         lines += ["f " + " ".join(str(base + k) for k in poly) for poly in s.polygons]
         base += len(s.vertices)
     write_atomic(mtl, ("\n".join(m_lines) + "\n").encode("utf-8"))
@@ -828,7 +830,9 @@ def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
     polys: list[str] = []
     base = 0
     for s in model.solids:
-        lines += [f"{_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        lines += [
+            f"{exact_text(x)} {exact_text(y)} {exact_text(z)}" for x, y, z in s.vertices.tolist()
+        ]
         polys += [f"{len(p)} " + " ".join(str(base + i) for i in p) for p in s.polygons]
         base += len(s.vertices)
     head = ["OFF", f"# csplab polyhedral model {model.name}: {len(model)} solids, labels "

@@ -60,6 +60,7 @@ from csplab.io._xml import Node, parse_xml
 from csplab.io.common import (
     NO,
     SURE,
+    exact_text,
     json_like,
     png_target,
     read_bytes,
@@ -171,17 +172,8 @@ points, got 2
     return m
 
 
-def _num(x: float) -> str:
-    """Shortest exact text of a float (integral values without ``.0``)."""
-    if x == 0:
-        return "0"
-    if x.is_integer() and abs(x) < 2**53:
-        return str(int(x))
-    return repr(x)
-
-
 def _pts(ring: Sequence[tuple[float, float]]) -> str:
-    return "[" + ", ".join(f"[{_num(x)}, {_num(y)}]" for x, y in ring) + "]"
+    return "[" + ", ".join(f"[{exact_text(x)}, {exact_text(y)}]" for x, y in ring) + "]"
 
 
 def write_polygons_json(model: PolygonModel, path: str | Path) -> None:
@@ -665,19 +657,19 @@ def write_svg(
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         '<svg xmlns="http://www.w3.org/2000/svg" '
-        f'viewBox="{" ".join(_num(float(v)) for v in vb)}">',
+        f'viewBox="{" ".join(exact_text(float(v)) for v in vb)}">',
     ]
     if model.name:
         lines.append(f"  <title>{_escape(model.name)}</title>")
     for poly in model.polygons:
         d = " ".join(
-            "M " + " L ".join(f"{_num(x)} {_num(-y)}" for x, y in ring) + " Z"
+            "M " + " L ".join(f"{exact_text(x)} {exact_text(-y)}" for x, y in ring) + " Z"
             for ring in poly.rings()
         )
         r, g, b = cols[poly.label]
         lines.append(
             f'  <path data-label="{poly.label}" d="{d}" fill="#{r:02x}{g:02x}{b:02x}" '
-            f'fill-rule="evenodd" stroke="#000000" stroke-width="{_num(stroke)}"/>'
+            f'fill-rule="evenodd" stroke="#000000" stroke-width="{exact_text(stroke)}"/>'
         )
     lines.append("</svg>")
     write_atomic(p, ("\n".join(lines) + "\n").encode("utf-8"))
