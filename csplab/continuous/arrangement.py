@@ -45,7 +45,13 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.lattice import MAX_FAMILIES, Lattice, gcd_fractions, rational
+from csplab.continuous.lattice import (
+    MAX_FAMILIES,
+    ArrangementGraph,
+    Lattice,
+    gcd_fractions,
+    rational,
+)
 from csplab.errors import InputError
 
 __all__ = ["LINES", "MAX_FAMILIES", "Arrangement", "Lattice", "gcd_fractions", "rational"]
@@ -61,7 +67,7 @@ def _lcm(a: int, b: int) -> int:
     return a * b // math.gcd(a, b)
 
 
-class Arrangement:
+class Arrangement(ArrangementGraph):
     """Vertices and edges of the lines of a lattice's families in a rectangular region.
 
     The region is ``[0, W] x [0, H]`` in lattice units; see the module docstring.
@@ -186,16 +192,6 @@ class Arrangement:
         """The region ``(W, H)`` in spacings."""
         return self.W, self.H
 
-    @property
-    def n_vertices(self) -> int:
-        """The number of arrangement vertices."""
-        return int(self.X.size)
-
-    @property
-    def n_edges(self) -> int:
-        """The number of arrangement edges (consecutive vertices on one line)."""
-        return int(self.edge_src.size)
-
     # ------------------------------------------------------------------ geometry
     @cached_property
     def ray_angles(self) -> NDArray[np.float64]:
@@ -212,18 +208,6 @@ class Arrangement:
             The ``(x, y)`` of each vertex, ``(X, Y) / D``.
         """
         out: NDArray[np.float64] = np.stack([self.X, self.Y], axis=1) / self.D
-        return out
-
-    def edge_positions(self) -> NDArray[np.float64]:
-        """Edge midpoints in lattice units.
-
-        Returns
-        -------
-        float array ``(n_edges, 2)``
-            The midpoint ``(x, y)`` of each edge.
-        """
-        v = self.vertex_positions()
-        out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 
     def on_side(self) -> NDArray[np.int64]:

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import bisect
 from collections.abc import Mapping, Sequence
-from typing import Any, overload
+from typing import Any, TypedDict, Unpack, overload
 
 import numpy as np
 import shapely
@@ -583,29 +583,25 @@ def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
     return PolygonModel(polys, name=example.name, meta=example.meta, source=example.source)
 
 
+class CSPOptions(TypedDict, total=False):
+    """The keyword options of :func:`continuous_csp` (defaults there), for its overloads."""
+
+    spacing: float | None
+    snap: bool
+    boundary: int | Mapping[str, int]
+    lines: str
+    constraints: UserConstraints3 | None
+
+
 @overload
 def continuous_csp(
-    example: PolygonModel,
-    size: Sequence[int],
-    *,
-    spacing: float | None = None,
-    snap: bool = False,
-    boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
-    constraints: UserConstraints3 | None = None,
+    example: PolygonModel, size: Sequence[int], **options: Unpack[CSPOptions]
 ) -> ContinuousCSP: ...
 
 
 @overload
 def continuous_csp(
-    example: PolyhedralModel,
-    size: Sequence[int],
-    *,
-    spacing: float | None = None,
-    snap: bool = False,
-    boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
-    constraints: UserConstraints3 | None = None,
+    example: PolyhedralModel, size: Sequence[int], **options: Unpack[CSPOptions]
 ) -> ContinuousCSP3: ...
 
 

@@ -432,6 +432,34 @@ class Lattice:
         return (*self.vectors, *extra), (False,) * len(self.vectors) + (True,) * len(extra)
 
 
+class ArrangementGraph:
+    """What the two arrangements of :class:`PlaneArrangement` count and place alike: their
+    vertices (``X``, the first coordinates times ``D``) and edges (``edge_src`` to
+    ``edge_dst``), and the edge midpoints from ``vertex_positions``."""
+
+    X: NDArray[np.int64]
+    edge_src: NDArray[np.int64]
+    edge_dst: NDArray[np.int64]
+
+    @property
+    def n_vertices(self) -> int:
+        return int(self.X.size)
+
+    @property
+    def n_edges(self) -> int:
+        return int(self.edge_src.size)
+
+    def vertex_positions(self) -> NDArray[np.float64]:
+        """Vertex coordinates ``(n_vertices, d)`` in lattice units."""
+        raise NotImplementedError
+
+    def edge_positions(self) -> NDArray[np.float64]:
+        """Edge midpoints in lattice units."""
+        v = self.vertex_positions()
+        out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
+        return out
+
+
 class PlaneArrangement(Protocol):
     """The arrangement protocol: what the 2D arrangement of lines
     (:class:`~csplab.continuous.arrangement.Arrangement`) and the 3D arrangement of planes

@@ -48,7 +48,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.lattice import MAX_FAMILIES3, Lattice, primitive3
+from csplab.continuous.lattice import MAX_FAMILIES3, ArrangementGraph, Lattice, primitive3
 from csplab.errors import InputError
 
 if TYPE_CHECKING:  # types only: neither imports this module
@@ -149,7 +149,7 @@ def central_cells(
     return signs, dirs
 
 
-class Arrangement3:
+class Arrangement3(ArrangementGraph):
     """Vertices and edges of the planes of ``lattice``'s families in the box ``size``
     (lattice units); see the module docstring.
 
@@ -246,23 +246,9 @@ class Arrangement3:
         """The vector naming each family: its face normal (3D; an edge direction in 2D)."""
         return self.normals
 
-    @property
-    def n_vertices(self) -> int:
-        return int(self.X.size)
-
-    @property
-    def n_edges(self) -> int:
-        return int(self.edge_src.size)
-
     def vertex_positions(self) -> NDArray[np.float64]:
         """Vertices in lattice units."""
         out: NDArray[np.float64] = np.stack([self.X, self.Y, self.Z], axis=1) / self.D
-        return out
-
-    def edge_positions(self) -> NDArray[np.float64]:
-        """Edge midpoints in lattice units."""
-        v = self.vertex_positions()
-        out: NDArray[np.float64] = 0.5 * (v[self.edge_src] + v[self.edge_dst])
         return out
 
     def on_side(self) -> NDArray[np.int64]:

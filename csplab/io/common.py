@@ -20,6 +20,7 @@ from __future__ import annotations
 import os
 import re
 import stat
+import tempfile
 import warnings
 from collections.abc import Container, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -29,7 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from csplab.errors import FormatError
+from csplab.errors import FormatError, InputError
 
 if TYPE_CHECKING:
     from csplab.example import ExampleModel
@@ -142,6 +143,52 @@ def read_bytes(path: str | Path, limit: int | None = None) -> bytes:
 def read_text(path: str | Path) -> str:
     """The file as UTF-8 text (undecodable bytes replaced), as :func:`read_bytes`."""
     return read_bytes(path).decode("utf-8", errors="replace")
+
+
+# ---------------------------------------------------------------------------- writing
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``; an
+    :class:`~csplab.errors.InputError` naming the file when it cannot be written."""
+    try:
+        fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
+    except OSError as e:
+        raise InputError(f"{path}: cannot write: {e.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, path)
+    except OSError as e:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"{path}: cannot write: {e.strerror}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def exact_text(x: float) -> str:
+    """Shortest exact text of a float (integral values without ``.0``), for the model
+    writers."""
+    if x == 0:
+        return "0"
+    if x.is_integer() and abs(x) < 2**53:
+        return str(int(x))
+    return repr(x)
+
+
+def png_target(path: str | Path, size_px: int, smallest: int, largest: int) -> Path:
+    """``path`` for a PNG writer, once ``size_px`` is checked to be an integer from
+    ``smallest`` to ``largest`` (else an :class:`~csplab.errors.InputError`)."""
+    whole = isinstance(size_px, int) and not isinstance(size_px, bool)
+    if not whole or not smallest <= size_px <= largest:
+        raise InputError(
+            f"{path}: size_px must be an integer from {smallest} to {largest}, not {size_px!r}"
+        )
+    return Path(path)
 
 
 # ---------------------------------------------------------------------------- sniffing

@@ -58,10 +58,8 @@ Examples
 from __future__ import annotations
 
 import io
-import os
 import re
 import struct
-import tempfile
 import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -73,7 +71,16 @@ from numpy.typing import NDArray
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
 from csplab.errors import CsplabError, FormatError, InputError
-from csplab.io.common import KIND, NO, PLAUSIBLE, SURE, read_bytes
+from csplab.io.common import (
+    KIND,
+    NO,
+    PLAUSIBLE,
+    SURE,
+    exact_text,
+    png_target,
+    read_bytes,
+    write_atomic,
+)
 from csplab.io.mesh_repair import (
     Repairs,
     check_coordinates,
@@ -151,29 +158,6 @@ def sniff_stl(head: bytes) -> int:
 
 
 # ---------------------------------------------------------------------------- helpers
-def _atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``."""
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
-    except OSError as e:
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        mask = os.umask(0)
-        os.umask(mask)
-        os.chmod(tmp, 0o666 & ~mask)
-        os.replace(tmp, path)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def _text(path: Path) -> str:
     data = read_bytes(path)
     if b"\0" in data:
@@ -602,15 +586,6 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
 
 
 # ---------------------------------------------------------------------------- OBJ out
-def _num(x: float) -> str:
-    """Shortest exact text of a float (integral values without ``.0``)."""
-    if x == 0:
-        return "0"
-    if x.is_integer() and abs(x) < 2**53:
-        return str(int(x))
-    return repr(x)
-
-
 def _colours(model: PolyhedralModel) -> dict[int, tuple[int, int, int]]:
     from csplab.render import palette
 
@@ -651,11 +626,13 @@ def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
     base = 1
     for i, s in enumerate(model.solids):
         lines += [f"o solid_{i}", f"usemtl label_{s.label}"]
-        lines += [f"v {_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        lines += [
+            f"v {exact_text(x)} {exact_text(y)} {exact_text(z)}" for x, y, z in s.vertices.tolist()
+        ]
         lines += ["f " + " ".join(str(base + k) for k in poly) for poly in s.polygons]
         base += len(s.vertices)
-    _atomic_write(mtl, ("\n".join(m_lines) + "\n").encode("utf-8"))
-    _atomic_write(p, ("\n".join(lines) + "\n").encode("utf-8"))
+    write_atomic(mtl, ("\n".join(m_lines) + "\n").encode("utf-8"))
+    write_atomic(p, ("\n".join(lines) + "\n").encode("utf-8"))
 
 
 # ---------------------------------------------------------------------------- PNG out
@@ -696,9 +673,7 @@ def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
-    if isinstance(size_px, bool) or not isinstance(size_px, int) or not 16 <= size_px <= 8192:
-        raise InputError(f"{path}: size_px must be an integer from 16 to 8192, not {size_px!r}")
-    p = Path(path)
+    p = png_target(path, size_px, 16, 8192)
     dpi = 100
     fig = Figure(figsize=(size_px / dpi, size_px / dpi), dpi=dpi)
     FigureCanvasAgg(fig)
@@ -731,7 +706,7 @@ def write_png(model: PolyhedralModel, path: str | Path, *, size_px: int = 512) -
         ax.set_box_aspect((1, 1, 1), zoom=1.3)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi, facecolor="white")
-    _atomic_write(p, buf.getvalue())
+    write_atomic(p, buf.getvalue())
 
 
 # ---------------------------------------------------------------------------- triangles out
@@ -860,7 +835,7 @@ def write_stl_model(model: PolyhedralModel, path: str | Path) -> None:
         rec["v"][k : k + len(t)] = tri
         k += len(t)
     head = f"csplab polyhedral model {model.name}: {len(model)} solids".encode()[:80]
-    _atomic_write(Path(path), head.ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes())
+    write_atomic(Path(path), head.ljust(80, b" ") + struct.pack("<I", n) + rec.tobytes())
 
 
 def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
@@ -885,12 +860,14 @@ def write_off_model(model: PolyhedralModel, path: str | Path) -> None:
     polys: list[str] = []
     base = 0
     for s in model.solids:
-        lines += [f"{_num(x)} {_num(y)} {_num(z)}" for x, y, z in s.vertices.tolist()]
+        lines += [
+            f"{exact_text(x)} {exact_text(y)} {exact_text(z)}" for x, y, z in s.vertices.tolist()
+        ]
         polys += [f"{len(p)} " + " ".join(str(base + i) for i in p) for p in s.polygons]
         base += len(s.vertices)
     head = ["OFF", f"# csplab polyhedral model {model.name}: {len(model)} solids, labels "
             f"{list(model.labels)}", f"{base} {len(polys)} 0"]  # fmt: skip
-    _atomic_write(Path(path), ("\n".join([*head, *lines, *polys]) + "\n").encode("utf-8"))
+    write_atomic(Path(path), ("\n".join([*head, *lines, *polys]) + "\n").encode("utf-8"))
 
 
 def write_glb(model: PolyhedralModel, path: str | Path) -> None:
@@ -936,7 +913,7 @@ def write_glb(model: PolyhedralModel, path: str | Path) -> None:
         mesh.visual = tm.visual.TextureVisuals(material=mat)
         scene.add_geometry(mesh, node_name=f"label_{b}", geom_name=f"label_{b}")
     data = scene.export(file_type="glb") if model.solids else _empty_glb()
-    _atomic_write(Path(path), bytes(data))
+    write_atomic(Path(path), bytes(data))
 
 
 def _empty_glb() -> bytes:

@@ -44,10 +44,8 @@ from __future__ import annotations
 import io
 import json
 import math
-import os
 import re
-import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -59,7 +57,16 @@ from csplab.continuous.model import Polygon, PolygonModel
 from csplab.errors import FormatError, InputError
 from csplab.io._json import load_json
 from csplab.io._xml import Node, parse_xml
-from csplab.io.common import NO, SURE, json_like, read_bytes, xml_root
+from csplab.io.common import (
+    NO,
+    SURE,
+    exact_text,
+    json_like,
+    png_target,
+    read_bytes,
+    write_atomic,
+    xml_root,
+)
 
 __all__ = [
     "read_polygons_json",
@@ -100,33 +107,6 @@ def sniff_svg(head: bytes) -> int:
 
 
 # ---------------------------------------------------------------------------- files
-def _atomic_write(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``."""
-    try:
-        fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
-    except OSError as e:
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_umask())
-        os.replace(tmp, path)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"{path}: cannot write: {e.strerror}") from None
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 def _model(
     polys: Sequence[Polygon | dict[str, Any]],
     *,
@@ -192,17 +172,8 @@ points, got 2
     return m
 
 
-def _num(x: float) -> str:
-    """Shortest exact text of a float (integral values without ``.0``)."""
-    if x == 0:
-        return "0"
-    if x.is_integer() and abs(x) < 2**53:
-        return str(int(x))
-    return repr(x)
-
-
 def _pts(ring: Sequence[tuple[float, float]]) -> str:
-    return "[" + ", ".join(f"[{_num(x)}, {_num(y)}]" for x, y in ring) + "]"
+    return "[" + ", ".join(f"[{exact_text(x)}, {exact_text(y)}]" for x, y in ring) + "]"
 
 
 def write_polygons_json(model: PolygonModel, path: str | Path) -> None:
@@ -236,7 +207,7 @@ def write_polygons_json(model: PolygonModel, path: str | Path) -> None:
         polys.append("    {" + ", ".join(items) + "}")
     body = "[]" if not polys else "[\n" + ",\n".join(polys) + "\n  ]"
     text = "{\n" + "\n".join(lines) + ("\n" if lines else "") + f'  "polygons": {body}\n}}\n'
-    _atomic_write(p, text.encode("utf-8"))
+    write_atomic(p, text.encode("utf-8"))
 
 
 # ---------------------------------------------------------------------------- SVG in
@@ -302,17 +273,27 @@ def _mul(m: Matrix, n: Matrix) -> Matrix:
             a * e2 + c * f2 + e, b * e2 + d * f2 + f)  # fmt: skip
 
 
+def _matches(
+    pattern: re.Pattern[str], text: str, el: _Element, error: Callable[[int], str]
+) -> Iterator[re.Match[str]]:
+    """The matches of ``pattern`` one after another through ``text``, up to where only
+    separators (white space, commas) are left; ``el.error(error(pos))`` at anything else."""
+    pos = 0
+    while pos < len(text):
+        hit = pattern.match(text, pos)
+        if hit is None:
+            if text[pos:].strip(" ,\t\r\n") == "":
+                return
+            raise el.error(error(pos))
+        yield hit
+        pos = hit.end()
+
+
 def _transform(text: str, el: _Element) -> Matrix:
     """The matrix of an SVG ``transform`` list."""
     m = _IDENTITY
-    pos, text = 0, text.strip()
-    while pos < len(text):
-        hit = _TRANSFORM.match(text, pos)
-        if hit is None:
-            if text[pos:].strip(" ,\t\r\n") == "":
-                break
-            raise el.error(f"cannot read transform {text!r}")
-        pos = hit.end()
+    text = text.strip()
+    for hit in _matches(_TRANSFORM, text, el, lambda pos: f"cannot read transform {text!r}"):
         kind, args = hit.group(1), _numbers(hit.group(2), el, f"transform {hit.group(1)}")
         n = len(args)
         t: Matrix
@@ -344,16 +325,12 @@ def _transform(text: str, el: _Element) -> Matrix:
 
 def _path_rings(d: str, el: _Element) -> list[list[tuple[float, float]]]:
     """The subpaths of path data with straight segments only."""
-    tokens: list[str] = []
-    pos = 0
-    while pos < len(d):
-        hit = _PATH_TOKEN.match(d, pos)
-        if hit is None:
-            if d[pos:].strip(" ,\t\r\n") == "":
-                break
-            raise el.error(f"cannot read path data near {d[pos : pos + 20]!r}")
-        tokens.append(hit.group(1))
-        pos = hit.end()
+    tokens = [
+        hit.group(1)
+        for hit in _matches(
+            _PATH_TOKEN, d, el, lambda p: f"cannot read path data near {d[p : p + 20]!r}"
+        )
+    ]
     rings: list[list[tuple[float, float]]] = []
     cur: list[tuple[float, float]] = []
     x = y = 0.0
@@ -680,22 +657,22 @@ def write_svg(
     lines = [
         '<?xml version="1.0" encoding="UTF-8"?>',
         '<svg xmlns="http://www.w3.org/2000/svg" '
-        f'viewBox="{" ".join(_num(float(v)) for v in vb)}">',
+        f'viewBox="{" ".join(exact_text(float(v)) for v in vb)}">',
     ]
     if model.name:
         lines.append(f"  <title>{_escape(model.name)}</title>")
     for poly in model.polygons:
         d = " ".join(
-            "M " + " L ".join(f"{_num(x)} {_num(-y)}" for x, y in ring) + " Z"
+            "M " + " L ".join(f"{exact_text(x)} {exact_text(-y)}" for x, y in ring) + " Z"
             for ring in poly.rings()
         )
         r, g, b = cols[poly.label]
         lines.append(
             f'  <path data-label="{poly.label}" d="{d}" fill="#{r:02x}{g:02x}{b:02x}" '
-            f'fill-rule="evenodd" stroke="#000000" stroke-width="{_num(stroke)}"/>'
+            f'fill-rule="evenodd" stroke="#000000" stroke-width="{exact_text(stroke)}"/>'
         )
     lines.append("</svg>")
-    _atomic_write(p, ("\n".join(lines) + "\n").encode("utf-8"))
+    write_atomic(p, ("\n".join(lines) + "\n").encode("utf-8"))
 
 
 def _escape(text: str) -> str:
@@ -737,9 +714,7 @@ def write_png(model: PolygonModel, path: str | Path, *, size_px: int = 512) -> N
     """
     from PIL import Image, ImageDraw
 
-    if isinstance(size_px, bool) or not isinstance(size_px, int) or not 8 <= size_px <= 16384:
-        raise InputError(f"{path}: size_px must be an integer from 8 to 16384, not {size_px!r}")
-    p = Path(path)
+    p = png_target(path, size_px, 8, 16384)
     x0, y0, x1, y1 = _bounds(model)
     span = max(x1 - x0, y1 - y0, 1e-12)
     margin = 1
@@ -764,4 +739,4 @@ def write_png(model: PolygonModel, path: str | Path, *, size_px: int = 512) -> N
         img.paste(cols[poly.label], (0, 0, w, h), mask)
     buf = io.BytesIO()
     img.save(buf, format="PNG")
-    _atomic_write(p, buf.getvalue())
+    write_atomic(p, buf.getvalue())

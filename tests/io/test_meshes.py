@@ -175,10 +175,14 @@ BAD = {
         [([], [*cube(), [0.5, 0, 1]], [*QUADS[2:], [0, 1, 5, 8, 4], [4, 8, 5]])],
         r"m\.obj: solid 0: face 5 has zero area",
     ),
-    "NaN": ([([], [[float("nan"), 0, 0], *cube()[1:]], QUADS)],
-            r"m\.obj: line 1: a vertex with a non-finite coordinate \(nan, 0\.0, 0\.0\)"),
-    "huge": ([([], [[4e9, 0, 0], *cube()[1:]], QUADS)],
-             r"m\.obj: line 1: coordinate 4e\+09 beyond the 1e\+07 csplab reads"),
+    "NaN": (
+        [([], [[float("nan"), 0, 0], *cube()[1:]], QUADS)],
+        r"m\.obj: line 1: a vertex with a non-finite coordinate \(nan, 0\.0, 0\.0\)",
+    ),
+    "huge": (
+        [([], [[4e9, 0, 0], *cube()[1:]], QUADS)],
+        r"m\.obj: line 1: coordinate 4e\+09 beyond the 1e\+07 csplab reads",
+    ),
     "overlap": (
         [(["usemtl a"], cube(), QUADS), (["usemtl b"], cube((0.5, 0.5, 0.5)), QUADS)],
         r"m\.obj: solids 0 \(label 1\) and 1 \(label 2\) overlap \(volume 0\.125\)",
