@@ -77,7 +77,7 @@ import hashlib
 import itertools
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -89,10 +89,14 @@ from csplab.grids import from_example
 from csplab.problem import AXIS_NAMES
 from csplab.result import Verdict
 
+if TYPE_CHECKING:
+    from csplab.io.ruleset import RuleSet
+
 __all__ = [
     "Rules",
     "alg36_failure",
     "corner_condition",
+    "proof_scope",
     "prove_infallible",
     "region_box",
     "region_catalog",
@@ -127,10 +131,13 @@ class Rules:
         self._union: dict[tuple[int, bool, int], int] = {}
 
     @classmethod
-    def of(cls, example: ExampleModel | Rules) -> Rules:
+    def of(cls, example: ExampleModel | RuleSet | Rules) -> Rules:
+        """The rules of an example (its labels in use) or of a rule set (every label)."""
         if isinstance(example, Rules):
             return example
-        return cls(example.transitions(), example.counts() > 0)
+        if isinstance(example, ExampleModel):
+            return cls(example.transitions(), example.counts() > 0)
+        return cls(example.transitions())
 
     def union(self, d: int, forward: bool, dom: int) -> int:
         """Labels supported along axis ``d`` by some label of ``dom`` (forward: as successor)."""
@@ -393,7 +400,7 @@ def _frame(
 
 
 def prove_infallible(
-    example: ExampleModel,
+    example: ExampleModel | RuleSet,
     region: Sequence[int] | str | int = 2,
     *,
     order: str = "scanline",
@@ -401,12 +408,16 @@ def prove_infallible(
     max_states: int = 5_000_000,
     realize: bool = True,
     refute: bool = True,
+    certificate: bool = False,
 ) -> Verdict:
     """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
 
     Parameters
     ----------
-    example : ExampleModel
+    example : ExampleModel or RuleSet
+        An example (its labels in use) or a tileset's rules (every label). The proof is
+        about open grids: not periodic, no boundary conditions (:func:`proof_scope` says
+        why a rule set falls outside it).
     region : int, ``"3x2"`` or sequence
         Region size ``r`` per axis (at least 2; missing trailing axes are 2).
     order : str
@@ -422,6 +433,15 @@ def prove_infallible(
     refute : bool
         When the proof fails, look for a failing run of Alg. 3.1 on small outputs
         (:func:`csplab.analysis.witness.find_failure`, exhaustive) to refute infallibility.
+    certificate : bool
+        Put a certificate in ``witness["certificate"]`` (a dict, JSON-ready): when proved,
+        the closed set of frame states of every configuration (checked by
+        :mod:`csplab.certcheck` without this module's code); when refuted, the failing run.
+
+    Raises
+    ------
+    InputError
+        A bad region, order or history, or a model outside the proof's scope.
 
     Returns
     -------
@@ -441,6 +461,9 @@ def prove_infallible(
     (None, True)
     """
     t0 = time.perf_counter()
+    why = proof_scope(example)
+    if why is not None:
+        raise InputError(f"{example.name or 'the model'}: {why}")
     rules = Rules.of(example)
     ndim = rules.ndim
     axes = scan_axes(ndim, order)
@@ -461,11 +484,19 @@ def prove_infallible(
     digest = hashlib.sha256()
     digest.update(repr((example.hash(), r, order, hist)).encode())
     failure: dict[str, Any] | None = None
+    closed: list[dict[str, Any]] = []
     try:
         for lo, hi in _configs(ndim, r, hist):
             walk, ext, q = _frame(lo, hi, axes, r)
             stats["configs"] += 1
-            fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"])
+            seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
+            fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"], seen)
+            if seen is not None:
+                closed.append({
+                    "lower": list(lo), "upper": list(hi),
+                    "keys": walk.key_at[: len(walk.cells)],
+                    "states": sorted([i, list(k)] for i, k in seen),
+                })  # fmt: skip
             stats["states"] += nstates
             stats["windows"] += len(windows)
             for w in sorted(windows):
@@ -492,13 +523,20 @@ def prove_infallible(
         h = digest.hexdigest()
         name = example.name or "MODEL"
         hs = "x".join(map(str, hist))
+        proof: dict[str, Any] = {
+            "sha256": h,
+            "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
+            f"--history {hs} --expect-hash {h}",
+        }
+        if certificate:
+            proof["certificate"] = _certificate(
+                example, rules, "infallible", stats,
+                {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
+                 "configs": closed},
+            )  # fmt: skip
         return Verdict(
             True,
-            {
-                "sha256": h,
-                "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
-                f"--history {hs} --expect-hash {h}",
-            },
+            proof,
             stats,
             f"infallible: Alg. 3.6 with {rtxt} regions ({order}) cannot fail "
             f"({stats['windows']} windows, {stats['states']} states, "
@@ -523,8 +561,10 @@ def prove_infallible(
         alg31 = _as_alg31_failure(example, failure["run"], order)
         if alg31 is not None:
             wit["alg31"] = alg31
+            if certificate:
+                wit["certificate"] = _certificate(example, rules, "fallible", stats, {"run": alg31})
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
-    if refute:
+    if refute and isinstance(example, ExampleModel):
         from csplab.analysis.witness import find_failure
 
         ff = find_failure(
@@ -534,11 +574,87 @@ def prove_infallible(
         stats["refute_states"] = ff.stats.get("states", 0)
         if ff.holds is False:
             wit["alg31"] = ff.witness
+            if certificate and ff.witness is not None:
+                wit["certificate"] = _certificate(
+                    example, rules, "fallible", stats, {"run": ff.witness}
+                )
             return Verdict(False, wit, stats, msg + "; Alg. 3.1 fails too: fallible")
         size = "x".join(map(str, _refute_size(ndim)))
         done = "exhaustive" if ff.holds is True else "incomplete search"
         msg += f"; no failure of Alg. 3.1 found on outputs up to {size} ({done})"
     return Verdict(None, wit, stats, msg)
+
+
+def proof_scope(model: ExampleModel | RuleSet) -> str | None:
+    """Why the region proof cannot decide ``model`` as the synthesizer builds it (one line),
+    or ``None`` when it can.
+
+    The proof is about Alg. 3.1 on open square grids of every size: no wrap-around, no
+    boundary condition, no global constraint, one transition matrix per axis. Examples
+    always qualify; a rule set qualifies when its file states none of these.
+
+    Parameters
+    ----------
+    model : ExampleModel or RuleSet
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> from csplab.io.ruleset import RuleSet
+    >>> proof_scope(RuleSet(np.ones((2, 2, 2), dtype=bool), periodic=True))
+    'the file makes the grid periodic: the region proof covers open grids only'
+    >>> proof_scope(RuleSet(np.ones((2, 2, 2), dtype=bool))) is None
+    True
+    """
+    if isinstance(model, ExampleModel):
+        return None
+    if getattr(model, "topology", "square") != "square":
+        return f"{model.topology} grids have no scan order with a region proof (square only)"
+    if model.constraints:
+        return "the file states global constraints, which the region proof does not cover"
+    per = model.periodic
+    if per if isinstance(per, bool | np.bool_) else any(per):
+        return "the file makes the grid periodic: the region proof covers open grids only"
+    ops = len(model.boundary_ops) + len(model.constraint_ops)
+    if ops:
+        return (
+            f"the file restricts cell domains ({ops} boundary/domain rules), which the region "
+            "proof does not model yet"
+        )
+    return None
+
+
+def _certificate(
+    example: ExampleModel | RuleSet,
+    rules: Rules,
+    claim: str,
+    stats: Mapping[str, Any],
+    body: Mapping[str, Any],
+) -> dict[str, Any]:
+    """A certificate (format ``csplab-certificate`` version 1) for :mod:`csplab.certcheck`."""
+    import json
+
+    rel = {
+        "labels": rules.K,
+        "used": [int(b) for b in rules.used_mask],
+        "pairs": [np.argwhere(rules.T[d]).tolist() for d in range(rules.ndim)],
+    }
+    canon = json.dumps(rel, sort_keys=True, separators=(",", ":")).encode()
+    return {
+        "format": "csplab-certificate",
+        "version": 1,
+        "claim": claim,
+        "scope": "Alg. 3.1 in the given scan order, on open grids of every size "
+        "(not periodic, no boundary conditions)",
+        "model": {"name": example.name, "hash": example.hash()},
+        "rules": rel,
+        "rules_sha256": hashlib.sha256(canon).hexdigest(),
+        "prover": {k: stats[k] for k in ("time_s", "states", "configs") if k in stats},
+        **body,
+    }
 
 
 def _refute_size(ndim: int) -> tuple[int, ...]:
@@ -549,9 +665,10 @@ _R = TypeVar("_R")
 
 
 def _enumerate(
-    rules: Rules, walk: _Walk, budget: int
+    rules: Rules, walk: _Walk, budget: int, seen: set[tuple[int, tuple[int, ...]]] | None = None
 ) -> tuple[list[int] | None, int, set[tuple[int, ...]]]:
-    """DFS over the frame's labellings; returns (failing labels or None, states, windows)."""
+    """DFS over the frame's labellings; returns (failing labels or None, states, windows).
+    ``seen`` (if given) receives the memoised states ``(step, key labels)``."""
     last = len(walk.cells) - 1
     windows: set[tuple[int, ...]] = set()
     src_q = [j for j in walk.steps[last][0] if j >= 0]
@@ -562,7 +679,7 @@ def _enumerate(
         windows.add((*(labels[j] for j in src_q), cat))
         return list(labels) if cat == 0 else None
 
-    fail, states = _dfs(rules, walk, budget, at_last)
+    fail, states = _dfs(rules, walk, budget, at_last, seen=seen)
     return fail, states, windows
 
 
@@ -572,6 +689,7 @@ def _dfs(
     budget: int,
     found: Callable[[int, int, list[int]], _R | None],
     first: Mapping[int, int] | None = None,
+    seen: set[tuple[int, tuple[int, ...]]] | None = None,
 ) -> tuple[_R | None, int]:
     """Depth-first search over the labellings of ``walk``'s cells in order, memoised on the
     labels later steps still see (``walk.key_at``); raises :class:`_Budget` past ``budget``
@@ -581,8 +699,9 @@ def _dfs(
     labels cell ``i`` may take, ``found(i, cat, labels)`` is what the search returns, if
     not ``None``; the search ends at the last cell. Labels are tried in increasing order,
     ``first[i]`` (if possible) first. Returns what was found (or ``None``) and the number
-    of states visited."""
-    seen: set[tuple[int, tuple[int, ...]]] = set()
+    of states visited (``seen``, if given, collects them)."""
+    if seen is None:
+        seen = set()
     labels: list[int] = []
     last = len(walk.cells) - 1
 
@@ -717,14 +836,17 @@ def _realize(
 
 
 def _as_alg31_failure(
-    example: ExampleModel, run: dict[str, Any], order: str
+    example: ExampleModel | RuleSet, run: dict[str, Any], order: str
 ) -> dict[str, Any] | None:
     """If a failing Alg. 3.6 run only used labels of Alg. 3.1's catalog, it is a failing
     run of Alg. 3.1 too (``C ⊆ C_R``): return it as a witness."""
     from csplab.catalog import Propagator
 
     shape = tuple(run["shape"])
-    P = from_example(example, shape)
+    if isinstance(example, ExampleModel):
+        P = from_example(example, shape)
+    else:  # the open grid of the proof's scope (proof_scope: no restrictions to drop)
+        P = example.problem(shape, periodic=False, boundary="none")
     eng = Propagator(P)
     choices: list[list[Any]] = []
     for c, b in run["choices"]:
@@ -744,7 +866,7 @@ def _as_alg31_failure(
 # ----------------------------------------------------------------------------- Eq. 3.11
 
 
-def corner_condition(example: ExampleModel, order: str = "scanline") -> Verdict:
+def corner_condition(example: ExampleModel | RuleSet, order: str = "scanline") -> Verdict:
     """The corner condition (Eq. 3.11, corrected), in 1D, 2D and 3D.
 
     For every face of the unit box (every non-empty set of axes): each labelling of the
@@ -760,13 +882,16 @@ def corner_condition(example: ExampleModel, order: str = "scanline") -> Verdict:
     the three backward neighbours ``u`` of the top corner (3D).
     """
     t0 = time.perf_counter()
+    why = proof_scope(example)
+    if why is not None:
+        raise InputError(f"{example.name or 'the model'}: {why}")
     T = example.transitions()
     ndim = T.shape[0]
     scan_axes(ndim, order)
     if ndim > 3:
         v = prove_infallible(example, 2, order=order, history=0, realize=False, refute=False)
         return Verdict(v.holds is True, v.witness, v.stats, "corner condition (4D, by prover)")
-    used = example.counts() > 0
+    used = Rules.of(example).used_mask
     Tu = T & used[None, :, None] & used[None, None, :]
     checked = 0
     # 1D faces
@@ -842,7 +967,7 @@ def _corner3(Tu: NDArray[np.bool_]) -> tuple[tuple[int, int, int] | None, int]:
 
 
 def _corner_fail(
-    example: ExampleModel,
+    example: ExampleModel | RuleSet,
     axes: tuple[int, ...],
     labels: dict[str, Any],
     checked: int,
