@@ -562,6 +562,7 @@ def prove_infallible(
         if alg31 is not None:
             wit["alg31"] = alg31
             if certificate:
+                stats["time_s"] = time.perf_counter() - t0
                 wit["certificate"] = _certificate(example, rules, "fallible", stats, {"run": alg31})
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
     if refute and isinstance(example, ExampleModel):
@@ -575,6 +576,7 @@ def prove_infallible(
         if ff.holds is False:
             wit["alg31"] = ff.witness
             if certificate and ff.witness is not None:
+                stats["time_s"] = time.perf_counter() - t0
                 wit["certificate"] = _certificate(
                     example, rules, "fallible", stats, {"run": ff.witness}
                 )

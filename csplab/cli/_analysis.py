@@ -11,12 +11,29 @@ import numpy as np
 from csplab.cli.common import load_model, model_options
 from csplab.errors import InputError
 from csplab.example import ExampleModel
+from csplab.io.ruleset import RuleSet
 from csplab.result import Verdict
 
 ORDER_HELP = (
     "scan order: scanline (x outermost, Alg. 3.1's loop; default) or scan:AXES, outermost "
     "first (scan:yx = the thesis' 2D figures: left to right, then bottom to top)"
 )
+
+
+def load_analysis_model(spec: str, options: list[str] | None = None) -> ExampleModel | RuleSet:
+    """An example or a tileset's rule set, loaded as ``synthesize`` loads it (continuous
+    models are refused in one line)."""
+    model = load_model(spec, model_options(options))
+    if not isinstance(model, ExampleModel | RuleSet):
+        raise InputError(f"{spec}: a continuous (polygon) model has no grid analysis")
+    return model
+
+
+def save_certificate(cert: dict[str, Any], path: str) -> None:
+    """Write a certificate as JSON, atomically (a temporary file, then renamed)."""
+    from csplab.io.meshes import _atomic_write
+
+    _atomic_write(Path(path), json.dumps(cert, default=_plain).encode())
 
 
 def load_example_model(spec: str, options: list[str] | None = None) -> ExampleModel:
@@ -35,7 +52,7 @@ def witness_grid(w: dict[str, Any]) -> np.ndarray:
     return g
 
 
-def save_witness(w: dict[str, Any], path: str, example: ExampleModel) -> None:
+def save_witness(w: dict[str, Any], path: str, example: ExampleModel | RuleSet) -> None:
     p = Path(path)
     if p.suffix == ".json":
         p.write_text(json.dumps(w, default=_plain, indent=1))
@@ -67,7 +84,7 @@ def print_verdict(v: Verdict, as_json: bool) -> None:
         print(v.message)
 
 
-def describe_run(w: dict[str, Any], example: ExampleModel) -> str:
+def describe_run(w: dict[str, Any], example: ExampleModel | RuleSet) -> str:
     """Lines describing a failing run: size, seed, choices, first step outside C*."""
     lines = [f"  output {'x'.join(map(str, w['shape']))}, order {w.get('order', 'scanline')}"]
     if w.get("seed") is not None:
