@@ -36,10 +36,14 @@ def save_certificate(cert: dict[str, Any], path: str) -> None:
     _atomic_write(Path(path), json.dumps(cert, default=_plain).encode())
 
 
-def load_example_model(spec: str, options: list[str] | None = None) -> ExampleModel:
+def load_example_model(
+    spec: str, options: list[str] | None = None, needs: str = "an example grid"
+) -> ExampleModel:
+    """An example model; anything else is refused in one line saying what ``needs`` it."""
     model = load_model(spec, model_options(options))
     if not isinstance(model, ExampleModel):
-        raise InputError(f"{spec}: the analysis commands need an example model, not a tileset")
+        kind = "a tileset" if isinstance(model, RuleSet) else "a continuous model"
+        raise InputError(f"{spec}: {needs}; this is {kind}, which has none")
     return model
 
 

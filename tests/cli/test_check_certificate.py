@@ -65,3 +65,37 @@ def test_tileset_outside_the_proof_is_one_line(capsys):
     code, _, err = run(capsys, "prove", str(DATA / "tiny_debroglie.json"))
     assert code == 2 and "global constraints" in err
     assert len([ln for ln in err.splitlines() if ln.startswith("csplab: error")]) == 1
+
+
+def test_witness_count_refine_on_tilesets(capsys):
+    pipes = str(DATA / "pipes.xml")
+    code, out, _ = run(capsys, "witness", pipes, "--max-size", "3x3", "--time-limit", "20")
+    assert code != 1 and "no failure" in out  # prove says infallible
+    code, out, _ = run(capsys, "count", pipes, "--size", "2x2", "--entropy", "2,3")
+    assert code == 0 and "entropy estimate" in out
+    code, _, err = run(capsys, "count", pipes, "--size", "2x2", "--bounds")
+    assert code == 2 and "Theorem 3.2.1" in err and "tileset" in err
+    code, _, err = run(capsys, "refine", pipes)
+    assert code == 2 and "example grid" in err and len(err.strip().splitlines()) == 1
+
+
+def test_witness_replays_on_a_tileset_with_its_own_boundary():
+    # isle on both x faces and no two isles side by side along x: the file's boundary
+    # makes every output of width 2 unsatisfiable, so Alg. 3.1 fails there; without the
+    # boundary the rules are infallible (proved, and witness finds nothing)
+    import numpy as np
+
+    from csplab.analysis import find_failure, prove_infallible, replay
+    from csplab.io.ruleset import DomainOp, RuleSet
+
+    T = np.ones((2, 2, 2), dtype=bool)
+    T[0, 1, 1] = False
+    isle = np.array([False, True])
+    faces = [DomainOp("force", isle, face="x-"), DomainOp("force", isle, face="x+")]
+    rs = RuleSet(T, names=["sea", "isle"], boundary_ops=faces)
+    own = find_failure(rs, max_size=(3, 3), random_runs=0, time_limit=20)
+    assert own.holds is False and own.witness["boundary"] == "auto"
+    assert own.witness["shape"][0] == 2 and replay(rs, own.witness).holds
+    free = RuleSet(T, names=["sea", "isle"])
+    assert find_failure(free, max_size=(3, 3), random_runs=0, time_limit=20).holds is True
+    assert prove_infallible(free).holds is True
