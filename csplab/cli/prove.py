@@ -81,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"  no certificate written to {args.certificate}: the verdict is undecided")
     if v.holds is True:
         if not args.json:
+            print("  scope: open grids of every size (not periodic, no boundary conditions)")
             print(f"  proof sha256 {v.witness['sha256']}")
             print(f"  re-check: {v.witness['recheck']}")
         if args.expect_hash and args.expect_hash != v.witness["sha256"]:

@@ -99,3 +99,14 @@ def test_witness_replays_on_a_tileset_with_its_own_boundary():
     free = RuleSet(T, names=["sea", "isle"])
     assert find_failure(free, max_size=(3, 3), random_runs=0, time_limit=20).holds is True
     assert prove_infallible(free).holds is True
+
+
+def test_catalog_gap_and_corner_on_a_tileset(capsys):
+    pipes = str(DATA / "pipes.xml")
+    code, out, _ = run(capsys, "catalog-gap", pipes, "--size", "3x3", "--seed", "1", "--steps",
+                       "summary")  # fmt: skip
+    assert code == 0 and out.startswith("pipes 3x3 (K=12)") and "ok: all 9" in out
+    code, out, _ = run(capsys, "prove", pipes, "--corner")
+    assert code == 0 and out.startswith("corner condition holds")
+    code, out, _ = run(capsys, "prove", pipes)
+    assert "scope: open grids" in out
