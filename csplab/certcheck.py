@@ -13,9 +13,17 @@ Format ``csplab-certificate``, version 1 (JSON)
 ``rules_sha256``: SHA-256 of ``rules`` as compact JSON with sorted keys (a changed rule
 without a new hash is rejected). ``claim`` is ``"infallible"`` or ``"fallible"``.
 
+``rules.faces`` (optional): the file's domain rules in file order, ``[op, where, labels]``
+with ``op`` one of keep / remove / force / add and ``where`` a face (``"x-"``), every cell
+but a face (``"!x-"``) or every cell (``"*"``): a cell's domain is the labels in use, edited
+by each rule that applies to it.
+
 *infallible*: ``region``, ``order``, ``axes`` (outermost first), ``history`` and
 ``configs``, one per position of a point relative to the output's lower edges (distance
-``0 .. 1 + history``, the last meaning "at least") and upper edges (``0 .. region - 2``).
+``0 .. 1 + history``, the last meaning "at least") and upper edges (``0 .. region - 2``),
+and -- with face rules -- whether the frame's first (``at_lower``) and last
+(``at_upper``) cell on each axis lies on the output's face (always when the frame is
+clipped there, both ways otherwise; without face rules, only when clipped).
 Each holds ``keys[i]`` (the earlier frame cells whose labels the state before step ``i``
 records) and ``states``, pairs ``[i, labels of keys[i]]``. The checker rebuilds each
 frame (the cells before the point ``q = lower`` in scan order, in the box of extent
@@ -34,7 +42,8 @@ frame (the cells before the point ``q = lower`` in scan order, in the box of ext
 
 Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 never fails
 (Theorem 3.3.6, the prover's docstring has the argument). *fallible*: ``run`` (``shape``,
-``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``): the checker replays
+``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``: a mapping face ->
+label, or ``"auto"`` for the face rules): the checker replays
 it with arc consistency on the whole grid -- the cells in scan order, each label in its
 cell's catalog -- and verifies that some catalog ends empty.
 
@@ -161,11 +170,12 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
         if rules_hash(rules) != cert.get("rules_sha256"):
             raise _Invalid("the rules do not match rules_sha256")
         fwd, bwd, used, ndim = _tables(rules)
+        face_rules = _face_rules(rules.get("faces") or [], ndim, rules)
         claim = cert.get("claim")
         if claim == "infallible":
-            msg = _check_closed(cert, fwd, bwd, used, ndim)
+            msg = _check_closed(cert, fwd, bwd, used, ndim, face_rules)
         elif claim == "fallible":
-            msg = _check_run(cert, fwd, bwd, used, ndim)
+            msg = _check_run(cert, fwd, bwd, used, ndim, face_rules)
         else:
             raise _Invalid(f"unknown claim {claim!r}")
     except _Invalid as e:
@@ -197,6 +207,40 @@ def _tables(rules: Mapping[str, Any]) -> tuple[list[list[int]], list[list[int]],
                 fwd[d][a] |= 1 << b
                 bwd[d][b] |= 1 << a
     return fwd, bwd, used, ndim
+
+
+FaceRule = tuple[str, str, int]
+
+
+def _face_rules(raw: Sequence[Any], ndim: int, rules: Mapping[str, Any]) -> list[FaceRule]:
+    out = []
+    for op, where, labels in raw:
+        face = where[1:] if where.startswith("!") else where
+        if op not in ("keep", "remove", "force", "add") or not (
+            where == "*" or (len(face) == 2 and face[0] in _AXES[:ndim] and face[1] in "-+")
+        ):
+            raise _Invalid(f"face rule {[op, where]} is not understood")
+        if any(not 0 <= b < int(rules["labels"]) for b in labels):
+            raise _Invalid(f"face rule {[op, where]}: label out of range")
+        out.append((str(op), str(where), sum(1 << int(b) for b in set(labels))))
+    return out
+
+
+def _domain(face_rules: list[FaceRule], faces: set[str], used: int) -> int:
+    """The domain of a cell lying on ``faces``: the labels in use, edited by the rules."""
+    dom = used
+    for op, where, bits in face_rules:
+        if where != "*" and (where[1:] in faces if where[0] == "!" else where not in faces):
+            continue
+        if op == "keep":
+            dom &= bits
+        elif op == "remove":
+            dom &= ~bits
+        elif op == "force":
+            dom = bits
+        else:
+            dom |= bits
+    return dom & used
 
 
 def _bits(x: int) -> Iterator[int]:
@@ -245,7 +289,12 @@ def _arc_consistency(
 
 
 def _check_closed(
-    cert: Mapping[str, Any], fwd: list[list[int]], bwd: list[list[int]], used: int, ndim: int
+    cert: Mapping[str, Any],
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    ndim: int,
+    face_rules: list[FaceRule],
 ) -> str:
     region = [int(t) for t in cert["region"]]
     history = [int(t) for t in cert["history"]]
@@ -256,18 +305,31 @@ def _check_closed(
         raise _Invalid("history must be non-negative")
     if _axes_of(str(cert["order"]), ndim) != axes:
         raise _Invalid("axes do not match the order")
-    want = {
-        (lo, hi)
-        for lo in itertools.product(*[range(2 + h) for h in history])
-        for hi in itertools.product(*[range(r - 1) for r in region])
-    }
+    both = (False, True) if face_rules else (False,)
+    want = set()
+    for lo in itertools.product(*[range(2 + h) for h in history]):
+        for hi in itertools.product(*[range(r - 1) for r in region]):
+            at_lo = [(True,) if lo[d] < 1 + history[d] else both for d in range(ndim)]
+            at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
+            for a in itertools.product(*at_lo):
+                for b in itertools.product(*at_hi):
+                    want.add((lo, hi, a, b))
     configs = cert["configs"]
-    got = [(tuple(c["lower"]), tuple(c["upper"])) for c in configs]
+    got = [
+        (
+            tuple(c["lower"]), tuple(c["upper"]),
+            tuple(bool(t) for t in c.get("at_lower", [])) or tuple(
+                lo < 1 + h for lo, h in zip(c["lower"], history, strict=True)),
+            tuple(bool(t) for t in c.get("at_upper", [])) or tuple(
+                hi < r - 2 for hi, r in zip(c["upper"], region, strict=True)),
+        )
+        for c in configs
+    ]  # fmt: skip
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
     nstates = 0
-    for c in configs:
-        nstates += _check_config(c, region, axes, fwd, bwd, used)
+    for c, (_, _, a, b) in zip(configs, got, strict=True):
+        nstates += _check_config(c, region, axes, fwd, bwd, used, face_rules, a, b)
     rtxt = "x".join(map(str, region))
     return (
         f"valid: {nstates} states in {len(configs)} configurations are closed under Alg. 3.6 "
@@ -283,6 +345,9 @@ def _check_config(
     fwd: list[list[int]],
     bwd: list[list[int]],
     used: int,
+    face_rules: list[FaceRule],
+    at_lo: tuple[bool, ...],
+    at_hi: tuple[bool, ...],
 ) -> int:
     lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
@@ -316,6 +381,13 @@ def _check_config(
                 raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
         boxes.append(box)
     graphs = [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
+
+    def base(x: Cell) -> int:
+        on = {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
+        on |= {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
+        return _domain(face_rules, on, used)
+
+    bases = [[base(x) for x in g[3]] for g in graphs]
     states = {(int(i), tuple(int(b) for b in labs)) for i, labs in conf["states"]}
     if (0, ()) not in states:
         raise _Invalid(f"{where}: no start state")
@@ -327,11 +399,11 @@ def _check_config(
         if any(not used >> b & 1 for b in labs):
             raise _Invalid(f"{where}: state {[i, list(labs)]} has a label not in use")
         known = dict(zip(keys[i], labs, strict=True))
-        src, arcs, target = graphs[i]
+        src, arcs, target, _ = graphs[i]
         mk = (i, tuple(known[j] for j in src if j >= 0))
         cat = memo.get(mk)
         if cat is None:
-            dom = [used if j < 0 else 1 << known[j] for j in src]
+            dom = [b0 if j < 0 else 1 << known[j] for j, b0 in zip(src, bases[i], strict=True)]
             out = _small_ac(dom, arcs, fwd, bwd, union)
             cat = memo[mk] = 0 if out is None else out[target]
         if i == n - 1:
@@ -350,10 +422,10 @@ def _check_config(
 
 def _graph(
     box: list[Cell], index: Mapping[Cell, int], i: int, key: Sequence[int], cell: Cell
-) -> tuple[list[int], list[list[tuple[int, int, bool]]], int]:
+) -> tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]:
     """The region of step ``i`` as a small graph: its unlabelled cells (``src`` -1) and its
     labelled cells whose label the state records (``src`` = their step); arcs
-    ``(node, axis, node is the + neighbour)``; the node of cell ``i``."""
+    ``(node, axis, node is the + neighbour)``; the node of cell ``i``; the nodes' cells."""
     known = set(key)
     nodes = [x for x in box if not (x in index and index[x] < i) or index[x] in known]
     pos = {x: k for k, x in enumerate(nodes)}
@@ -365,7 +437,7 @@ def _graph(
                 arcs[k].append((m, d, True))
                 arcs[m].append((k, d, False))
     src = [index[x] if x in index and index[x] < i else -1 for x in nodes]
-    return src, arcs, pos[cell]
+    return src, arcs, pos[cell], nodes
 
 
 def _small_ac(
@@ -406,7 +478,12 @@ def _small_ac(
 
 
 def _check_run(
-    cert: Mapping[str, Any], fwd: list[list[int]], bwd: list[list[int]], used: int, ndim: int
+    cert: Mapping[str, Any],
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    ndim: int,
+    face_rules: list[FaceRule],
 ) -> str:
     run = cert["run"]
     shape = tuple(int(s) for s in run["shape"])
@@ -416,8 +493,17 @@ def _check_run(
     cells = sorted(
         itertools.product(*[range(s) for s in shape]), key=lambda c: tuple(c[a] for a in axes)
     )
-    start = {c: used for c in cells}
+
+    def faces(c: Cell) -> set[str]:
+        on = {_AXES[d] + "-" for d in range(ndim) if c[d] == 0}
+        return on | {_AXES[d] + "+" for d in range(ndim) if c[d] == shape[d] - 1}
+
     bnd = run.get("boundary") or {}
+    if bnd == "auto":  # the file's own rules, as stated in the certificate
+        start = {c: _domain(face_rules, faces(c), used) for c in cells}
+        bnd = {}
+    else:
+        start = {c: used for c in cells}
     if not isinstance(bnd, Mapping):
         raise _Invalid("run: boundary must map faces to labels")
     for face, label in bnd.items():

@@ -96,6 +96,7 @@ __all__ = [
     "Rules",
     "alg36_failure",
     "corner_condition",
+    "face_rules_of",
     "proof_scope",
     "prove_infallible",
     "region_box",
@@ -303,11 +304,15 @@ class _Walk:
         ext: Coords,
         cells: list[Coords],
         region: Coords,
+        base: Callable[[Coords], int] | None = None,
     ) -> None:
         self.ext, self.cells, self.region = ext, cells, region
         index = {c: i for i, c in enumerate(cells)}
         ndim = len(ext)
         self.steps: list[tuple[list[int], list[list[tuple[int, int, bool]]], int]] = []
+        # per step, the domain of each unassigned node before arc consistency (None: the
+        # labels in use; else a cell's domain under the file's face rules)
+        self.bases: list[list[int] | None] = []
         relfixed: list[list[int]] = []
         for i, c in enumerate(cells):
             lo, hi = region_box(c, ext, region)
@@ -343,6 +348,7 @@ class _Walk:
                         arcs[m].append((k, d, False))
             src = [index[x] if fixed(x) else -1 for x in keep]
             self.steps.append((src, arcs, pos[c]))
+            self.bases.append(None if base is None else [base(x) for x in keep])
             relfixed.append([j for j in src if j >= 0])
         n = len(cells)
         # labels of steps < i that some step >= i still depends on
@@ -359,7 +365,14 @@ class _Walk:
         hit = self._cache.get(key)
         if hit is not None:
             return hit
-        dom = [rules.used if j < 0 else (1 << labels[j]) for j in src]
+        bases = self.bases[i]
+        if bases is None:
+            dom = [rules.used if j < 0 else (1 << labels[j]) for j in src]
+        else:
+            dom = [
+                b0 & rules.used if j < 0 else (1 << labels[j])
+                for j, b0 in zip(src, bases, strict=True)
+            ]
         out = _graph_ac(rules, dom, arcs)
         res = 0 if out is None else out[target]
         if len(self._cache) < 4_000_000:
@@ -380,23 +393,56 @@ def _scan_cells(ext: Coords, axes: tuple[int, ...]) -> list[Coords]:
 # ----------------------------------------------------------------------------- the prover
 
 
-def _configs(ndim: int, region: Coords, history: Coords) -> Iterator[tuple[Coords, Coords]]:
+Edges = tuple[tuple[bool, ...], tuple[bool, ...]]
+
+
+def _configs(
+    ndim: int, region: Coords, history: Coords, faces: bool = False
+) -> Iterator[tuple[Coords, Coords, Edges]]:
+    """Positions of a point: distances to the lower edges (the last value meaning "at
+    least"), to the upper edges (likewise), and whether the frame's first / last cell on
+    each axis is on the output's edge (always when the frame is clipped there; both ways
+    otherwise, when the file has face rules)."""
     lo_ranges = [range(2 + history[d]) for d in range(ndim)]
     hi_ranges = [range(region[d] - 1) for d in range(ndim)]
     for lo in itertools.product(*lo_ranges):
         for hi in itertools.product(*hi_ranges):
-            yield lo, hi
+            opts_lo = [
+                (True,) if lo[d] < 1 + history[d] else ((False, True) if faces else (False,))
+                for d in range(ndim)
+            ]
+            opts_hi = [
+                (True,) if hi[d] < region[d] - 2 else ((False, True) if faces else (False,))
+                for d in range(ndim)
+            ]
+            for at_lo in itertools.product(*opts_lo):
+                for at_hi in itertools.product(*opts_hi):
+                    yield lo, hi, (at_lo, at_hi)
 
 
 def _frame(
-    lo: Coords, hi: Coords, axes: tuple[int, ...], region: Coords
+    lo: Coords,
+    hi: Coords,
+    axes: tuple[int, ...],
+    region: Coords,
+    edges: Edges | None = None,
+    face_domain: Callable[[frozenset[str]], int] | None = None,
 ) -> tuple[_Walk, Coords, Coords]:
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     q = lo
     key_q = tuple(q[a] for a in axes)
     cells = [c for c in _scan_cells(ext, axes) if tuple(c[a] for a in axes) < key_q]
     cells.append(q)
-    return _Walk(ext, cells, region), ext, q
+    base = None
+    if face_domain is not None and edges is not None:
+        at_lo, at_hi = edges
+
+        def base(x: Coords) -> int:
+            on = {AXIS_NAMES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
+            on |= {AXIS_NAMES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
+            return face_domain(frozenset(on))
+
+    return _Walk(ext, cells, region, base), ext, q
 
 
 def prove_infallible(
@@ -468,6 +514,10 @@ def prove_infallible(
     ndim = rules.ndim
     axes = scan_axes(ndim, order)
     r = parse_region(region, ndim)
+    face_rules = face_rules_of(example)
+    face_domain = _face_domain(face_rules, rules) if face_rules else None
+    if face_rules:
+        realize = False  # exhaustive Alg. 3.6 on a concrete output ignores the face rules
     hist = (int(history),) * ndim if isinstance(history, int) else tuple(int(h) for h in history)
     if len(hist) != ndim or any(h < 0 for h in hist):
         raise InputError(f"history needs {ndim} non-negative values, got {history!r}")
@@ -483,27 +533,30 @@ def prove_infallible(
     }
     digest = hashlib.sha256()
     digest.update(repr((example.hash(), r, order, hist)).encode())
+    if face_rules:
+        digest.update(repr(face_rules).encode())
     failure: dict[str, Any] | None = None
     closed: list[dict[str, Any]] = []
     try:
-        for lo, hi in _configs(ndim, r, hist):
-            walk, ext, q = _frame(lo, hi, axes, r)
+        for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules)):
+            walk, ext, q = _frame(lo, hi, axes, r, edges, face_domain)
             stats["configs"] += 1
             seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
             fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"], seen)
             if seen is not None:
                 closed.append({
                     "lower": list(lo), "upper": list(hi),
+                    "at_lower": list(edges[0]), "at_upper": list(edges[1]),
                     "keys": walk.key_at[: len(walk.cells)],
                     "states": sorted([i, list(k)] for i, k in seen),
                 })  # fmt: skip
             stats["states"] += nstates
             stats["windows"] += len(windows)
             for w in sorted(windows):
-                digest.update(repr((lo, hi, w)).encode())
+                digest.update(repr((lo, hi, w) if not face_rules else (lo, hi, edges, w)).encode())
             if fail is not None:
                 failure = {
-                    "config": {"lower": list(lo), "upper": list(hi)},
+                    "config": {"lower": list(lo), "upper": list(hi), "edges": edges},
                     "output": list(ext),
                     "p": list(q),
                     "frame": [[list(c), int(b)] for c, b in zip(walk.cells, fail, strict=False)],
@@ -524,6 +577,7 @@ def prove_infallible(
         name = example.name or "MODEL"
         hs = "x".join(map(str, hist))
         proof: dict[str, Any] = {
+            "scope": _scope(face_rules),
             "sha256": h,
             "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
             f"--history {hs} --expect-hash {h}",
@@ -565,7 +619,7 @@ def prove_infallible(
                 stats["time_s"] = time.perf_counter() - t0
                 wit["certificate"] = _certificate(example, rules, "fallible", stats, {"run": alg31})
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
-    if refute and isinstance(example, ExampleModel):
+    if refute:
         from csplab.analysis.witness import find_failure
 
         ff = find_failure(
@@ -591,9 +645,10 @@ def proof_scope(model: ExampleModel | RuleSet) -> str | None:
     """Why the region proof cannot decide ``model`` as the synthesizer builds it (one line),
     or ``None`` when it can.
 
-    The proof is about Alg. 3.1 on open square grids of every size: no wrap-around, no
-    boundary condition, no global constraint, one transition matrix per axis. Examples
-    always qualify; a rule set qualifies when its file states none of these.
+    The proof is about Alg. 3.1 on square grids of every size: no wrap-around, no global
+    constraint, one transition matrix per axis; domain rules are covered when each applies
+    to a face of the output or to every cell (the file's boundary conditions). Examples
+    always qualify (on open grids); a rule set when its file states nothing else.
 
     Parameters
     ----------
@@ -620,13 +675,106 @@ def proof_scope(model: ExampleModel | RuleSet) -> str | None:
     per = model.periodic
     if per if isinstance(per, bool | np.bool_) else any(per):
         return "the file makes the grid periodic: the region proof covers open grids only"
-    ops = len(model.boundary_ops) + len(model.constraint_ops)
-    if ops:
+    boxes = [op for op in (*model.boundary_ops, *model.constraint_ops) if _op_face(op) is None]
+    if boxes:
         return (
-            f"the file restricts cell domains ({ops} boundary/domain rules), which the region "
-            "proof does not model yet"
+            f"the file restricts the domains of boxes of cells ({len(boxes)} rules such as "
+            f"{boxes[0].key or boxes[0].op!r}), which the region proof does not model: only "
+            "faces and the whole grid"
         )
     return None
+
+
+def _op_face(op: Any) -> str | None:
+    """Where a domain rule applies, if the region proof can say: ``"x-"`` ... a face,
+    ``"!x-"`` every cell but that face, ``"*"`` every cell; else ``None``."""
+    if op.face is not None:
+        return str(op.face)
+    if op.region is None:
+        return "*"
+    parts = []
+    for d, (a, b) in enumerate(op.region):
+        if a in (None, 0) and b is None:
+            continue
+        sign = {(0, 1): "-", (-1, None): "+", (1, None): "!-", (None, -1): "!+"}.get((a, b))
+        if sign is None or d >= len(AXIS_NAMES):
+            return None
+        if d < len(op.flip) and op.flip[d]:
+            sign = sign.replace("-", "?").replace("+", "-").replace("?", "+")
+        neg = sign.startswith("!")
+        parts.append(("!" if neg else "") + AXIS_NAMES[d] + sign[-1])
+    if not parts:
+        return "*"
+    return parts[0] if len(parts) == 1 else None
+
+
+def _scope(face_rules: Sequence[Any]) -> str:
+    n = len(face_rules)
+    return "grids of every size, not periodic, " + (
+        f"with the file's {n} face/domain rules" if n else "no boundary conditions"
+    )
+
+
+def face_rules_of(model: ExampleModel | RuleSet) -> list[tuple[str, str, list[int]]]:
+    """A rule set's domain rules as the region proof reads them, in file order (boundary
+    rules first, as :meth:`RuleSet.problem` applies them on open grids).
+
+    Parameters
+    ----------
+    model : ExampleModel or RuleSet
+        Within :func:`proof_scope` (examples have no rules).
+
+    Returns
+    -------
+    list of (op, where, labels)
+        ``op`` keep / remove / force / add; ``where`` a face (``"z-"``), every cell but a
+        face (``"!z-"``) or every cell (``"*"``); the labels, sorted.
+
+    Examples
+    --------
+    >>> from csplab.io.ruleset import DomainOp, RuleSet
+    >>> rs = RuleSet(np.ones((2, 2, 2), dtype=bool),
+    ...              boundary_ops=[DomainOp("force", np.array([False, True]), face="y-")])
+    >>> face_rules_of(rs)
+    [('force', 'y-', [1])]
+    """
+    if isinstance(model, ExampleModel):
+        return []
+    out = []
+    for op in (*model.boundary_ops, *model.constraint_ops):
+        face = _op_face(op)
+        assert face is not None  # proof_scope refused the others
+        out.append((str(op.op), face, np.flatnonzero(op.labels).tolist()))
+    return out
+
+
+def _face_domain(
+    face_rules: Sequence[tuple[str, str, list[int]]], rules: Rules
+) -> Callable[[frozenset[str]], int]:
+    """The domain (bit set) of a cell on the given faces, under the rules in file order."""
+    cache: dict[frozenset[str], int] = {}
+
+    def domain(faces: frozenset[str]) -> int:
+        hit = cache.get(faces)
+        if hit is None:
+            dom = rules.used
+            for op, face, labels in face_rules:
+                on = face == "*" or (face[1:] not in faces if face[0] == "!" else face in faces)
+                if not on:
+                    continue
+                bits = sum(1 << b for b in labels)
+                if op == "keep":
+                    dom &= bits
+                elif op == "remove":
+                    dom &= ~bits
+                elif op == "force":
+                    dom = bits
+                else:  # add
+                    dom |= bits
+            hit = cache[faces] = dom & rules.used
+        return hit
+
+    return domain
 
 
 def _certificate(
@@ -639,18 +787,19 @@ def _certificate(
     """A certificate (format ``csplab-certificate`` version 1) for :mod:`csplab.certcheck`."""
     import json
 
+    face_rules = face_rules_of(example)
     rel = {
         "labels": rules.K,
         "used": [int(b) for b in rules.used_mask],
         "pairs": [np.argwhere(rules.T[d]).tolist() for d in range(rules.ndim)],
+        "faces": [[op, face, labels] for op, face, labels in face_rules],
     }
     canon = json.dumps(rel, sort_keys=True, separators=(",", ":")).encode()
     return {
         "format": "csplab-certificate",
         "version": 1,
         "claim": claim,
-        "scope": "Alg. 3.1 in the given scan order, on open grids of every size "
-        "(not periodic, no boundary conditions)",
+        "scope": "Alg. 3.1 in the given scan order, " + _scope(face_rules),
         "model": {"name": example.name, "hash": example.hash()},
         "rules": rel,
         "rules_sha256": hashlib.sha256(canon).hexdigest(),

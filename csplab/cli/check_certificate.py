@@ -51,6 +51,7 @@ def run(args: argparse.Namespace) -> int:
 def _same_rules(cert: dict[str, object], path: str, spec: str, options: list[str] | None) -> None:
     import numpy as np
 
+    from csplab.analysis.infallible import face_rules_of
     from csplab.cli._analysis import load_analysis_model
     from csplab.example import ExampleModel
 
@@ -62,6 +63,7 @@ def _same_rules(cert: dict[str, object], path: str, spec: str, options: list[str
         "labels": int(T.shape[1]),
         "used": [int(b) for b in used],
         "pairs": [np.argwhere(T[d]).tolist() for d in range(T.shape[0])],
+        "faces": [list(f) for f in face_rules_of(M)],
     }
     if rules != mine:
         raise InputError(f"{path}: the certificate's rules are not those of {spec}")

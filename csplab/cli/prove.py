@@ -26,8 +26,8 @@ HELP = "prove a model infallible (Alg. 3.1 never fails) by region enumeration"
 DESCRIPTION = (
     "Enumerate every window state Alg. 3.6 can reach with the given region "
     "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
-    "fails on the model, at any output size (Theorem 3.3.6). Examples and tilesets (open "
-    "grids: not periodic, no boundary rules). --certificate writes what the verdict rests "
+    "fails on the model, at any output size (Theorem 3.3.6). Examples (open grids) and "
+    "tilesets (not periodic; their face rules apply). --certificate writes what the verdict rests "
     "on, for `csplab check-certificate`. Exit 0 proven, 1 refuted (fallible), 3 undecided, "
     "2 bad input."
 )
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"  no certificate written to {args.certificate}: the verdict is undecided")
     if v.holds is True:
         if not args.json:
-            print("  scope: open grids of every size (not periodic, no boundary conditions)")
+            print(f"  scope: {(v.witness or {}).get('scope')}")
             print(f"  proof sha256 {v.witness['sha256']}")
             print(f"  re-check: {v.witness['recheck']}")
         if args.expect_hash and args.expect_hash != v.witness["sha256"]:

@@ -16,12 +16,14 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from csplab.analysis.infallible import proof_scope, prove_infallible
 from csplab.certcheck import check_certificate, rules_hash
 from csplab.errors import InputError
 from csplab.examples import load_example, load_model
-from csplab.io.ruleset import RuleSet
+from csplab.io.ruleset import DomainOp, RuleSet
 
 DATA = Path(__file__).resolve().parents[1] / "io" / "data"
 _ROOT = Path(__file__).resolve().parents[2]
@@ -172,15 +174,26 @@ def test_checker_imports_nothing_of_csplab_but_errors():
     assert {n for n in names if n.split(".")[0] == "csplab"} == {"csplab.errors"}
 
 
-@pytest.mark.parametrize(
-    ("name", "why"),
-    [("tiny_debroglie.json", "global constraints"), ("tiny_poms.json", "restricts cell domains")],
-)
-def test_rule_sets_outside_the_proof_say_why(name, why):
-    M = load_model(str(DATA / name))
-    assert why in proof_scope(M)
-    with pytest.raises(InputError, match=why):
+def test_rule_sets_outside_the_proof_say_why():
+    M = load_model(str(DATA / "tiny_debroglie.json"))
+    assert "global constraints" in proof_scope(M)
+    with pytest.raises(InputError, match="global constraints"):
         prove_infallible(M)
+    T = np.ones((2, 2, 2), dtype=bool)
+    box = DomainOp("force", np.array([True, False]), region=[(2, 4), (1, 3)], key="lake")
+    assert "boxes of cells" in proof_scope(RuleSet(T, constraint_ops=[box]))
+    assert "periodic" in proof_scope(RuleSet(T, periodic=True))
+
+
+def test_poms_face_rules_proved_and_checked():
+    # tiny_poms: 5 boundary rules on faces, label 1 forced on z- and removed elsewhere
+    cert = _cert(str(DATA / "tiny_poms.json"), "2", "scanline")
+    assert len(cert["rules"]["faces"]) == 7 and len(cert["configs"]) == 512
+    bad = copy.deepcopy(cert)  # drop the rule that removes label 1 above the ground
+    bad["rules"]["faces"] = [f for f in bad["rules"]["faces"] if f[1] != "!z-"]
+    bad["rules_sha256"] = rules_hash(bad["rules"])
+    ok, msg = check_certificate(bad)
+    assert not ok and "not closed" in msg
 
 
 @pytest.mark.skipif(ANCHORS is None, reason="no shared/anchors-data")
@@ -200,3 +213,56 @@ def test_anchor_rule_sets_get_a_verdict_or_a_reason():
         print(f"{f.name}: {v.message}")
         if v.holds is True:
             assert check_certificate(json.loads(json.dumps(v.witness["certificate"])))[0]
+
+
+# ----------------------------------------------------------------------------- face rules
+
+
+@st.composite
+def rule_sets_with_faces(draw):
+    """Random 2D rule sets (2-3 labels) with 1-3 domain rules on faces, the whole grid or
+    every cell but a face, as POMS and DeBroglie files state them."""
+    K = draw(st.integers(2, 3))
+    T = np.array(draw(st.lists(st.booleans(), min_size=2 * K * K, max_size=2 * K * K)))
+    T = T.reshape(2, K, K)
+    ops = []
+    for _ in range(draw(st.integers(1, 3))):
+        op = draw(st.sampled_from(["keep", "remove", "force", "add"]))
+        labels = np.array(draw(st.lists(st.booleans(), min_size=K, max_size=K)))
+        where = draw(st.sampled_from(["x-", "x+", "y-", "y+", "*", "!y-"]))
+        if where == "*":
+            ops.append(DomainOp(op, labels))
+        elif where == "!y-":
+            ops.append(DomainOp(op, labels, region=[(None, None), (1, None)]))
+        else:
+            ops.append(DomainOp(op, labels, face=where, kind="boundary"))
+    return RuleSet(T, boundary_ops=ops)
+
+
+@settings(max_examples=60, deadline=None)
+@given(rule_sets_with_faces(), st.sampled_from(["scanline", "scan:yx"]))
+def test_face_rule_proofs_are_sound_against_exhaustive_runs(rs, order):
+    from csplab.analysis import alg31_exhaustive
+
+    assert proof_scope(rs) is None
+    v = prove_infallible(rs, 2, order=order, refute=False, max_states=20_000, certificate=True)
+    if v.holds is not True:
+        return
+    for shape in [(1, 3), (3, 1), (2, 2), (2, 3), (3, 2), (3, 3), (4, 3), (3, 4)]:
+        ex = alg31_exhaustive(rs.problem(shape), order, max_states=20_000)
+        assert ex.holds is not False, (shape, ex.witness)
+    cert = json.loads(json.dumps(v.witness["certificate"]))
+    assert check_certificate(cert)[0]
+    bad = copy.deepcopy(cert)  # the face rules are part of the hashed rules
+    bad["rules"]["faces"] = bad["rules"]["faces"][:-1]
+    assert not check_certificate(bad)[0]
+
+
+@settings(max_examples=40, deadline=None)
+@given(rule_sets_with_faces())
+def test_face_rule_refutations_check(rs):
+    v = prove_infallible(rs, 2, realize=False, certificate=True, max_states=20_000)
+    if v.holds is False:
+        cert = json.loads(json.dumps(v.witness["certificate"]))
+        ok, msg = check_certificate(cert)
+        assert ok, msg

@@ -109,4 +109,4 @@ def test_catalog_gap_and_corner_on_a_tileset(capsys):
     code, out, _ = run(capsys, "prove", pipes, "--corner")
     assert code == 0 and out.startswith("corner condition holds")
     code, out, _ = run(capsys, "prove", pipes)
-    assert "scope: open grids" in out
+    assert "scope: grids of every size, not periodic, no boundary conditions" in out
