@@ -1,4 +1,4 @@
-"""Certificates of ``prove`` and their independent checker (csplab.certcheck), issue 26.
+"""csplab.certcheck, the independent checker of ``prove``'s certificates (issue 26).
 
 The checker must accept what the prover proves, on a 2D example, a 3D built-in and a
 tileset, and reject planted defects: a state removed, a transition altered (with or
@@ -25,8 +25,8 @@ from csplab.errors import InputError
 from csplab.examples import load_example, load_model
 from csplab.io.ruleset import DomainOp, RuleSet
 
-DATA = Path(__file__).resolve().parents[1] / "io" / "data"
-_ROOT = Path(__file__).resolve().parents[2]
+DATA = Path(__file__).resolve().parent / "io" / "data"
+_ROOT = Path(__file__).resolve().parents[1]
 ANCHORS = next(
     (p for p in (_ROOT.parent / "shared" / "anchors-data",
                  _ROOT.parents[1] / "shared" / "anchors-data") if p.is_dir()),
