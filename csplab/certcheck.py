@@ -499,18 +499,18 @@ def _check_run(
         return on | {_AXES[d] + "+" for d in range(ndim) if c[d] == shape[d] - 1}
 
     bnd = run.get("boundary") or {}
-    if bnd == "auto":  # the file's own rules, as stated in the certificate
-        start = {c: _domain(face_rules, faces(c), used) for c in cells}
-        bnd = {}
+    if bnd == "auto":  # the certificate's face rules
+        rules_here = face_rules
+    elif isinstance(bnd, Mapping):  # face -> label; the bottom face wins, then later faces
+        every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
+        if any(f not in every for f in bnd):
+            raise _Invalid(f"run: unknown boundary faces in {sorted(bnd)}")
+        bottom = _AXES[ndim - 1] + "-"
+        order = [f for f in every if f != bottom] + [bottom]
+        rules_here = [("force", f, 1 << int(bnd[f])) for f in order if f in bnd]
     else:
-        start = {c: used for c in cells}
-    if not isinstance(bnd, Mapping):
-        raise _Invalid("run: boundary must map faces to labels")
-    for face, label in bnd.items():
-        d = _AXES.index(face[0])
-        for c in cells:
-            if c[d] == (0 if face[1] == "-" else shape[d] - 1):
-                start[c] &= 1 << int(label)
+        raise _Invalid("run: boundary must be 'auto' or map faces to labels")
+    start = {c: _domain(rules_here, faces(c), used) for c in cells}
     if any(v == 0 for v in start.values()):
         return "valid: Alg. 3.1 fails before its first choice (a boundary cell has no label)"
     dom = _arc_consistency(start, fwd, bwd)

@@ -455,6 +455,7 @@ def prove_infallible(
     realize: bool = True,
     refute: bool = True,
     certificate: bool = False,
+    boundary: Mapping[str, int] | str | None = None,
 ) -> Verdict:
     """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
 
@@ -483,6 +484,11 @@ def prove_infallible(
         Put a certificate in ``witness["certificate"]`` (a dict, JSON-ready): when proved,
         the closed set of frame states of every configuration (checked by
         :mod:`csplab.certcheck` without this module's code); when refuted, the failing run.
+    boundary : mapping face -> label, "auto", "none" or None
+        An example's boundary labels, as in :func:`~csplab.grids.from_example` (``"auto"``:
+        :func:`~csplab.grids.auto_boundary`, the ground and empty space, whatever the
+        output size; ``synthesize`` falls back to Merrell's rule where that has no
+        solution). A tileset's boundary is its file's own.
 
     Raises
     ------
@@ -514,7 +520,7 @@ def prove_infallible(
     ndim = rules.ndim
     axes = scan_axes(ndim, order)
     r = parse_region(region, ndim)
-    face_rules = face_rules_of(example)
+    face_rules = face_rules_of(example, boundary)
     face_domain = _face_domain(face_rules, rules) if face_rules else None
     if face_rules:
         realize = False  # exhaustive Alg. 3.6 on a concrete output ignores the face rules
@@ -584,7 +590,7 @@ def prove_infallible(
         }
         if certificate:
             proof["certificate"] = _certificate(
-                example, rules, "infallible", stats,
+                example, rules, face_rules, "infallible", stats,
                 {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
                  "configs": closed},
             )  # fmt: skip
@@ -617,22 +623,27 @@ def prove_infallible(
             wit["alg31"] = alg31
             if certificate:
                 stats["time_s"] = time.perf_counter() - t0
-                wit["certificate"] = _certificate(example, rules, "fallible", stats, {"run": alg31})
+                wit["certificate"] = _certificate(
+                    example, rules, face_rules, "fallible", stats, {"run": alg31}
+                )
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
     if refute:
         from csplab.analysis.witness import find_failure
 
         ff = find_failure(
             example, order=order, max_size=_refute_size(ndim), random_runs=0,
-            max_states=50_000 if ndim <= 2 else 5_000,
+            max_states=50_000 if ndim <= 2 else 5_000, boundary=_boundary_map(example, boundary),
         )  # fmt: skip
         stats["refute_states"] = ff.stats.get("states", 0)
         if ff.holds is False:
             wit["alg31"] = ff.witness
             if certificate and ff.witness is not None:
                 stats["time_s"] = time.perf_counter() - t0
+                run = dict(ff.witness)
+                if face_rules:  # the run's boundary is the certificate's face rules
+                    run["boundary"] = "auto"
                 wit["certificate"] = _certificate(
-                    example, rules, "fallible", stats, {"run": ff.witness}
+                    example, rules, face_rules, "fallible", stats, {"run": run}
                 )
             return Verdict(False, wit, stats, msg + "; Alg. 3.1 fails too: fallible")
         size = "x".join(map(str, _refute_size(ndim)))
@@ -711,18 +722,45 @@ def _op_face(op: Any) -> str | None:
 def _scope(face_rules: Sequence[Any]) -> str:
     n = len(face_rules)
     return "grids of every size, not periodic, " + (
-        f"with the file's {n} face/domain rules" if n else "no boundary conditions"
+        f"with {n} boundary/domain rules on faces" if n else "no boundary conditions"
     )
 
 
-def face_rules_of(model: ExampleModel | RuleSet) -> list[tuple[str, str, list[int]]]:
-    """A rule set's domain rules as the region proof reads them, in file order (boundary
-    rules first, as :meth:`RuleSet.problem` applies them on open grids).
+def _boundary_map(
+    model: ExampleModel | RuleSet, boundary: Mapping[str, int] | str | None
+) -> dict[str, int] | None:
+    """An example's boundary as a mapping face -> label (``None``: none)."""
+    if boundary is None or boundary == "none":
+        return None
+    if not isinstance(model, ExampleModel):
+        raise InputError(
+            f"{model.name or 'a tileset'}: its boundary is its file's own (no --boundary)"
+        )
+    if isinstance(boundary, str):
+        if boundary != "auto":
+            return _boundary_map(model, grids.parse_boundary(boundary))
+        return grids.auto_boundary(model, model.ndim)
+    faces = [f"{AXIS_NAMES[d]}{s}" for d in range(model.ndim) for s in "-+"]
+    bad = [f for f in boundary if f not in faces]
+    if bad:
+        raise InputError(f"unknown boundary face(s) {bad}; faces are {faces}")
+    return {str(f): int(b) for f, b in boundary.items()}
+
+
+def face_rules_of(
+    model: ExampleModel | RuleSet, boundary: Mapping[str, int] | str | None = None
+) -> list[tuple[str, str, list[int]]]:
+    """The domain rules the region proof applies, in order: a rule set's own (boundary
+    rules first, as :meth:`RuleSet.problem` applies them on open grids), or an example's
+    ``boundary`` labels (each face forced, the bottom face last: it wins where faces meet,
+    as in :func:`~csplab.grids.from_example`).
 
     Parameters
     ----------
     model : ExampleModel or RuleSet
-        Within :func:`proof_scope` (examples have no rules).
+        Within :func:`proof_scope`.
+    boundary : mapping face -> label, "auto", "none" or None
+        An example's boundary (a tileset's is its file's own).
 
     Returns
     -------
@@ -739,7 +777,14 @@ def face_rules_of(model: ExampleModel | RuleSet) -> list[tuple[str, str, list[in
     [('force', 'y-', [1])]
     """
     if isinstance(model, ExampleModel):
-        return []
+        bnd = _boundary_map(model, boundary)
+        if not bnd:
+            return []
+        bottom = f"{AXIS_NAMES[model.ndim - 1]}-"
+        faces = [f"{AXIS_NAMES[d]}{s}" for d in range(model.ndim) for s in "-+"]
+        order = [f for f in faces if f != bottom] + [bottom]
+        return [("force", f, [bnd[f]]) for f in order if f in bnd]
+    _boundary_map(model, boundary)  # refuses a boundary for a tileset
     out = []
     for op in (*model.boundary_ops, *model.constraint_ops):
         face = _op_face(op)
@@ -780,6 +825,7 @@ def _face_domain(
 def _certificate(
     example: ExampleModel | RuleSet,
     rules: Rules,
+    face_rules: Sequence[tuple[str, str, list[int]]],
     claim: str,
     stats: Mapping[str, Any],
     body: Mapping[str, Any],
@@ -787,7 +833,6 @@ def _certificate(
     """A certificate (format ``csplab-certificate`` version 1) for :mod:`csplab.certcheck`."""
     import json
 
-    face_rules = face_rules_of(example)
     rel = {
         "labels": rules.K,
         "used": [int(b) for b in rules.used_mask],

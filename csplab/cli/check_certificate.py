@@ -27,13 +27,14 @@ DESCRIPTION = (
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("file", metavar="FILE", help="certificate (JSON) from csplab prove")
     p.add_argument("--model", help="also require the certificate's rules to be this model's")
+    p.add_argument("--boundary", help="with --model: the example's boundary given to prove")
     add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:
     cert = load_certificate(args.file)
     if args.model:
-        _same_rules(cert, args.file, args.model, args.model_option)
+        _same_rules(cert, args.file, args.model, args.model_option, args.boundary)
     t0 = time.perf_counter()
     ok, msg = check_certificate(cert)
     dt = time.perf_counter() - t0
@@ -48,7 +49,9 @@ def run(args: argparse.Namespace) -> int:
     return 0 if ok else 1
 
 
-def _same_rules(cert: dict[str, object], path: str, spec: str, options: list[str] | None) -> None:
+def _same_rules(
+    cert: dict[str, object], path: str, spec: str, options: list[str] | None, boundary: str | None
+) -> None:
     import numpy as np
 
     from csplab.analysis.infallible import face_rules_of
@@ -63,7 +66,7 @@ def _same_rules(cert: dict[str, object], path: str, spec: str, options: list[str
         "labels": int(T.shape[1]),
         "used": [int(b) for b in used],
         "pairs": [np.argwhere(T[d]).tolist() for d in range(T.shape[0])],
-        "faces": [list(f) for f in face_rules_of(M)],
+        "faces": [list(f) for f in face_rules_of(M, boundary)],
     }
     if rules != mine:
         raise InputError(f"{path}: the certificate's rules are not those of {spec}")

@@ -40,6 +40,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--history", default="1", help="extra frame cells per axis (default 1)")
     p.add_argument("--max-states", type=int, default=5_000_000, help="state budget")
     p.add_argument("--corner", action="store_true", help="only check Eq. 3.11 (corner test)")
+    p.add_argument(
+        "--boundary",
+        help="an example's boundary: auto (ground and empty space), none (default) or "
+        "face=label,...; a tileset's is its file's own",
+    )
     p.add_argument("--expect-hash", help="re-check a proof: exit 3 unless the hash matches")
     p.add_argument("--out", help="save the failing run as a .png picture or .json")
     p.add_argument(
@@ -69,7 +74,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--max-states must be positive")
     v = prove_infallible(
         E, args.region, order=args.order, history=history, max_states=args.max_states,
-        certificate=bool(args.certificate),
+        certificate=bool(args.certificate), boundary=args.boundary,
     )  # fmt: skip
     cert = (v.witness or {}).pop("certificate", None) if args.certificate else None
     print_verdict(v, args.json)
