@@ -388,36 +388,52 @@ def _check_config(
         return _domain(face_rules, on, used)
 
     bases = [[base(x) for x in g[3]] for g in graphs]
-    states = {(int(i), tuple(int(b) for b in labs)) for i, labs in conf["states"]}
-    if (0, ()) not in states:
+    by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
+    try:
+        for i, labs in conf["states"]:
+            by_step[i if i >= 0 else n].add(tuple(labs))
+    except (IndexError, TypeError):
+        raise _Invalid(f"{where}: a state's step is not one of its {n} steps") from None
+    in_use = set(_bits(used))
+    for i, group in enumerate(by_step):
+        if any(len(t) != len(keys[i]) for t in group):
+            raise _Invalid(f"{where}: a state at step {i} does not fit keys[{i}]")
+        labels = set(itertools.chain.from_iterable(group))
+        if not labels <= in_use:
+            raise _Invalid(f"{where}: a state at step {i} has a label not in use")
+    if () not in by_step[0]:
         raise _Invalid(f"{where}: no start state")
-    memo: dict[tuple[int, tuple[int, ...]], int] = {}
     union: dict[tuple[int, int, int], int] = {}
-    for i, labs in states:
-        if not 0 <= i < n or len(labs) != len(keys[i]):
-            raise _Invalid(f"{where}: state {[i, list(labs)]} does not fit keys[{i}]")
-        if any(not used >> b & 1 for b in labs):
-            raise _Invalid(f"{where}: state {[i, list(labs)]} has a label not in use")
-        known = dict(zip(keys[i], labs, strict=True))
+    for i in range(n):
         src, arcs, target, _ = graphs[i]
-        mk = (i, tuple(known[j] for j in src if j >= 0))
-        cat = memo.get(mk)
-        if cat is None:
-            dom = [b0 if j < 0 else 1 << known[j] for j, b0 in zip(src, bases[i], strict=True)]
-            out = _small_ac(dom, arcs, fwd, bwd, union)
-            cat = memo[mk] = 0 if out is None else out[target]
-        if i == n - 1:
-            if cat == 0:
-                raise _Invalid(f"{where}: the point's catalog is empty in state {[i, list(labs)]}")
-            continue
-        for b in _bits(cat):
-            nxt = tuple(b if j == i else known[j] for j in keys[i + 1])
-            if (i + 1, nxt) not in states:
-                raise _Invalid(
-                    f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
-                    f"{[i + 1, list(nxt)]}, which is missing"
-                )
-    return len(states)
+        pos = {j: k for k, j in enumerate(keys[i])}
+        # where each fixed node's label, and each label of the next state, sits in a state
+        src_at = [pos[j] for j in src if j >= 0]
+        nxt_at = [-1 if j == i else pos[j] for j in keys[i + 1]] if i + 1 < n else []
+        later = by_step[i + 1] if i + 1 < n else set()
+        memo: dict[tuple[int, ...], int] = {}
+        for labs in by_step[i]:
+            mk = tuple([labs[k] for k in src_at])
+            cat = memo.get(mk)
+            if cat is None:
+                it = iter(mk)
+                dom = [b0 if j < 0 else 1 << next(it) for j, b0 in zip(src, bases[i], strict=True)]
+                out = _small_ac(dom, arcs, fwd, bwd, union)
+                cat = memo[mk] = 0 if out is None else out[target]
+            if i == n - 1:
+                if cat == 0:
+                    raise _Invalid(
+                        f"{where}: the point's catalog is empty in state {[i, list(labs)]}"
+                    )
+                continue
+            for b in _bits(cat):
+                nxt = tuple([b if k < 0 else labs[k] for k in nxt_at])
+                if nxt not in later:
+                    raise _Invalid(
+                        f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
+                        f"{[i + 1, list(nxt)]}, which is missing"
+                    )
+    return sum(len(s) for s in by_step)
 
 
 def _graph(
