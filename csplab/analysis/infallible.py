@@ -580,7 +580,12 @@ def prove_infallible(
     stats["time_s"] = time.perf_counter() - t0
     if failure is None:
         h = digest.hexdigest()
-        name = example.name or "MODEL"
+        name = (example.meta.get("source") if not isinstance(example, ExampleModel) else None) or (
+            example.name or "MODEL"
+        )
+        if face_rules and isinstance(example, ExampleModel):
+            bnd = _boundary_map(example, boundary) or {}
+            name += " --boundary " + ",".join(f"{f}={b}" for f, b in bnd.items())
         hs = "x".join(map(str, hist))
         proof: dict[str, Any] = {
             "scope": _scope(face_rules),
