@@ -1084,6 +1084,11 @@ def corner_condition(example: ExampleModel | RuleSet, order: str = "scanline") -
     """
     t0 = time.perf_counter()
     why = proof_scope(example)
+    if why is None and face_rules_of(example):
+        why = (
+            "the corner condition is about open grids; prove without --corner applies the "
+            "file's face rules"
+        )
     if why is not None:
         raise InputError(f"{example.name or 'the model'}: {why}")
     T = example.transitions()

@@ -110,3 +110,9 @@ def test_catalog_gap_and_corner_on_a_tileset(capsys):
     assert code == 0 and out.startswith("corner condition holds")
     code, out, _ = run(capsys, "prove", pipes)
     assert "scope: grids of every size, not periodic, no boundary conditions" in out
+
+
+def test_corner_refuses_face_rules_in_one_line(capsys):
+    code, _, err = run(capsys, "prove", str(DATA / "tiny_poms.json"), "--corner")
+    assert code == 2 and "face rules" in err
+    assert len([ln for ln in err.splitlines() if ln.startswith("csplab: error")]) == 1
