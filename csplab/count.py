@@ -54,6 +54,7 @@ from csplab.catalog import Propagator
 from csplab.deps import available, require
 from csplab.errors import CsplabError, InputError
 from csplab.grids import from_example
+from csplab.io.ruleset import RuleSet
 from csplab.problem import Problem
 from csplab.progress import progress_bar
 from csplab.rng import RngLike, make_rng
@@ -542,8 +543,14 @@ def entropy_per_cell(
     if not 1 <= L1 < L2:
         raise InputError("lengths must be two increasing positive integers")
     w = tuple(int(v) for v in width)
-    c1 = count_solutions(from_example(example, (*w, L1), periodic=periodic), method, **kw)
-    c2 = count_solutions(from_example(example, (*w, L2), periodic=periodic), method, **kw)
+
+    def strip(length: int) -> Problem:
+        if isinstance(example, RuleSet):  # a tileset's rules (its domain rules, no boundary)
+            return example.problem((*w, length), periodic=periodic, boundary="none")
+        return from_example(example, (*w, length), periodic=periodic)
+
+    c1 = count_solutions(strip(L1), method, **kw)
+    c2 = count_solutions(strip(L2), method, **kw)
     cells = math.prod(w)
     if int(c1) == 0 or int(c2) == 0:
         rate = float("-inf")

@@ -77,7 +77,7 @@ import hashlib
 import itertools
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -90,10 +90,15 @@ from csplab.grids import from_example
 from csplab.problem import AXIS_NAMES
 from csplab.result import Verdict
 
+if TYPE_CHECKING:
+    from csplab.io.ruleset import RuleSet
+
 __all__ = [
     "Rules",
     "alg36_failure",
     "corner_condition",
+    "face_rules_of",
+    "proof_scope",
     "prove_infallible",
     "region_box",
     "region_catalog",
@@ -128,10 +133,13 @@ class Rules:
         self._union: dict[tuple[int, bool, int], int] = {}
 
     @classmethod
-    def of(cls, example: ExampleModel | Rules) -> Rules:
+    def of(cls, example: ExampleModel | RuleSet | Rules) -> Rules:
+        """The rules of an example (its labels in use) or of a rule set (every label)."""
         if isinstance(example, Rules):
             return example
-        return cls(example.transitions(), example.counts() > 0)
+        if isinstance(example, ExampleModel):
+            return cls(example.transitions(), example.counts() > 0)
+        return cls(example.transitions())
 
     def union(self, d: int, forward: bool, dom: int) -> int:
         """Labels supported along axis ``d`` by some label of ``dom`` (forward: as successor)."""
@@ -290,11 +298,15 @@ class _Walk:
         ext: Coords,
         cells: list[Coords],
         region: Coords,
+        base: Callable[[Coords], int] | None = None,
     ) -> None:
         self.ext, self.cells, self.region = ext, cells, region
         index = {c: i for i, c in enumerate(cells)}
         ndim = len(ext)
         self.steps: list[tuple[list[int], list[list[tuple[int, int, bool]]], int]] = []
+        # per step, the domain of each unassigned node before arc consistency (None: the
+        # labels in use; else a cell's domain under the file's face rules)
+        self.bases: list[list[int] | None] = []
         relfixed: list[list[int]] = []
         for i, c in enumerate(cells):
             lo, hi = region_box(c, ext, region)
@@ -330,6 +342,7 @@ class _Walk:
                         arcs[m].append((k, d, False))
             src = [index[x] if fixed(x) else -1 for x in keep]
             self.steps.append((src, arcs, pos[c]))
+            self.bases.append(None if base is None else [base(x) for x in keep])
             relfixed.append([j for j in src if j >= 0])
         n = len(cells)
         # labels of steps < i that some step >= i still depends on
@@ -346,7 +359,14 @@ class _Walk:
         hit = self._cache.get(key)
         if hit is not None:
             return hit
-        dom = [rules.used if j < 0 else (1 << labels[j]) for j in src]
+        bases = self.bases[i]
+        if bases is None:
+            dom = [rules.used if j < 0 else (1 << labels[j]) for j in src]
+        else:
+            dom = [
+                b0 & rules.used if j < 0 else (1 << labels[j])
+                for j, b0 in zip(src, bases, strict=True)
+            ]
         out = _graph_ac(rules, dom, arcs)
         res = 0 if out is None else out[target]
         if len(self._cache) < 4_000_000:
@@ -367,27 +387,60 @@ def _scan_cells(ext: Coords, axes: tuple[int, ...]) -> list[Coords]:
 # ----------------------------------------------------------------------------- the prover
 
 
-def _configs(ndim: int, region: Coords, history: Coords) -> Iterator[tuple[Coords, Coords]]:
+Edges = tuple[tuple[bool, ...], tuple[bool, ...]]
+
+
+def _configs(
+    ndim: int, region: Coords, history: Coords, faces: bool = False
+) -> Iterator[tuple[Coords, Coords, Edges]]:
+    """Positions of a point: distances to the lower edges (the last value meaning "at
+    least"), to the upper edges (likewise), and whether the frame's first / last cell on
+    each axis is on the output's edge (always when the frame is clipped there; both ways
+    otherwise, when the file has face rules)."""
     lo_ranges = [range(2 + history[d]) for d in range(ndim)]
     hi_ranges = [range(region[d] - 1) for d in range(ndim)]
     for lo in itertools.product(*lo_ranges):
         for hi in itertools.product(*hi_ranges):
-            yield lo, hi
+            opts_lo = [
+                (True,) if lo[d] < 1 + history[d] else ((False, True) if faces else (False,))
+                for d in range(ndim)
+            ]
+            opts_hi = [
+                (True,) if hi[d] < region[d] - 2 else ((False, True) if faces else (False,))
+                for d in range(ndim)
+            ]
+            for at_lo in itertools.product(*opts_lo):
+                for at_hi in itertools.product(*opts_hi):
+                    yield lo, hi, (at_lo, at_hi)
 
 
 def _frame(
-    lo: Coords, hi: Coords, axes: tuple[int, ...], region: Coords
+    lo: Coords,
+    hi: Coords,
+    axes: tuple[int, ...],
+    region: Coords,
+    edges: Edges | None = None,
+    face_domain: Callable[[frozenset[str]], int] | None = None,
 ) -> tuple[_Walk, Coords, Coords]:
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     q = lo
     key_q = tuple(q[a] for a in axes)
     cells = [c for c in _scan_cells(ext, axes) if tuple(c[a] for a in axes) < key_q]
     cells.append(q)
-    return _Walk(ext, cells, region), ext, q
+    base = None
+    if face_domain is not None and edges is not None:
+        at_lo, at_hi = edges
+
+        def base(x: Coords) -> int:
+            on = {AXIS_NAMES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
+            on |= {AXIS_NAMES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
+            return face_domain(frozenset(on))
+
+    return _Walk(ext, cells, region, base), ext, q
 
 
 def prove_infallible(
-    example: ExampleModel,
+    example: ExampleModel | RuleSet,
     region: Sequence[int] | str | int = 2,
     *,
     order: str = "scanline",
@@ -395,12 +448,17 @@ def prove_infallible(
     max_states: int = 5_000_000,
     realize: bool = True,
     refute: bool = True,
+    certificate: bool = False,
+    boundary: Mapping[str, int] | str | None = None,
 ) -> Verdict:
     """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
 
     Parameters
     ----------
-    example : ExampleModel
+    example : ExampleModel or RuleSet
+        An example (its labels in use) or a tileset's rules (every label). The proof is
+        about open grids: not periodic, no boundary conditions (:func:`proof_scope` says
+        why a rule set falls outside it).
     region : int, ``"3x2"`` or sequence
         Region size ``r`` per axis (at least 2; missing trailing axes are 2).
     order : str
@@ -416,6 +474,20 @@ def prove_infallible(
     refute : bool
         When the proof fails, look for a failing run of Alg. 3.1 on small outputs
         (:func:`csplab.analysis.witness.find_failure`, exhaustive) to refute infallibility.
+    certificate : bool
+        Put a certificate in ``witness["certificate"]`` (a dict, JSON-ready): when proved,
+        the closed set of frame states of every configuration (checked by
+        :mod:`csplab.certcheck` without this module's code); when refuted, the failing run.
+    boundary : mapping face -> label, "auto", "none" or None
+        An example's boundary labels, as in :func:`~csplab.grids.from_example` (``"auto"``:
+        :func:`~csplab.grids.auto_boundary`, the ground and empty space, whatever the
+        output size; ``synthesize`` falls back to Merrell's rule where that has no
+        solution). A tileset's boundary is its file's own.
+
+    Raises
+    ------
+    InputError
+        A bad region, order or history, or a model outside the proof's scope.
 
     Returns
     -------
@@ -435,10 +507,17 @@ def prove_infallible(
     (None, True)
     """
     t0 = time.perf_counter()
+    why = proof_scope(example)
+    if why is not None:
+        raise InputError(f"{example.name or 'the model'}: {why}")
     rules = Rules.of(example)
     ndim = rules.ndim
     axes = scan_axes(ndim, order)
     r = parse_region(region, ndim)
+    face_rules = face_rules_of(example, boundary)
+    face_domain = _face_domain(face_rules, rules) if face_rules else None
+    if face_rules:
+        realize = False  # exhaustive Alg. 3.6 on a concrete output ignores the face rules
     hist = (int(history),) * ndim if isinstance(history, int) else tuple(int(h) for h in history)
     if len(hist) != ndim or any(h < 0 for h in hist):
         raise InputError(f"history needs {ndim} non-negative values, got {history!r}")
@@ -454,19 +533,30 @@ def prove_infallible(
     }
     digest = hashlib.sha256()
     digest.update(repr((example.hash(), r, order, hist)).encode())
+    if face_rules:
+        digest.update(repr(face_rules).encode())
     failure: dict[str, Any] | None = None
+    closed: list[dict[str, Any]] = []
     try:
-        for lo, hi in _configs(ndim, r, hist):
-            walk, ext, q = _frame(lo, hi, axes, r)
+        for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules)):
+            walk, ext, q = _frame(lo, hi, axes, r, edges, face_domain)
             stats["configs"] += 1
-            fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"])
+            seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
+            fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"], seen)
+            if seen is not None:
+                closed.append({
+                    "lower": list(lo), "upper": list(hi),
+                    "at_lower": list(edges[0]), "at_upper": list(edges[1]),
+                    "keys": walk.key_at[: len(walk.cells)],
+                    "states": sorted([i, list(k)] for i, k in seen),
+                })  # fmt: skip
             stats["states"] += nstates
             stats["windows"] += len(windows)
             for w in sorted(windows):
-                digest.update(repr((lo, hi, w)).encode())
+                digest.update(repr((lo, hi, w) if not face_rules else (lo, hi, edges, w)).encode())
             if fail is not None:
                 failure = {
-                    "config": {"lower": list(lo), "upper": list(hi)},
+                    "config": {"lower": list(lo), "upper": list(hi), "edges": edges},
                     "output": list(ext),
                     "p": list(q),
                     "frame": [[list(c), int(b)] for c, b in zip(walk.cells, fail, strict=False)],
@@ -484,15 +574,28 @@ def prove_infallible(
     stats["time_s"] = time.perf_counter() - t0
     if failure is None:
         h = digest.hexdigest()
-        name = example.name or "MODEL"
+        name = (example.meta.get("source") if not isinstance(example, ExampleModel) else None) or (
+            example.name or "MODEL"
+        )
+        if face_rules and isinstance(example, ExampleModel):
+            bnd = _boundary_map(example, boundary) or {}
+            name += " --boundary " + ",".join(f"{f}={b}" for f, b in bnd.items())
         hs = "x".join(map(str, hist))
+        proof: dict[str, Any] = {
+            "scope": _scope(face_rules),
+            "sha256": h,
+            "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
+            f"--history {hs} --expect-hash {h}",
+        }
+        if certificate:
+            proof["certificate"] = _certificate(
+                example, rules, face_rules, "infallible", stats,
+                {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
+                 "configs": closed},
+            )  # fmt: skip
         return Verdict(
             True,
-            {
-                "sha256": h,
-                "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
-                f"--history {hs} --expect-hash {h}",
-            },
+            proof,
             stats,
             f"infallible: Alg. 3.6 with {rtxt} regions ({order}) cannot fail "
             f"({stats['windows']} windows, {stats['states']} states, "
@@ -517,22 +620,236 @@ def prove_infallible(
         alg31 = _as_alg31_failure(example, failure["run"], order)
         if alg31 is not None:
             wit["alg31"] = alg31
+            if certificate:
+                stats["time_s"] = time.perf_counter() - t0
+                wit["certificate"] = _certificate(
+                    example, rules, face_rules, "fallible", stats, {"run": alg31}
+                )
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
     if refute:
         from csplab.analysis.witness import find_failure
 
         ff = find_failure(
             example, order=order, max_size=_refute_size(ndim), random_runs=0,
-            max_states=50_000 if ndim <= 2 else 5_000,
+            max_states=50_000 if ndim <= 2 else 5_000, boundary=_boundary_map(example, boundary),
         )  # fmt: skip
         stats["refute_states"] = ff.stats.get("states", 0)
         if ff.holds is False:
             wit["alg31"] = ff.witness
+            if certificate and ff.witness is not None:
+                stats["time_s"] = time.perf_counter() - t0
+                run = dict(ff.witness)
+                if face_rules:  # the run's boundary is the certificate's face rules
+                    run["boundary"] = "auto"
+                wit["certificate"] = _certificate(
+                    example, rules, face_rules, "fallible", stats, {"run": run}
+                )
             return Verdict(False, wit, stats, msg + "; Alg. 3.1 fails too: fallible")
         size = "x".join(map(str, _refute_size(ndim)))
         done = "exhaustive" if ff.holds is True else "incomplete search"
         msg += f"; no failure of Alg. 3.1 found on outputs up to {size} ({done})"
     return Verdict(None, wit, stats, msg)
+
+
+def proof_scope(model: ExampleModel | RuleSet) -> str | None:
+    """Why the region proof cannot decide ``model`` as the synthesizer builds it (one line),
+    or ``None`` when it can.
+
+    The proof is about Alg. 3.1 on square grids of every size: no wrap-around, no global
+    constraint, one transition matrix per axis; domain rules are covered when each applies
+    to a face of the output or to every cell (the file's boundary conditions). Examples
+    always qualify (on open grids); a rule set when its file states nothing else.
+
+    Parameters
+    ----------
+    model : ExampleModel or RuleSet
+
+    Returns
+    -------
+    str or None
+
+    Examples
+    --------
+    >>> from csplab.io.ruleset import RuleSet
+    >>> proof_scope(RuleSet(np.ones((2, 2, 2), dtype=bool), periodic=True))
+    'the file makes the grid periodic: the region proof covers open grids only'
+    >>> proof_scope(RuleSet(np.ones((2, 2, 2), dtype=bool))) is None
+    True
+    """
+    if isinstance(model, ExampleModel):
+        return None
+    if getattr(model, "topology", "square") != "square":
+        return f"{model.topology} grids have no scan order with a region proof (square only)"
+    if model.constraints:
+        return "the file states global constraints, which the region proof does not cover"
+    per = model.periodic
+    if per if isinstance(per, bool | np.bool_) else any(per):
+        return "the file makes the grid periodic: the region proof covers open grids only"
+    boxes = [op for op in (*model.boundary_ops, *model.constraint_ops) if _op_face(op) is None]
+    if boxes:
+        return (
+            f"the file restricts the domains of boxes of cells ({len(boxes)} rules such as "
+            f"{boxes[0].key or boxes[0].op!r}), which the region proof does not model: only "
+            "faces and the whole grid"
+        )
+    return None
+
+
+def _op_face(op: Any) -> str | None:
+    """Where a domain rule applies, if the region proof can say: ``"x-"`` ... a face,
+    ``"!x-"`` every cell but that face, ``"*"`` every cell; else ``None``."""
+    if op.face is not None:
+        return str(op.face)
+    if op.region is None:
+        return "*"
+    parts = []
+    for d, (a, b) in enumerate(op.region):
+        if a in (None, 0) and b is None:
+            continue
+        sign = {(0, 1): "-", (-1, None): "+", (1, None): "!-", (None, -1): "!+"}.get((a, b))
+        if sign is None or d >= len(AXIS_NAMES):
+            return None
+        if d < len(op.flip) and op.flip[d]:
+            sign = sign.replace("-", "?").replace("+", "-").replace("?", "+")
+        neg = sign.startswith("!")
+        parts.append(("!" if neg else "") + AXIS_NAMES[d] + sign[-1])
+    if not parts:
+        return "*"
+    return parts[0] if len(parts) == 1 else None
+
+
+def _scope(face_rules: Sequence[Any]) -> str:
+    n = len(face_rules)
+    return "grids of every size, not periodic, " + (
+        f"with {n} boundary/domain rules on faces" if n else "no boundary conditions"
+    )
+
+
+def _boundary_map(
+    model: ExampleModel | RuleSet, boundary: Mapping[str, int] | str | None
+) -> dict[str, int] | None:
+    """An example's boundary as a mapping face -> label (``None``: none)."""
+    if boundary is None or boundary == "none":
+        return None
+    if not isinstance(model, ExampleModel):
+        raise InputError(
+            f"{model.name or 'a tileset'}: its boundary is its file's own (no --boundary)"
+        )
+    if isinstance(boundary, str):
+        if boundary != "auto":
+            return _boundary_map(model, grids.parse_boundary(boundary))
+        return grids.auto_boundary(model, model.ndim)
+    faces = [f"{AXIS_NAMES[d]}{s}" for d in range(model.ndim) for s in "-+"]
+    bad = [f for f in boundary if f not in faces]
+    if bad:
+        raise InputError(f"unknown boundary face(s) {bad}; faces are {faces}")
+    return {str(f): int(b) for f, b in boundary.items()}
+
+
+def face_rules_of(
+    model: ExampleModel | RuleSet, boundary: Mapping[str, int] | str | None = None
+) -> list[tuple[str, str, list[int]]]:
+    """The domain rules the region proof applies, in order: a rule set's own (boundary
+    rules first, as :meth:`RuleSet.problem` applies them on open grids), or an example's
+    ``boundary`` labels (each face forced, the bottom face last: it wins where faces meet,
+    as in :func:`~csplab.grids.from_example`).
+
+    Parameters
+    ----------
+    model : ExampleModel or RuleSet
+        Within :func:`proof_scope`.
+    boundary : mapping face -> label, "auto", "none" or None
+        An example's boundary (a tileset's is its file's own).
+
+    Returns
+    -------
+    list of (op, where, labels)
+        ``op`` keep / remove / force / add; ``where`` a face (``"z-"``), every cell but a
+        face (``"!z-"``) or every cell (``"*"``); the labels, sorted.
+
+    Examples
+    --------
+    >>> from csplab.io.ruleset import DomainOp, RuleSet
+    >>> rs = RuleSet(np.ones((2, 2, 2), dtype=bool),
+    ...              boundary_ops=[DomainOp("force", np.array([False, True]), face="y-")])
+    >>> face_rules_of(rs)
+    [('force', 'y-', [1])]
+    """
+    if isinstance(model, ExampleModel):
+        bnd = _boundary_map(model, boundary)
+        if not bnd:
+            return []
+        bottom = f"{AXIS_NAMES[model.ndim - 1]}-"
+        faces = [f"{AXIS_NAMES[d]}{s}" for d in range(model.ndim) for s in "-+"]
+        order = [f for f in faces if f != bottom] + [bottom]
+        return [("force", f, [bnd[f]]) for f in order if f in bnd]
+    _boundary_map(model, boundary)  # refuses a boundary for a tileset
+    out = []
+    for op in (*model.boundary_ops, *model.constraint_ops):
+        face = _op_face(op)
+        assert face is not None  # proof_scope refused the others
+        out.append((str(op.op), face, np.flatnonzero(op.labels).tolist()))
+    return out
+
+
+def _face_domain(
+    face_rules: Sequence[tuple[str, str, list[int]]], rules: Rules
+) -> Callable[[frozenset[str]], int]:
+    """The domain (bit set) of a cell on the given faces, under the rules in file order."""
+    cache: dict[frozenset[str], int] = {}
+
+    def domain(faces: frozenset[str]) -> int:
+        hit = cache.get(faces)
+        if hit is None:
+            dom = rules.used
+            for op, face, labels in face_rules:
+                on = face == "*" or (face[1:] not in faces if face[0] == "!" else face in faces)
+                if not on:
+                    continue
+                bits = sum(1 << b for b in labels)
+                if op == "keep":
+                    dom &= bits
+                elif op == "remove":
+                    dom &= ~bits
+                elif op == "force":
+                    dom = bits
+                else:  # add
+                    dom |= bits
+            hit = cache[faces] = dom & rules.used
+        return hit
+
+    return domain
+
+
+def _certificate(
+    example: ExampleModel | RuleSet,
+    rules: Rules,
+    face_rules: Sequence[tuple[str, str, list[int]]],
+    claim: str,
+    stats: Mapping[str, Any],
+    body: Mapping[str, Any],
+) -> dict[str, Any]:
+    """A certificate (format ``csplab-certificate`` version 1) for :mod:`csplab.certcheck`."""
+    import json
+
+    rel = {
+        "labels": rules.K,
+        "used": [int(b) for b in rules.used_mask],
+        "pairs": [np.argwhere(rules.T[d]).tolist() for d in range(rules.ndim)],
+        "faces": [[op, face, labels] for op, face, labels in face_rules],
+    }
+    canon = json.dumps(rel, sort_keys=True, separators=(",", ":")).encode()
+    return {
+        "format": "csplab-certificate",
+        "version": 1,
+        "claim": claim,
+        "scope": "Alg. 3.1 in the given scan order, " + _scope(face_rules),
+        "model": {"name": example.name, "hash": example.hash()},
+        "rules": rel,
+        "rules_sha256": hashlib.sha256(canon).hexdigest(),
+        "prover": {k: stats[k] for k in ("time_s", "states", "configs") if k in stats},
+        **body,
+    }
 
 
 def _refute_size(ndim: int) -> tuple[int, ...]:
@@ -543,9 +860,10 @@ _R = TypeVar("_R")
 
 
 def _enumerate(
-    rules: Rules, walk: _Walk, budget: int
+    rules: Rules, walk: _Walk, budget: int, seen: set[tuple[int, tuple[int, ...]]] | None = None
 ) -> tuple[list[int] | None, int, set[tuple[int, ...]]]:
-    """DFS over the frame's labellings; returns (failing labels or None, states, windows)."""
+    """DFS over the frame's labellings; returns (failing labels or None, states, windows).
+    ``seen`` (if given) receives the memoised states ``(step, key labels)``."""
     last = len(walk.cells) - 1
     windows: set[tuple[int, ...]] = set()
     src_q = [j for j in walk.steps[last][0] if j >= 0]
@@ -556,7 +874,7 @@ def _enumerate(
         windows.add((*(labels[j] for j in src_q), cat))
         return list(labels) if cat == 0 else None
 
-    fail, states = _dfs(rules, walk, budget, at_last)
+    fail, states = _dfs(rules, walk, budget, at_last, seen=seen)
     return fail, states, windows
 
 
@@ -566,6 +884,7 @@ def _dfs(
     budget: int,
     found: Callable[[int, int, list[int]], _R | None],
     first: Mapping[int, int] | None = None,
+    seen: set[tuple[int, tuple[int, ...]]] | None = None,
 ) -> tuple[_R | None, int]:
     """Depth-first search over the labellings of ``walk``'s cells in order, memoised on the
     labels later steps still see (``walk.key_at``); raises :class:`_Budget` past ``budget``
@@ -575,8 +894,9 @@ def _dfs(
     labels cell ``i`` may take, ``found(i, cat, labels)`` is what the search returns, if
     not ``None``; the search ends at the last cell. Labels are tried in increasing order,
     ``first[i]`` (if possible) first. Returns what was found (or ``None``) and the number
-    of states visited."""
-    seen: set[tuple[int, tuple[int, ...]]] = set()
+    of states visited (``seen``, if given, collects them)."""
+    if seen is None:
+        seen = set()
     labels: list[int] = []
     last = len(walk.cells) - 1
 
@@ -711,14 +1031,17 @@ def _realize(
 
 
 def _as_alg31_failure(
-    example: ExampleModel, run: dict[str, Any], order: str
+    example: ExampleModel | RuleSet, run: dict[str, Any], order: str
 ) -> dict[str, Any] | None:
     """If a failing Alg. 3.6 run only used labels of Alg. 3.1's catalog, it is a failing
     run of Alg. 3.1 too (``C ⊆ C_R``): return it as a witness."""
     from csplab.catalog import Propagator
 
     shape = tuple(run["shape"])
-    P = from_example(example, shape)
+    if isinstance(example, ExampleModel):
+        P = from_example(example, shape)
+    else:  # the open grid of the proof's scope (proof_scope: no restrictions to drop)
+        P = example.problem(shape, periodic=False, boundary="none")
     eng = Propagator(P)
     choices: list[list[Any]] = []
     for c, b in run["choices"]:
@@ -738,7 +1061,7 @@ def _as_alg31_failure(
 # ----------------------------------------------------------------------------- Eq. 3.11
 
 
-def corner_condition(example: ExampleModel, order: str = "scanline") -> Verdict:
+def corner_condition(example: ExampleModel | RuleSet, order: str = "scanline") -> Verdict:
     """The corner condition (Eq. 3.11, corrected), in 1D, 2D and 3D.
 
     For every face of the unit box (every non-empty set of axes): each labelling of the
@@ -754,13 +1077,21 @@ def corner_condition(example: ExampleModel, order: str = "scanline") -> Verdict:
     the three backward neighbours ``u`` of the top corner (3D).
     """
     t0 = time.perf_counter()
+    why = proof_scope(example)
+    if why is None and face_rules_of(example):
+        why = (
+            "the corner condition is about open grids; prove without --corner applies the "
+            "file's face rules"
+        )
+    if why is not None:
+        raise InputError(f"{example.name or 'the model'}: {why}")
     T = example.transitions()
     ndim = T.shape[0]
     scan_axes(ndim, order)
     if ndim > 3:
         v = prove_infallible(example, 2, order=order, history=0, realize=False, refute=False)
         return Verdict(v.holds is True, v.witness, v.stats, "corner condition (4D, by prover)")
-    used = example.counts() > 0
+    used = Rules.of(example).used_mask
     Tu = T & used[None, :, None] & used[None, None, :]
     checked = 0
     # 1D faces
@@ -836,7 +1167,7 @@ def _corner3(Tu: NDArray[np.bool_]) -> tuple[tuple[int, int, int] | None, int]:
 
 
 def _corner_fail(
-    example: ExampleModel,
+    example: ExampleModel | RuleSet,
     axes: tuple[int, ...],
     labels: dict[str, Any],
     checked: int,

@@ -46,7 +46,7 @@ import itertools
 import math
 import time
 from collections.abc import Mapping, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -65,7 +65,10 @@ from csplab.problem import Problem
 from csplab.result import Verdict
 from csplab.rng import make_rng
 
-__all__ = ["alg31_exhaustive", "find_failure", "replay", "searched"]
+if TYPE_CHECKING:
+    from csplab.io.ruleset import RuleSet
+
+__all__ = ["alg31_exhaustive", "find_failure", "model_problem", "replay", "searched"]
 
 
 class _Budget(Exception):
@@ -232,7 +235,7 @@ class _Search:
 
     def __init__(
         self,
-        example: ExampleModel,
+        example: ExampleModel | RuleSet,
         order: str,
         gen: np.random.Generator,
         stats: dict[str, Any],
@@ -250,8 +253,7 @@ class _Search:
     def problem(self, shape: tuple[int, ...]) -> Problem:
         P = self._problems.get(shape)
         if P is None:
-            kw = {} if self.boundary is None else {"boundary": self.boundary}
-            P = from_example(self.example, shape, **kw)
+            P = model_problem(self.example, shape, self.boundary)
             if P.n <= 200_000:
                 self._problems[shape] = P
         return P
@@ -423,7 +425,7 @@ def _shortest_continuation(
 
 
 def find_failure(
-    example: ExampleModel,
+    example: ExampleModel | RuleSet,
     *,
     order: str = "scanline",
     max_size: Sequence[int] | str | None = None,
@@ -450,7 +452,9 @@ def find_failure(
 
     Parameters
     ----------
-    example : ExampleModel
+    example : ExampleModel or RuleSet
+        An example, or a tileset's rules on the file's own grid (its periodicity, domain
+        rules and, unless ``boundary`` says otherwise, boundary rules).
     order : str
         Alg. 3.1's cell order: a scan order (exhaustive and random search) or ``random`` /
         ``min-entropy`` (random search only).
@@ -508,8 +512,9 @@ def find_failure(
     rounds = ndim >= 3 and random_runs > 0 and not late
     if max_size is None and not auto:
         max_size = (4, 4)[:ndim] if ndim <= 2 else (4,) * ndim
+    own = example.shape if isinstance(example, ExampleModel) else example.shape or (4,) * ndim
     if auto:
-        lim = tuple(max(s) for s in zip(*_auto_ladder(example.shape), strict=True))
+        lim = tuple(max(s) for s in zip(*_auto_ladder(own), strict=True))
     else:
         assert max_size is not None
         lim = (
@@ -521,9 +526,11 @@ def find_failure(
             raise InputError(f"max_size {max_size!r} has more axes than the example ({ndim})")
     is_scan = order == "scanline" or order.startswith("scan:")
     scan_order(lim, order)  # validates the order
+    if boundary is None and not isinstance(example, ExampleModel):
+        boundary = "auto"  # a rule set's own boundary rules
     bnd = parse_boundary(boundary) if isinstance(boundary, str) else boundary
     if boundary is not None:
-        from_example(example, (2,) * ndim, boundary=bnd)  # validates the boundary
+        model_problem(example, (2,) * ndim, bnd)  # validates the boundary
     gen, seed0 = make_rng(rng)
     stats: dict[str, Any] = {
         "states": 0,
@@ -565,7 +572,7 @@ def find_failure(
     if found is None and random_runs > 0 and not late:
         s.deadline = search_deadline
         if rounds:
-            ladder = _auto_ladder(example.shape) if auto else _ladder(lim)
+            ladder = _auto_ladder(own) if auto else _ladder(lim)
             found = _climb(s, ladder, random_runs, exhaustive_cells)
         else:
             for shp in _ladder(lim):
@@ -690,7 +697,35 @@ def searched(stats: dict[str, Any]) -> str:
     return line
 
 
-def replay(example: ExampleModel, witness: dict[str, Any]) -> Verdict:
+def model_problem(model: ExampleModel | RuleSet, shape: Sequence[int], boundary: Any) -> Problem:
+    """The output problem of a run: :func:`~csplab.grids.from_example` for an example, the
+    rule set's own problem (its periodicity, its domain rules; ``boundary="auto"`` or
+    ``None`` its own boundary rules, as :meth:`RuleSet.problem`) for a tileset.
+
+    Parameters
+    ----------
+    model : ExampleModel or RuleSet
+    shape : sequence of int
+    boundary : None, "auto", "none" or mapping face -> label
+
+    Returns
+    -------
+    Problem
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> model_problem(load_example("line"), (3, 2), None).shape
+    (3, 2)
+    """
+    shp = tuple(int(t) for t in shape)
+    if isinstance(model, ExampleModel):
+        return from_example(model, shp) if boundary is None else from_example(
+            model, shp, boundary=boundary)  # fmt: skip
+    return model.problem(shp, boundary="auto" if boundary is None else boundary)
+
+
+def replay(example: ExampleModel | RuleSet, witness: dict[str, Any]) -> Verdict:
     """Re-check a witness: ``holds=True`` iff it is a failing run of Alg. 3.1.
 
     Every label must be in the catalog when it is chosen, cells must come in the scan
@@ -703,8 +738,7 @@ def replay(example: ExampleModel, witness: dict[str, Any]) -> Verdict:
     bnd = witness.get("boundary")
     if isinstance(bnd, str):
         bnd = parse_boundary(bnd)
-    P = from_example(example, shape) if bnd is None else from_example(
-        example, shape, boundary=bnd)  # fmt: skip
+    P = model_problem(example, shape, bnd)
     eng = Propagator(P)
     choices = witness.get("choices", [])
     if not eng.ok:

@@ -29,6 +29,7 @@ COMMANDS: dict[str, str] = {
     "catalog-gap": "csplab.cli.catalog_gap",
     "show": "csplab.cli.show",
     "prove": "csplab.cli.prove",
+    "check-certificate": "csplab.cli.check_certificate",
     "witness": "csplab.cli.witness",
     "refine": "csplab.cli.refine",
     "reduction": "csplab.cli.reduction",
@@ -84,7 +85,7 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: object
 
 
 # commands that run csplab's numba kernels (the first run compiles them: one line on stderr)
-_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check"}
+_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check", "check-certificate"}
 
 
 _ANNOUNCING = [False]

@@ -11,6 +11,7 @@ import numpy as np
 from csplab.cli.common import load_model, model_options
 from csplab.errors import InputError
 from csplab.example import ExampleModel
+from csplab.io.ruleset import RuleSet
 from csplab.result import Verdict
 
 ORDER_HELP = (
@@ -19,10 +20,40 @@ ORDER_HELP = (
 )
 
 
-def load_example_model(spec: str, options: list[str] | None = None) -> ExampleModel:
+def load_analysis_model(spec: str, options: list[str] | None = None) -> ExampleModel | RuleSet:
+    """An example or a tileset's rule set, loaded as ``synthesize`` loads it (continuous
+    models are refused in one line)."""
+    model = load_model(spec, model_options(options))
+    if not isinstance(model, ExampleModel | RuleSet):
+        raise InputError(f"{spec}: a continuous (polygon) model has no grid analysis")
+    return model
+
+
+def save_certificate(cert: dict[str, Any], path: str) -> None:
+    """Write a certificate as JSON, atomically (a temporary file, then renamed): a reader
+    never sees half a certificate."""
+    import os
+    import tempfile
+
+    out = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.")
+    try:
+        with os.fdopen(fd, "w") as fh:
+            json.dump(cert, fh, default=_plain)
+        os.replace(tmp, out)
+    except OSError as e:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"--certificate {path}: cannot write: {e.strerror}") from None
+
+
+def load_example_model(
+    spec: str, options: list[str] | None = None, needs: str = "an example grid"
+) -> ExampleModel:
+    """An example model; anything else is refused in one line saying what ``needs`` it."""
     model = load_model(spec, model_options(options))
     if not isinstance(model, ExampleModel):
-        raise InputError(f"{spec}: the analysis commands need an example model, not a tileset")
+        kind = "a tileset" if isinstance(model, RuleSet) else "a continuous model"
+        raise InputError(f"{spec}: {needs}; this is {kind}, which has none")
     return model
 
 
@@ -35,7 +66,7 @@ def witness_grid(w: dict[str, Any]) -> np.ndarray:
     return g
 
 
-def save_witness(w: dict[str, Any], path: str, example: ExampleModel) -> None:
+def save_witness(w: dict[str, Any], path: str, example: ExampleModel | RuleSet) -> None:
     p = Path(path)
     if p.suffix == ".json":
         p.write_text(json.dumps(w, default=_plain, indent=1))
@@ -67,7 +98,7 @@ def print_verdict(v: Verdict, as_json: bool) -> None:
         print(v.message)
 
 
-def describe_run(w: dict[str, Any], example: ExampleModel) -> str:
+def describe_run(w: dict[str, Any], example: ExampleModel | RuleSet) -> str:
     """Lines describing a failing run: size, seed, choices, first step outside C*."""
     lines = [f"  output {'x'.join(map(str, w['shape']))}, order {w.get('order', 'scanline')}"]
     if w.get("seed") is not None:

@@ -15,6 +15,7 @@ from csplab.cli.common import (
     problem_from_args,
 )
 from csplab.errors import InputError
+from csplab.example import ExampleModel
 
 HELP = "count the models consistent with an example: D_E(n) (Sec. 3.2)"
 DESCRIPTION = (
@@ -85,6 +86,11 @@ def run(args: argparse.Namespace) -> int:
         return 3
     out: dict[str, Any] = {"example": example.name or args.model, "size": list(problem.shape)}
     out.update(c.to_dict())
+    if args.bounds and not isinstance(example, ExampleModel):
+        raise InputError(
+            f"{args.model}: --bounds (Theorem 3.2.1) needs an example grid's enclosed sets; "
+            "this is a tileset, which has none"
+        )
     if args.bounds:
         lo = lower_bound_3_2_1(example, problem.shape)
         hi_log2 = problem.n * math.log2(problem.K)

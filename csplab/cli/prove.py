@@ -14,31 +14,44 @@ from csplab.analysis import corner_condition, prove_infallible
 from csplab.cli._analysis import (
     ORDER_HELP,
     describe_run,
-    load_example_model,
+    load_analysis_model,
     print_verdict,
+    save_certificate,
     save_witness,
 )
 from csplab.cli.common import add_model_option, check_output_path
 from csplab.errors import InputError
 
-HELP = "prove an example infallible (Alg. 3.1 never fails) by region enumeration"
+HELP = "prove a model infallible (Alg. 3.1 never fails) by region enumeration"
 DESCRIPTION = (
     "Enumerate every window state Alg. 3.6 can reach with the given region "
     "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
-    "fails on the example, at any output size (Theorem 3.3.6). Exit 0 proven, "
-    "1 refuted (fallible), 3 undecided, 2 bad input."
+    "fails on the model, at any output size (Theorem 3.3.6). Examples (open grids) and "
+    "tilesets (not periodic; their face rules apply). --certificate writes what the verdict rests "
+    "on, for `csplab check-certificate`. Exit 0 proven, 1 refuted (fallible), 3 undecided, "
+    "2 bad input."
 )
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
+    p.add_argument("model", metavar="MODEL", help="built-in example, example or tileset file")
     p.add_argument("--region", default="2", help="region size per axis, e.g. 3x2 (default 2)")
     p.add_argument("--order", default="scanline", help=ORDER_HELP)
     p.add_argument("--history", default="1", help="extra frame cells per axis (default 1)")
     p.add_argument("--max-states", type=int, default=5_000_000, help="state budget")
     p.add_argument("--corner", action="store_true", help="only check Eq. 3.11 (corner test)")
+    p.add_argument(
+        "--boundary",
+        help="an example's boundary: auto (ground and empty space), none (default) or "
+        "face=label,...; a tileset's is its file's own",
+    )
     p.add_argument("--expect-hash", help="re-check a proof: exit 3 unless the hash matches")
     p.add_argument("--out", help="save the failing run as a .png picture or .json")
+    p.add_argument(
+        "--certificate",
+        metavar="FILE",
+        help="write a certificate (JSON) of a proved or refuted verdict",
+    )
     p.add_argument("--json", action="store_true", help="print the verdict as JSON")
     add_model_option(p)
 
@@ -48,7 +61,9 @@ def run(args: argparse.Namespace) -> int:
         if Path(args.out).suffix not in (".png", ".json"):
             raise InputError(f"--out {args.out}: use a .png picture or a .json file")
         check_output_path(args.out, "--out")
-    E = load_example_model(args.model, args.model_option)
+    if args.certificate:
+        check_output_path(args.certificate, "--certificate")
+    E = load_analysis_model(args.model, args.model_option)
     if args.corner:
         v = corner_condition(E, args.order)
         print_verdict(v, args.json)
@@ -58,11 +73,20 @@ def run(args: argparse.Namespace) -> int:
     if args.max_states < 1:
         raise InputError("--max-states must be positive")
     v = prove_infallible(
-        E, args.region, order=args.order, history=history, max_states=args.max_states
-    )
+        E, args.region, order=args.order, history=history, max_states=args.max_states,
+        certificate=bool(args.certificate), boundary=args.boundary,
+    )  # fmt: skip
+    cert = (v.witness or {}).pop("certificate", None) if args.certificate else None
     print_verdict(v, args.json)
+    if cert is not None:
+        save_certificate(cert, args.certificate)
+        if not args.json:
+            print(f"  wrote certificate {args.certificate} ({cert['claim']})")
+    elif args.certificate and not args.json:
+        print(f"  no certificate written to {args.certificate}: the verdict is undecided")
     if v.holds is True:
         if not args.json:
+            print(f"  scope: {(v.witness or {}).get('scope')}")
             print(f"  proof sha256 {v.witness['sha256']}")
             print(f"  re-check: {v.witness['recheck']}")
         if args.expect_hash and args.expect_hash != v.witness["sha256"]:

@@ -39,7 +39,10 @@ def run(args: argparse.Namespace) -> int:
 
         output_format(args.out, gives="ExampleModel")  # a format that reads back as an example
         check_output_path(args.out, "--out")
-    E = load_example_model(args.model, args.model_option)
+    E = load_example_model(
+        args.model, args.model_option,
+        needs="refine splits the labels of an example grid's cells (Sec. 3.3.8)",
+    )  # fmt: skip
     regions = [r.strip() for r in args.regions.split(",") if r.strip()]
     if E.ndim == 3 and args.regions == "2x2,3x2,4x2":
         regions = ["2x2x2"]

@@ -15,7 +15,7 @@ from csplab.analysis.witness import searched
 from csplab.cli._analysis import (
     ORDER_HELP,
     describe_run,
-    load_example_model,
+    load_analysis_model,
     print_verdict,
     save_witness,
 )
@@ -42,7 +42,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--boundary",
         default=None,
-        help="boundary of the outputs: auto, none or face=label,... (default none)",
+        help="boundary of the outputs: auto, none or face=label,... (default none; a "
+        "tileset: its own boundary rules)",
     )
     p.add_argument("--order", default="scanline", help=ORDER_HELP + "; or random, min-entropy")
     p.add_argument("--exhaustive-cells", type=int, default=20,
@@ -59,7 +60,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit}: give a positive number of seconds")
-    E = load_example_model(args.model, args.model_option)
+    E = load_analysis_model(args.model, args.model_option)
     v = find_failure(
         E,
         order=args.order,

@@ -1,0 +1,566 @@
+"""An independent checker of infallibility certificates (``csplab check-certificate``).
+
+``csplab prove --certificate FILE`` writes what its verdict rests on; this module re-verifies
+it from the file alone, as a DRAT checker re-verifies a SAT solver's refutation. It shares
+no code with the prover (:mod:`csplab.analysis.infallible`; an import-linter contract
+forbids importing it, or anything of csplab but :mod:`csplab.errors`): the frames, regions,
+arc consistency and grid replay below are written again, plainly.
+
+Format ``csplab-certificate``, version 1 (JSON)
+-----------------------------------------------
+``rules``: ``labels`` (K), ``used`` (K flags: the labels a cell may take) and ``pairs``
+(per axis ``d``, the pairs ``[a, b]``: ``b`` may follow ``a`` along ``+d``);
+``rules_sha256``: SHA-256 of ``rules`` as compact JSON with sorted keys (a changed rule
+without a new hash is rejected). ``claim`` is ``"infallible"`` or ``"fallible"``.
+
+``rules.faces`` (optional): the file's domain rules in file order, ``[op, where, labels]``
+with ``op`` one of keep / remove / force / add and ``where`` a face (``"x-"``), every cell
+but a face (``"!x-"``) or every cell (``"*"``): a cell's domain is the labels in use, edited
+by each rule that applies to it.
+
+*infallible*: ``region``, ``order``, ``axes`` (outermost first), ``history`` and
+``configs``, one per position of a point relative to the output's lower edges (distance
+``0 .. 1 + history``, the last meaning "at least") and upper edges (``0 .. region - 2``),
+and -- with face rules -- whether the frame's first (``at_lower``) and last
+(``at_upper``) cell on each axis lies on the output's face (always when the frame is
+clipped there, both ways otherwise; without face rules, only when clipped).
+Each holds ``keys[i]`` (the earlier frame cells whose labels the state before step ``i``
+records) and ``states``, pairs ``[i, labels of keys[i]]``. The checker rebuilds each
+frame (the cells before the point ``q = lower`` in scan order, in the box of extent
+``lower + 1 + upper``, then ``q``) and verifies that
+
+1. the configurations are exactly all of them;
+2. ``keys[0]`` is empty, ``keys[i + 1] ⊆ keys[i] ∪ {i}``, and ``keys[i]`` holds every
+   earlier cell of step ``i``'s region that borders a cell of that region not yet
+   labelled (only those can change its catalog: a labelled cell whose region neighbours
+   are all labelled agrees with them, since each label agrees with its backward
+   neighbours, which border the cell being labelled);
+3. the start state ``[0, []]`` is present and the set is closed: for each state at step
+   ``i`` and each label of ``C_R`` at step ``i`` (arc consistency on the region of cell
+   ``i``, clipped to the frame, with the recorded labels), the next state is present;
+4. at the last step (the point) ``C_R`` is never empty.
+
+Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 never fails
+(Theorem 3.3.6, the prover's docstring has the argument). *fallible*: ``run`` (``shape``,
+``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``: a mapping face ->
+label, or ``"auto"`` for the face rules): the checker replays
+it with arc consistency on the whole grid -- the cells in scan order, each label in its
+cell's catalog -- and verifies that some catalog ends empty.
+
+Examples
+--------
+>>> import json
+>>> cert = {"format": "csplab-certificate", "version": 1, "claim": "fallible",
+...         "rules": {"labels": 2, "used": [1, 1], "pairs": [[[0, 1], [1, 0]]]}}
+>>> cert["rules_sha256"] = rules_hash(cert["rules"])
+>>> cert["run"] = {"shape": [3], "order": "scanline", "choices": [[[0], 0]]}
+>>> check_certificate(cert)
+(False, 'invalid: the run of Alg. 3.1 does not fail (every catalog non-empty at the end)')
+>>> cert["rules"]["pairs"] = [[[0, 1]]]; cert["rules_sha256"] = rules_hash(cert["rules"])
+>>> check_certificate(cert)[0]
+True
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from csplab.errors import InputError
+
+__all__ = ["check_certificate", "load_certificate", "rules_hash"]
+
+FORMAT = "csplab-certificate"
+VERSION = 1
+_AXES = "xyzw"
+
+Cell = tuple[int, ...]
+
+
+class _Invalid(Exception):
+    pass
+
+
+def rules_hash(rules: Mapping[str, Any]) -> str:
+    """SHA-256 of the ``rules`` object as compact JSON with sorted keys.
+
+    Parameters
+    ----------
+    rules : mapping
+        The certificate's ``rules`` (``labels``, ``used``, ``pairs``).
+
+    Returns
+    -------
+    str
+        The hex digest.
+
+    Examples
+    --------
+    >>> rules_hash({"labels": 1, "used": [1], "pairs": [[[0, 0]]]})[:12]
+    '2d2bbe2d9229'
+    """
+    return hashlib.sha256(
+        json.dumps(rules, sort_keys=True, separators=(",", ":")).encode()
+    ).hexdigest()
+
+
+def load_certificate(path: str | Path) -> dict[str, Any]:
+    """Read a certificate file (JSON object of format ``csplab-certificate``).
+
+    Parameters
+    ----------
+    path : str or Path
+
+    Returns
+    -------
+    dict
+
+    Raises
+    ------
+    InputError
+        The file is missing, not JSON, or not a certificate of a known version.
+
+    Examples
+    --------
+    >>> load_certificate("/nonexistent.json")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: /nonexistent.json: no such file
+    """
+    p = Path(path)
+    try:
+        data = json.loads(p.read_text())
+    except FileNotFoundError:
+        raise InputError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise InputError(f"{path}: not a JSON certificate ({type(e).__name__})") from None
+    if not isinstance(data, dict) or data.get("format") != FORMAT:
+        raise InputError(f"{path}: not a csplab certificate (no format {FORMAT!r})")
+    if data.get("version") != VERSION:
+        raise InputError(f"{path}: certificate version {data.get('version')!r} is not {VERSION}")
+    return data
+
+
+def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
+    """Re-verify a certificate without the prover's code.
+
+    Parameters
+    ----------
+    cert : mapping
+        A certificate as :func:`load_certificate` reads it.
+
+    Returns
+    -------
+    (bool, str)
+        Whether it is valid, and one line saying what was verified or the first defect.
+
+    Examples
+    --------
+    >>> check_certificate({"claim": "infallible"})
+    (False, 'invalid: no rules')
+    """
+    try:
+        rules = cert.get("rules")
+        if not isinstance(rules, Mapping):
+            raise _Invalid("no rules")
+        if rules_hash(rules) != cert.get("rules_sha256"):
+            raise _Invalid("the rules do not match rules_sha256")
+        fwd, bwd, used, ndim = _tables(rules)
+        face_rules = _face_rules(rules.get("faces") or [], ndim, rules)
+        claim = cert.get("claim")
+        if claim == "infallible":
+            msg = _check_closed(cert, fwd, bwd, used, ndim, face_rules)
+        elif claim == "fallible":
+            msg = _check_run(cert, fwd, bwd, used, ndim, face_rules)
+        else:
+            raise _Invalid(f"unknown claim {claim!r}")
+    except _Invalid as e:
+        return False, f"invalid: {e}"
+    except (KeyError, TypeError, ValueError, IndexError) as e:
+        return False, f"invalid: malformed certificate ({type(e).__name__}: {e})"
+    return True, msg
+
+
+# ----------------------------------------------------------------------------- rules
+
+
+def _tables(rules: Mapping[str, Any]) -> tuple[list[list[int]], list[list[int]], int, int]:
+    K = int(rules["labels"])
+    flags = list(rules["used"])
+    if K < 1 or len(flags) != K:
+        raise _Invalid("rules: 'used' needs one flag per label")
+    used = sum(1 << b for b, f in enumerate(flags) if f)
+    ndim = len(rules["pairs"])
+    if not 1 <= ndim <= 4:
+        raise _Invalid("rules: 1 to 4 axes")
+    fwd = [[0] * K for _ in range(ndim)]
+    bwd = [[0] * K for _ in range(ndim)]
+    for d, pairs in enumerate(rules["pairs"]):
+        for a, b in pairs:
+            if not (0 <= a < K and 0 <= b < K):
+                raise _Invalid(f"rules: label out of range in {[a, b]}")
+            if used >> a & 1 and used >> b & 1:
+                fwd[d][a] |= 1 << b
+                bwd[d][b] |= 1 << a
+    return fwd, bwd, used, ndim
+
+
+FaceRule = tuple[str, str, int]
+
+
+def _face_rules(raw: Sequence[Any], ndim: int, rules: Mapping[str, Any]) -> list[FaceRule]:
+    out = []
+    for op, where, labels in raw:
+        face = where[1:] if where.startswith("!") else where
+        if op not in ("keep", "remove", "force", "add") or not (
+            where == "*" or (len(face) == 2 and face[0] in _AXES[:ndim] and face[1] in "-+")
+        ):
+            raise _Invalid(f"face rule {[op, where]} is not understood")
+        if any(not 0 <= b < int(rules["labels"]) for b in labels):
+            raise _Invalid(f"face rule {[op, where]}: label out of range")
+        out.append((str(op), str(where), sum(1 << int(b) for b in set(labels))))
+    return out
+
+
+def _domain(face_rules: list[FaceRule], faces: set[str], used: int) -> int:
+    """The domain of a cell lying on ``faces``: the labels in use, edited by the rules."""
+    dom = used
+    for op, where, bits in face_rules:
+        if where != "*" and (where[1:] in faces if where[0] == "!" else where not in faces):
+            continue
+        if op == "keep":
+            dom &= bits
+        elif op == "remove":
+            dom &= ~bits
+        elif op == "force":
+            dom = bits
+        else:
+            dom |= bits
+    return dom & used
+
+
+def _bits(x: int) -> Iterator[int]:
+    while x:
+        low = x & -x
+        yield low.bit_length() - 1
+        x ^= low
+
+
+def _axes_of(order: str, ndim: int) -> tuple[int, ...]:
+    if order == "scanline":
+        return tuple(range(ndim))
+    if order.startswith("scan:") and sorted(order[5:]) == sorted(_AXES[:ndim]):
+        return tuple(_AXES.index(a) for a in order[5:])
+    raise _Invalid(f"order {order!r} is not a scan order over {ndim} axes")
+
+
+def _arc_consistency(
+    dom: dict[Cell, int], fwd: list[list[int]], bwd: list[list[int]]
+) -> dict[Cell, int] | None:
+    """Revise every arc between cells of ``dom`` until nothing changes; ``None`` on a
+    wipe-out."""
+    changed = True
+    while changed:
+        changed = False
+        for c, dc in dom.items():
+            for d in range(len(c)):
+                for step, table in ((-1, fwd[d]), (1, bwd[d])):
+                    n = (*c[:d], c[d] + step, *c[d + 1 :])
+                    dn = dom.get(n)
+                    if dn is None:
+                        continue
+                    support = 0
+                    for b in _bits(dn):
+                        support |= table[b]
+                    new = dc & support
+                    if new != dc:
+                        if new == 0:
+                            return None
+                        dom[c] = dc = new
+                        changed = True
+    return dom
+
+
+# ----------------------------------------------------------------------------- infallible
+
+
+def _check_closed(
+    cert: Mapping[str, Any],
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    ndim: int,
+    face_rules: list[FaceRule],
+) -> str:
+    region = [int(t) for t in cert["region"]]
+    history = [int(t) for t in cert["history"]]
+    axes = tuple(int(a) for a in cert["axes"])
+    if len(region) != ndim or len(history) != ndim or any(r < 2 for r in region):
+        raise _Invalid("region needs at least 2 cells on every axis of the rules")
+    if any(h < 0 for h in history):
+        raise _Invalid("history must be non-negative")
+    if _axes_of(str(cert["order"]), ndim) != axes:
+        raise _Invalid("axes do not match the order")
+    both = (False, True) if face_rules else (False,)
+    want = set()
+    for lo in itertools.product(*[range(2 + h) for h in history]):
+        for hi in itertools.product(*[range(r - 1) for r in region]):
+            at_lo = [(True,) if lo[d] < 1 + history[d] else both for d in range(ndim)]
+            at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
+            for a in itertools.product(*at_lo):
+                for b in itertools.product(*at_hi):
+                    want.add((lo, hi, a, b))
+    configs = cert["configs"]
+    got = [
+        (
+            tuple(c["lower"]), tuple(c["upper"]),
+            tuple(bool(t) for t in c.get("at_lower", [])) or tuple(
+                lo < 1 + h for lo, h in zip(c["lower"], history, strict=True)),
+            tuple(bool(t) for t in c.get("at_upper", [])) or tuple(
+                hi < r - 2 for hi, r in zip(c["upper"], region, strict=True)),
+        )
+        for c in configs
+    ]  # fmt: skip
+    if len(got) != len(set(got)) or set(got) != want:
+        raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
+    nstates = 0
+    for c, (_, _, a, b) in zip(configs, got, strict=True):
+        nstates += _check_config(c, region, axes, fwd, bwd, used, face_rules, a, b)
+    rtxt = "x".join(map(str, region))
+    return (
+        f"valid: {nstates} states in {len(configs)} configurations are closed under Alg. 3.6 "
+        f"with {rtxt} regions ({cert['order']}) and no catalog of a point is empty: "
+        "Alg. 3.1 never fails (Theorem 3.3.6)"
+    )
+
+
+def _check_config(
+    conf: Mapping[str, Any],
+    region: list[int],
+    axes: tuple[int, ...],
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    face_rules: list[FaceRule],
+    at_lo: tuple[bool, ...],
+    at_hi: tuple[bool, ...],
+) -> int:
+    lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
+    ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
+
+    def order_key(c: Cell) -> Cell:
+        return tuple(c[a] for a in axes)
+
+    cells = sorted(itertools.product(*[range(e) for e in ext]), key=order_key)
+    cells = [c for c in cells if order_key(c) < order_key(lo)] + [lo]
+    index = {c: i for i, c in enumerate(cells)}
+    n = len(cells)
+    keys = [list(k) for k in conf["keys"]]
+    where = f"configuration lower={list(lo)} upper={list(hi)}"
+    if len(keys) != n or keys[0]:
+        raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
+    boxes: list[list[Cell]] = []
+    for i, c in enumerate(cells):
+        if keys[i] != sorted(set(keys[i])) or any(not 0 <= j < i for j in keys[i]):
+            raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
+        if i + 1 < n and not set(keys[i + 1]) <= set(keys[i]) | {i}:
+            raise _Invalid(f"{where}: keys[{i + 1}] records a label step {i} forgot")
+        box = list(itertools.product(*[
+            range(max(0, c[d] - 1), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
+            for d in range(len(c))
+        ]))  # fmt: skip
+        inbox = set(box)
+        labelled = {x for x in box if x in index and index[x] < i}
+        for x in labelled:
+            near = ((*x[:d], x[d] + s, *x[d + 1 :]) for d in range(len(x)) for s in (-1, 1))
+            if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
+                raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
+        boxes.append(box)
+    graphs = [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
+
+    def base(x: Cell) -> int:
+        on = {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
+        on |= {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
+        return _domain(face_rules, on, used)
+
+    bases = [[base(x) for x in g[3]] for g in graphs]
+    by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
+    try:
+        for i, labs in conf["states"]:
+            by_step[i if i >= 0 else n].add(tuple(labs))
+    except (IndexError, TypeError):
+        raise _Invalid(f"{where}: a state's step is not one of its {n} steps") from None
+    in_use = set(_bits(used))
+    for i, group in enumerate(by_step):
+        if any(len(t) != len(keys[i]) for t in group):
+            raise _Invalid(f"{where}: a state at step {i} does not fit keys[{i}]")
+        labels = set(itertools.chain.from_iterable(group))
+        if not labels <= in_use:
+            raise _Invalid(f"{where}: a state at step {i} has a label not in use")
+    if () not in by_step[0]:
+        raise _Invalid(f"{where}: no start state")
+    union: dict[tuple[int, int, int], int] = {}
+    for i in range(n):
+        src, arcs, target, _ = graphs[i]
+        pos = {j: k for k, j in enumerate(keys[i])}
+        # where each fixed node's label, and each label of the next state, sits in a state
+        src_at = [pos[j] for j in src if j >= 0]
+        nxt_at = [-1 if j == i else pos[j] for j in keys[i + 1]] if i + 1 < n else []
+        later = by_step[i + 1] if i + 1 < n else set()
+        memo: dict[tuple[int, ...], int] = {}
+        for labs in by_step[i]:
+            mk = tuple([labs[k] for k in src_at])
+            cat = memo.get(mk)
+            if cat is None:
+                it = iter(mk)
+                dom = [b0 if j < 0 else 1 << next(it) for j, b0 in zip(src, bases[i], strict=True)]
+                out = _small_ac(dom, arcs, fwd, bwd, union)
+                cat = memo[mk] = 0 if out is None else out[target]
+            if i == n - 1:
+                if cat == 0:
+                    raise _Invalid(
+                        f"{where}: the point's catalog is empty in state {[i, list(labs)]}"
+                    )
+                continue
+            for b in _bits(cat):
+                nxt = tuple([b if k < 0 else labs[k] for k in nxt_at])
+                if nxt not in later:
+                    raise _Invalid(
+                        f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
+                        f"{[i + 1, list(nxt)]}, which is missing"
+                    )
+    return sum(len(s) for s in by_step)
+
+
+def _graph(
+    box: list[Cell], index: Mapping[Cell, int], i: int, key: Sequence[int], cell: Cell
+) -> tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]:
+    """The region of step ``i`` as a small graph: its unlabelled cells (``src`` -1) and its
+    labelled cells whose label the state records (``src`` = their step); arcs
+    ``(node, axis, node is the + neighbour)``; the node of cell ``i``; the nodes' cells."""
+    known = set(key)
+    nodes = [x for x in box if not (x in index and index[x] < i) or index[x] in known]
+    pos = {x: k for k, x in enumerate(nodes)}
+    arcs: list[list[tuple[int, int, bool]]] = [[] for _ in nodes]
+    for x, k in pos.items():
+        for d in range(len(cell)):
+            m = pos.get((*x[:d], x[d] + 1, *x[d + 1 :]))
+            if m is not None:
+                arcs[k].append((m, d, True))
+                arcs[m].append((k, d, False))
+    src = [index[x] if x in index and index[x] < i else -1 for x in nodes]
+    return src, arcs, pos[cell], nodes
+
+
+def _small_ac(
+    dom: list[int],
+    arcs: list[list[tuple[int, int, bool]]],
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    union: dict[tuple[int, int, int], int],
+) -> list[int] | None:
+    """Arc consistency (a work list of nodes) on a small graph; ``None`` on a wipe-out."""
+    queue = list(range(len(dom)))
+    waiting = [True] * len(dom)
+    while queue:
+        u = queue.pop()
+        waiting[u] = False
+        du = dom[u]
+        for v, d, plus in arcs[u]:
+            ukey = (d if plus else -1 - d, du, 0)
+            sup = union.get(ukey)
+            if sup is None:
+                table = fwd[d] if plus else bwd[d]
+                sup = 0
+                for b in _bits(du):
+                    sup |= table[b]
+                union[ukey] = sup
+            new = dom[v] & sup
+            if new != dom[v]:
+                if new == 0:
+                    return None
+                dom[v] = new
+                if not waiting[v]:
+                    waiting[v] = True
+                    queue.append(v)
+    return dom
+
+
+# ----------------------------------------------------------------------------- fallible
+
+
+def _check_run(
+    cert: Mapping[str, Any],
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    ndim: int,
+    face_rules: list[FaceRule],
+) -> str:
+    run = cert["run"]
+    shape = tuple(int(s) for s in run["shape"])
+    if len(shape) != ndim or any(s < 1 for s in shape):
+        raise _Invalid(f"run: shape {list(shape)} does not have {ndim} positive sizes")
+    axes = _axes_of(str(run.get("order", "scanline")), ndim)
+    cells = sorted(
+        itertools.product(*[range(s) for s in shape]), key=lambda c: tuple(c[a] for a in axes)
+    )
+
+    def faces(c: Cell) -> set[str]:
+        on = {_AXES[d] + "-" for d in range(ndim) if c[d] == 0}
+        return on | {_AXES[d] + "+" for d in range(ndim) if c[d] == shape[d] - 1}
+
+    bnd = run.get("boundary") or {}
+    if bnd == "auto":  # the certificate's face rules
+        rules_here = face_rules
+    elif isinstance(bnd, Mapping):  # face -> label; the bottom face wins, then later faces
+        every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
+        if any(f not in every for f in bnd):
+            raise _Invalid(f"run: unknown boundary faces in {sorted(bnd)}")
+        bottom = _AXES[ndim - 1] + "-"
+        order = [f for f in every if f != bottom] + [bottom]
+        rules_here = [("force", f, 1 << int(bnd[f])) for f in order if f in bnd]
+    else:
+        raise _Invalid("run: boundary must be 'auto' or map faces to labels")
+    start = {c: _domain(rules_here, faces(c), used) for c in cells}
+    if any(v == 0 for v in start.values()):
+        return "valid: Alg. 3.1 fails before its first choice (a boundary cell has no label)"
+    dom = _arc_consistency(start, fwd, bwd)
+    if dom is None:
+        return "valid: Alg. 3.1 fails before its first choice (the grid has no solution)"
+    choices = list(run["choices"])
+    for k, (cell, label) in enumerate(choices):
+        c = tuple(int(t) for t in cell)
+        if c != cells[k]:
+            raise _Invalid(f"run: choice {k + 1} is at {list(c)}, the scan visits {cells[k]}")
+        if label is None:  # a run that stops at an empty catalog: it is wiped out before
+            raise _Invalid(f"run: choice {k + 1} claims an empty catalog, which is not")
+        if not dom[c] >> int(label) & 1:
+            raise _Invalid(f"run: choice {k + 1} ({label} at {list(c)}) is not in its catalog")
+        dom[c] = 1 << int(label)
+        dom = _arc_consistency(dom, fwd, bwd)
+        if dom is None:
+            rest = choices[k + 1 :]  # at most the cell found empty, marked [cell, None]
+            if rest and (len(rest) > 1 or rest[0][1] is not None):
+                raise _Invalid(f"run: the catalog is wiped out at choice {k + 1}, not the last")
+            return (
+                f"valid: the run of Alg. 3.1 ({len(choices)} choices on "
+                f"{'x'.join(map(str, shape))}) wipes out a catalog: fallible"
+            )
+    raise _Invalid("the run of Alg. 3.1 does not fail (every catalog non-empty at the end)")
+
+
+def _main(argv: Sequence[str]) -> int:  # pragma: no cover - `python -m csplab.certcheck FILE`
+    ok, msg = check_certificate(load_certificate(argv[0]))
+    print(msg)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":  # pragma: no cover
+    import sys
+
+    raise SystemExit(_main(sys.argv[1:]))
