@@ -53,17 +53,22 @@ def boundary_label(args: argparse.Namespace, example: Any) -> Any:
     return label
 
 
-def polygon_output(path: str | None, flag: str = "--out", gives: Any = "PolygonModel") -> Any:
-    """The polygon (or polyhedral) format for an output path (checked before any work),
+def polygon_output(
+    path: str | None,
+    flag: str = "--out",
+    gives: Any = "PolygonModel",
+    args: argparse.Namespace | None = None,
+) -> Any:
+    """The polygon (or polyhedral) format for an output path (checked before any work:
+    the format, the folder, and that it is none of the files ``args`` names as inputs),
     or None."""
     if not path:
         return None
-    from csplab.cli.common import check_output_path
+    from csplab.cli.common import check_output_path, input_files
     from csplab.io.registry import output_format
 
-    fmt = output_format(path, gives=gives)
-    check_output_path(path, flag)
-    return fmt
+    check_output_path(path, flag, inputs=input_files(args) if args is not None else ())
+    return output_format(path, gives=gives)
 
 
 def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> int:
@@ -85,7 +90,9 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
     size = region(args, dim)
     boundary = boundary_label(args, example)
-    fmt = polygon_output(args.out, gives="PolygonModel" if dim == 2 else "PolyhedralModel")
+    fmt = polygon_output(
+        args.out, gives="PolygonModel" if dim == 2 else "PolyhedralModel", args=args
+    )
     cls = solver_class(args.solver.partition(":")[0])
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
@@ -115,7 +122,7 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         s = synthesize3(example, size, **common, **opts)
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
-    if fmt is not None and s.model is not None:
+    if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
         fmt.write(s.model, args.out)
         wrote = args.out
     A = csp.arrangement
@@ -164,7 +171,8 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         if wrote:
             print(f"  wrote {wrote}")
         elif args.out:
-            print(f"  not written: {args.out} (no solution)", file=sys.stderr)
+            why = "no solution" if s.model is None else "the run failed"
+            print(f"  not written: {args.out} ({why})", file=sys.stderr)
         if r.status == "failed" and not cls.complete and cls.name != "blocks":
             hint = (
                 "  hint: --solver blocks modifies the model in parts (Fig. 4.23) and always "

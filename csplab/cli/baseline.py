@@ -7,7 +7,7 @@ import argparse
 import json
 import time
 
-from csplab.cli.common import check_output_path, load_model, model_options
+from csplab.cli.common import check_output_path, input_files, load_model, model_options
 from csplab.errors import InputError
 
 HELP = "run a baseline the seeds compare against (texture synthesis ...) on an example"
@@ -62,7 +62,10 @@ def run(args: argparse.Namespace) -> int:
     if len(size) < example.ndim:
         size = (*size, *([1] * (example.ndim - len(size))))
     if args.out:
-        check_output_path(args.out, "--out")
+        from csplab.io.registry import output_format
+
+        output_format(args.out)  # a bad extension: refused before the work
+        check_output_path(args.out, "--out", inputs=input_files(args))
     opts = {o.name: getattr(args, o.name) for o in b.options if getattr(args, o.name) is not None}
     _, seed = make_rng(args.seed)
     t0 = time.perf_counter()
@@ -101,7 +104,7 @@ def _mesh(args: argparse.Namespace, b: object, example: object) -> int:
     if len(size) != 3:
         raise InputError(f"--size {args.size}: the geometry baseline needs three sides")
     if args.out:
-        check_output_path(args.out, "--out")
+        check_output_path(args.out, "--out", inputs=input_files(args))
         if Path(args.out).suffix.lower() not in (".obj", ".stl", ".off", ".ply"):
             raise InputError(f"--out {args.out}: a mesh file (.obj, .stl, .off, .ply)")
     names = [o.name for o in getattr(b, "options", ())]

@@ -34,6 +34,7 @@ __all__ = [
     "check_output_dir",
     "check_output_path",
     "check_time_limit",
+    "input_files",
     "kernels_cold",
     "load_grid",
     "load_model",
@@ -110,9 +111,49 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     return model
 
 
-def check_output_path(path: str | Path, what: str, *, force: bool = True) -> Path:
+def input_files(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """The files a command reads, as ``(role, path)`` pairs: the model (when it is a file,
+    not a built-in name), every ``--constraints`` file, the grid ``check`` reads and a
+    blocks ``--option init=FILE``; an output must be none of them."""
+    found: list[tuple[str, Path]] = []
+    model = getattr(args, "model", None)
+    if isinstance(model, str) and os.path.isfile(model):
+        found.append(("the model", Path(model)))
+    for c in getattr(args, "constraints", None) or []:
+        found.append(("a --constraints file", Path(c)))
+    grid = getattr(args, "grid", None)
+    if isinstance(grid, str) and os.path.isfile(grid):
+        found.append(("the grid to check", Path(grid)))
+    for kv in getattr(args, "option", None) or []:
+        key, _, val = str(kv).partition("=")
+        if key == "init" and os.path.isfile(val):
+            found.append(("the --option init grid", Path(val)))
+    return found
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
+
+
+def _companions(p: Path) -> list[Path]:
+    """The files written beside ``p``: an OBJ mesh's material library (same stem)."""
+    return [p.with_suffix(".mtl")] if p.suffix.lower() == ".obj" else []
+
+
+def check_output_path(
+    path: str | Path,
+    what: str,
+    *,
+    force: bool = True,
+    inputs: Sequence[tuple[str, Path]] = (),
+) -> Path:
     """``path`` as a file the command can write, checked before the work: its folder exists
-    and is writable, ``path`` is not a folder, and (``force=False``) no file is there yet.
+    and is writable, ``path`` is not a folder, it is none of the ``inputs`` (never
+    overwrite what was read), and (``force=False``) no file is there yet. An ``.obj``
+    path checks its ``.mtl`` companion the same way.
 
     Parameters
     ----------
@@ -122,6 +163,8 @@ def check_output_path(path: str | Path, what: str, *, force: bool = True) -> Pat
         The argument that named it (``"--out"``), for the message.
     force : bool
         Whether an existing file may be overwritten.
+    inputs : sequence of (str, Path)
+        The files the command reads (:func:`input_files`), with their roles.
 
     Raises
     ------
@@ -139,6 +182,17 @@ not exist
     p = Path(path)
     if str(path) == "" or p.name in ("", ".", ".."):
         raise InputError(f"{what} {str(path)!r} is not a file name")
+    for q in (p, *_companions(p)):
+        for role, src in inputs:
+            if _same_file(q, src) or q.resolve() == src.resolve():
+                raise InputError(
+                    f"{what} {p}: {q} is {role} this command reads; write the output elsewhere"
+                )
+    for q in _companions(p):
+        if q.is_dir():
+            raise InputError(f"{what} {p}: its material file {q} is a folder")
+        if q.exists() and not os.access(q, os.W_OK):
+            raise InputError(f"{what} {p}: its material file {q} is not writable")
     folder = p.parent
     if not folder.exists():
         raise InputError(f"{what} {p}: the folder {folder} does not exist")

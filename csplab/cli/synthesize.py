@@ -11,6 +11,7 @@ from csplab.cli.common import (
     add_constraints_arg,
     add_problem_args,
     check_output_path,
+    input_files,
     key_values,
     load_model,
     model_options,
@@ -186,9 +187,9 @@ def run(args: argparse.Namespace) -> int:
     problem = problem_from_args(args, example)
     opts = _options(args)
     settings = _settings(args, example, opts)
+    if args.out:  # an input, a folder, an unwritable place: refused before the work
+        check_output_path(args.out, "--out", inputs=input_files(args))
     out_format = output_format(args.out) if args.out else None  # bad extension: fail early
-    if args.out:
-        check_output_path(args.out, "--out")  # an unwritable folder: fail before the work
     if out_format is not None and args.out_partial and not out_format.partial:
         raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
     result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"], **opts)

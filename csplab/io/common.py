@@ -342,3 +342,46 @@ class Output:
             colors=m.voxel_palette[1:],
             empty=-1,
         )
+
+
+def atomic_write(path: str | Path, data: bytes | str) -> None:
+    """Write ``data`` (text as UTF-8) to a temporary file beside ``path``, then rename it
+    over ``path``: a reader never sees half a file, and a failed write leaves the old
+    one as it was.
+
+    Raises
+    ------
+    InputError
+        One line naming ``path`` when the folder refuses the file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     atomic_write(Path(d) / "a.txt", "hello")
+    ...     (Path(d) / "a.txt").read_text()
+    'hello'
+    """
+    import tempfile
+
+    from csplab.errors import InputError
+
+    p = Path(path)
+    raw = data.encode("utf-8") if isinstance(data, str) else data
+    try:
+        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.")
+    except OSError as e:
+        raise InputError(f"{p}: cannot write: {e.strerror}") from None
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(raw)
+        mask = os.umask(0)
+        os.umask(mask)
+        os.chmod(tmp, 0o666 & ~mask)
+        os.replace(tmp, p)
+    except OSError as e:
+        Path(tmp).unlink(missing_ok=True)
+        raise InputError(f"{p}: cannot write: {e.strerror}") from None
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise

@@ -271,7 +271,9 @@ def format_grid(example: ExampleModel, comments: str = "") -> str:
 
 
 def write_grid(example: ExampleModel, path: str | Path, comments: str = "") -> None:
-    Path(path).write_text(format_grid(example, comments), encoding="utf-8")
+    from csplab.io.common import atomic_write
+
+    atomic_write(path, format_grid(example, comments))
 
 
 def grid_safe_names(names: Sequence[str]) -> list[str]:

@@ -59,5 +59,11 @@ def read_npy(path: str | Path) -> ExampleModel:
 
 def write_output(out: Output, path: Path) -> None:
     """The grid as an int32 array (int64 when the file's label ids need it)."""
+    import io
+
+    from csplab.io.common import atomic_write
+
     g = out.file_grid()
-    np.save(path, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)
+    buf = io.BytesIO()
+    np.save(buf, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)
+    atomic_write(path, buf.getvalue())

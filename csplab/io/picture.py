@@ -28,16 +28,20 @@ __all__ = ["write_output"]
 def write_output(out: Output, path: Path) -> None:
     """A picture of the grid: the rule set's own (tile pictures, voxels, the overlapping
     model's colours) or one colour per label."""
+    import io
+
+    from csplab.io.common import atomic_write
     from csplab.io.ruleset import RuleSet
 
+    buf = io.BytesIO()
     if isinstance(out.model, RuleSet):
-        out.model.render(out.grid, periodic=out.periodic).save(path, format="PNG")
-        return
-    from csplab.render import model_objects, render
+        out.model.render(out.grid, periodic=out.periodic).save(buf, format="PNG")
+    else:
+        from csplab.render import model_objects, render
 
-    K = len(out.names) if out.names is not None else None
-    objects = model_objects(out.model) if out.model is not None else None
-    topology = out.meta.get("topology")
-    render(out.grid, K=K, colors=out.colors, objects=objects, topology=topology).save(
-        path, format="PNG"
-    )
+        K = len(out.names) if out.names is not None else None
+        objects = model_objects(out.model) if out.model is not None else None
+        topology = out.meta.get("topology")
+        img = render(out.grid, K=K, colors=out.colors, objects=objects, topology=topology)
+        img.save(buf, format="PNG")
+    atomic_write(path, buf.getvalue())

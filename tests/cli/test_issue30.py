@@ -1,0 +1,127 @@
+"""Issue 30 (a new user's audit of bad inputs): one test per row of the issue's table.
+
+Every bad input is refused with exit 2 and one line naming the file or flag, before any
+work; a run never overwrites what it reads and a failed run writes nothing.
+"""
+
+import hashlib
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from csplab.cli import main
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "csplab" / "examples"
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def refused(capsys, *argv, words=()):
+    """Exit 2, exactly one line on stderr, no traceback, naming ``words``."""
+    code, out, err = run(capsys, *argv)
+    lines = err.strip().splitlines()
+    assert code == 2, (code, out, err)
+    assert len(lines) == 1 and lines[0].startswith("csplab: error: "), err
+    assert "Traceback" not in err
+    for w in words:
+        assert w in lines[0], (w, lines[0])
+    return lines[0]
+
+
+def digest(p):
+    return hashlib.sha256(Path(p).read_bytes()).hexdigest()
+
+
+# ---------------------------------------------------------------- row 1: data loss
+@pytest.mark.parametrize(
+    ("src", "name", "size"),
+    [
+        ("continuous/triangle.json", "X.json", "10x10"),
+        ("fig3_5a_fallible.grid", "X.grid", "10x10"),
+        ("continuous3d/tetrahedron.obj", "X.obj", "3x3x3"),
+    ],
+)
+def test_row1_out_never_overwrites_the_model(capsys, tmp_path, monkeypatch, src, name, size):
+    monkeypatch.chdir(tmp_path)
+    shutil.copy(EXAMPLES / src, name)
+    before = digest(name)
+    for out in (name, f"./{name}", str(tmp_path / name)):
+        refused(capsys, "synthesize", name, "--size", size, "--out", out, words=(name, "reads"))
+    assert digest(name) == before
+
+
+def test_row1_out_never_overwrites_an_npy_model_or_constraints(capsys, tmp_path):
+    import numpy as np
+
+    m = tmp_path / "X.npy"
+    np.save(m, np.array([[0, 0, 1], [0, 1, 1]], dtype=np.int32))
+    before = digest(m)
+    refused(capsys, "synthesize", m, "--size", "5x5", "--out", m, words=("X.npy",))
+    c = tmp_path / "c.json"
+    c.write_text('{"constraints": [{"type": "count", "labels": [1], "min": 1}]}')
+    refused(capsys, "synthesize", m, "--size", "5x5", "--constraints", c, "--out", c,
+            words=("--constraints",))  # fmt: skip
+    assert digest(m) == before and json.loads(c.read_text())["constraints"]
+
+
+# ------------------------------------------------- row 9: a failed 3D run writes nothing
+def test_row9_failed_constrained_3d_run_writes_nothing(capsys, tmp_path):
+    pytest.importorskip("trimesh")
+    c = tmp_path / "conn.json"
+    c.write_text('{"constraints": [{"type": "connected", "labels": [1]}]}')
+    out = tmp_path / "r.obj"
+    code, _, err = run(capsys, "synthesize", "houses", "--size", "6x6x3", "--constraints", c,
+                       "--out", out, "--restarts", "0", "--seed", "1")  # fmt: skip
+    assert code == 1
+    assert not out.exists() and not out.with_suffix(".mtl").exists()
+    assert "not written" in err
+
+
+# ------------------------------------------------ row 13: refused before the work
+def test_row13_baseline_bad_extension_is_refused_before_the_work(capsys, tmp_path, monkeypatch):
+    import csplab.baselines as b
+
+    def boom(*a, **k):
+        raise AssertionError("the baseline ran before the output was checked")
+
+    monkeypatch.setattr(b, "run_baseline", boom)
+    refused(capsys, "baseline", "texture", "castle", "--size", "10x10x8", "--out",
+            tmp_path / "r.svg", words=("r.svg",))  # fmt: skip
+
+
+def test_row13_obj_next_to_a_folder_named_like_its_mtl(capsys, tmp_path):
+    (tmp_path / "r.mtl").mkdir()
+    refused(capsys, "synthesize", "castle", "--size", "6x6x4", "--out", tmp_path / "r.obj",
+            words=("r.mtl", "folder"))  # fmt: skip
+    refused(capsys, "synthesize", "tetrahedron", "--size", "3x3x3", "--out",
+            tmp_path / "r.obj", words=("r.mtl", "folder"))  # fmt: skip
+
+
+def test_grid_writers_are_atomic(tmp_path, monkeypatch):
+    """A writer that fails half-way leaves the old file as it was (no half-written file)."""
+    import numpy as np
+
+    import csplab.io.common as common
+    from csplab.io import write_labels
+
+    for ext in (".npy", ".grid", ".txt", ".png", ".vox", ".obj"):
+        p = tmp_path / f"a{ext}"
+        g = np.zeros((3, 3, 2), dtype=np.int32) if ext in (".vox", ".obj") else np.zeros((3, 3))
+        write_labels(g.astype(np.int32), p)
+        before = digest(p)
+
+        def fail(*a, **k):
+            raise OSError(28, "No space left on device")
+
+        monkeypatch.setattr(common.os, "replace", fail)
+        with pytest.raises(Exception, match="No space left"):
+            write_labels((g + 1).astype(np.int32), p)
+        monkeypatch.undo()
+        assert digest(p) == before, ext
+        assert sorted(x.name for x in tmp_path.iterdir() if x.name.startswith(".")) == []
