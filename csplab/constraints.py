@@ -59,7 +59,6 @@ Examples
 from __future__ import annotations
 
 import itertools
-import json
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -1071,15 +1070,10 @@ def parse_constraints(data: Any, problem: Problem, source: object = None) -> lis
 def read_entries(path: str | Path) -> list[Any]:
     """The entries of a constraints file, unparsed (a bad file is one
     :class:`FormatError` line)."""
+    from csplab.io._json import read_json_file
+
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as e:
-        raise FormatError(f"cannot read: {e.strerror or e}", path=p) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise FormatError(f"not JSON: {e.msg}", path=p, line=e.lineno) from None
+    data = read_json_file(p)  # size, special files, nesting depth: one line each
     items = data.get("constraints") if isinstance(data, Mapping) else data
     if not isinstance(items, list):
         raise FormatError('a constraints file is {"constraints": [ ... ]}', path=p)

@@ -14,7 +14,7 @@ import pytest
 
 from csplab.continuous.synthesis import synthesize3
 from csplab.continuous.user3d import parse_user_constraints, read_user_constraints, user_violations3
-from csplab.errors import InputError
+from csplab.errors import FormatError, InputError
 from tests._meshes import box as _box
 
 polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
@@ -111,7 +111,7 @@ def test_unknown_normal_and_label_name_the_file(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="not a plane family"):
         synthesize3(E, (4, 4, 2), constraints=read_user_constraints(f))
     f.write_text("{")
-    with pytest.raises(InputError, match=r"c\.json: line 1: not JSON"):
+    with pytest.raises(FormatError, match=r"c\.json, line 1: not valid JSON"):
         read_user_constraints(f)
 
 

@@ -125,3 +125,70 @@ def test_grid_writers_are_atomic(tmp_path, monkeypatch):
         monkeypatch.undo()
         assert digest(p) == before, ext
         assert sorted(x.name for x in tmp_path.iterdir() if x.name.startswith(".")) == []
+
+
+# ------------------------------------- rows 2, 3: labels the renderers and formats can hold
+TETRA = (EXAMPLES / "continuous3d" / "tetrahedron.obj").read_text()
+
+
+def _big_label_files(tmp_path, label):
+    tri = [[0, 0], [4, 0], [4, 4]]
+    j = tmp_path / "big.json"
+    j.write_text(json.dumps({"polygons": [{"label": label, "points": tri}]}))
+    s = tmp_path / "big.svg"
+    s.write_text(f'<svg><path data-label="{label}" d="M0 0 L4 0 L4 4 Z" fill="red"/></svg>')
+    o = tmp_path / "big.obj"
+    assert "usemtl label_1" in TETRA
+    o.write_text(TETRA.replace("usemtl label_1", f"usemtl label_{label}"))
+    return j, s, o
+
+
+@pytest.mark.parametrize("label", [2_000_000_000, 10**30])
+def test_rows2_3_huge_labels_are_refused_at_load(capsys, tmp_path, label):
+    pytest.importorskip("trimesh")
+    j, s, o = _big_label_files(tmp_path, label)
+    for src, size, outs in ((j, "6x6", ("r.svg", "r.png", "r.json")), (s, "6x6", ("r.png",)),
+                            (o, "3x3x3", ("r.obj", "r.png"))):  # fmt: skip
+        for out in outs:
+            refused(capsys, "synthesize", src, "--size", size, "--out", tmp_path / out,
+                    words=(src.name, str(label), "65535"))  # fmt: skip
+        refused(capsys, "show", src, "--out", tmp_path / "s.png", "--force",
+                words=(src.name, str(label)))  # fmt: skip
+
+
+def test_rows2_3_the_largest_label_still_draws(capsys, tmp_path):
+    j = tmp_path / "ok.json"
+    j.write_text(json.dumps({"polygons": [{"label": 65535, "points": [[0, 0], [4, 0], [4, 4]]}]}))
+    code, _, err = run(capsys, "show", j, "--out", tmp_path / "ok.png")
+    assert code == 0, err
+
+
+# ------------------------------------------------ row 8: deep nesting in constraints files
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ("synthesize", "fig3_5a", "--size", "6x6"),
+        ("check", "fig3_5a", "GRID"),
+        ("synthesize", "tetrahedron", "--size", "3x3x3"),
+        ("check", "tetrahedron", "MESH"),
+    ],
+)
+def test_row8_deeply_nested_constraints_file(capsys, tmp_path, argv):
+    import numpy as np
+
+    deep = tmp_path / "deep.json"
+    deep.write_text('{"constraints": ' + "[" * 50_000 + "]" * 50_000 + "}")
+    grid = tmp_path / "g.npy"
+    np.save(grid, np.zeros((6, 6), dtype=np.int32))
+    mesh = tmp_path / "m.obj"
+    mesh.write_text(TETRA)
+    argv = [{"GRID": grid, "MESH": mesh}.get(a, a) for a in argv]
+    refused(capsys, *argv, "--constraints", deep, words=("deep.json", "nesting is too deep"))
+
+
+def test_row19_nan_in_a_constraints_file_is_located(capsys, tmp_path):
+    c = tmp_path / "nan.json"
+    c.write_text('{"constraints": [\n  {"type": "count", "labels": [1], "min": NaN}]}')
+    line = refused(capsys, "synthesize", "fig3_5a", "--size", "6x6", "--constraints", c,
+                   words=("nan.json, line 2", "NaN"))  # fmt: skip
+    assert "(column 1)" not in line
