@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 import warnings
 from collections.abc import Sequence
@@ -40,9 +41,36 @@ COMMANDS: dict[str, str] = {
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.print_usage(sys.stderr)
-        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        """One line, as every bad input (no usage text: ``--help`` has it)."""
+        print(f"csplab: error: {message} (see `{self.prog} --help`)", file=sys.stderr)
         raise SystemExit(2)
+
+
+_NEGATIVE = re.compile(r"-[0-9.]")
+
+
+def _attach_negative_values(words: list[str]) -> list[str]:
+    """``--size -5x5x5`` as ``--size=-5x5x5``: argparse would take ``-5x5x5`` for an option
+    and print a usage text; attached, the value reaches the option's own check (one line
+    naming the flag and the value).
+
+    Examples
+    --------
+    >>> _attach_negative_values(["synthesize", "x", "--size", "-5x5x5", "--seed", "1"])
+    ['synthesize', 'x', '--size=-5x5x5', '--seed', '1']
+    """
+    out: list[str] = []
+    i = 0
+    while i < len(words):
+        w = words[i]
+        nxt = words[i + 1] if i + 1 < len(words) else None
+        if w.startswith("--") and "=" not in w and nxt is not None and _NEGATIVE.match(nxt):
+            out.append(f"{w}={nxt}")
+            i += 2
+            continue
+        out.append(w)
+        i += 1
+    return out
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -114,11 +142,11 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
     line on stderr before numba's one-time compilation of the kernels, when its cache is
     cold.
     """
-    words = list(sys.argv[1:] if argv is None else argv)
+    words = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     first = next((w for w in words if not w.startswith("-")), None)
     plain = first in COMMANDS and words and words[0] == first
     parser = build_parser(only=first if plain else None)
-    args = parser.parse_args(argv)
+    args = parser.parse_args(words)
     if announce is None:
         announce = argv is None
     if announce and args.command in _KERNEL_COMMANDS:

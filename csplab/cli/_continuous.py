@@ -82,6 +82,11 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
 
     if args.periodic:
         raise InputError("--periodic: continuous models are not periodic")
+    if getattr(args, "topology", None):
+        raise InputError(
+            f"--grid {args.topology}: {example.name or args.model} is a "
+            f"{'polygon' if dim == 2 else 'polyhedral'} model; --grid applies to grid examples"
+        )
     if args.out_partial:
         raise InputError("--out-partial: a failed continuous run has no partial polygons")
     if args.spacing is not None and not args.spacing > 0:
@@ -189,6 +194,11 @@ def check(args: argparse.Namespace, example: Any) -> int:
     from csplab.continuous.check import violations
     from csplab.continuous.polyhedra import PolyhedralModel
 
+    if getattr(args, "topology", None):
+        raise InputError(
+            f"--grid {args.topology}: {example.name or args.model} is a continuous model; "
+            "--grid applies to grid examples"
+        )
     out = load_model(args.grid)
     if isinstance(example, PolyhedralModel):
         from csplab.continuous.check3d import violations3
@@ -234,9 +244,21 @@ def user_constraints(args: argparse.Namespace, example: Any) -> Any:
     from csplab.continuous.user3d import read_user_constraints
 
     names = {str(v): int(k) for k, v in (example.meta.get("label_names") or {}).items()}
+    have = set(example.labels)
     out = None
     for path in args.constraints:
         c = read_user_constraints(path, names)
+        for kind, labels in (
+            ("connected", c.connected),
+            ("dimensional", [b for b, _ in c.dimensional]),
+            ("large-scale", [b for b, _ in c.allowed]),
+        ):
+            missing = [int(b) for b in labels if b not in have]
+            if missing:  # as grid constraints: refused before any work
+                raise InputError(
+                    f"{path}: {kind}: label {missing[0]} does not occur in "
+                    f"{example.name or args.model} (its labels: {sorted(have)})"
+                )
         out = c if out is None else out.merged(c)
     return out
 

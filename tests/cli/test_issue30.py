@@ -192,3 +192,58 @@ def test_row19_nan_in_a_constraints_file_is_located(capsys, tmp_path):
     line = refused(capsys, "synthesize", "fig3_5a", "--size", "6x6", "--constraints", c,
                    words=("nan.json, line 2", "NaN"))  # fmt: skip
     assert "(column 1)" not in line
+
+
+# ---------------------------------------- row 10: 3D constraint labels must exist
+@pytest.mark.parametrize(
+    "entry",
+    [
+        {"type": "connected", "labels": [7]},
+        {"type": "dimensional", "labels": [7], "normals": ["z"]},
+    ],
+)
+def test_row10_3d_constraint_label_not_in_the_model(capsys, tmp_path, entry):
+    pytest.importorskip("trimesh")
+    c = tmp_path / "c7.json"
+    c.write_text(json.dumps({"constraints": [entry]}))
+    out = tmp_path / "r.obj"
+    refused(capsys, "synthesize", "houses", "--size", "6x6x3", "--constraints", c, "--out", out,
+            words=("c7.json", "label 7", "houses"))  # fmt: skip
+    assert not out.exists()
+
+
+# ---------------------------------------------- row 15: --grid on a polygon example
+@pytest.mark.parametrize("model", ["triangle", "tetrahedron"])
+def test_row15_grid_on_a_continuous_model_is_refused(capsys, model):
+    size = "10x10" if model == "triangle" else "3x3x3"
+    refused(capsys, "synthesize", model, "--size", size, "--grid", "hex:odd-r",
+            words=("--grid", model))  # fmt: skip
+
+
+# ---------------------------------------------- row 16: explain's exit codes
+def test_row16_explain_satisfiable_exits_0(capsys):
+    code, out, _ = run(capsys, "explain", "fig3_5a", "--size", "8x8")
+    assert code == 0 and out.startswith("satisfiable")
+
+
+# ---------------------------------------------- row 17: argument errors are one line
+@pytest.mark.parametrize(
+    ("argv", "words"),
+    [
+        (("synthesize", "castle", "--size", "-5x5x5"), ("--size", "-5x5x5")),
+        (("synthesize", "triangle", "--size", "10x10", "--spacing", "abc"), ("--spacing", "abc")),
+        (("synthesize", "castle", "--size", "5x5x5", "--seed", "x"), ("--seed",)),
+        (("synthesize",), ("MODEL",)),
+        (("baseline", "texture", "castle"), ("--size",)),
+        (("frobnicate",), ("frobnicate",)),
+    ],
+)
+def test_row17_argument_errors_are_one_line(capsys, argv, words):
+    try:
+        code = main(list(argv))
+    except SystemExit as e:  # argparse's own errors
+        code = e.code
+    _, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1, err
+    assert lines[0].startswith("csplab: error: ") and all(w in lines[0] for w in words), err
