@@ -22,7 +22,7 @@ are 1..65535)
 Traceback (most recent call last):
 ...
 csplab.errors.MemoryLimitError: synthesize would need about 2.0 GB, over the memory budget \
-of 1.0 GB: use a smaller --size (or raise --memory-limit)
+of 1.0 GB: use a smaller --size, or raise --memory-limit
 """
 
 from __future__ import annotations
@@ -74,18 +74,18 @@ def memory_budget(limit_gb: float | None = None) -> float:
 
 
 def fmt_bytes(n: float) -> str:
-    """``n`` bytes as ``"1.5 GB"`` (or MB below a gigabyte)."""
-    return f"{n / 1e9:.1f} GB" if n >= 1e9 else f"{n / 1e6:.0f} MB"
+    """``n`` bytes as ``"1.5 GB"`` (MB below a gigabyte, kB below a megabyte)."""
+    if n >= 1e9:
+        return f"{n / 1e9:.1f} GB"
+    return f"{n / 1e6:.0f} MB" if n >= 1e6 else f"{n / 1e3:.0f} kB"
 
 
-def check_memory(
-    estimate: float, what: str, change: str, *, budget: float | None = None
-) -> None:
+def check_memory(estimate: float, what: str, change: str, *, budget: float | None = None) -> None:
     """Refuse (:class:`MemoryLimitError`, one line) when ``estimate`` bytes exceed
     ``budget`` (default :func:`memory_budget`); ``change`` says what to change."""
     limit = memory_budget() if budget is None else budget
     if estimate > limit:
         raise MemoryLimitError(
             f"{what} would need about {fmt_bytes(estimate)}, over the memory budget of "
-            f"{fmt_bytes(limit)}: {change} (or raise --memory-limit)"
+            f"{fmt_bytes(limit)}: {change}, or raise --memory-limit"
         )

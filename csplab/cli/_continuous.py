@@ -71,6 +71,49 @@ def polygon_output(
     return output_format(path, gives=gives)
 
 
+#: What a continuous synthesis needs per vertex and edge of the arrangement, in bytes:
+#: ``BYTES_PER_ELEMENT + BYTES_PER_ELEMENT_LABEL * K`` (measured peaks: triangle 200x200,
+#: K=8, 1.56 M vertices and edges, 712 MB; houses 40x40x20, K=40, 0.33 M, 445 MB), on top of
+#: :data:`BASE_BYTES` (the interpreter, numpy, numba).
+BYTES_PER_ELEMENT = 300
+BYTES_PER_ELEMENT_LABEL = 9
+BASE_BYTES = 250e6
+
+
+def estimate_peak(
+    example: Any,
+    size: tuple[int, ...],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    lines: str = "lattice",
+) -> float:
+    """The peak memory (bytes) of a continuous synthesis of ``example`` in a region of
+    ``size`` spacings, estimated before building it: the arrangement of a small probe
+    region (at most 12x12, or 6x6x4 in 3D; a fraction of a second) scaled to ``size`` by
+    area (volume), times the bytes per vertex and edge (:data:`BYTES_PER_ELEMENT`).
+    Scaling a probe overestimates a little (its border is a larger share). A region no
+    larger than the probe is not estimated (0)."""
+    import math
+
+    dim = len(size)
+    probe = tuple(min(s, p) for s, p in zip(size, (12, 12) if dim == 2 else (6, 6, 4), strict=True))
+    ratio = math.prod(size) / math.prod(probe)
+    if ratio <= 1:
+        return 0.0
+    if dim == 2:
+        from csplab.continuous.csp import ContinuousCSP
+
+        csp: Any = ContinuousCSP(example, probe, spacing=spacing, snap=snap, lines=lines)
+    else:
+        from csplab.continuous.csp3d import ContinuousCSP3
+
+        csp = ContinuousCSP3(example, probe, spacing=spacing, snap=snap)
+    A = csp.arrangement
+    elements = (A.n_vertices + A.n_edges) * ratio
+    return BASE_BYTES + elements * (BYTES_PER_ELEMENT + BYTES_PER_ELEMENT_LABEL * csp.problem.K)
+
+
 def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
@@ -99,6 +142,16 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         args.out, gives="PolygonModel" if dim == 2 else "PolyhedralModel", args=args
     )
     cls = solver_class(args.solver.partition(":")[0])
+    from csplab.limits import check_memory, memory_budget
+
+    budget = memory_budget(getattr(args, "memory_limit", None))
+    need = estimate_peak(example, size, spacing=args.spacing, snap=args.snap, lines=args.lines)
+    check_memory(
+        need,
+        f"{example.name or args.model} --size {'x'.join(map(str, size))}",
+        "use a smaller --size or a larger --spacing",
+        budget=budget,
+    )
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
     for key in ("order", "choice"):

@@ -39,6 +39,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                 continue
             seen.add(o.name)
             p.add_argument(f"--{o.name}", type=o.type, help=f"{o.help} (default {o.default})")
+    from csplab.cli.common import add_memory_limit_arg
+
+    add_memory_limit_arg(p)
     p.add_argument("--json", action="store_true")
 
 
@@ -69,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     opts = {o.name: getattr(args, o.name) for o in b.options if getattr(args, o.name) is not None}
     _, seed = make_rng(args.seed)
     t0 = time.perf_counter()
-    grid = run_baseline(args.name, example, size, rng=seed, **opts)
+    grid = run_baseline(args.name, example, size, rng=seed, memory_limit=args.memory_limit, **opts)
     dt = time.perf_counter() - t0
     P = Problem.from_example(example, size)
     v = P.violations(grid)

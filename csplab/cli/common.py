@@ -30,6 +30,7 @@ __all__ = [
     "COMPILING",
     "Model",
     "add_constraints_arg",
+    "add_memory_limit_arg",
     "add_problem_args",
     "check_output_dir",
     "check_output_path",
@@ -342,6 +343,20 @@ def _vox_labels(p: Path, model: Model | None) -> NDArray[np.int64]:
     if empty is not None and empty >= 0:
         g[g < 0] = empty
     return g
+
+
+def add_memory_limit_arg(p: argparse.ArgumentParser) -> None:
+    """``--memory-limit GB``: the budget a command's up-front memory estimate must fit
+    (:func:`csplab.limits.memory_budget`)."""
+    from csplab.limits import MEMORY_SHARE
+
+    p.add_argument(
+        "--memory-limit",
+        type=float,
+        metavar="GB",
+        help="refuse, before the work, a run whose estimated peak memory is larger (default: "
+        f"{MEMORY_SHARE:.0%} of the machine's RAM, or the memory available when less)",
+    )
 
 
 def add_constraints_arg(p: argparse.ArgumentParser) -> None:

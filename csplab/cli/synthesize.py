@@ -9,6 +9,7 @@ from typing import Any
 
 from csplab.cli.common import (
     add_constraints_arg,
+    add_memory_limit_arg,
     add_problem_args,
     check_output_path,
     input_files,
@@ -87,6 +88,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="continuous models: round example vertices onto the --spacing lattice",
     )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
+    add_memory_limit_arg(p)
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument(
         "--option",

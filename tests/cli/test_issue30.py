@@ -247,3 +247,54 @@ def test_row17_argument_errors_are_one_line(capsys, argv, words):
     lines = err.strip().splitlines()
     assert code == 2 and len(lines) == 1, err
     assert lines[0].startswith("csplab: error: ") and all(w in lines[0] for w in words), err
+
+
+# ------------------------------------- rows 11, 12: memory estimated before the work
+def _no_work(monkeypatch, module, name):
+    import importlib
+
+    def boom(*a, **k):
+        raise AssertionError(f"{name} ran before the memory estimate refused the run")
+
+    monkeypatch.setattr(importlib.import_module(module), name, boom)
+
+
+def test_row11_texture_window_estimate_refuses_before_the_work(capsys, monkeypatch):
+    _no_work(monkeypatch, "csplab.baselines.texture", "efros_leung")
+    line = refused(capsys, "baseline", "texture", "castle", "--size", "10x10x8", "--window",
+                   "999", words=("GB", "memory budget", "--window", "--memory-limit"))  # fmt: skip
+    assert "would need about" in line
+
+
+def test_row11_memory_limit_option(capsys, tmp_path):
+    refused(capsys, "baseline", "texture", "fig3_10", "--size", "12x12", "--memory-limit",
+            "0.00001", words=("memory budget of 10 kB",))  # fmt: skip
+    code, _, err = run(capsys, "baseline", "texture", "fig3_10", "--size", "12x12", "--window",
+                       "3", "--memory-limit", "1")  # fmt: skip
+    assert code == 0, err
+
+
+@pytest.mark.parametrize(
+    ("model", "size", "builder"),
+    [
+        ("triangle", "3000x3000", ("csplab.continuous.synthesis", "synthesize")),
+        ("houses", "300x300x100", ("csplab.continuous.synthesis", "synthesize3")),
+    ],
+)
+def test_row12_continuous_estimate_refuses_in_a_second(capsys, monkeypatch, model, size, builder):
+    import time
+
+    pytest.importorskip("trimesh")
+    _no_work(monkeypatch, *builder)
+    t0 = time.perf_counter()
+    line = refused(capsys, "synthesize", model, "--size", size,
+                   words=(model, size, "GB", "--size", "--memory-limit"))  # fmt: skip
+    assert time.perf_counter() - t0 < 10, line
+
+
+def test_row12_estimate_is_not_below_a_measured_peak():
+    """The estimate is an upper bound of a measured peak (triangle 200x200: 712 MB RSS)."""
+    from csplab.cli._continuous import estimate_peak
+    from csplab.io import load_model
+
+    assert 712e6 <= estimate_peak(load_model("triangle"), (200, 200)) <= 3 * 712e6
