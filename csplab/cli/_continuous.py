@@ -110,8 +110,9 @@ def estimate_peak(
 
         csp = ContinuousCSP3(example, probe, spacing=spacing, snap=snap)
     A = csp.arrangement
-    elements = (A.n_vertices + A.n_edges) * ratio
-    return BASE_BYTES + elements * (BYTES_PER_ELEMENT + BYTES_PER_ELEMENT_LABEL * csp.problem.K)
+    elements = float(A.n_vertices + A.n_edges) * ratio
+    per = BYTES_PER_ELEMENT + BYTES_PER_ELEMENT_LABEL * int(csp.problem.K)
+    return BASE_BYTES + elements * per
 
 
 def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> int:
