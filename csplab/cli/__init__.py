@@ -105,9 +105,32 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+_NP_SCALAR = re.compile(r"np\.(?:float|int|uint|complex|bool|str)_?\d*\(([^()]*)\)")
+_NP_BOOL = re.compile(r"np\.(True|False)_")
+_NP_ARRAY = re.compile(r"array\((\[[^()]*?\])(?:, dtype=\w+)?\)")
+_ERRNO = re.compile(r"\(?\((\d+), '([^']*)'\)\)?")
+
+
+def readable(message: str) -> str:
+    """``message`` without Python's reprs: numpy scalars and arrays as plain numbers and
+    lists, an ``OSError``-style ``(errno, 'text')`` pair as its text.
+
+    Examples
+    --------
+    >>> readable("spacing np.float64(3.0) at array([1, 2], dtype=int64): np.True_")
+    'spacing 3.0 at [1, 2]: True'
+    >>> readable("cannot: ((34, 'Numerical result out of range'))")
+    'cannot: (Numerical result out of range)'
+    """
+    message = _NP_SCALAR.sub(r"\1", message)
+    message = _NP_BOOL.sub(r"\1", message)
+    message = _NP_ARRAY.sub(lambda m: " ".join(m.group(1).split()), message)
+    return _ERRNO.sub(r"(\2)", message)
+
+
 def _show_warning(message: Warning | str, category: type[Warning], *args: object,
                   **kwargs: object) -> None:  # fmt: skip
-    print(f"csplab: warning: {str(message).strip().splitlines()[0]}", file=sys.stderr)
+    print(f"csplab: warning: {readable(str(message).strip().splitlines()[0])}", file=sys.stderr)
 
 
 # commands that run csplab's numba kernels (the first run compiles them: one line on stderr)
@@ -157,7 +180,7 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
             code: int = args._run(args)
         return code
     except CsplabError as e:
-        msg = str(e).strip().splitlines()
+        msg = readable(str(e)).strip().splitlines()
         print(f"csplab: error: {msg[0] if msg else type(e).__name__}", file=sys.stderr)
         for extra in msg[1:6]:
             print(f"  {extra}", file=sys.stderr)

@@ -162,7 +162,10 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
     settings["restarts"] = restarts
-    common = dict(solver=args.solver, rng=args.seed, spacing=args.spacing, snap=args.snap,
+    from csplab.rng import make_rng
+
+    _, seed = make_rng(args.seed)  # the seed the header prints: it reproduces every attempt
+    common = dict(solver=args.solver, rng=seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts)  # fmt: skip
     cons = user_constraints(args, example)
     if cons is not None and dim == 2:
@@ -174,11 +177,14 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
             common["progress"] = True  # the cut loop's rounds, once it takes over 2 s
         if not cls.complete or cons.connected:
             common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
-    if dim == 2:
-        settings["lines"] = args.lines
-        s = run2(example, size, lines=args.lines, **common, **opts)
-    else:
-        s = synthesize3(example, size, **common, **opts)
+    try:
+        if dim == 2:
+            settings["lines"] = args.lines
+            s = run2(example, size, lines=args.lines, **common, **opts)
+        else:
+            s = synthesize3(example, size, **common, **opts)
+    except InputError as e:  # the library names its arguments; the user typed flags
+        raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
     if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
@@ -210,19 +216,25 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         print(
             f"{r.status}: {example.name or args.model} {'x'.join(map(str, size))} {unit} of "
             f"{spacing:g} ({fams} {what}, {A.n_vertices} vertices, {A.n_edges} "
-            f"edges, K={P.K}) with {r.solver} in {r.time_s:.3f} s, seed {r.seed}"
+            f"edges, K={P.K}) with {r.solver} in {s.times['solve']:.3f} s, seed {seed}"
         )
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
-        keys = [k for k in r.stats if k not in ("order", "choice")]
+        # the solver's own count ("violations" of the CSP) is not the output's: the Eq. 4.1
+        # line below is the one count of defects
+        keys = [k for k in r.stats if k not in ("order", "choice", "violations")]
         if keys:
             print("  " + ", ".join(f"{k}={r.stats[k]}" for k in keys))
         if s.model is not None:
             made = f"{polys} polygons" if dim == 2 else (
                 f"{len(s.model.solids)} solids of {polys} polygons")  # fmt: skip
             on = "polygons" if dim == 2 else "solids"
+            user = sum(1 for d in s.violations if d.kind in USER_KINDS)
+            counts = f"Eq. 4.1 violations={len(s.violations) - user}"
+            if cons is not None:
+                counts += f", constraint violations={user}"
             print(
                 f"  {made}, labels {list(s.model.labels)}; "
-                f"Eq. 4.1 violations={len(s.violations)} (checked on the {on}); "
+                f"{counts} (checked on the {on}); "
                 + ", ".join(f"{k} {v:.3f} s" for k, v in s.times.items())
             )
             if s.violations:
@@ -232,13 +244,47 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
         elif args.out:
             why = "no solution" if s.model is None else "the run failed"
             print(f"  not written: {args.out} ({why})", file=sys.stderr)
-        if r.status == "failed" and not cls.complete and cls.name != "blocks":
+        hint = None
+        if r.status == "failed" and "broken" in r.stats:  # a user constraint, not Eq. 4.1
+            hint = (
+                "  hint: connectivity is checked on the output, not searched for, by every "
+                "solver but sat (--solver sat adds cuts until it holds); or more --restarts"
+            )
+        elif r.status == "failed" and not cls.complete and cls.name != "blocks":
             hint = (
                 "  hint: --solver blocks modifies the model in parts (Fig. 4.23) and always "
                 "returns a consistent model; an exact solver (sat) decides"
             )
+        if hint:
             print(hint, file=sys.stderr)
     return 0 if s.ok else 1
+
+
+#: The kinds of defect that are user constraints (Sec. 4.6), not Eq. 4.1
+USER_KINDS = frozenset({"connected", "dimensional", "large-scale"})
+
+#: The library's names of its arguments -> the flags a user typed
+_FLAGS = (
+    ("snap=true", "--snap"),
+    ("pass a spacing", "pass --spacing"),
+    ("a larger spacing", "a larger --spacing"),
+    ("a coarser spacing", "a coarser --spacing"),
+    ("another spacing", "another --spacing"),
+)
+
+
+def as_flags(message: str) -> str:
+    """``message`` with the library's argument names (``snap=true``) as the command-line
+    flags (``--snap``).
+
+    Examples
+    --------
+    >>> as_flags("choose another spacing or snap=true")
+    'choose another --spacing or --snap'
+    """
+    for lib, flag in _FLAGS:
+        message = message.replace(lib, flag)
+    return message
 
 
 def check(args: argparse.Namespace, example: Any) -> int:

@@ -107,8 +107,10 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     finally:
         if timer is not None:
             timer.cancel()
+    from csplab.cli import readable
+
     for w in caught:  # one line each, no source location
-        print(f"csplab: warning: {w.message}", file=sys.stderr)
+        print(f"csplab: warning: {readable(str(w.message))}", file=sys.stderr)
     return model
 
 

@@ -66,6 +66,8 @@ class Defect:
     detail: str
 
     def __str__(self) -> str:
+        if not all(math.isfinite(c) for c in self.point):  # a defect of no one place
+            return f"{self.kind}: {self.detail}"
         x, y = self.point
         return f"{self.kind} at ({x:.6g}, {y:.6g}): {self.detail}"
 

@@ -298,3 +298,67 @@ def test_row12_estimate_is_not_below_a_measured_peak():
     from csplab.io import load_model
 
     assert 712e6 <= estimate_peak(load_model("triangle"), (200, 200)) <= 3 * 712e6
+
+
+# ---------------------------------------------------------------- row 19: messages
+def test_row19_no_numpy_reprs_in_messages():
+    from csplab.cli import readable
+
+    msg = readable(
+        "spacing np.float64(3.0) at array([[1, 2],\n [3, 4]]); np.int64(7) ((34, 'x y'))"
+    )
+    assert "np." not in msg and "array(" not in msg and "34" not in msg
+    assert "3.0" in msg and "[[1, 2], [3, 4]]" in msg and "(x y)" in msg
+
+
+def test_row19_numpy_repr_in_an_error_is_printed_plainly(capsys, monkeypatch):
+    import numpy as np
+
+    import csplab.cli.info as info
+    from csplab.errors import InputError
+
+    def bad(args):
+        raise InputError(f"spacing {np.float64(3.0)!r} for {np.array([1, 2])!r}")
+
+    monkeypatch.setattr(info, "run", bad)
+    line = refused(capsys, "info", words=("spacing 3.0 for [1, 2]",))
+    assert "np." not in line
+
+
+def test_row19_flags_as_typed(capsys):
+    line = refused(capsys, "synthesize", "triangle", "--size", "10x10", "--spacing", "0.3",
+                   words=("--spacing", "--snap"))  # fmt: skip
+    assert "snap=true" not in line
+
+
+def test_row19_doctype_in_an_svg_is_not_a_tileset(capsys, tmp_path):
+    p = tmp_path / "d.svg"
+    p.write_text('<?xml version="1.0"?>\n<!DOCTYPE svg [<!ENTITY a "b">]>\n<svg/>')
+    line = refused(capsys, "show", p, "--out", tmp_path / "d.png", words=("d.svg", "DOCTYPE"))
+    assert "tileset" not in line
+
+
+def test_row19_failed_3d_report_is_consistent(capsys, tmp_path):
+    """The seed given, the whole solve time, one count of defects, no "at (nan, nan)", a
+    true hint (blocks checks connectivity too: it is not recommended)."""
+    pytest.importorskip("trimesh")
+    c = tmp_path / "conn.json"
+    c.write_text('{"constraints": [{"type": "connected", "labels": [1]}]}')
+    code, out, err = run(capsys, "synthesize", "houses", "--size", "6x6x3", "--constraints", c,
+                         "--restarts", "2", "--seed", "1")  # fmt: skip
+    assert code == 1
+    head = out.splitlines()[0]
+    assert head.endswith("seed 1"), head
+    assert "Eq. 4.1 violations=0, constraint violations=1" in out
+    assert out.count("violations=") == 2  # no solver count that contradicts them
+    assert "nan" not in out + err
+    assert "--solver blocks" not in err and "--solver sat" in err
+
+
+def test_row19_the_plane_family_limit_is_documented():
+    from csplab.continuous.space import MAX_FAMILIES3
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    assert f"at\n  most {MAX_FAMILIES3} plane families" in readme or (
+        f"most {MAX_FAMILIES3} plane families" in " ".join(readme.split())
+    )
