@@ -1070,7 +1070,7 @@ def parse_constraints(data: Any, problem: Problem, source: object = None) -> lis
 def read_entries(path: str | Path) -> list[Any]:
     """The entries of a constraints file, unparsed (a bad file is one
     :class:`FormatError` line)."""
-    from csplab.io._json import read_json_file
+    from csplab.io.common import read_json_file
 
     p = Path(path)
     data = read_json_file(p)  # size, special files, nesting depth: one line each

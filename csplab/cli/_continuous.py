@@ -168,13 +168,15 @@ def synthesize(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> 
     common = dict(solver=args.solver, rng=seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts)  # fmt: skip
     cons = user_constraints(args, example)
+    if cls.takes("progress") and dim == 2:
+        opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
+    if dim == 3:  # synthesize3 gives it to the solver (and to the connectivity rounds)
+        common["progress"] = bool(opts.pop("progress", True))
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
     if cons is not None:
         common["constraints"] = cons
         settings["constraints"] = ", ".join(cons_summary(cons))
-        if cons.connected and cls.name == "sat":
-            common["progress"] = True  # the cut loop's rounds, once it takes over 2 s
         if not cls.complete or cons.connected:
             common["restarts"] = settings["restarts"] = args.restarts  # a broken output reruns
     try:
@@ -346,8 +348,11 @@ def user_constraints(args: argparse.Namespace, example: Any) -> Any:
     names = {str(v): int(k) for k, v in (example.meta.get("label_names") or {}).items()}
     have = set(example.labels)
     out = None
+    from csplab.progress import notice_after
+
     for path in args.constraints:
-        c = read_user_constraints(path, names)
+        with notice_after(f"reading the constraints of {path}"):  # a large file: one line
+            c = read_user_constraints(path, names)
         for kind, labels in (
             ("connected", c.connected),
             ("dimensional", [b for b, _ in c.dimensional]),

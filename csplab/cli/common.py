@@ -460,6 +460,10 @@ def with_constraint_files(problem: Problem, paths: Sequence[str] | None) -> Prob
     if not paths:
         return problem
     from csplab.constraints import read_constraints
+    from csplab.progress import notice_after
 
-    extra = [c for p in paths for c in read_constraints(p, problem)]
+    extra = []
+    for p in paths:
+        with notice_after(f"reading the constraints of {p}"):  # a large file: one line
+            extra += read_constraints(p, problem)
     return problem.with_constraints(extra)

@@ -125,7 +125,8 @@ def synthesize3(
     ones restrict the CSP, and while the output breaks one (a connectivity constraint) the
     synthesis runs again with a fresh derived seed, at most ``restarts`` times (for every
     solver); an output that still breaks one is ``failed`` (its ``stats["broken"]`` says
-    which), never ``solved``. ``progress`` shows the exact connectivity search's rounds.
+    which), never ``solved``. ``progress`` shows the exact connectivity search's rounds, or
+    the solver's bar when it takes one (``blocks``, ``perfect``).
 
     Examples
     --------
@@ -163,7 +164,11 @@ def synthesize3(
                                    time_limit=options.get("time_limit"),
                                    progress=progress)  # fmt: skip
         else:
-            result = solve(csp.problem, solver, rng=run_seed, restarts=restarts, **options)
+            from csplab.solvers import solver_class
+
+            takes = solver_class(solver.partition(":")[0]).takes("progress")
+            extra = {"progress": progress} if takes else {}
+            result = solve(csp.problem, solver, rng=run_seed, restarts=restarts, **options, **extra)
         t2 = time.perf_counter()
         model = csp.model(result.grid) if result.ok else None
         t3 = time.perf_counter()

@@ -185,7 +185,7 @@ def read_user_constraints(
     path: str | Path, names: Mapping[str, int] | None = None
 ) -> UserConstraints3:
     """:func:`parse_user_constraints` of a JSON file."""
-    from csplab.io._json import read_json_file
+    from csplab.io.common import read_json_file
 
     p = Path(path)
     data = read_json_file(p)  # the same checks as every JSON reader (size, nesting depth)

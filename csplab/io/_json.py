@@ -14,12 +14,11 @@ from __future__ import annotations
 
 import json
 import re
-from pathlib import Path
 from typing import Any
 
 from csplab.errors import FormatError
 
-__all__ = ["MAX_DEPTH", "load_json", "read_json_file", "strip_comments"]
+__all__ = ["MAX_DEPTH", "MAX_JSON_BYTES", "load_json", "strip_comments"]
 
 MAX_JSON_BYTES = 50_000_000
 
@@ -88,39 +87,6 @@ def load_json(text: str | bytes, *, path: object = "<string>", comments: bool = 
         line = text.count("\n", 0, at) + 1 if at is not None else None
         raise FormatError("JSON nesting is too deep", path=path, line=line) from None
     return data
-
-
-def read_json_file(path: str | Path) -> Any:
-    """A JSON file (no comments) parsed, with the checks of every csplab reader: a
-    regular file of at most :data:`MAX_JSON_BYTES`, valid JSON, no ``NaN``/``Infinity``,
-    nesting at most :data:`MAX_DEPTH` deep; a :class:`FormatError` line naming the file
-    otherwise. Files over :data:`csplab.progress.DELAY_S` to parse get one line on stderr
-    (``csplab: reading FILE (N MB) ...``)."""
-    import sys
-    import threading
-
-    from csplab import progress
-    from csplab.io.common import read_bytes
-
-    p = Path(path)
-    data = read_bytes(p)
-    if len(data) > MAX_JSON_BYTES:
-        raise FormatError(
-            f"the file has {len(data) / 1e6:.0f} MB; csplab reads JSON files of at most "
-            f"{MAX_JSON_BYTES // 1_000_000} MB",
-            path=p,
-        )
-
-    def notice() -> None:
-        print(f"csplab: reading {p} ({len(data) / 1e6:.0f} MB) ...", file=sys.stderr, flush=True)
-
-    timer = threading.Timer(progress.DELAY_S, notice)
-    timer.daemon = True
-    timer.start()
-    try:
-        return load_json(data, path=p)
-    finally:
-        timer.cancel()
 
 
 def _depth_error(text: str) -> int | None:

@@ -48,6 +48,7 @@ __all__ = [
     "json_like",
     "load_image",
     "read_bytes",
+    "read_json_file",
     "read_text",
     "text_lines",
     "xml_bool",
@@ -385,3 +386,25 @@ def atomic_write(path: str | Path, data: bytes | str) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def read_json_file(path: str | Path) -> Any:
+    """A JSON file (no comments) parsed, with the checks of every csplab reader: a regular
+    file of at most 50 MB (``csplab.io._json.MAX_JSON_BYTES``), valid JSON without ``NaN``
+    or ``Infinity``, nesting the parser can follow; a :class:`FormatError` line naming the
+    file otherwise. A parse over :data:`csplab.progress.DELAY_S` gets one line on stderr
+    (``csplab: parsing FILE (N MB) ...``)."""
+    from csplab import progress
+    from csplab.io._json import MAX_JSON_BYTES, load_json
+
+    p = Path(path)
+    data = read_bytes(p)
+    if len(data) > MAX_JSON_BYTES:
+        raise FormatError(
+            f"the file has {len(data) / 1e6:.0f} MB; csplab reads JSON files of at most "
+            f"{MAX_JSON_BYTES // 1_000_000} MB",
+            path=p,
+        )
+
+    with progress.notice_after(f"parsing {p} ({len(data) / 1e6:.0f} MB)"):
+        return load_json(data, path=p)

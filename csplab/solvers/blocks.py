@@ -65,6 +65,7 @@ from csplab.engine import waves as wv
 from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
+from csplab.progress import progress_bar
 from csplab.result import Result, Status
 from csplab.soft import Breaches, Energy
 from csplab.solvers.base import (
@@ -215,6 +216,7 @@ def run_blocks(
     energy: Energy | None = None,
     temperature: float = 1.0,
     cooling: float = 1.0,
+    progress: bool = False,
 ) -> Result:
     """Alg. 3.4 (see the module docstring).
 
@@ -306,7 +308,7 @@ def run_blocks(
         status, tried, accepted, retry_count, revisions = _run_sweep(
             problem, grid, boxes, None if m == (0,) else m, rng,
             retries=retries, sweeps=sweeps, order=order, choice=choice, deadline=deadline,
-            window=window, soft=soft,
+            window=window, soft=soft, progress=progress,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -386,6 +388,7 @@ def _run_sweep(
     deadline: float | None,
     window: int = 1,
     soft: _Soft | None = None,
+    progress: bool = False,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
     ``grid`` (flat) in place. With the compiled kernels loaded and a plain setting (grid
@@ -394,7 +397,7 @@ def _run_sweep(
     if _compiled_sweep_applies(boxes, m, order, choice, soft):
         return _run_sweep_compiled(
             problem, grid, boxes, m, rng, retries=retries, sweeps=sweeps, order=order,
-            deadline=deadline, choice=choice,
+            deadline=deadline, choice=choice, progress=progress,
         )  # fmt: skip
     touching = _arc_index(problem) if len(boxes) > 1 else None
     tried = accepted = retry_count = 0
@@ -402,8 +405,9 @@ def _run_sweep(
     status: Status = "solved"
     if soft is not None:
         soft.start(grid, problem.shape)
-    for _sweep in range(sweeps):
-        for cells in boxes:
+    for sweep in range(sweeps):
+        for cells in progress_bar(boxes, total=len(boxes), desc=_desc(sweep, sweeps),
+                                  enabled=progress, unit="block"):  # fmt: skip
             if deadline is not None and time.perf_counter() > deadline:
                 status = "timeout"
                 break
@@ -441,6 +445,10 @@ def _run_sweep(
 _SWEEP_CHUNK = 64  # blocks per kernel call (the deadline is checked between calls)
 
 
+def _desc(sweep: int, sweeps: int) -> str:
+    return "blocks" if sweeps == 1 else f"blocks, sweep {sweep + 1}/{sweeps}"
+
+
 def _compiled_sweep_applies(
     boxes: Sequence[NDArray[np.int64]], m: tuple[int, ...] | None, order: str, choice: str,
     soft: _Soft | None,
@@ -475,6 +483,7 @@ def _run_sweep_compiled(
     order: str,
     choice: str,
     deadline: float | None,
+    progress: bool = False,
 ) -> _Counts:
     """:func:`_run_sweep` in one compiled kernel per :data:`_SWEEP_CHUNK` blocks
     (:func:`csplab.catalog.sweep_blocks`): the same blocks, draws and results."""
@@ -492,8 +501,10 @@ def _run_sweep_compiled(
     key_weighted = weighted and order == "min-entropy"
     counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, queue pops
     status: Status = "solved"
-    for _sweep in range(sweeps):
-        for a in range(0, len(boxes), _SWEEP_CHUNK):
+    chunks = range(0, len(boxes), _SWEEP_CHUNK)
+    for sweep in range(sweeps):
+        for a in progress_bar(chunks, total=len(chunks), desc=_desc(sweep, sweeps),
+                              enabled=progress, unit=f"x{_SWEEP_CHUNK} blocks"):  # fmt: skip
             if deadline is not None and time.perf_counter() > deadline:
                 status = "timeout"
                 break
@@ -774,6 +785,7 @@ class BlocksSolver(Solver):
                convert=_positive),
         Option("cooling", float, 1.0, "T is multiplied by this after each sweep (0 < c <= 1)",
                convert=_positive),
+        Option("progress", bool, False, "a progress bar on stderr (after 2 s; the CLI's default)"),
     )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:

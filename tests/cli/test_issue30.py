@@ -362,3 +362,30 @@ def test_row19_the_plane_family_limit_is_documented():
     assert f"at\n  most {MAX_FAMILIES3} plane families" in readme or (
         f"most {MAX_FAMILIES3} plane families" in " ".join(readme.split())
     )
+
+
+# ------------------------------------------------------- row 18: progress over 2 s
+@pytest.mark.parametrize(
+    ("model", "size"), [("castle", "12x12x6"), ("tetrahedron", "4x4x4"), ("triangle", "12x12")]
+)
+def test_row18_blocks_shows_progress(capsys, monkeypatch, model, size):
+    """The bar of ``--solver blocks`` (grids and continuous models), with the 2 s delay at 0."""
+    import csplab.progress as progress
+
+    if model == "tetrahedron":
+        pytest.importorskip("trimesh")
+    monkeypatch.setattr(progress, "DELAY_S", 0.0)
+    code, _, err = run(capsys, "synthesize", model, "--size", size, "--solver", "blocks",
+                       "--block", "4", "--seed", "1")  # fmt: skip
+    assert code in (0, 1) and "blocks" in err and "%" in err, err
+
+
+def test_row18_large_constraints_file_says_it_is_reading(capsys, monkeypatch, tmp_path):
+    import csplab.progress as progress
+
+    monkeypatch.setattr(progress, "DELAY_S", 0.0)
+    c = tmp_path / "c.json"
+    c.write_text('{"constraints": [{"type": "count", "labels": [1], "min": 0}]}')
+    code, _, err = run(capsys, "synthesize", "fig3_5a", "--size", "6x6", "--constraints", c)
+    assert code in (0, 1)
+    assert "csplab: reading the constraints of" in err or "csplab: parsing" in err, err
