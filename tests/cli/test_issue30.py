@@ -389,3 +389,14 @@ def test_row18_large_constraints_file_says_it_is_reading(capsys, monkeypatch, tm
     code, _, err = run(capsys, "synthesize", "fig3_5a", "--size", "6x6", "--constraints", c)
     assert code in (0, 1)
     assert "csplab: reading the constraints of" in err or "csplab: parsing" in err, err
+
+
+# -------------------------------------------------- row 21: the README's Python calls
+def test_row21_subpackages_are_attributes_after_import_csplab():
+    import subprocess
+    import sys
+
+    code = "import csplab; print(type(csplab.io.read_model).__name__, csplab.grids.__name__)"
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    assert p.stdout.split() == ["function", "csplab.grids"]
