@@ -77,7 +77,8 @@ def bad_polygon_files(draw):
         pt = draw(st.one_of(NONFINITE, st.sampled_from(['"x"', "null", "[]"])))
     elif kind == "points":
         pts = draw(st.sampled_from(["[]", "[[0, 0]]", '"abc"', "[[0, 0], [1]]", "7"]))
-    text = '{"polygons": [{"label": %s, "points": %s}]}' % (label, pts.replace("PT", pt))
+    points = pts.replace("PT", pt)
+    text = '{"polygons": [{"label": ' + label + ', "points": ' + points + "}]}"
     if kind == "deep":
         n = draw(st.integers(2000, 60000))
         text = '{"polygons": ' + "[" * n + "]" * n + "}"
@@ -108,7 +109,8 @@ def bad_constraints_files(draw, labels_3d=False):
         n = draw(st.integers(2000, 60000))
         return '{"constraints": ' + "[" * n + "]" * n + "}"
     if kind == "nan":
-        return '{"constraints": [{"type": "count", "labels": [1], "min": %s}]}' % draw(NONFINITE)
+        value = draw(NONFINITE)
+        return '{"constraints": [{"type": "count", "labels": [1], "min": ' + value + "}]}"
     if kind == "type":
         t = draw(st.text(st.characters(codec="ascii", exclude_characters='"\\'), max_size=8))
         return json.dumps({"constraints": [{"type": "x" + t, "labels": [1]}]})
