@@ -1062,7 +1062,9 @@ def parse_constraints(data: Any, problem: Problem, source: object = None) -> lis
         try:
             out.append(_one(c, problem))
         except InputError as e:
-            what = f"constraints[{i}] ({c.get('type', '?')})"
+            typ = c.get("type", "?")
+            shown = typ if isinstance(typ, str) and typ.isprintable() else repr(typ)
+            what = f"constraints[{i}] ({shown})"
             raise FormatError(f"{what}: {e}", path=source) from None
     return out
 
