@@ -400,3 +400,54 @@ def test_row21_subpackages_are_attributes_after_import_csplab():
     p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert p.returncode == 0, p.stderr
     assert p.stdout.split() == ["function", "csplab.grids"]
+
+
+# ------------------------------------------- rows 22, 23: the README's try-it commands
+def _try_its():
+    from csplab.io.registry import formats
+
+    return [f.example for f in formats() if f.example.startswith("csplab synthesize")]
+
+
+def test_row22_try_it_commands_write_distinct_files():
+    """Run in order, no command overwrites another's output or trips on it (``show F``
+    without ``--out`` writes ``F``'s stem ``.png``)."""
+    import shlex
+
+    seen: dict[str, str] = {}
+    for cmd in _try_its():
+        for part in cmd.split("&&"):
+            words = shlex.split(part.split("#")[0])
+            if "--out" in words:
+                out = words[words.index("--out") + 1]
+            elif words[:2] == ["csplab", "show"]:
+                out = Path(words[2]).with_suffix(".png").name
+            else:
+                continue
+            same = seen.get(out)
+            assert same is None or same == part.strip(), (out, same, part)
+            seen[out] = part.strip()
+
+
+def test_row23_try_its_name_the_shared_data_from_the_repo_root_and_the_extras():
+    import shlex
+
+    for cmd in _try_its():
+        model = shlex.split(cmd)[2]
+        if "/" in model and not model.startswith(("tests/", "csplab/")):
+            assert model.startswith("../shared/anchors-data/"), cmd
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    setup = readme.split("## Set up", 1)[1].split("\n## ", 1)[0]
+    assert "mesh" in setup and "baselines" in setup and "[all]" in setup
+
+
+# ------------------------------------------------- row 27: the one-time compile apart
+def test_row27_compile_time_is_reported_apart(capsys, monkeypatch):
+    from csplab import _jit
+
+    ticks = iter([0.0, 5.0])
+    monkeypatch.setattr(_jit, "compile_seconds", lambda: next(ticks))
+    code, out, _ = run(capsys, "synthesize", "line", "--size", "8x6", "--seed", "1")
+    head = out.splitlines()[0]
+    assert code == 0 and "(+ 5.0 s compiling csplab's kernels, once)" in head, head
+    assert " in 0.0" in head
