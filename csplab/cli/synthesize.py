@@ -170,6 +170,29 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
     return settings
 
 
+def _check_grid_memory(args: argparse.Namespace, example: Any) -> None:
+    """Refuse, before building anything, a grid problem whose estimated peak
+    (:func:`csplab.problem.memory_estimate`: domains, arcs, the propagator) is over
+    ``--memory-limit`` (default :func:`csplab.limits.memory_budget`)."""
+    import math
+
+    from csplab.limits import check_memory, memory_budget
+    from csplab.problem import memory_estimate
+
+    shape = parse_shape(args.size, what="--size") if args.size else getattr(example, "shape", None)
+    K = getattr(example, "K", None)
+    if not shape or not K:
+        return
+    n = math.prod(int(s) for s in shape)
+    need = memory_estimate(n, int(K), len(shape) * n)
+    check_memory(
+        need,
+        f"{example.name or args.model} --size {'x'.join(map(str, shape))} (K={K})",
+        "use a smaller --size",
+        budget=memory_budget(args.memory_limit),
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     from csplab.io import write_labels
     from csplab.io.registry import output_format
@@ -186,6 +209,7 @@ def run(args: argparse.Namespace) -> int:
         return _continuous.synthesize(args, example, _options(args))
     if args.spacing is not None or args.snap or args.lines != "lattice":
         raise InputError("--spacing, --snap and --lines apply to continuous (polygon) models only")
+    _check_grid_memory(args, example)
     problem = problem_from_args(args, example)
     opts = _options(args)
     settings = _settings(args, example, opts)

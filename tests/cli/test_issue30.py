@@ -452,3 +452,10 @@ def test_row27_compile_time_is_reported_apart(capsys, monkeypatch):
     head = out.splitlines()[0]
     assert code == 0 and "(+ 5.0 s compiling csplab's kernels, once)" in head, head
     assert " in 0.0" in head
+
+
+def test_row12_grid_synthesis_honours_memory_limit(capsys):
+    refused(capsys, "synthesize", "fig3_5a", "--size", "600x600", "--memory-limit", "0.01",
+            words=("600x600", "MB", "--memory-limit"))  # fmt: skip
+    refused(capsys, "synthesize", "fig3_5a", "--size", "6x6", "--memory-limit", "0",
+            words=("--memory-limit",))  # fmt: skip
