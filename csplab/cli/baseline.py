@@ -6,6 +6,9 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from typing import Any
+
+import numpy as np
 
 from csplab.cli.common import check_output_path, input_files, load_model, model_options
 from csplab.errors import InputError
@@ -93,6 +96,37 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
+def mesh_samples(
+    example: Any, spacings: tuple[int, ...], name: str, resolution: int | None
+) -> tuple[tuple[int, ...], float]:
+    """``--size`` of a mesh baseline, in plane spacings of the example (as ``csplab
+    synthesize`` counts them: the lattice spacing of its vertices), as samples of the
+    baseline's grid (``resolution`` along the example's longest side): ``(samples,
+    spacing)``. Asking for more spacings always gives a larger output.
+
+    Examples
+    --------
+    >>> from csplab.io import load_model
+    >>> mesh_samples(load_model("tetrahedron"), (8, 8, 8), "retarget", 24)
+    ((192, 192, 192), 1.0)
+    """
+    import math
+
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.continuous.space import Lattice3
+
+    if not isinstance(example, PolyhedralModel):
+        raise InputError(f"the {name} baseline takes a polyhedral model (a closed mesh)")
+    res = int(resolution if resolution is not None else 24)
+    b = np.asarray(example.bounds, dtype=np.float64)
+    longest = float((b[3:] - b[:3]).max())
+    unit = float(Lattice3.of_model(example).spacing)
+    # retarget: ``res`` voxels along the longest side; geometry: ``res`` samples, res - 1 gaps
+    per = (res if name == "retarget" else res - 1) / longest
+    samples = tuple(max(1, math.ceil(s * unit * per - 1e-9)) for s in spacings)
+    return samples, unit
+
+
 def _mesh(args: argparse.Namespace, b: object, example: object) -> int:
     """A baseline that makes a mesh: written by extension (.obj, .stl, .off, .ply)."""
     import os
@@ -103,9 +137,10 @@ def _mesh(args: argparse.Namespace, b: object, example: object) -> int:
     from csplab.grids import parse_shape
     from csplab.rng import make_rng
 
-    size = parse_shape(args.size, what="--size")
-    if len(size) != 3:
-        raise InputError(f"--size {args.size}: the geometry baseline needs three sides")
+    spacings = parse_shape(args.size, what="--size")
+    if len(spacings) != 3:
+        raise InputError(f"--size {args.size}: the {args.name} baseline needs three sides")
+    size, unit = mesh_samples(example, spacings, args.name, getattr(args, "resolution", None))
     if args.out:
         check_output_path(args.out, "--out", inputs=input_files(args))
         if Path(args.out).suffix.lower() not in (".obj", ".stl", ".off", ".ply"):
@@ -122,14 +157,16 @@ def _mesh(args: argparse.Namespace, b: object, example: object) -> int:
         os.close(fd)
         mesh.export(tmp)
         os.replace(tmp, out)
-    info = {"baseline": args.name, "size": list(size), "seed": seed, "time_s": dt,
+    info = {"baseline": args.name, "size": list(spacings), "samples": list(size),
+            "spacing": unit, "seed": seed, "time_s": dt,
             "faces": len(mesh.faces), "watertight": bool(mesh.is_watertight),
             "volume": float(mesh.volume), "out": args.out,
             **mesh.metadata.get("retarget", {})}  # fmt: skip
     if args.json:
         print(json.dumps(info))
     else:
-        print(f"{args.name}: {'x'.join(map(str, size))} samples in {dt:.2f} s, seed {seed}; "
+        print(f"{args.name}: {'x'.join(map(str, spacings))} plane spacings of {unit:g} "
+              f"({'x'.join(map(str, size))} samples) in {dt:.2f} s, seed {seed}; "
               f"{len(mesh.faces)} triangles, closed {info['watertight']}, volume "
               f"{info['volume']:.4g}")  # fmt: skip
         if "nodes" in info:

@@ -459,3 +459,31 @@ def test_row12_grid_synthesis_honours_memory_limit(capsys):
             words=("600x600", "MB", "--memory-limit"))  # fmt: skip
     refused(capsys, "synthesize", "fig3_5a", "--size", "6x6", "--memory-limit", "0",
             words=("--memory-limit",))  # fmt: skip
+
+
+# ----------------------------------- row 25: baseline --size is the output's size
+def test_row25_mesh_baseline_size_is_in_plane_spacings():
+    from csplab.cli.baseline import mesh_samples
+    from csplab.io import load_model
+
+    pytest.importorskip("trimesh")
+    m = load_model("skyscrapers")  # 6 units along its longest side, spacing 1
+    small, unit = mesh_samples(m, (6, 5, 3), "retarget", 24)
+    big, _ = mesh_samples(m, (24, 16, 8), "retarget", 24)
+    assert unit == 1.0 and small == (24, 20, 12) and big == (96, 64, 32)
+    assert all(b > s for b, s in zip(big, small, strict=True))  # asking for more never gives less
+    geo, _ = mesh_samples(m, (6, 6, 6), "geometry", 24)
+    assert geo == (23, 23, 23)  # 24 samples span the 6 units: 23 gaps
+
+
+@pytest.mark.slow
+def test_row25_retarget_output_has_the_size_asked_for(capsys, tmp_path):
+    import trimesh
+
+    pytest.importorskip("maxflow")
+    out = tmp_path / "rt.obj"
+    code, _, err = run(capsys, "baseline", "retarget", "skyscrapers", "--size", "8x8x4",
+                          "--resolution", "12", "--seed", "1", "--out", out)  # fmt: skip
+    assert code == 0, err
+    ext = trimesh.load(out).extents
+    assert all(abs(a - b) <= 1 for a, b in zip(sorted(ext), sorted((8, 8, 4)), strict=True)), ext
