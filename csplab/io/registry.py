@@ -526,8 +526,10 @@ FORMATS: dict[str, Format] = {
             "`mirrorX`/`mirrorY`, `maxConsecutive` and `separation` become global "
             "constraints (`csplab.constraints`); any other constraint is a one-line warning, "
             "never dropped silently; `overlapping` "
-            "configs use their PNG sample; tile pictures (Tiled `.tsx`) are not read, and a "
-            "warning says so",
+            "configs use their PNG sample; a Tiled `.tsx` tileset `src` gives the tile "
+            "pictures (a number is a tile's gid, id + 1; a name its `name` property) and the "
+            "per-tile properties (`meta['tile_properties']`); without one, a warning says "
+            "pictures show one colour per tile",
             example=f"csplab synthesize {_DATA}/DeBroglie/edged_path_constraint.json --size 30x30 "
             "--seed 1 --out path.png",
         ),
