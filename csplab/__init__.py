@@ -43,6 +43,7 @@ def __getattr__(name: str) -> object:
         return importlib.import_module(f"csplab.{name}")
     raise AttributeError(f"module 'csplab' has no attribute {name!r}")
 
+
 __all__ = [
     "CsplabError",
     "ExampleModel",
