@@ -487,3 +487,13 @@ def test_row25_retarget_output_has_the_size_asked_for(capsys, tmp_path):
     assert code == 0, err
     ext = trimesh.load(out).extents
     assert all(abs(a - b) <= 1 for a, b in zip(sorted(ext), sorted((8, 8, 4)), strict=True)), ext
+
+
+def test_row12_count_bounds_its_states_by_the_memory_budget(capsys):
+    from csplab.cli.count import MAX_STATES, transfer_states
+
+    assert transfer_states((3, 12), 2, None) == MAX_STATES
+    assert transfer_states((40, 40, 10), 119, 1.0) * 119 * 4 * 161 <= 1e9
+    argv = ("count", "castle", "--size", "12x12x6", "--method", "transfer", "--memory-limit")
+    line = refused(capsys, *argv, "0.01", words=("--memory-limit", "--method ganak"))
+    assert "max_states" not in line
