@@ -105,8 +105,8 @@ def run(args: argparse.Namespace) -> int:
             time_limit=time_limit, progress=True,
             max_states=transfer_states(problem.shape, problem.K, args.memory_limit),
         )  # fmt: skip
-    except InputError as e:  # the library names its arguments; the user typed flags
-        msg = str(e).replace("raise max_states", "raise --memory-limit")
+    except InputError as bad:  # the library names its arguments; the user typed flags
+        msg = str(bad).replace("raise max_states", "raise --memory-limit")
         raise InputError(msg.replace("method='ganak'", "--method ganak")) from None
     except CountTimeoutError as stop:
         size = "x".join(map(str, problem.shape))
