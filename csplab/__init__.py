@@ -24,6 +24,28 @@ from csplab.world import World
 
 __version__ = "0.1.0"
 
+#: csplab's subpackages and modules, imported on first use as attributes: ``import csplab``
+#: then ``csplab.io.read_model(...)`` works as the README writes it (without importing
+#: every optional dependency up front)
+_SUBMODULES = frozenset(
+    {
+        "analysis", "baselines", "catalog", "cli", "cnf", "complexity", "constraints",
+        "continuous", "count", "deps", "engine", "errors", "exact", "example", "examples",
+        "experiments", "grids", "io", "limits", "problem", "progress", "readme", "render",
+        "result", "rng", "soft", "solvers", "testing", "topology",
+    }
+)  # fmt: skip
+
+
+def __getattr__(name: str) -> object:
+    """``csplab.io``, ``csplab.grids``, ...: the submodule, imported on first use."""
+    if name in _SUBMODULES:
+        import importlib
+
+        return importlib.import_module(f"csplab.{name}")
+    raise AttributeError(f"module 'csplab' has no attribute {name!r}")
+
+
 __all__ = [
     "CsplabError",
     "ExampleModel",

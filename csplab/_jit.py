@@ -33,12 +33,13 @@ import threading
 from collections.abc import Callable
 from typing import Any, TypeVar, overload
 
-__all__ = ["Kernel", "compiled", "load", "loaded", "njit", "on_load", "prange"]
+__all__ = ["Kernel", "compile_seconds", "compiled", "load", "loaded", "njit", "on_load", "prange"]
 
 _PENDING: dict[str, list[Kernel]] = {}
 _HOOKS: list[Callable[[str], None]] = []
 _LOCK = threading.RLock()
 _STATE = {"loaded": False}
+_TIMER: list[Any] = [None]
 
 
 def prange(*args: int) -> range:
@@ -106,6 +107,11 @@ def _materialize(module: str) -> None:
             return
         import numba
 
+        if not _STATE["loaded"]:  # time numba's compilations from now on (cache loads: 0)
+            from numba.core import event
+
+            _TIMER[0] = event.TimingListener()  # type: ignore[no-untyped-call]
+            event.register("numba:compile", _TIMER[0])  # type: ignore[no-untyped-call]
         _STATE["loaded"] = True
         mod = sys.modules[module]
         if getattr(mod, "prange", None) is prange:
@@ -127,6 +133,20 @@ def on_load(hook: Callable[[str], None]) -> None:
     """Call ``hook(module_name)`` each time a module's kernels become numba dispatchers."""
     with _LOCK:
         _HOOKS.append(hook)
+
+
+def compile_seconds() -> float:
+    """Seconds numba has spent compiling csplab's kernels in this process (0 when numba is
+    not loaded or every kernel came from its on-disk cache): the one-time cost a first run
+    reports apart from the solve.
+
+    Examples
+    --------
+    >>> compile_seconds() >= 0
+    True
+    """
+    t = _TIMER[0]
+    return float(t.duration) if t is not None and t.done else 0.0
 
 
 def loaded() -> bool:

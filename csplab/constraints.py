@@ -25,7 +25,8 @@ kind           meaning
                of ``axes`` (DeBroglie's ``maxConsecutive``)
 =============  ==========================================================================
 
-The constraints file (``csplab synthesize ... --constraints FILE``; :func:`read_constraints`)::
+The constraints file (``csplab synthesize ... --constraints FILE``; read by
+:func:`csplab.io.constraints.read_constraints`)::
 
     {"constraints": [
       {"type": "count", "labels": ["cross 0", "cross 1"], "min": 0, "max": 2,
@@ -59,11 +60,9 @@ Examples
 from __future__ import annotations
 
 import itertools
-import json
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 import numpy as np
@@ -91,8 +90,6 @@ __all__ = [
     "mirror",
     "parse_constraints",
     "propagate_all",
-    "read_constraints",
-    "read_entries",
     "rotate",
 ]
 
@@ -1138,32 +1135,11 @@ def parse_constraints(data: Any, problem: Problem, source: object = None) -> lis
         try:
             out.append(_one(c, problem))
         except InputError as e:
-            what = f"constraints[{i}] ({c.get('type', '?')})"
+            typ = c.get("type", "?")
+            shown = typ if isinstance(typ, str) and typ.isprintable() else repr(typ)
+            what = f"constraints[{i}] ({shown})"
             raise FormatError(f"{what}: {e}", path=source) from None
     return out
-
-
-def read_entries(path: str | Path) -> list[Any]:
-    """The entries of a constraints file, unparsed (a bad file is one
-    :class:`FormatError` line)."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as e:
-        raise FormatError(f"cannot read: {e.strerror or e}", path=p) from None
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise FormatError(f"not JSON: {e.msg}", path=p, line=e.lineno) from None
-    items = data.get("constraints") if isinstance(data, Mapping) else data
-    if not isinstance(items, list):
-        raise FormatError('a constraints file is {"constraints": [ ... ]}', path=p)
-    return items
-
-
-def read_constraints(path: str | Path, problem: Problem) -> list[Constraint]:
-    """:func:`parse_constraints` of a JSON file."""
-    return parse_constraints(read_entries(path), problem, Path(path))
 
 
 def constraints_json(problem: Problem) -> dict[str, Any]:

@@ -41,6 +41,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import InputError, MemoryLimitError
+from csplab.limits import available_memory
 
 if TYPE_CHECKING:
     from csplab.constraints import Constraint
@@ -769,22 +770,7 @@ class Problem:
 
 # ----------------------------------------------------------------------------- memory
 
-#: assumed available memory (bytes) where ``/proc/meminfo`` cannot be read
-FALLBACK_MEMORY = 8 * 2**30
 _SMALL = 256 * 2**20
-
-
-def available_memory() -> int:
-    """Bytes of memory available to a new allocation: ``MemAvailable`` of
-    ``/proc/meminfo`` (Linux), else :data:`FALLBACK_MEMORY`."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    return FALLBACK_MEMORY
 
 
 def memory_estimate(

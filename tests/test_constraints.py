@@ -23,12 +23,12 @@ from csplab.constraints import (
     mirror,
     parse_constraints,
     propagate_all,
-    read_constraints,
     rotate,
 )
 from csplab.engine.sat import enumerate_solutions
 from csplab.errors import FormatError
 from csplab.grids import from_example
+from csplab.io.constraints import read_constraints
 
 from .io._helpers import installed_solvers
 

@@ -78,8 +78,10 @@ def test_cli_memory_estimate_exit_2(monkeypatch: Any, capsys: Any) -> None:
     assert main(["synthesize", "city", "--size", "2000x2000x10"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1
-    assert err[0].startswith("csplab: error: 2000x2000x10 with K=119 needs about ")
-    assert err[0].endswith("; 1.0 GiB available (a smaller --size, or fewer labels)")
+    # the CLI's estimate (csplab.limits: the budget is at most the memory available) comes
+    # first, before the problem is built
+    assert err[0].startswith("csplab: error: city --size 2000x2000x10 (K=119) would need about ")
+    assert err[0].endswith("budget of 1.1 GB: use a smaller --size, or raise --memory-limit")
 
 
 def test_cli_late_memory_error_is_one_line(monkeypatch: Any, capsys: Any) -> None:

@@ -49,6 +49,11 @@ class Baseline:
     function: str
     options: tuple[BaselineOption, ...] = ()
     gives: str = "grid"
+    #: ``"module:function"`` of ``f(example, size, **options) -> bytes``: the peak memory,
+    #: estimated from the sizes before the work (``None``: small by construction)
+    memory: str | None = None
+    #: what the refusal of a too-large estimate tells the user to change
+    memory_hint: str = "use a smaller --size"
 
     def resolve(self) -> Callable[..., Any]:
         mod, _, fn = self.function.partition(":")
@@ -71,6 +76,8 @@ BASELINES: dict[str, Baseline] = {
             BaselineOption("overlap", int, 3, "graphcut: overlap of neighbouring patches"),
             BaselineOption("eps", float, 0.1, "candidates within (1 + eps) of the best match"),
         ),
+        memory="csplab.baselines.texture:texture_memory",
+        memory_hint="use a smaller --size, --window (efros-leung) or --patch (graphcut)",
     ),
     "geometry": Baseline(
         "geometry",
@@ -102,10 +109,19 @@ BASELINES: dict[str, Baseline] = {
 
 
 def run_baseline(
-    name: str, example: Any, size: Sequence[int], *, rng: Any = None, **options: Any
+    name: str,
+    example: Any,
+    size: Sequence[int],
+    *,
+    rng: Any = None,
+    memory_limit: float | None = None,
+    **options: Any,
 ) -> Any:
     """Run the baseline ``name`` on ``example`` at ``size`` with its ``options``: a label
-    grid (``gives="grid"``) or a ``trimesh.Trimesh`` (``gives="mesh"``)."""
+    grid (``gives="grid"``) or a ``trimesh.Trimesh`` (``gives="mesh"``). A baseline that
+    declares its :attr:`Baseline.memory` is refused before the work
+    (:class:`~csplab.errors.MemoryLimitError`, one line) when its estimate exceeds
+    ``memory_limit`` GB (default :func:`csplab.limits.memory_budget`)."""
     b = BASELINES.get(name)
     if b is None:
         raise InputError(f"unknown baseline {name!r}; baselines: {', '.join(BASELINES)}")
@@ -115,5 +131,16 @@ def run_baseline(
         raise InputError(
             f"baseline {name!r} has no option(s) {', '.join(sorted(bad))}; "
             f"it has {', '.join(sorted(known)) or 'none'}"
+        )
+    if b.memory is not None:
+        from csplab.limits import check_memory, memory_budget
+
+        mod, _, fn = b.memory.partition(":")
+        need = float(getattr(importlib.import_module(mod), fn)(example, size, **options))
+        check_memory(
+            need,
+            f"baseline {name} at {'x'.join(map(str, size))}",
+            b.memory_hint,
+            budget=memory_budget(memory_limit),
         )
     return b.resolve()(example, size, rng=rng, **options)

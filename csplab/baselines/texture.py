@@ -205,6 +205,42 @@ def graphcut(
 METHODS = ("efros-leung", "graphcut")
 
 
+def texture_memory(
+    example: ExampleModel,
+    size: Sequence[int],
+    *,
+    method: str = "efros-leung",
+    window: int = 5,
+    patch: int = 8,
+    overlap: int = 3,
+    **_: object,
+) -> float:
+    """The peak bytes :func:`texture` would allocate, from the sizes alone (nothing is
+    built). Efros-Leung keeps, per example cell, its causal neighbourhood of
+    ``(window**d - 1) / 2`` offsets: coordinates twice (8 bytes per axis each), an inside
+    mask and the labels (``17 d + 16`` bytes per pair), after listing the ``window**d``
+    offsets of the box (about 100 bytes each). Graph-cut keeps the output, the example's
+    patch corners and one patch's flow graph.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> texture_memory(load_example("castle"), (10, 10, 8), window=999) > 1e12
+    True
+    >>> texture_memory(load_example("castle"), (10, 10, 8)) < 1e8
+    True
+    """
+    E = np.asarray(example.labels)
+    d = E.ndim
+    cells = float(np.prod([float(s) for s in size]))
+    ex = float(E.size)
+    if method == "graphcut":
+        p = float(min(patch, *E.shape)) ** d
+        return 24 * cells + 8 * d * ex + 400 * p
+    box = float(window) ** d
+    return (box - 1) / 2 * ex * (17 * d + 16) + 100 * box + 24 * cells
+
+
 def texture(
     example: ExampleModel,
     size: Sequence[int],

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 import warnings
 from collections.abc import Sequence
@@ -42,9 +43,36 @@ COMMANDS: dict[str, str] = {
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.print_usage(sys.stderr)
-        print(f"{self.prog}: error: {message}", file=sys.stderr)
+        """One line, as every bad input (no usage text: ``--help`` has it)."""
+        print(f"csplab: error: {message} (see `{self.prog} --help`)", file=sys.stderr)
         raise SystemExit(2)
+
+
+_NEGATIVE = re.compile(r"-[0-9.]")
+
+
+def _attach_negative_values(words: list[str]) -> list[str]:
+    """``--size -5x5x5`` as ``--size=-5x5x5``: argparse would take ``-5x5x5`` for an option
+    and print a usage text; attached, the value reaches the option's own check (one line
+    naming the flag and the value).
+
+    Examples
+    --------
+    >>> _attach_negative_values(["synthesize", "x", "--size", "-5x5x5", "--seed", "1"])
+    ['synthesize', 'x', '--size=-5x5x5', '--seed', '1']
+    """
+    out: list[str] = []
+    i = 0
+    while i < len(words):
+        w = words[i]
+        nxt = words[i + 1] if i + 1 < len(words) else None
+        if w.startswith("--") and "=" not in w and nxt is not None and _NEGATIVE.match(nxt):
+            out.append(f"{w}={nxt}")
+            i += 2
+            continue
+        out.append(w)
+        i += 1
+    return out
 
 
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
@@ -79,9 +107,32 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     return parser
 
 
+_NP_SCALAR = re.compile(r"np\.(?:float|int|uint|complex|bool|str)_?\d*\(([^()]*)\)")
+_NP_BOOL = re.compile(r"np\.(True|False)_")
+_NP_ARRAY = re.compile(r"array\((\[[^()]*?\])(?:, dtype=\w+)?\)")
+_ERRNO = re.compile(r"\(?\((\d+), '([^']*)'\)\)?")
+
+
+def readable(message: str) -> str:
+    """``message`` without Python's reprs: numpy scalars and arrays as plain numbers and
+    lists, an ``OSError``-style ``(errno, 'text')`` pair as its text.
+
+    Examples
+    --------
+    >>> readable("spacing np.float64(3.0) at array([1, 2], dtype=int64): np.True_")
+    'spacing 3.0 at [1, 2]: True'
+    >>> readable("cannot: ((34, 'Numerical result out of range'))")
+    'cannot: (Numerical result out of range)'
+    """
+    message = _NP_SCALAR.sub(r"\1", message)
+    message = _NP_BOOL.sub(r"\1", message)
+    message = _NP_ARRAY.sub(lambda m: " ".join(m.group(1).split()), message)
+    return _ERRNO.sub(r"(\2)", message)
+
+
 def _show_warning(message: Warning | str, category: type[Warning], *args: object,
                   **kwargs: object) -> None:  # fmt: skip
-    print(f"csplab: warning: {str(message).strip().splitlines()[0]}", file=sys.stderr)
+    print(f"csplab: warning: {readable(str(message).strip().splitlines()[0])}", file=sys.stderr)
 
 
 # commands that run csplab's numba kernels (the first run compiles them: one line on stderr)
@@ -116,11 +167,11 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
     line on stderr before numba's one-time compilation of the kernels, when its cache is
     cold.
     """
-    words = list(sys.argv[1:] if argv is None else argv)
+    words = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     first = next((w for w in words if not w.startswith("-")), None)
     plain = first in COMMANDS and words and words[0] == first
     parser = build_parser(only=first if plain else None)
-    args = parser.parse_args(argv)
+    args = parser.parse_args(words)
     if announce is None:
         announce = argv is None
     if announce and args.command in _KERNEL_COMMANDS:
@@ -131,7 +182,7 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
             code: int = args._run(args)
         return code
     except CsplabError as e:
-        msg = str(e).strip().splitlines()
+        msg = readable(str(e)).strip().splitlines()
         print(f"csplab: error: {msg[0] if msg else type(e).__name__}", file=sys.stderr)
         for extra in msg[1:6]:
             print(f"  {extra}", file=sys.stderr)

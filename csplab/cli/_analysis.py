@@ -32,18 +32,9 @@ def load_analysis_model(spec: str, options: list[str] | None = None) -> ExampleM
 def save_certificate(cert: dict[str, Any], path: str) -> None:
     """Write a certificate as JSON, atomically (a temporary file, then renamed): a reader
     never sees half a certificate."""
-    import os
-    import tempfile
+    from csplab.io.common import write_atomic
 
-    out = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=out.parent, prefix=f".{out.name}.")
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(cert, fh, default=_plain)
-        os.replace(tmp, out)
-    except OSError as e:
-        Path(tmp).unlink(missing_ok=True)
-        raise InputError(f"--certificate {path}: cannot write: {e.strerror}") from None
+    write_atomic(path, json.dumps(cert, default=_plain))
 
 
 def load_example_model(

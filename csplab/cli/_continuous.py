@@ -7,7 +7,7 @@ import json
 import sys
 from typing import Any
 
-from csplab.cli.common import explain, fallback_setting, not_written, outcome
+from csplab.cli.common import EXPLAINED_STATS, explain, fallback_setting, not_written, outcome
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -58,19 +58,66 @@ def boundary_label(
     return label
 
 
-def polygon_output(path: str | None, flag: str = "--out", gives: Any = "PolygonModel") -> Any:
-    """The polygon (or polyhedral) format for an output path (checked before any work),
+def polygon_output(
+    path: str | None,
+    flag: str = "--out",
+    gives: Any = "PolygonModel",
+    args: argparse.Namespace | None = None,
+) -> Any:
+    """The polygon (or polyhedral) format for an output path (checked before any work:
+    the format, the folder, and that it is none of the files ``args`` names as inputs),
     or None."""
     if not path:
         return None
-    from csplab.cli.common import (
-        check_output_path,
-    )
+    from csplab.cli.common import check_output_path, input_files
     from csplab.io.registry import output_format
 
-    fmt = output_format(path, gives=gives)
-    check_output_path(path, flag)
-    return fmt
+    check_output_path(path, flag, inputs=input_files(args) if args is not None else ())
+    return output_format(path, gives=gives)
+
+
+#: What a continuous synthesis needs per vertex and edge of the arrangement, in bytes:
+#: ``BYTES_PER_ELEMENT + BYTES_PER_ELEMENT_LABEL * K`` (measured peaks: triangle 200x200,
+#: K=8, 1.56 M vertices and edges, 712 MB; houses 40x40x20, K=40, 0.33 M, 445 MB), on top of
+#: :data:`BASE_BYTES` (the interpreter, numpy, numba).
+BYTES_PER_ELEMENT = 300
+BYTES_PER_ELEMENT_LABEL = 9
+BASE_BYTES = 250e6
+
+
+def estimate_peak(
+    example: Any,
+    size: tuple[int, ...],
+    *,
+    spacing: float | None = None,
+    snap: bool = False,
+    lines: str = "lattice",
+) -> float:
+    """The peak memory (bytes) of a continuous synthesis of ``example`` in a region of
+    ``size`` spacings, estimated before building it: the arrangement of a small probe
+    region (at most 12x12, or 6x6x4 in 3D; a fraction of a second) scaled to ``size`` by
+    area (volume), times the bytes per vertex and edge (:data:`BYTES_PER_ELEMENT`).
+    Scaling a probe overestimates a little (its border is a larger share). A region no
+    larger than the probe is not estimated (0)."""
+    import math
+
+    dim = len(size)
+    probe = tuple(min(s, p) for s, p in zip(size, (12, 12) if dim == 2 else (6, 6, 4), strict=True))
+    ratio = math.prod(size) / math.prod(probe)
+    if ratio <= 1:
+        return 0.0
+    if dim == 2:
+        from csplab.continuous.csp import ContinuousCSP
+
+        csp: Any = ContinuousCSP(example, probe, spacing=spacing, snap=snap, lines=lines)
+    else:
+        from csplab.continuous.csp3d import ContinuousCSP3
+
+        csp = ContinuousCSP3(example, probe, spacing=spacing, snap=snap)
+    A = csp.arrangement
+    elements = float(A.n_vertices + A.n_edges) * ratio
+    per = BYTES_PER_ELEMENT + BYTES_PER_ELEMENT_LABEL * int(csp.problem.K)
+    return BASE_BYTES + elements * per
 
 
 def synthesize(
@@ -86,6 +133,11 @@ def synthesize(
 
     if args.periodic:
         raise InputError("--periodic: continuous models are not periodic")
+    if getattr(args, "topology", None):
+        raise InputError(
+            f"--grid {args.topology}: {example.name or args.model} is a "
+            f"{'polygon' if dim == 2 else 'polyhedral'} model; --grid applies to grid examples"
+        )
     if args.out_partial:
         raise InputError("--out-partial: a failed continuous run has no partial polygons")
     if args.spacing is not None and not args.spacing > 0:
@@ -94,8 +146,18 @@ def synthesize(
         raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
     size = region(args, dim)
     boundary = boundary_label(args, example)
-    fmt = polygon_output(args.out, gives=type(example).__name__)
+    fmt = polygon_output(args.out, gives=type(example).__name__, args=args)
     cls = solver_class(args.solver.partition(":")[0])
+    from csplab.limits import check_memory, memory_budget
+
+    budget = memory_budget(getattr(args, "memory_limit", None))
+    need = estimate_peak(example, size, spacing=args.spacing, snap=args.snap, lines=args.lines)
+    check_memory(
+        need,
+        f"{example.name or args.model} --size {'x'.join(map(str, size))}",
+        "use a smaller --size or a larger --spacing",
+        budget=budget,
+    )
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
     for key in ("order", "choice"):
@@ -108,19 +170,27 @@ def synthesize(
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
     fallback = None if cls.complete or args.fallback == "none" else args.fallback
-    common = dict(solver=args.solver, rng=args.seed, spacing=args.spacing, snap=args.snap,
+    from csplab.rng import make_rng
+
+    _, seed = make_rng(args.seed)  # the seed the header prints: it reproduces every attempt
+    common = dict(solver=args.solver, rng=seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts, fallback=fallback)  # fmt: skip
     cons = user_constraints(args, example)
+    if cls.takes("progress"):
+        opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
     if cons is not None:
         settings["constraints"] = ", ".join(cons_summary(cons))
     if dim == 2:
         settings["lines"] = args.lines
-    s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
+    try:
+        s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
+    except InputError as e:  # the library names its arguments; the user typed flags
+        raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
-    if fmt is not None and s.model is not None:
+    if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
         fmt.write(s.model, args.out)
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
@@ -153,22 +223,28 @@ def synthesize(
         print(
             f"{said}: {example.name or args.model} {'x'.join(map(str, size))} {unit} of "
             f"{spacing:g} ({fams} {what}, {A.n_vertices} vertices, {A.n_edges} "
-            f"edges, K={P.K}) with {r.solver} in {r.time_s:.3f} s, seed {r.seed}"
+            f"edges, K={P.K}) with {r.solver} in {s.times['solve']:.3f} s, seed {seed}"
         )
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
         for line in explain(r):
             print(line)
-        keys = [k for k in r.stats if k not in ("order", "choice", "proof", "fallback_from",
-                                                "gave_up_s", "reason")]  # fmt: skip
+        # the solver's own count ("violations" of the CSP) is not the output's: the Eq. 4.1
+        # line below is the one count of defects
+        keys = [k for k in r.stats if k not in ("order", "choice", "violations",
+                                                *EXPLAINED_STATS)]  # fmt: skip
         if keys:
             print("  " + ", ".join(f"{k}={r.stats[k]}" for k in keys))
         if s.model is not None:
             made = f"{polys} polygons" if n_solids is None else (
                 f"{n_solids} solids of {polys} polygons")  # fmt: skip
             on = "polygons" if dim == 2 else "solids"
+            user = sum(1 for d in s.violations if d.kind in USER_KINDS)
+            counts = f"Eq. 4.1 violations={len(s.violations) - user}"
+            if cons is not None:
+                counts += f", constraint violations={user}"
             print(
                 f"  {made}, labels {list(s.model.labels)}; "
-                f"Eq. 4.1 violations={len(s.violations)} (checked on the {on}); "
+                f"{counts} (checked on the {on}); "
                 + ", ".join(f"{k} {v:.3f} s" for k, v in s.times.items())
             )
             if s.violations:
@@ -178,13 +254,50 @@ def synthesize(
         elif args.out:
             print(not_written(args.out, r.status).replace(
                 "; --out-partial writes the partial grid", ""), file=sys.stderr)  # fmt: skip
-        if r.status == "failed" and fallback is None and not cls.complete and cls.name != "blocks":
+        hint = None
+        if r.status == "failed" and "broken" in r.stats:  # a user constraint, not Eq. 4.1
+            hint = (
+                "  hint: a user constraint still breaks after the restarts; --solver sat "
+                "searches with it (exact), or more --restarts"
+            )
+        elif (
+            r.status == "failed" and fallback is None and not cls.complete
+            and cls.name != "blocks"
+        ):  # fmt: skip
             hint = (
                 "  hint: --solver blocks modifies the model in parts (Fig. 4.23) and always "
                 "returns a consistent model; an exact solver (sat) decides"
             )
+        if hint:
             print(hint, file=sys.stderr)
     return 0 if s.ok else 1
+
+
+#: The kinds of defect that are user constraints (Sec. 4.6), not Eq. 4.1
+USER_KINDS = frozenset({"connected", "dimensional", "large-scale"})
+
+#: The library's names of its arguments -> the flags a user typed
+_FLAGS = (
+    ("snap=true", "--snap"),
+    ("pass a spacing", "pass --spacing"),
+    ("a larger spacing", "a larger --spacing"),
+    ("a coarser spacing", "a coarser --spacing"),
+    ("another spacing", "another --spacing"),
+)
+
+
+def as_flags(message: str) -> str:
+    """``message`` with the library's argument names (``snap=true``) as the command-line
+    flags (``--snap``).
+
+    Examples
+    --------
+    >>> as_flags("choose another spacing or snap=true")
+    'choose another --spacing or --snap'
+    """
+    for lib, flag in _FLAGS:
+        message = message.replace(lib, flag)
+    return message
 
 
 def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> int:
@@ -196,6 +309,11 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     from csplab.continuous.defects import Violations
     from csplab.continuous.lattice import Lattice
 
+    if getattr(args, "topology", None):
+        raise InputError(
+            f"--grid {args.topology}: {example.name or args.model} is a continuous model; "
+            "--grid applies to grid examples"
+        )
     out = load_model(args.grid)
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
@@ -226,9 +344,24 @@ def user_constraints(
     from csplab.continuous.user3d import read_user_constraints
 
     names = {str(v): int(k) for k, v in (example.meta.get("label_names") or {}).items()}
+    have = set(example.labels)
     out = None
+    from csplab.progress import notice_after
+
     for path in args.constraints:
-        c = read_user_constraints(path, names)
+        with notice_after(f"reading the constraints of {path}"):  # a large file: one line
+            c = read_user_constraints(path, names)
+        for kind, labels in (
+            ("connected", c.connected),
+            ("dimensional", [b for b, _ in c.dimensional]),
+            ("large-scale", [b for b, _ in c.allowed]),
+        ):
+            missing = [int(b) for b in labels if b not in have]
+            if missing:  # as grid constraints: refused before any work
+                raise InputError(
+                    f"{path}: {kind}: label {missing[0]} does not occur in "
+                    f"{example.name or args.model} (its labels: {sorted(have)})"
+                )
         out = c if out is None else out.merged(c)
     return out
 

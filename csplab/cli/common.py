@@ -30,11 +30,13 @@ __all__ = [
     "COMPILING",
     "Model",
     "add_constraints_arg",
+    "add_memory_limit_arg",
     "add_model_option",
     "add_problem_args",
     "check_output_dir",
     "check_output_path",
     "check_time_limit",
+    "input_files",
     "kernels_cold",
     "load_grid",
     "load_model",
@@ -106,14 +108,56 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     finally:
         if timer is not None:
             timer.cancel()
+    from csplab.cli import readable
+
     for w in caught:  # one line each, no source location
-        print(f"csplab: warning: {w.message}", file=sys.stderr)
+        print(f"csplab: warning: {readable(str(w.message))}", file=sys.stderr)
     return model
 
 
-def check_output_path(path: str | Path, what: str, *, force: bool = True) -> Path:
+def input_files(args: argparse.Namespace) -> list[tuple[str, Path]]:
+    """The files a command reads, as ``(role, path)`` pairs: the model (when it is a file,
+    not a built-in name), every ``--constraints`` file, the grid ``check`` reads and a
+    blocks ``--option init=FILE``; an output must be none of them."""
+    found: list[tuple[str, Path]] = []
+    model = getattr(args, "model", None)
+    if isinstance(model, str) and os.path.isfile(model):
+        found.append(("the model", Path(model)))
+    for c in getattr(args, "constraints", None) or []:
+        found.append(("a --constraints file", Path(c)))
+    grid = getattr(args, "grid", None)
+    if isinstance(grid, str) and os.path.isfile(grid):
+        found.append(("the grid to check", Path(grid)))
+    for kv in getattr(args, "option", None) or []:
+        key, _, val = str(kv).partition("=")
+        if key == "init" and os.path.isfile(val):
+            found.append(("the --option init grid", Path(val)))
+    return found
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    try:
+        return a.exists() and b.exists() and os.path.samefile(a, b)
+    except OSError:
+        return a.resolve() == b.resolve()
+
+
+def _companions(p: Path) -> list[Path]:
+    """The files written beside ``p``: an OBJ mesh's material library (same stem)."""
+    return [p.with_suffix(".mtl")] if p.suffix.lower() == ".obj" else []
+
+
+def check_output_path(
+    path: str | Path,
+    what: str,
+    *,
+    force: bool = True,
+    inputs: Sequence[tuple[str, Path]] = (),
+) -> Path:
     """``path`` as a file the command can write, checked before the work: its folder exists
-    and is writable, ``path`` is not a folder, and (``force=False``) no file is there yet.
+    and is writable, ``path`` is not a folder, it is none of the ``inputs`` (never
+    overwrite what was read), and (``force=False``) no file is there yet. An ``.obj``
+    path checks its ``.mtl`` companion the same way.
 
     Parameters
     ----------
@@ -123,6 +167,8 @@ def check_output_path(path: str | Path, what: str, *, force: bool = True) -> Pat
         The argument that named it (``"--out"``), for the message.
     force : bool
         Whether an existing file may be overwritten.
+    inputs : sequence of (str, Path)
+        The files the command reads (:func:`input_files`), with their roles.
 
     Raises
     ------
@@ -140,6 +186,17 @@ not exist
     p = Path(path)
     if str(path) == "" or p.name in ("", ".", ".."):
         raise InputError(f"{what} {str(path)!r} is not a file name")
+    for q in (p, *_companions(p)):
+        for role, src in inputs:
+            if _same_file(q, src) or q.resolve() == src.resolve():
+                raise InputError(
+                    f"{what} {p}: {q} is {role} this command reads; write the output elsewhere"
+                )
+    for q in _companions(p):
+        if q.is_dir():
+            raise InputError(f"{what} {p}: its material file {q} is a folder")
+        if q.exists() and not os.access(q, os.W_OK):
+            raise InputError(f"{what} {p}: its material file {q} is not writable")
     folder = p.parent
     if not folder.exists():
         raise InputError(f"{what} {p}: the folder {folder} does not exist")
@@ -291,6 +348,20 @@ def _vox_labels(p: Path, model: Model | None) -> NDArray[np.int64]:
     return g
 
 
+def add_memory_limit_arg(p: argparse.ArgumentParser) -> None:
+    """``--memory-limit GB``: the budget a command's up-front memory estimate must fit
+    (:func:`csplab.limits.memory_budget`)."""
+    from csplab.limits import MEMORY_SHARE
+
+    p.add_argument(
+        "--memory-limit",
+        type=float,
+        metavar="GB",
+        help="refuse, before the work, a run whose estimated peak memory is larger (default: "
+        f"{MEMORY_SHARE:.0%} of the machine's RAM, or the memory available when less)",
+    )
+
+
 def add_constraints_arg(p: argparse.ArgumentParser) -> None:
     """``--constraints FILE`` (repeatable), for the commands that take constraints."""
     p.add_argument(
@@ -391,12 +462,16 @@ def problem_from_args(
 
 def with_constraint_files(problem: Problem, paths: Sequence[str] | None) -> Problem:
     """``problem`` with the constraints of every ``--constraints FILE``
-    (:func:`csplab.constraints.read_constraints`)."""
+    (:func:`csplab.io.constraints.read_constraints`)."""
     if not paths:
         return problem
-    from csplab.constraints import read_constraints
+    from csplab.io.constraints import read_constraints
+    from csplab.progress import notice_after
 
-    extra = [c for p in paths for c in read_constraints(p, problem)]
+    extra = []
+    for p in paths:
+        with notice_after(f"reading the constraints of {p}"):  # a large file: one line
+            extra += read_constraints(p, problem)
     return problem.with_constraints(extra)
 
 

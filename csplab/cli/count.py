@@ -8,6 +8,7 @@ import math
 from typing import Any
 
 from csplab.cli.common import (
+    add_memory_limit_arg,
     add_problem_args,
     check_time_limit,
     load_model,
@@ -38,6 +39,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--epsilon", type=float, default=0.8, help="approxmc tolerance")
     p.add_argument("--delta", type=float, default=0.2, help="approxmc failure probability")
     p.add_argument("--seed", type=int, default=0, help="seed of the randomised counters")
+    add_memory_limit_arg(p)
     p.add_argument(
         "--time-limit",
         type=float,
@@ -59,6 +61,34 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", action="store_true")
 
 
+#: the transfer-matrix method's own cap on frontier states (csplab.count.count_solutions)
+MAX_STATES = 2_000_000
+
+
+def transfer_states(shape: tuple[int, ...], K: int, memory_limit: float | None) -> int:
+    """The frontier states the transfer-matrix count may keep within the memory budget
+    (``--memory-limit``, default :func:`csplab.limits.memory_budget`), estimated from the
+    sizes before the work: a step extends each of ``S`` states by each of ``K`` labels, so
+    it holds ``S K`` rows of the frontier (about the cross-section, ``n / longest side``,
+    cells of 4 bytes) and their counts; at most :data:`MAX_STATES`. Beyond it the count
+    moves on to another method (``auto``) or says the model is too wide.
+
+    Examples
+    --------
+    >>> transfer_states((3, 12), 2, None) == MAX_STATES
+    True
+    >>> transfer_states((40, 40, 10), 119, 1.0) < MAX_STATES
+    True
+    """
+    from csplab.limits import memory_budget
+
+    n = math.prod(int(s) for s in shape)
+    frontier = n // max(1, max(int(s) for s in shape)) + 1
+    per_state = K * (4 * (frontier + 1) + 16)  # labels of the S x K candidates + counts
+    fit = int(memory_budget(memory_limit) // max(1, per_state))
+    return max(1, min(MAX_STATES, fit))
+
+
 def run(args: argparse.Namespace) -> int:
     from csplab.count import (
         CountTimeoutError,
@@ -74,7 +104,11 @@ def run(args: argparse.Namespace) -> int:
         c = count_solutions(
             problem, args.method, rng=args.seed, epsilon=args.epsilon, delta=args.delta,
             time_limit=time_limit, progress=True,
+            max_states=transfer_states(problem.shape, problem.K, args.memory_limit),
         )  # fmt: skip
+    except InputError as bad:  # the library names its arguments; the user typed flags
+        msg = str(bad).replace("raise max_states", "raise --memory-limit")
+        raise InputError(msg.replace("method='ganak'", "--method ganak")) from None
     except CountTimeoutError as stop:
         size = "x".join(map(str, problem.shape))
         if args.json:

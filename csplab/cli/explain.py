@@ -4,8 +4,9 @@ fixed cells, boundary faces and masks (an assumption core, shrunk by deletion).
 Fixed cells come from ``--fixed FILE``: a ``.npy`` integer array of the output size with -1
 for free cells, or a text file with one cell per line, ``x y [z ...] label`` (``#``
 comments; commas and ``=`` may separate the numbers). Masks from ``--mask FILE``: a ``.npy``
-boolean array ``(*size, K)``. Exit codes: 0 the problem is unsatisfiable and the
-explanation is printed, 1 it is satisfiable (nothing to explain), 2 bad input, 3 time limit.
+boolean array ``(*size, K)``. Exit codes as every csplab command: 0 the problem is
+satisfiable (nothing to explain), 1 it is unsatisfiable (the explanation is printed), 2 bad
+input, 3 time limit.
 """
 
 from __future__ import annotations
@@ -136,4 +137,4 @@ def run(args: argparse.Namespace) -> int:
             for line in v.witness["unary"]:
                 print(f"  {line}")
             print(f"  ({v.stats['sat_calls']} SAT calls, {v.stats['time_s']:.3f} s)")
-    return 3 if v.holds is None else (0 if v.holds else 1)
+    return 3 if v.holds is None else (1 if v.holds else 0)  # 1: unsat, as every command

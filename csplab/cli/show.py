@@ -60,7 +60,9 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--out {out}: the picture is a .png")
     if args.out is None and src.exists() and out.resolve() == src.resolve():
         out = out.with_name(f"{src.stem}.show.png")
-    check_output_path(out, "--out" if args.out else "the picture", force=args.force)
+    reads = [(r, Path(f)) for r, f in (("the file", args.file), ("--tiles", args.tiles)) if f]
+    check_output_path(out, "--out" if args.out else "the picture", force=args.force,
+                      inputs=[(r, p) for r, p in reads if p.is_file()])  # fmt: skip
     partial = _partial_npy(src)
     if args.tiles:
         tiles = load_model(args.tiles, opts)

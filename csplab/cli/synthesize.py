@@ -10,10 +10,12 @@ from typing import Any
 from csplab.cli.common import (
     EXPLAINED_STATS,
     add_constraints_arg,
+    add_memory_limit_arg,
     add_problem_args,
     check_output_path,
     explain,
     fallback_setting,
+    input_files,
     key_values,
     load_model,
     model_options,
@@ -104,6 +106,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="continuous models: round example vertices onto the --spacing lattice",
     )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
+    add_memory_limit_arg(p)
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument(
         "--option",
@@ -194,6 +197,29 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
     return settings
 
 
+def _check_grid_memory(args: argparse.Namespace, example: Any) -> None:
+    """Refuse, before building anything, a grid problem whose estimated peak
+    (:func:`csplab.problem.memory_estimate`: domains, arcs, the propagator) is over
+    ``--memory-limit`` (default :func:`csplab.limits.memory_budget`)."""
+    import math
+
+    from csplab.limits import check_memory, memory_budget
+    from csplab.problem import memory_estimate
+
+    shape = parse_shape(args.size, what="--size") if args.size else getattr(example, "shape", None)
+    K = getattr(example, "K", None)
+    if not shape or not K:
+        return
+    n = math.prod(int(s) for s in shape)
+    need = memory_estimate(n, int(K), len(shape) * n)
+    check_memory(
+        need,
+        f"{example.name or args.model} --size {'x'.join(map(str, shape))} (K={K})",
+        "use a smaller --size",
+        budget=memory_budget(args.memory_limit),
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     from csplab.io import write_labels
     from csplab.io.registry import output_format
@@ -210,17 +236,22 @@ def run(args: argparse.Namespace) -> int:
         return _continuous.synthesize(args, example, _options(args))
     if args.spacing is not None or args.snap or args.lines != "lattice":
         raise InputError("--spacing, --snap and --lines apply to continuous (polygon) models only")
+    _check_grid_memory(args, example)
     problem = problem_from_args(args, example)
     opts = _options(args)
     settings = _settings(args, example, opts)
+    if args.out:  # an input, a folder, an unwritable place: refused before the work
+        check_output_path(args.out, "--out", inputs=input_files(args))
     out_format = output_format(args.out) if args.out else None  # bad extension: fail early
-    if args.out:
-        check_output_path(args.out, "--out")  # an unwritable folder: fail before the work
     if out_format is not None and args.out_partial and not out_format.partial:
         raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
     fallback = None if solver_complete(args.solver) or args.fallback == "none" else args.fallback
+    from csplab import _jit
+
+    compiling = _jit.compile_seconds()
     result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
                    fallback=fallback, **opts)  # fmt: skip
+    compiling = _jit.compile_seconds() - compiling  # numba's one-time cost, not the solve's
     wrote = None
     if out_format is not None and (result.ok or args.out_partial):
         per = problem.meta.get("periodic", False)
@@ -241,9 +272,12 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(d))
     else:
         size = "x".join(map(str, problem.shape))
+        took = f"{max(0.0, result.time_s - compiling):.3f} s"
+        if compiling >= 0.05:
+            took += f" (+ {compiling:.1f} s compiling csplab's kernels, once)"
         msg = (
             f"{outcome(result.status)}: {example.name or args.model} {size} (K={problem.K}) "
-            f"with {result.solver} in {result.time_s:.3f} s, seed {result.seed}"
+            f"with {result.solver} in {took}, seed {result.seed}"
         )
         print(msg)
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))

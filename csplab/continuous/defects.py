@@ -4,6 +4,7 @@ give the same types)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from dataclasses import dataclass
 
@@ -19,6 +20,8 @@ class Defect:
     detail: str
 
     def __str__(self) -> str:
+        if not all(math.isfinite(c) for c in self.point):  # a defect of no one place
+            return f"{self.kind}: {self.detail}"
         x, y = self.point
         return f"{self.kind} at ({x:.6g}, {y:.6g}): {self.detail}"
 

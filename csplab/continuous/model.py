@@ -428,6 +428,9 @@ def _polygon(p: Polygon | Mapping[str, Any], where: str) -> Polygon:
     label = int(raw_label)
     if label < 1:
         raise InputError(f"{where}: label must be >= 1 (0 is empty space), not {label}")
+    from csplab.limits import check_label
+
+    check_label(label, where)  # a picture or a file must be able to hold it
     if not isinstance(holes, Sequence) or isinstance(holes, str | bytes):
         raise InputError(f"{where}: holes must be a list of rings")
     outer = _oriented(_ring(ext, where), ccw=True)

@@ -481,7 +481,9 @@ def _label(raw: Any, where: str) -> int:
     label = int(raw)
     if label < 1:
         raise InputError(f"{where}: label must be >= 1 (0 is empty space), not {label}")
-    return label
+    from csplab.limits import check_label
+
+    return check_label(label, where)  # a picture or a file must be able to hold it
 
 
 def _vertices(raw: Any, where: str) -> NDArray[np.float64]:

@@ -41,7 +41,6 @@ Examples
 
 from __future__ import annotations
 
-import json
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -188,15 +187,10 @@ def read_user_constraints(
     path: str | Path, names: Mapping[str, int] | None = None
 ) -> UserConstraints3:
     """:func:`parse_user_constraints` of a JSON file."""
+    from csplab.io.common import read_json_file
+
     p = Path(path)
-    try:
-        data = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(f"{p}: no such file") from None
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(f"{p}: cannot read ({e})") from None
-    except json.JSONDecodeError as e:
-        raise InputError(f"{p}: line {e.lineno}: not JSON ({e.msg})") from None
+    data = read_json_file(p)  # the same checks as every JSON reader (size, nesting depth)
     return parse_user_constraints(data, source=str(p), names=names)
 
 

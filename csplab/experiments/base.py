@@ -461,7 +461,8 @@ class Experiment:
         paths = config.get("constraints") or []
         if not paths:
             return []
-        from csplab.constraints import parse_constraints, read_entries
+        from csplab.constraints import parse_constraints
+        from csplab.io.constraints import read_entries
 
         entries = [e for path in paths for e in read_entries(path)]
         P = build_problem(example, size, str(config.get("boundary", "none")),

@@ -13,13 +13,18 @@ csplab.errors.FormatError: c.json, line 1: not valid JSON: Expecting ',' delimit
 from __future__ import annotations
 
 import json
+import re
 from typing import Any
 
 from csplab.errors import FormatError
 
-__all__ = ["load_json", "strip_comments"]
+__all__ = ["MAX_DEPTH", "MAX_JSON_BYTES", "load_json", "strip_comments"]
 
 MAX_JSON_BYTES = 50_000_000
+
+#: The bracket depth named in a "nesting is too deep" error (where the parser gave up is
+#: deeper; csplab's formats need fewer than 10 levels).
+MAX_DEPTH = 100
 
 
 def strip_comments(text: str) -> str:
@@ -66,13 +71,47 @@ def load_json(text: str | bytes, *, path: object = "<string>", comments: bool = 
     if comments:
         text = strip_comments(text)
     try:
-        return json.loads(text, parse_constant=_no_constant)
+        data = json.loads(text, parse_constant=_no_constant)
     except json.JSONDecodeError as e:
+        if e.doc in ("NaN", "Infinity", "-Infinity"):  # parse_constant: find it in the text
+            m = re.search(r"-?\b" + re.escape(e.doc.lstrip("-")) + r"\b", text)
+            line = text.count("\n", 0, m.start()) + 1 if m else None
+            col = m.start() - text.rfind("\n", 0, m.start()) if m else None
+            where = f" (column {col})" if col else ""
+            raise FormatError(f"not valid JSON: {e.msg}{where}", path=path, line=line) from None
         raise FormatError(
             f"not valid JSON: {e.msg} (column {e.colno})", path=path, line=e.lineno
         ) from None
     except RecursionError:
-        raise FormatError("JSON nesting is too deep", path=path) from None
+        at = _depth_error(text)
+        line = text.count("\n", 0, at) + 1 if at is not None else None
+        raise FormatError("JSON nesting is too deep", path=path, line=line) from None
+    return data
+
+
+def _depth_error(text: str) -> int | None:
+    """The offset where ``text``'s bracket nesting first exceeds :data:`MAX_DEPTH`
+    (brackets inside strings do not count), or ``None``."""
+    depth = 0
+    in_str = False
+    esc = False
+    for i, c in enumerate(text):
+        if in_str:
+            if esc:
+                esc = False
+            elif c == "\\":
+                esc = True
+            elif c == '"':
+                in_str = False
+        elif c == '"':
+            in_str = True
+        elif c in "[{":
+            depth += 1
+            if depth > MAX_DEPTH:
+                return i
+        elif c in "]}":
+            depth -= 1
+    return None
 
 
 def _no_constant(name: str) -> Any:

@@ -12,7 +12,8 @@ Examples
 >>> parse_xml('<!DOCTYPE x [<!ENTITY a "b">]><x/>', path="t.xml")
 Traceback (most recent call last):
 ...
-csplab.errors.FormatError: t.xml, line 1: DOCTYPE declarations are not allowed in tileset files
+csplab.errors.FormatError: t.xml, line 1: DOCTYPE declarations are not allowed (csplab reads \
+XML without DTDs or entities)
 """
 
 from __future__ import annotations
@@ -64,7 +65,9 @@ def parse_xml(text: str | bytes, *, path: object = "<string>") -> Node:
 
     def refuse(what: str) -> None:
         raise FormatError(
-            f"{what} are not allowed in tileset files", path=path, line=parser.CurrentLineNumber
+            f"{what} are not allowed (csplab reads XML without DTDs or entities)",
+            path=path,
+            line=parser.CurrentLineNumber,
         )
 
     def start(tag: str, attrs: dict[str, str]) -> None:

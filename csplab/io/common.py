@@ -50,6 +50,7 @@ __all__ = [
     "load_image",
     "neighbor_side",
     "read_bytes",
+    "read_json_file",
     "read_text",
     "text_lines",
     "xml_bool",
@@ -146,9 +147,35 @@ def read_text(path: str | Path) -> str:
 
 
 # ---------------------------------------------------------------------------- writing
-def write_atomic(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path`` and rename it over ``path``; an
-    :class:`~csplab.errors.InputError` naming the file when it cannot be written."""
+def write_atomic(path: str | Path, data: bytes | str) -> None:
+    """Write a file atomically: a temporary file beside ``path``, renamed over it.
+
+    A reader never sees half a file, and a failed write leaves the old one as it was (the
+    one atomic writer of csplab's outputs).
+
+    Parameters
+    ----------
+    path : str or Path
+        The file to write.
+    data : bytes or str
+        Its contents (text is written as UTF-8).
+
+    Raises
+    ------
+    InputError
+        One line naming ``path`` when the folder refuses the file.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_atomic(Path(d) / "a.txt", "hello")
+    ...     (Path(d) / "a.txt").read_text()
+    'hello'
+    """
+    path = Path(path)
+    if isinstance(data, str):
+        data = data.encode("utf-8")
     try:
         fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.")
     except OSError as e:
@@ -429,3 +456,25 @@ class Output:
             colors=m.voxel_palette[1:],
             empty=-1,
         )
+
+
+def read_json_file(path: str | Path) -> Any:
+    """A JSON file (no comments) parsed, with the checks of every csplab reader: a regular
+    file of at most 50 MB (``csplab.io._json.MAX_JSON_BYTES``), valid JSON without ``NaN``
+    or ``Infinity``, nesting the parser can follow; a :class:`FormatError` line naming the
+    file otherwise. A parse over :data:`csplab.progress.DELAY_S` gets one line on stderr
+    (``csplab: parsing FILE (N MB) ...``)."""
+    from csplab import progress
+    from csplab.io._json import MAX_JSON_BYTES, load_json
+
+    p = Path(path)
+    data = read_bytes(p)
+    if len(data) > MAX_JSON_BYTES:
+        raise FormatError(
+            f"the file has {len(data) / 1e6:.0f} MB; csplab reads JSON files of at most "
+            f"{MAX_JSON_BYTES // 1_000_000} MB",
+            path=p,
+        )
+
+    with progress.notice_after(f"parsing {p} ({len(data) / 1e6:.0f} MB)"):
+        return load_json(data, path=p)

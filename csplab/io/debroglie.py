@@ -4,7 +4,10 @@ The parts csplab reads (``//`` and ``/* */`` comments are allowed, as DeBroglie 
 
     {
       "model": {"type": "adjacent"},            or {"type": "overlapping", "n": 3} with a PNG src
-      "src": "tiles.tsx",                        a PNG sample for "overlapping" (or "adjacent"
+      "src": "tiles.tsx",                        a Tiled tileset: the tile pictures and
+                                                 per-tile properties (a number is a tile's
+                                                 gid, id + 1; a name its "name" property);
+                                                 a PNG sample for "overlapping" (or "adjacent"
                                                  without adjacencies: learnt from the sample)
       "width": 10, "height": 10, "depth": 1, "periodic": false,
       "symmetry": 8,                             or rotationalSymmetry (1, 2, 4) and
@@ -216,6 +219,10 @@ def parse_debroglie(
         "values": list(order),
         "group_order": len(G),
     }
+    images = None
+    tsx = Path(str(path)).parent / src if isinstance(src, str) else None
+    if tsx is not None and tsx.suffix.lower() == ".tsx" and tsx.is_file():
+        images = _tsx_pictures(tsx, list(order), meta, warn)
     rs = RuleSet(
         T,
         names=names,
@@ -228,17 +235,56 @@ def parse_debroglie(
         constraints=global_ops,
         symmetry=(G, perm),
         meta=meta,
+        images=images,
     )
     bad = rs.closure_violations(limit=20)
     meta["closure_violations"] = bad
     for msg in bad[:5]:
         warn.add(f"rule set not closed under the symmetry group: {msg}")
-    # csplab reads no tile pictures of adjacent models (Tiled .tsx tilesets, tile 'src'):
-    # say so, or a picture in one colour per tile looks like a bug
-    where = f" (csplab does not read {src!r})" if isinstance(src, str) and src else ""
-    if where or Path(str(path)).is_file():
-        warn.add(f"no tile pictures{where}: pictures show one colour per tile")
+    # without a readable .tsx there are no tile pictures: say so, or a picture in one
+    # colour per tile looks like a bug
+    if images is None:
+        where = ""
+        if isinstance(src, str) and src:
+            tsx_named = src.lower().endswith(".tsx")
+            where = f" ({src!r} is not next to the config)" if tsx_named else (
+                f" (csplab reads tile pictures from a Tiled .tsx, not {src!r})")  # fmt: skip
+        if where or Path(str(path)).is_file():
+            warn.add(f"no tile pictures{where}: pictures show one colour per tile")
     return rs
+
+
+def _tsx_pictures(
+    tsx: Path, values: list[Any], meta: dict[str, Any], warn: LoaderWarnings
+) -> np.ndarray | None:
+    """The tile pictures of ``values`` from a Tiled tileset, as DeBroglie finds them: a
+    number is the tile's gid (its id + 1), a name the tile whose ``name`` (or ``value``)
+    property it is; the tiles' properties go to ``meta["tile_properties"]``."""
+    from csplab.io.tiled import read_tsx
+
+    tiles = read_tsx(tsx)
+    by_gid = {t.gid: t for t in tiles}
+    by_name = {t.properties.get(k): t for t in tiles for k in ("name", "value")
+               if t.properties.get(k) is not None}  # fmt: skip
+    found = []
+    for v in values:
+        t = by_gid.get(v) if isinstance(v, int) else by_name.get(str(v))
+        if t is None and isinstance(v, str) and v.isdigit():
+            t = by_gid.get(int(v))
+        found.append(t)
+    missing = [str(v) for v, t in zip(values, found, strict=True) if t is None]
+    if missing:
+        warn.add(f"{tsx.name} has no tile {missing[0]}: pictures show one colour per tile")
+        return None
+    shapes = {t.image.shape for t in found if t is not None}
+    if len(shapes) != 1:
+        warn.add(f"{tsx.name}: tiles of different sizes; pictures show one colour per tile")
+        return None
+    meta["tile_properties"] = {
+        str(v): dict(t.properties) for v, t in zip(values, found, strict=True) if t is not None
+    }
+    meta["tileset"] = str(tsx)
+    return np.stack([t.image for t in found if t is not None])
 
 
 def _shape(d: dict[str, Any], ndim: int, path: object) -> tuple[int, ...] | None:

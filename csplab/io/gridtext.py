@@ -291,7 +291,9 @@ def format_grid(example: ExampleModel, comments: str = "") -> str:
 
 
 def write_grid(example: ExampleModel, path: str | Path, comments: str = "") -> None:
-    Path(path).write_text(format_grid(example, comments), encoding="utf-8")
+    from csplab.io.common import write_atomic
+
+    write_atomic(path, format_grid(example, comments))
 
 
 def grid_safe_names(names: Sequence[str]) -> list[str]:

@@ -182,7 +182,9 @@ def format_merrell(example: ExampleModel) -> str:
 
 
 def write_merrell(example: ExampleModel, path: str | Path) -> None:
-    Path(path).write_text(format_merrell(example), encoding="utf-8")
+    from csplab.io.common import write_atomic
+
+    write_atomic(path, format_merrell(example))
 
 
 def write_output(out: Output, path: Path) -> None:

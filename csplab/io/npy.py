@@ -86,5 +86,12 @@ def write_output(out: Output, path: Path) -> None:
     path : Path
         The file to write (overwritten).
     """
+
+    import io
+
+    from csplab.io.common import write_atomic
+
     g = out.file_grid()
-    np.save(path, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)
+    buf = io.BytesIO()
+    np.save(buf, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)
+    write_atomic(path, buf.getvalue())

@@ -185,14 +185,17 @@ def write_obj(
             faces += 1
         nverts += len(mesh.vertices)
         placed += 1
-    p.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    text = "\n".join(lines) + "\n"
     mlines = ["# csplab materials: one per label"]
     for lab in sorted({int(v) for v in np.unique(g[filled])}):
         r, gg, b = (int(c) / 255.0 for c in cols[lab])
         nm = f" ({names[lab]})" if names is not None and lab < len(names) else ""
         mlines += [f"newmtl label_{lab}", f"# label {lab}{nm}", f"Kd {r:.4f} {gg:.4f} {b:.4f}",
                    "Ka 0 0 0", "d 1", ""]  # fmt: skip
-    mtl.write_text("\n".join(mlines), encoding="utf-8")
+    from csplab.io.common import write_atomic
+
+    write_atomic(mtl, "\n".join(mlines))  # the materials first: the mesh names them
+    write_atomic(p, text)
     return {
         "vertices": nverts,
         "faces": faces,

@@ -38,16 +38,21 @@ def write_output(out: Output, path: Path) -> None:
     path : Path
         The file to write (overwritten).
     """
+
+    import io
+
+    from csplab.io.common import write_atomic
     from csplab.io.ruleset import RuleSet
 
+    buf = io.BytesIO()
     if isinstance(out.model, RuleSet):
-        out.model.render(out.grid, periodic=out.periodic).save(path, format="PNG")
-        return
-    from csplab.render import model_objects, render
+        out.model.render(out.grid, periodic=out.periodic).save(buf, format="PNG")
+    else:
+        from csplab.render import model_objects, render
 
-    K = len(out.names) if out.names is not None else None
-    objects = model_objects(out.model) if out.model is not None else None
-    topology = out.meta.get("topology")
-    render(out.grid, K=K, colors=out.colors, objects=objects, topology=topology).save(
-        path, format="PNG"
-    )
+        K = len(out.names) if out.names is not None else None
+        objects = model_objects(out.model) if out.model is not None else None
+        topology = out.meta.get("topology")
+        img = render(out.grid, K=K, colors=out.colors, objects=objects, topology=topology)
+        img.save(buf, format="PNG")
+    write_atomic(path, buf.getvalue())

@@ -326,6 +326,7 @@ class Format:
 
 
 _SHARED = "`../shared/anchors-data/`"
+_DATA = "../shared/anchors-data"  # the shared test data, from the repository root
 _CONT = "csplab/examples/continuous"  # polygon examples (continuous model synthesis)
 _EMPTY6 = "x-=0,x+=0,y-=0,y+=0,z-=0,z+=0"
 #: the labels of the mesh formats without materials or groups (OFF, STL)
@@ -489,7 +490,7 @@ FORMATS: dict[str, Format] = {
             "the default output (a non-periodic overlapping output is `width - N + 1` cells "
             "across: WFC's picture size)",
             example="csplab synthesize tests/io/data/wfc_samples.xml --model-option "
-            "name=sample --seed 1 --out flowers.png",
+            "name=sample --seed 1 --out samples.png",
         ),
         Format(
             name="poms",
@@ -514,7 +515,7 @@ FORMATS: dict[str, Format] = {
             "(a virtual tile outside the grid), `remove`/`add`/`force`/`pin` (and `quilt…`) "
             "constraints applied in file order, `objMap` pieces, `tileset` pictures; 2D maps "
             "are flipped to `y` up, 3D configs with an `objMap` are read `y`-up",
-            example="csplab synthesize PunchOutModelSynthesis/brutal-plum_poms.json "
+            example=f"csplab synthesize {_DATA}/PunchOutModelSynthesis/brutal-plum_poms.json "
             "--size 20x20x10 --solver blocks --seed 1 --out plum.vox",
         ),
         Format(
@@ -533,9 +534,11 @@ FORMATS: dict[str, Format] = {
             "`mirrorX`/`mirrorY`, `maxConsecutive` and `separation` become global "
             "constraints (`csplab.constraints`); any other constraint is a one-line warning, "
             "never dropped silently; `overlapping` "
-            "configs use their PNG sample; tile pictures (Tiled `.tsx`) are not read, and a "
-            "warning says so",
-            example="csplab synthesize DeBroglie/edged_path_constraint.json --size 30x30 "
+            "configs use their PNG sample; a Tiled `.tsx` tileset `src` gives the tile "
+            "pictures (a number is a tile's gid, id + 1; a name its `name` property) and the "
+            "per-tile properties (`meta['tile_properties']`); without one, a warning says "
+            "pictures show one colour per tile",
+            example=f"csplab synthesize {_DATA}/DeBroglie/edged_path_constraint.json --size 30x30 "
             "--seed 1 --out path.png",
         ),
         Format(
@@ -553,7 +556,7 @@ FORMATS: dict[str, Format] = {
             "inferred from the rules (a warning says so); pictures and `.vox`/`.obj` "
             "outputs composite the tiles' voxels (inferred tiles are drawn as pipes towards "
             "their connected faces)",
-            example=f"csplab synthesize MarkovJunior/Knots3D.xml --size 20x20x10 "
+            example=f"csplab synthesize {_DATA}/MarkovJunior/Knots3D.xml --size 20x20x10 "
             f"--boundary {_EMPTY6} --seed 1 --out knots.obj",
         ),
         Format(
@@ -580,7 +583,8 @@ FORMATS: dict[str, Format] = {
             details="in: a voxel model as an example grid (label 0 empty, one label per "
             "colour); out: label `b` = colour `b + 1`, the empty label left out",
             example=f"csplab synthesize tests/io/data/pipes3d.xml --size 12x12x6 "
-            f"--boundary {_EMPTY6} --seed 1 --out pipes.vox && csplab show pipes.vox",
+            f"--boundary {_EMPTY6} --seed 1 --out pipes.vox && csplab show pipes.vox "
+            "--out pipes3d.png",
         ),
         Format(
             name="obj",
@@ -594,7 +598,7 @@ FORMATS: dict[str, Format] = {
             "`y` up (csplab `(x, y, z)` → `(x, z, -y)`); POMS `objMap` pieces are placed "
             "instead of cubes when the files exist "
             '(`csplab.io.obj.write_obj(grid, path, pieces={label: "piece.obj"})`)',
-            example="csplab synthesize PunchOutModelSynthesis/brutal-plum_poms.json "
+            example=f"csplab synthesize {_DATA}/PunchOutModelSynthesis/brutal-plum_poms.json "
             "--size 20x20x10 --solver blocks --seed 1 --out plum.obj",
         ),
         Format(

@@ -41,7 +41,7 @@ from csplab.example import ExampleModel
 from csplab.io._xml import parse_xml
 from csplab.io.common import KIND, NO, SURE, read_bytes, xml_root
 
-__all__ = ["parse_tmx", "read_tmx", "sniff"]
+__all__ = ["TsxTile", "parse_tmx", "read_tmx", "read_tsx", "sniff"]
 
 _FLAGS = 0x0FFFFFFF  # the low 28 bits are the tile id; the high ones flip/rotate
 
@@ -150,3 +150,95 @@ def parse_tmx(text: str | bytes, *, path: object = "<string>") -> ExampleModel:
             meta["topology"] = "hex:even-q" if index == "odd" else "hex:odd-q"
     name = Path(str(path)).stem
     return ExampleModel(lab, names=names, name=name, meta=meta)
+
+
+# ------------------------------------------------------------------- tilesets (.tsx)
+class TsxTile:
+    """One tile of a Tiled tileset: its local ``id``, ``gid`` (``id + 1``: the first gid
+    of a tileset loaded on its own, as DeBroglie loads one), RGBA ``image`` and
+    ``properties`` (``<property name= value=>``)."""
+
+    def __init__(self, tid: int, image: np.ndarray, properties: dict[str, str]) -> None:
+        self.id = tid
+        self.gid = tid + 1
+        self.image = image
+        self.properties = properties
+
+
+def read_tsx(path: str | Path) -> list[TsxTile]:
+    """A Tiled tileset (``.tsx``): every tile's picture, cut from the tileset image
+    (``tilewidth``, ``tileheight``, ``columns``, ``margin``, ``spacing``) or its own
+    ``<image>`` (an image-collection tileset), and its properties; a
+    :class:`~csplab.errors.FormatError` naming the file and line otherwise.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from PIL import Image
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     Image.new("RGBA", (4, 2), (255, 0, 0, 255)).save(f"{d}/t.png")
+    ...     _ = Path(f"{d}/t.tsx").write_text(
+    ...         '<tileset tilewidth="2" tileheight="2" tilecount="2" columns="2">'
+    ...         '<image source="t.png" width="4" height="2"/><tile id="1"><properties>'
+    ...         '<property name="name" value="wall"/></properties></tile></tileset>')
+    ...     tiles = read_tsx(f"{d}/t.tsx")
+    >>> [(t.gid, t.image.shape, t.properties) for t in tiles]
+    [(1, (2, 2, 4), {}), (2, (2, 2, 4), {'name': 'wall'})]
+    """
+    from csplab.io.common import load_image
+
+    p = Path(path)
+    root = parse_xml(read_bytes(p), path=p)
+    if root.tag.lower() != "tileset":
+        raise FormatError(f"root element <{root.tag}>, not <tileset>", path=p, line=root.line)
+
+    def num(node: object, key: str, default: int | None = None) -> int:
+        raw = getattr(node, "attrib", {}).get(key)
+        if raw is None:
+            if default is None:
+                raise FormatError(f"<tileset> has no {key}", path=p, line=root.line)
+            return default
+        try:
+            v = int(raw)
+        except ValueError:
+            raise FormatError(f"{key}={raw!r} is not an integer", path=p, line=root.line) from None
+        if v < 0 or v > 1_000_000:
+            raise FormatError(f"{key}={v} is out of range", path=p, line=root.line)
+        return v
+
+    tw, th = num(root, "tilewidth"), num(root, "tileheight")
+    margin, spacing = num(root, "margin", 0), num(root, "spacing", 0)
+    sheet = root.find("image")
+    props: dict[int, dict[str, str]] = {}
+    own: dict[int, np.ndarray] = {}
+    for t in root.children:
+        if t.tag.lower() != "tile":
+            continue
+        tid = num(t, "id")
+        pr = t.find("properties")
+        props[tid] = {
+            q.attrib.get("name", ""): q.attrib.get("value", q.text)
+            for q in (pr.children if pr is not None else [])
+            if q.tag.lower() == "property"
+        }
+        im = t.find("image")
+        if im is not None and im.attrib.get("source"):
+            own[tid] = load_image(p.parent / im.attrib["source"], where=p)
+    tiles: list[TsxTile] = []
+    if sheet is not None and sheet.attrib.get("source"):
+        img = load_image(p.parent / sheet.attrib["source"], where=p)
+        h, w = img.shape[:2]
+        cols = num(root, "columns", max(1, (w - 2 * margin + spacing) // (tw + spacing)))
+        count = num(root, "tilecount", cols * max(1, (h - 2 * margin + spacing) // (th + spacing)))
+        for i in range(count):
+            x = margin + (i % cols) * (tw + spacing)
+            y = margin + (i // cols) * (th + spacing)
+            if x + tw > w or y + th > h:
+                raise FormatError(f"tile {i} lies outside the {w}x{h} image", path=p)
+            tiles.append(TsxTile(i, img[y : y + th, x : x + tw].copy(), props.get(i, {})))
+    else:
+        for tid in sorted(own):
+            tiles.append(TsxTile(tid, own[tid], props.get(tid, {})))
+    if not tiles:
+        raise FormatError("the tileset has no tiles (no <image>)", path=p, line=root.line)
+    return tiles

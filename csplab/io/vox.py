@@ -118,7 +118,9 @@ def write_vox(
     colors : uint8 array ``(K, 3)``, optional
         One colour per label (default: csplab's palette, as in the PNG pictures).
     """
-    Path(path).write_bytes(vox_bytes(grid, empty=empty, colors=colors))
+    from csplab.io.common import write_atomic
+
+    write_atomic(path, vox_bytes(grid, empty=empty, colors=colors))
 
 
 def parse_vox(data: bytes, *, path: object = "<bytes>") -> VoxModel:

@@ -65,6 +65,7 @@ from csplab.engine import waves as wv
 from csplab.engine.alg31 import run_alg31, scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.problem import Problem
+from csplab.progress import progress_bar
 from csplab.result import Result, Status
 from csplab.soft import Breaches, Energy
 from csplab.solvers.base import (
@@ -216,6 +217,7 @@ def run_blocks(
     temperature: float = 1.0,
     cooling: float = 1.0,
     exact: str = "none",
+    progress: bool = False,
 ) -> tuple[Status, NDArray[np.int32], dict[str, Any]]:
     """Alg. 3.4 (see the module docstring): the engine of :class:`BlocksSolver`.
 
@@ -315,7 +317,7 @@ def run_blocks(
         completion = ExactCompletion(exact) if exact != "none" else None
         status, tried, accepted, retry_count, revisions = _run_sweep(
             problem, grid, boxes, None if m == (0,) else m, rng, plan, window=window, soft=soft,
-            completion=completion,
+            completion=completion, progress=progress,
         )  # fmt: skip
     out = grid.reshape(problem.shape)
     final = len(problem.violations(out))
@@ -439,6 +441,7 @@ def _run_sweep(
     window: int = 1,
     soft: _Soft | None = None,
     completion: ExactCompletion | None = None,
+    progress: bool = False,
 ) -> _Counts:
     """The thesis' sweep (``workers=0``): every block in turn, one random stream; updates
     ``grid`` (flat) in place. A step solves one block (``block_step``: Alg. 3.1 on its
@@ -447,7 +450,7 @@ def _run_sweep(
     setting (grid blocks, scan or entropy orders, uniform or weighted choice, no energy),
     the :data:`_SWEEP_CHUNK` blocks from the given one on in one kernel call
     (:func:`_chunk_step`: the same blocks, draws and results); the deadline is checked
-    between steps."""
+    between steps; ``progress``: a bar on stderr (after 2 s) counting the steps."""
     retries, sweeps, order, choice, deadline = plan
     counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, revisions
     touching = _arc_index(problem) if len(boxes) > 1 else None
@@ -483,8 +486,10 @@ def _run_sweep(
     status: Status = "solved"
     if soft is not None:
         soft.start(grid, problem.shape)
-    for _sweep in range(sweeps):
-        for unit in units:
+    unit_name = "block" if step is block_step else f"x{_SWEEP_CHUNK} blocks"
+    for sweep in range(sweeps):
+        for unit in progress_bar(units, total=len(units), desc=_desc(sweep, sweeps),
+                                 enabled=progress, unit=unit_name):  # fmt: skip
             if (deadline is not None and time.perf_counter() > deadline) or not step(unit):
                 status = "timeout"
                 break
@@ -497,6 +502,10 @@ def _run_sweep(
 
 
 _SWEEP_CHUNK = 64  # blocks per kernel call (the deadline is checked between calls)
+
+
+def _desc(sweep: int, sweeps: int) -> str:
+    return "blocks" if sweeps == 1 else f"blocks, sweep {sweep + 1}/{sweeps}"
 
 
 def _compiled_sweep_applies(
@@ -821,6 +830,7 @@ class BlocksSolver(Solver):
         Option("exact", str, "none", "exact block completion: a block whose retries all fail "
                "is solved by sat or backtrack with its border fixed (none: Alg. 3.4's restore)",
                values=("none", "sat", "backtrack")),
+        Option("progress", bool, False, "a progress bar on stderr (after 2 s; the CLI's default)"),
     )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:

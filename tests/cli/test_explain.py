@@ -20,24 +20,24 @@ def test_explain_prints_a_minimal_core(tmp_path, capsys):
     f = tmp_path / "fixed.txt"
     f.write_text("# x y label\n0 0 0\n1, 1 = 0\n2 0 1\n")
     code, out, _ = run(capsys, "explain", "E1", "--size", "3x3", "--fixed", str(f))
-    assert code == 0
+    assert code == 1
     assert out.startswith("unsat:") and "2 of 3 restrictions conflict (minimal)" in out
     assert "fixed cell (2, 0) = 1" in out and "fixed cell (1, 1) = 0" not in out
     code, out, _ = run(capsys, "explain", "E1", "--size", "3x3", "--fixed", str(f), "--json")
     d = json.loads(out)
-    assert code == 0 and d["holds"] is True and d["witness"]["minimal"] is True
+    assert code == 1 and d["holds"] is True and d["witness"]["minimal"] is True
 
 
 def test_explain_satisfiable_unsat_without_restrictions_and_npy(tmp_path, capsys):
     code, out, _ = run(capsys, "explain", "line", "--size", "6x6", "--boundary", "auto")
-    assert code == 1 and out.startswith("satisfiable")
+    assert code == 0 and out.startswith("satisfiable")
     code, out, _ = run(capsys, "explain", "fig3_1d", "--size", "5x5")
-    assert code == 0 and "even without" in out
+    assert code == 1 and "even without" in out
     g = np.full((3, 3), -1)
     g[0, 0], g[0, 1] = 0, 0
     np.save(tmp_path / "f.npy", g)
     code, out, _ = run(capsys, "explain", "E1", "--size", "3x3", "--fixed", str(tmp_path / "f.npy"))
-    assert code == 0 and "(0, 1) = 0" in out
+    assert code == 1 and "(0, 1) = 0" in out
 
 
 def test_explain_bad_input_is_one_line(tmp_path, capsys):

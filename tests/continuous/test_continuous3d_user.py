@@ -16,7 +16,7 @@ import pytest
 from csplab.continuous.check3d import user_violations3
 from csplab.continuous.synthesis import synthesize
 from csplab.continuous.user3d import parse_user_constraints, read_user_constraints
-from csplab.errors import InputError
+from csplab.errors import FormatError, InputError
 from tests._meshes import box as _box
 
 polyhedra = pytest.importorskip("csplab.continuous.polyhedra")
@@ -117,7 +117,7 @@ def test_unknown_normal_and_label_name_the_file(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="not a plane family"):
         synthesize(E, (4, 4, 2), constraints=read_user_constraints(f))
     f.write_text("{")
-    with pytest.raises(InputError, match=r"c\.json: line 1: not JSON"):
+    with pytest.raises(FormatError, match=r"c\.json, line 1: not valid JSON"):
         read_user_constraints(f)
 
 

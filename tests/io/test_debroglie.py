@@ -12,7 +12,7 @@ from ._helpers import DATA, anchor, installed_solvers
 
 
 def load_tiny(**kw):
-    with pytest.warns(UserWarning, match=r"no tile pictures \(csplab does not read 'roads.tsx'\)"):
+    with pytest.warns(UserWarning, match=r"no tile pictures \('roads.tsx' is not next to"):
         return read_debroglie(DATA / "tiny_debroglie.json", **kw)
 
 
@@ -112,7 +112,7 @@ def test_shared_edged_path_every_solver_30x30(solver):
 
 
 def test_missing_tile_pictures_are_reported(tmp_path):
-    rs = load_tiny()  # warns: no tile pictures (csplab does not read 'roads.tsx')
+    rs = load_tiny()  # warns: no tile pictures ('roads.tsx' is not next to the config)
     assert rs.images is None
     assert any("one colour per tile" in w for w in rs.warnings)
     text = '{"tiles": [{"value": 1}], "adjacencies": [{"left": [1], "right": [1]}]}'
@@ -124,5 +124,37 @@ def test_missing_tile_pictures_are_reported(tmp_path):
 
 def test_shared_edged_path_file_says_why_its_pictures_are_colours():
     p = anchor("DeBroglie/edged_path_constraint.json")
-    with pytest.warns(UserWarning, match="does not read 'grass_biome.tsx'"):
+    with pytest.warns(UserWarning, match="'grass_biome.tsx' is not next to the config"):
         read_model(p)
+
+
+def test_a_tiled_tsx_tileset_gives_pictures_and_properties(tmp_path):
+    """Issue 30 row 26: DeBroglie configs name a Tiled ``.tsx``; its tiles (by gid, id + 1,
+    or by their ``name`` property) give the pictures and properties."""
+    import json
+
+    from PIL import Image
+
+    from csplab.io import read_model
+
+    img = Image.new("RGBA", (8, 4))
+    for i, c in enumerate([(255, 0, 0, 255), (0, 255, 0, 255), (0, 0, 255, 255), (9, 9, 9, 255)]):
+        img.paste(c, ((i % 2) * 4, (i // 2) * 2, (i % 2) * 4 + 4, (i // 2) * 2 + 2))
+    img = img.crop((0, 0, 8, 4))
+    img.save(tmp_path / "t.png")
+    (tmp_path / "t.tsx").write_text(
+        '<tileset tilewidth="4" tileheight="2" tilecount="4" columns="2">'
+        '<image source="t.png" width="8" height="4"/>'
+        '<tile id="2"><properties><property name="name" value="water"/>'
+        '<property name="cost" value="3"/></properties></tile></tileset>'
+    )
+    cfg = {"src": "t.tsx", "tiles": [{"value": 1}, {"value": "water"}],
+           "adjacencies": [{"left": [1, "water"], "right": [1, "water"]},
+                           {"up": [1, "water"], "down": [1, "water"]}]}  # fmt: skip
+    (tmp_path / "c.json").write_text(json.dumps(cfg))
+    rs = read_model(tmp_path / "c.json")
+    assert rs.images is not None and rs.images.shape == (2, 2, 4, 4)
+    assert tuple(rs.images[0, 0, 0]) == (255, 0, 0, 255)  # gid 1 = tile id 0
+    assert tuple(rs.images[1, 0, 0]) == (0, 0, 255, 255)  # "water" = tile id 2
+    assert rs.meta["tile_properties"]["water"] == {"name": "water", "cost": "3"}
+    assert not any("no tile pictures" in w for w in rs.meta["warnings"])

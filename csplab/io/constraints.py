@@ -1,0 +1,53 @@
+"""Reading a constraints file (the schema and the meaning: :mod:`csplab.constraints`).
+
+The file is JSON read by the one JSON reader of csplab's files
+(:func:`csplab.io.common.read_json_file`: size, special files, nesting depth), so the
+global constraints (core) read no file themselves.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+from csplab.constraints import Constraint, parse_constraints
+from csplab.errors import FormatError
+from csplab.io.common import read_json_file
+from csplab.problem import Problem
+
+__all__ = ["read_constraints", "read_entries"]
+
+
+def read_entries(path: str | Path) -> list[Any]:
+    """The entries of a constraints file, unparsed (a bad file is one
+    :class:`FormatError` line)."""
+    p = Path(path)
+    data = read_json_file(p)  # size, special files, nesting depth: one line each
+    items = data.get("constraints") if isinstance(data, Mapping) else data
+    if not isinstance(items, list):
+        raise FormatError('a constraints file is {"constraints": [ ... ]}', path=p)
+    return items
+
+
+def read_constraints(path: str | Path, problem: Problem) -> list[Constraint]:
+    """:func:`~csplab.constraints.parse_constraints` of a JSON file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The constraints file.
+    problem : Problem
+        The problem the constraints apply to (labels are checked against it).
+
+    Returns
+    -------
+    list of Constraint
+        The parsed constraints.
+
+    Raises
+    ------
+    FormatError
+        One line naming the file and the entry.
+    """
+    return parse_constraints(read_entries(path), problem, Path(path))
