@@ -31,7 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-TIMEOUT_S = 300  # a test run that takes longer has hung: the mutation is killed
+TIMEOUT_S = 900  # a test run that takes longer has hung: the mutation is killed
 
 
 @dataclass(frozen=True)
@@ -206,6 +206,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{m.id}: {m.what} ({m.path}) <- {', '.join(m.tests)}")
         return 0
     killed = 0
+    baseline: dict[tuple[str, ...], tuple[bool, float, str]] = {}
     with tempfile.TemporaryDirectory(prefix="csplab-mut-") as tmp:
         work = Path(tmp)
         _copy_tree(work)
@@ -215,7 +216,9 @@ def main(argv: list[str] | None = None) -> int:
             if text.count(m.old) != 1:
                 print(f"{m.id}: STALE (the text to mutate occurs {text.count(m.old)} times)")
                 continue
-            ok, dt, tail = _pytest(work, m.tests)
+            if m.tests not in baseline:  # each set of tests once, unmutated
+                baseline[m.tests] = _pytest(work, m.tests)
+            ok, dt, tail = baseline[m.tests]
             if not ok:
                 print(f"{m.id}: BROKEN (the tests fail unmutated: {tail})")
                 continue

@@ -7,7 +7,7 @@ only the functions that decide truth or run the engines (``TARGETS``), each agai
 tests that are meant to guard it, in a copy of the work tree (the tree itself never changes),
 with a time box per test run (a run that hangs counts as killed) and an optional total
 budget. The report lists the score per target and every survivor with its line, so each
-survivor can be killed by a new test or explained (``tests/mutation/equivalent.md``).
+survivor can be killed by a new test or explained (``benchmarks/results/mutation_equivalent.md``).
 
 Usage::
 
