@@ -57,7 +57,9 @@ def test_propagator_checks_what_it_adds(monkeypatch: Any) -> None:
 
 
 def test_available_memory_reads_meminfo_or_falls_back(monkeypatch: Any) -> None:
-    assert problem_mod.available_memory() > 0
+    from csplab import limits
+
+    assert limits.available_memory() > 0
     import builtins
 
     real_open = builtins.open
@@ -68,13 +70,14 @@ def test_available_memory_reads_meminfo_or_falls_back(monkeypatch: Any) -> None:
         return real_open(path, *a, **k)
 
     monkeypatch.setattr(builtins, "open", no_proc)
-    assert problem_mod.available_memory() == problem_mod.FALLBACK_MEMORY
+    assert limits.available_memory() == limits.FALLBACK_MEMORY
 
 
 def test_cli_memory_estimate_exit_2(monkeypatch: Any, capsys: Any) -> None:
+    from csplab import limits
     from csplab.cli import main
 
-    monkeypatch.setattr(problem_mod, "available_memory", lambda: 2**30)
+    monkeypatch.setattr(limits, "available_memory", lambda: 2**30)
     assert main(["synthesize", "city", "--size", "2000x2000x10"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1

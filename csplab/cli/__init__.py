@@ -17,6 +17,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 
+from csplab.cli.common import readable
 from csplab.errors import CsplabError
 
 __all__ = ["COMMANDS", "main"]
@@ -105,29 +106,6 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
         mod.add_arguments(p)
         p.set_defaults(_run=mod.run)
     return parser
-
-
-_NP_SCALAR = re.compile(r"np\.(?:float|int|uint|complex|bool|str)_?\d*\(([^()]*)\)")
-_NP_BOOL = re.compile(r"np\.(True|False)_")
-_NP_ARRAY = re.compile(r"array\((\[[^()]*?\])(?:, dtype=\w+)?\)")
-_ERRNO = re.compile(r"\(?\((\d+), '([^']*)'\)\)?")
-
-
-def readable(message: str) -> str:
-    """``message`` without Python's reprs: numpy scalars and arrays as plain numbers and
-    lists, an ``OSError``-style ``(errno, 'text')`` pair as its text.
-
-    Examples
-    --------
-    >>> readable("spacing np.float64(3.0) at array([1, 2], dtype=int64): np.True_")
-    'spacing 3.0 at [1, 2]: True'
-    >>> readable("cannot: ((34, 'Numerical result out of range'))")
-    'cannot: (Numerical result out of range)'
-    """
-    message = _NP_SCALAR.sub(r"\1", message)
-    message = _NP_BOOL.sub(r"\1", message)
-    message = _NP_ARRAY.sub(lambda m: " ".join(m.group(1).split()), message)
-    return _ERRNO.sub(r"(\2)", message)
 
 
 def _show_warning(message: Warning | str, category: type[Warning], *args: object,

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
+import re
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -108,8 +109,6 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     finally:
         if timer is not None:
             timer.cancel()
-    from csplab.cli import readable
-
     for w in caught:  # one line each, no source location
         print(f"csplab: warning: {readable(str(w.message))}", file=sys.stderr)
     return model
@@ -527,3 +526,26 @@ def not_written(out: str, status: str) -> str:
     if status == "unsat":
         return f"  not written: {out} (no solution exists: unsat, proof above)"
     return f"  not written: {out} (not solved; --out-partial writes the partial grid)"
+
+
+_NP_SCALAR = re.compile(r"np\.(?:float|int|uint|complex|bool|str)_?\d*\(([^()]*)\)")
+_NP_BOOL = re.compile(r"np\.(True|False)_")
+_NP_ARRAY = re.compile(r"array\((\[[^()]*?\])(?:, dtype=\w+)?\)")
+_ERRNO = re.compile(r"\(?\((\d+), '([^']*)'\)\)?")
+
+
+def readable(message: str) -> str:
+    """``message`` without Python's reprs: numpy scalars and arrays as plain numbers and
+    lists, an ``OSError``-style ``(errno, 'text')`` pair as its text.
+
+    Examples
+    --------
+    >>> readable("spacing np.float64(3.0) at array([1, 2], dtype=int64): np.True_")
+    'spacing 3.0 at [1, 2]: True'
+    >>> readable("cannot: ((34, 'Numerical result out of range'))")
+    'cannot: (Numerical result out of range)'
+    """
+    message = _NP_SCALAR.sub(r"\1", message)
+    message = _NP_BOOL.sub(r"\1", message)
+    message = _NP_ARRAY.sub(lambda m: " ".join(m.group(1).split()), message)
+    return _ERRNO.sub(r"(\2)", message)

@@ -202,9 +202,9 @@ def test_every_stat_of_every_path_is_named_in_STATS(spec, opts):
 
 @pytest.mark.parametrize("solver", ["catalog", "blocks", "sat"])
 def test_continuous_synthesis_stats_are_named_in_STATS(solver):
-    """Rule 7 for the continuous path (through its public API): the solver's stats, plus
-    what synthesis adds (``synthesize3``'s ``rounds`` of the connectivity cut loop and its
-    ``constraint_attempts``)."""
+    """Rule 7 for the continuous path (through its public API): the solver's stats, with a
+    connectivity constraint too (the grid solvers' ``Connected`` on the CSP's problem, through
+    ``solve()``: its stats are the solvers' own)."""
     from csplab.continuous import synthesize
 
     if solver == "sat" and "sat" not in _INSTALLED:
@@ -220,8 +220,7 @@ def test_continuous_synthesis_stats_are_named_in_STATS(solver):
     tet = load_polyhedral_example("tetrahedron")
     connected = parse_user_constraints({"constraints": [{"type": "connected", "labels": [1]}]})
     s3 = synthesize3(tet, (3, 3, 2), solver=solver, rng=2, restarts=1, constraints=connected)
-    # sat runs the exact cut loop; the others break the constraint here and are retried
-    assert {"sat": "rounds"}.get(solver, "constraint_attempts") in s3.result.stats
+    assert s3.result.stats
     assert not unknown_stats(s3.result.stats), unknown_stats(s3.result.stats)
 
 
