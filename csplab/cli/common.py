@@ -11,6 +11,7 @@ import argparse
 import math
 import os
 import re
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -269,7 +270,7 @@ def check_time_limit(value: float | None, what: str = "--time-limit") -> float |
     """
     if value is None:
         return None
-    if not math.isfinite(value) or value <= 0:
+    if not math.isfinite(value) or value < sys.float_info.min:  # subnormal: no usable time
         raise InputError(f"{what} must be a positive number of seconds, not {value:g}")
     return float(value)
 

@@ -51,6 +51,7 @@ csplab.errors.InputError: solver 'catalog': order must be one of scanline, rando
 from __future__ import annotations
 
 import math
+import sys
 import time
 from abc import ABC, abstractmethod
 from collections.abc import Callable, Mapping
@@ -194,7 +195,8 @@ def positive_seconds(value: Any) -> float:
         num = float(value)
     except (TypeError, ValueError):
         num = math.nan
-    if isinstance(value, bool) or not math.isfinite(num) or num <= 0:
+    # a subnormal float (below ~2.2e-308) is no time a clock can measure: refused as 0 is
+    if isinstance(value, bool) or not math.isfinite(num) or num < sys.float_info.min:
         raise InputError(f"must be a positive number of seconds, not {value!r}")
     return num
 
