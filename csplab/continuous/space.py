@@ -127,6 +127,14 @@ def central_cells(
             o = np.argsort(ang)
             base = np.sign(N @ p).astype(np.int8)
             base[on] = 0
+            # step off the vertex by less than half its angular distance to any plane not
+            # through it, so each sample keeps the vertex's signs on those planes (a fixed
+            # step crossed planes of nearly parallel families: a sample filed under the
+            # wrong cell, and the cell's mean direction outside it)
+            off = np.ones(F, dtype=bool)
+            off[on] = False
+            gap = np.abs(N[off].astype(np.float64) @ pf) / nn[off]
+            step = min(1e-3, 0.5 * float(gap.min())) if gap.size else 1e-3
             for a in range(len(o)):
                 ta, tb = tang[o[a]], tang[o[(a + 1) % len(o)]]
                 b = ta + tb
@@ -137,7 +145,7 @@ def central_cells(
                 sig[on] = np.sign(N[on] @ b).astype(np.int8)
                 if (sig == 0).any():  # pragma: no cover - bisectors avoid the circles
                     continue
-                w = pf + 1e-3 * b
+                w = pf + step * b
                 found.setdefault(sig.tobytes(), []).append(w / np.linalg.norm(w))
     signs = np.array([np.frombuffer(k, dtype=np.int8) for k in sorted(found)], dtype=np.int8)
     dirs = np.array([np.mean(found[k], axis=0) for k in sorted(found)])
