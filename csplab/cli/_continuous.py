@@ -29,6 +29,29 @@ def region(args: argparse.Namespace, dim: int = 2) -> tuple[int, ...]:
     return tuple(shp)
 
 
+_UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
+
+
+def parse_memory(text: str | None) -> int | None:
+    """``--max-memory``: bytes, or a number with K, M, G or T (powers of 1024; ``B``,
+    ``B`` and ``iB`` suffixes allowed), or ``None`` when not given.
+
+    >>> parse_memory("1.5G"), parse_memory("500MiB"), parse_memory(None)
+    (1610612736, 524288000, None)
+    """
+    if text is None:
+        return None
+    t = text.strip().upper().removesuffix("B").removesuffix("I")
+    unit = t[-1:] if t[-1:] in _UNITS and t[-1:] else ""
+    try:
+        v = float(t[: len(t) - len(unit)]) * _UNITS[unit]
+    except ValueError:
+        v = -1.0
+    if not (v > 0 and v < 2**60):
+        raise InputError(f"--max-memory {text}: give bytes such as 2G, 500M or 1000000000")
+    return int(v)
+
+
 def boundary_label(
     args: argparse.Namespace, example: PolygonModel | PolyhedralModel
 ) -> int | dict[str, int]:
@@ -108,8 +131,13 @@ def synthesize(
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
     fallback = None if cls.complete or args.fallback == "none" else args.fallback
+    max_memory = parse_memory(getattr(args, "max_memory", None))
+    if max_memory is not None and dim == 2:
+        raise InputError("--max-memory applies to polyhedral (3D) models")
     common = dict(solver=args.solver, rng=args.seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts, fallback=fallback)  # fmt: skip
+    if dim == 3:
+        common["max_memory"] = max_memory
     cons = user_constraints(args, example)
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
@@ -125,6 +153,11 @@ def synthesize(
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
+    if dim == 3:
+        from csplab.continuous.space import estimate3
+
+        v, e, b = estimate3(csp.lattice, size)
+        settings["estimate"] = f"<={v} vertices, <={e} edges, ~{b / 2**20:.0f} MiB"
     fams = int((~A.boundary_only).sum())
     out = s.model
     polys = None if out is None else out.n_polygons

@@ -103,6 +103,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="continuous models: round example vertices onto the --spacing lattice",
     )
+    p.add_argument(
+        "--max-memory",
+        help="continuous 3D models: refuse (one line with the estimate) an arrangement "
+        "estimated above this many bytes, e.g. 2G or 500M (default: half the available memory)",
+    )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     p.add_argument("--time-limit", type=float, help="seconds")
     p.add_argument(
@@ -210,6 +215,8 @@ def run(args: argparse.Namespace) -> int:
         return _continuous.synthesize(args, example, _options(args))
     if args.spacing is not None or args.snap or args.lines != "lattice":
         raise InputError("--spacing, --snap and --lines apply to continuous (polygon) models only")
+    if args.max_memory is not None:
+        raise InputError("--max-memory applies to polyhedral (3D) models")
     problem = problem_from_args(args, example)
     opts = _options(args)
     settings = _settings(args, example, opts)

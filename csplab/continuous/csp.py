@@ -504,6 +504,7 @@ def continuous_csp(
     boundary: int | Mapping[str, int] = 0,
     lines: str = "lattice",
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
 ) -> ContinuousCSP: ...
 
 
@@ -517,6 +518,7 @@ def continuous_csp(
     boundary: int | Mapping[str, int] = 0,
     lines: str = "lattice",
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
 ) -> ContinuousCSP3: ...
 
 
@@ -529,18 +531,20 @@ def continuous_csp(
     boundary: int | Mapping[str, int] = 0,
     lines: str = "lattice",
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
 ) -> ContinuousCSP | ContinuousCSP3:
     """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4) for an example of either
     dimension: :class:`ContinuousCSP` of a polygon model in a ``W x H`` region (``lines``),
     :class:`~csplab.continuous.csp3d.ContinuousCSP3` of a polyhedral one in ``A x B x C``
     (``boundary`` also per face, user ``constraints`` of thesis Sec. 4.6). Both give
     ``problem``, ``lattice``, ``arrangement``, ``labels``, ``boundary``, ``region()``,
-    ``model(grid)`` and ``encode(model)``."""
+    ``model(grid)`` and ``encode(model)``. ``max_memory`` (bytes, 3D) refuses before
+    building an arrangement estimated larger (:func:`~csplab.continuous.space.estimate3`)."""
     if isinstance(example, PolyhedralModel):
         if lines != "lattice":
             raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")
         return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                              constraints=constraints)  # fmt: skip
+                              constraints=constraints, max_memory=max_memory)  # fmt: skip
     if constraints:
         raise InputError("polygon models (2D) take no user constraints yet")
     if isinstance(boundary, Mapping):

@@ -124,16 +124,21 @@ def _local_labels(
 
 
 def example_signatures3(
-    example: PolyhedralModel, lattice: Lattice, index: dict[int, int]
+    example: PolyhedralModel,
+    lattice: Lattice,
+    index: dict[int, int],
+    max_memory: int | None = None,
 ) -> set[Labeling]:
     """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
     of the central cells: vertices and edges of its own arrangement (its bounding box plus
-    one spacing), the faces next to those edges, and the solid interiors."""
+    one spacing), the faces next to those edges, and the solid interiors (``max_memory``
+    as for :class:`~csplab.continuous.space.Arrangement3`)."""
     pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
     lo = np.floor(lattice.to_lattice(pts).min(axis=0) + 1e-9)
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
     shift = 1.0 - lo
-    A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)))
+    A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)),
+                     max_memory=max_memory, where=example.source, hint="")  # fmt: skip
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
@@ -196,6 +201,7 @@ class ContinuousCSP3:
         snap: bool = False,
         boundary: int | Mapping[str, int] = 0,
         constraints: UserConstraints3 | None = None,
+        max_memory: int | None = None,
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
@@ -210,8 +216,9 @@ class ContinuousCSP3:
                     f"boundary {face}={lab}: label {lab} does not occur in the example"
                 )
         self.boundary = faces
-        self.signatures = example_signatures3(example, self.lattice, index)
-        self.arrangement = Arrangement3(self.lattice, size)
+        self.signatures = example_signatures3(example, self.lattice, index, max_memory)
+        self.arrangement = Arrangement3(self.lattice, size, max_memory=max_memory,
+                                        where=example.source)  # fmt: skip
         self._types(index)
         self.problem = self._problem()
         #: the user constraints of Sec. 4.6 (:mod:`csplab.continuous.user3d`), if any

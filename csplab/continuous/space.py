@@ -55,7 +55,16 @@ if TYPE_CHECKING:  # types only: neither imports this module
     from csplab.continuous.polyhedra import PolyhedralModel
     from csplab.problem import Problem
 
-__all__ = ["MAX_FAMILIES3", "Arrangement3", "States3", "central_cells", "primitive3"]
+__all__ = [
+    "MAX_FAMILIES3",
+    "Arrangement3",
+    "States3",
+    "central_cells",
+    "check_budget3",
+    "estimate3",
+    "plane_counts",
+    "primitive3",
+]
 
 #: per vertex or edge type: its families, its states (a label per group of central cells)
 #: and the group of every central cell
@@ -157,9 +166,79 @@ def central_cells(
     return signs, dirs
 
 
+#: peak bytes per vertex of the bound (:func:`estimate3`) while building the arrangement and
+#: its CSP (measured 77: the bevelled CAD part at spacing 0.5 in 40x40x20, 298 MiB)
+BYTES_PER_VERTEX = 100
+#: share of the available memory a default budget allows
+MEMORY_SHARE = 0.5
+
+
+def _gib(b: float) -> str:
+    return f"{b / 2**30:.1f} GiB" if b >= 2**29 else f"{b / 2**20:.0f} MiB"
+
+
+def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
+    """Planes of each family (:meth:`Lattice.families` order) in the box ``size``: every
+    integer ``k`` with ``n . x = k`` meeting the box, two for a boundary-only family."""
+    fams, bonly = lattice.families()
+    corners = np.array(list(itertools.product(*[(0, int(s)) for s in size])), dtype=np.int64)
+    out = []
+    for n, b in zip(fams, bonly, strict=True):
+        kc = corners @ np.array(n, dtype=np.int64)
+        out.append(2 if b else int(kc.max() - kc.min()) + 1)
+    return out
+
+
+def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
+    """Upper bounds on the vertices and edges of the arrangement of ``lattice`` in ``size``
+    and its estimated peak bytes, before building anything (thesis Sec. 4.5.7: three planes
+    with independent normals meet once, so at most ``sum over triples of n_a n_b n_c``
+    vertices for families of ``n_f`` planes, ``C(m, 3) n^3`` with ``n`` each; each vertex
+    starts at most three edges along the lines of its planes).
+
+    Examples
+    --------
+    >>> lat = Lattice.of_points(np.array([[0, 0, 0], [1, 1, 1.0]]), [])
+    >>> estimate3(lat, (2, 2, 2))[:2]     # boundary-only axis families: the 8 corners
+    (8, 24)
+    """
+    n = plane_counts(lattice, size)
+    v = sum(n[a] * n[b] * n[c] for a, b, c in itertools.combinations(range(len(n)), 3))
+    return v, 3 * v, BYTES_PER_VERTEX * v
+
+
+def check_budget3(
+    lattice: Lattice,
+    size: Sequence[int],
+    max_memory: int | None,
+    where: str = "<model>",
+    hint: str = " or a smaller --size",
+) -> int:
+    """Refuse in one line (:class:`~csplab.errors.MemoryLimitError`) an arrangement whose
+    :func:`estimate3` exceeds ``max_memory`` bytes (default :data:`MEMORY_SHARE` of
+    :func:`~csplab.problem.available_memory`; ``hint`` follows "a larger --spacing" in the
+    message); returns the estimated bytes."""
+    from csplab.errors import MemoryLimitError
+    from csplab.problem import available_memory
+
+    v, e, need = estimate3(lattice, size)
+    budget = int(MEMORY_SHARE * available_memory()) if max_memory is None else int(max_memory)
+    if need > budget:
+        box = "x".join(str(int(s)) for s in size)
+        n = plane_counts(lattice, size)
+        raise MemoryLimitError(
+            f"{where}: {len(n)} plane families ({max(n)} planes in the densest) in {box} "
+            f"spacings make up to {v:.3g} vertices and {e:.3g} edges, about {_gib(need)} "
+            f"(--max-memory {_gib(budget)}); a larger --spacing{hint} lowers it"
+        )
+    return need
+
+
 class Arrangement3:
     """Vertices and edges of the planes of ``lattice``'s families in the box ``size``
-    (lattice units); see the module docstring.
+    (lattice units); see the module docstring. Refused before building when
+    :func:`estimate3` exceeds ``max_memory`` bytes (:func:`check_budget3`; ``where`` names
+    the example and ``hint`` the other remedy in the message).
 
     Attributes
     ----------
@@ -175,9 +254,18 @@ class Arrangement3:
         along ``lines[edge_line]`` (a primitive integer direction).
     """
 
-    def __init__(self, lattice: Lattice, size: Sequence[int]) -> None:
+    def __init__(
+        self,
+        lattice: Lattice,
+        size: Sequence[int],
+        *,
+        max_memory: int | None = None,
+        where: str = "<model>",
+        hint: str = " or a smaller --size",
+    ) -> None:
         if len(size) != 3 or any(int(s) < 1 for s in size):
             raise InputError(f"the region must be AxBxC with positive sides, not {tuple(size)}")
+        check_budget3(lattice, size, max_memory, where, hint)
         self.lattice = lattice
         self.size = tuple(int(s) for s in size)
         fams, bonly = lattice.families()
@@ -190,6 +278,13 @@ class Arrangement3:
         for t in triples:
             D = _lcm(D, abs(_det3(N[list(t)])))
         self.D = D
+        if math.prod(int(x) * D + 1 for x in self.size) >= 2**62:
+            raise InputError(
+                f"{where}: the planes of {F} families meet at points of denominator "
+                f"{D if D < 10**9 else f'~10^{len(str(D)) - 1}'}: their exact coordinates in "
+                f"{'x'.join(map(str, self.size))} spacings exceed 64-bit integers; a larger "
+                "--spacing (with --snap) gives simpler normals"
+            )
         ext = np.array(self.size, dtype=np.int64) * D
         corners = np.array(list(itertools.product(*[(0, s) for s in self.size])), dtype=np.int64)
         self.k_range: list[NDArray[np.int64]] = []

@@ -2,9 +2,16 @@
 
 from __future__ import annotations
 
-import numpy as np
+from pathlib import Path
 
-from csplab.continuous.space import central_cells
+import numpy as np
+import pytest
+
+from csplab.cli.common import load_model
+from csplab.continuous.csp3d import ContinuousCSP3
+from csplab.continuous.lattice import Lattice
+from csplab.continuous.space import Arrangement3, central_cells, estimate3
+from csplab.errors import MemoryLimitError
 
 
 def test_central_cells_of_nearly_parallel_families() -> None:
@@ -17,3 +24,32 @@ def test_central_cells_of_nearly_parallel_families() -> None:
     assert len(signs) == 8  # three planes in general position
     assert (np.sign(dirs @ N.T.astype(np.float64)) == signs).all()
     assert len({tuple(s) for s in signs.tolist()}) == 8
+
+
+def test_arrangement_refused_over_the_memory_budget() -> None:
+    tet = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]], dtype=float)
+    lat = Lattice.of_points(tet, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    # 3 planes per axis family and 7 of (1, 1, 1) in 2x2x2: 3*3*3 + 3 * (3*3*7) triples
+    assert estimate3(lat, (2, 2, 2))[:2] == (216, 648)
+    assert Arrangement3(lat, (2, 2, 2)).n_vertices <= 216
+    Arrangement3(lat, (2, 2, 2), max_memory=10**6)  # within the budget: built
+    with pytest.raises(MemoryLimitError) as e:
+        Arrangement3(lat, (40, 40, 20), max_memory=10**6, where="box.obj")
+    msg = str(e.value)
+    assert "\n" not in msg and msg.startswith("box.obj: ")
+    assert "--max-memory 1 MiB" in msg and "a larger --spacing or a smaller --size" in msg
+
+
+def test_slanted_cad_part_refused_in_one_line_not_overflow(tmp_path: Path) -> None:
+    # at spacing 0.5 with snap, the slanted L-bracket's snapped faces have normals such as
+    # (105, 32, 2): the lattice of their meeting points overflowed int64 (OverflowError in
+    # Arrangement3); now the estimate refuses it before building
+    pytest.importorskip("manifold3d")
+    from csplab.testing import cad
+
+    path = cad.export(cad.build("slanted"), tmp_path / "slanted.stl")
+    ex = load_model(str(path))
+    with pytest.raises(MemoryLimitError) as e:
+        ContinuousCSP3(ex, (40, 40, 20), spacing=0.5, snap=True, max_memory=2**30)
+    msg = str(e.value)
+    assert "\n" not in msg and "slanted.stl" in msg and "--max-memory 1.0 GiB" in msg
