@@ -101,7 +101,7 @@ def synthesize(
 ) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
-    from csplab.continuous.lattice import PlaneArrangement
+    from csplab.continuous.lattice import DIVISIONS, PlaneArrangement
     from csplab.continuous.synthesis import synthesize as run
     from csplab.solvers import solver_class
 
@@ -157,7 +157,18 @@ def synthesize(
         from csplab.continuous.space import estimate3
 
         v, e, b = estimate3(csp.lattice, size)
-        settings["estimate"] = f"<={v} vertices, <={e} edges, ~{b / 2**20:.0f} MiB"
+        settings["estimate"] = f"~{v} vertices, ~{e} edges, ~{b / 2**20:.0f} MiB"
+    lat = csp.lattice
+    if lat.derived:
+        settings["spacing"] = (
+            f"{spacing:g} (derived: the example's thinnest side / {DIVISIONS}, rounded down "
+            "to 1, 2 or 5 x 10^k)"
+        )
+    if lat.snapped:
+        settings["snap"] = (
+            f"largest vertex move {lat.snapped * spacing:.3g} ({lat.snapped:.2f} spacings)"
+            + (f", largest normal change {lat.normal_change:.2f} deg" if dim == 3 else "")
+        )
     fams = int((~A.boundary_only).sum())
     out = s.model
     polys = None if out is None else out.n_polygons

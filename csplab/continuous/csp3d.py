@@ -32,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
@@ -47,7 +48,7 @@ from csplab.continuous.user3d import UserConstraints3, allowed_states
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3"]
+__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3", "snapped3"]
 
 #: the region's faces; a point outside several takes the label of the first (the ground
 #: ``z-`` wins at the bottom edges)
@@ -121,6 +122,36 @@ def _local_labels(
         pos += ng
         out.append(tuple(int(x) for x in local[g]))
     return out
+
+
+def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
+    """``example`` with every vertex rounded onto ``lattice`` (vertices that meet merged,
+    faces flattened to a segment dropped); refused in one line
+    (:class:`~csplab.errors.InputError`) when that breaks a solid (flattens it, turns it
+    inside out, makes two overlap)."""
+    solids = []
+    for sol in example.solids:
+        uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
+        uv, inv = np.unique(uv, axis=0, return_inverse=True)  # vertices that met: one
+        inv = inv.reshape(-1)
+        faces = []
+        for f in sol.faces:
+            ring = [int(inv[int(k)]) for k in f]
+            ring = [k for i, k in enumerate(ring) if k != ring[i - 1]] if len(ring) > 1 else ring
+            if len(set(ring)) >= 3:  # a face that snapping flattened to a segment is dropped
+                faces.append(ring)
+        solids.append({"label": int(sol.label), "vertices": lattice.to_world(uv).tolist(),
+                       "faces": faces})  # fmt: skip
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            return PolyhedralModel(solids, name=example.name, meta=example.meta,
+                                   source=example.source)  # fmt: skip
+    except (InputError, UserWarning) as e:
+        raise InputError(
+            f"{example.source}: snapping onto spacing {float(lattice.spacing):g} breaks it "
+            f"({str(e).splitlines()[0]}); pass a smaller --spacing"
+        ) from None
 
 
 def example_signatures3(
@@ -205,8 +236,12 @@ class ContinuousCSP3:
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
-        self.example = example
         self.lattice = Lattice.of_model(example, spacing, snap=snap)
+        if self.lattice.snapped:
+            example = snapped3(example, self.lattice)
+        #: the example as synthesized (its vertices snapped onto the lattice when they were not
+        #: on it; the checker compares the output with this)
+        self.example = example
         self.labels: tuple[int, ...] = (0, *example.labels)
         index = {b: i for i, b in enumerate(self.labels)}
         faces = _boundary_faces(boundary)

@@ -166,9 +166,11 @@ def central_cells(
     return signs, dirs
 
 
-#: peak bytes per vertex of the bound (:func:`estimate3`) while building the arrangement and
-#: its CSP (measured 77: the bevelled CAD part at spacing 0.5 in 40x40x20, 298 MiB)
-BYTES_PER_VERTEX = 100
+#: peak bytes per vertex of :func:`estimate3` while building the arrangement and its CSP,
+#: the largest measured: 2,150 for the float tetrahedron (CAD STL) in 8x8x6 at its derived
+#: spacing 0.5 (6.1 GB peak RSS; its own arrangement estimated 2.84e6 vertices); 270 for
+#: the bevelled part at spacing 0.5 in 40x40x20 (298 MiB, 1.16e6 estimated)
+BYTES_PER_VERTEX = 2200
 #: share of the available memory a default budget allows
 MEMORY_SHARE = 0.5
 
@@ -190,11 +192,16 @@ def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
 
 
 def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
-    """Upper bounds on the vertices and edges of the arrangement of ``lattice`` in ``size``
-    and its estimated peak bytes, before building anything (thesis Sec. 4.5.7: three planes
-    with independent normals meet once, so at most ``sum over triples of n_a n_b n_c``
-    vertices for families of ``n_f`` planes, ``C(m, 3) n^3`` with ``n`` each; each vertex
-    starts at most three edges along the lines of its planes).
+    """Estimated vertices, edges and peak bytes of the arrangement of ``lattice`` in the
+    box ``size`` and of its CSP, before building anything.
+
+    Thesis Sec. 4.5.7: three planes with independent normals meet once, so families of
+    ``n_a, n_b, n_c`` planes give at most ``n_a n_b n_c`` vertices (``C(m, 3) n^3`` for
+    ``m`` families of ``n``). Most of those meeting points lie outside the box: the points
+    of a triple form a lattice of ``|det(N_a, N_b, N_c)|`` points per unit volume, so a
+    triple counts ``min(n_a n_b n_c, |det| (A + 1)(B + 1)(C + 1))`` (the full product when
+    one family is boundary-only). Each vertex starts at most three edges per triple through
+    it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
 
     Examples
     --------
@@ -203,7 +210,16 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
     (8, 24)
     """
     n = plane_counts(lattice, size)
-    v = sum(n[a] * n[b] * n[c] for a, b, c in itertools.combinations(range(len(n)), 3))
+    fams, bonly = lattice.families()
+    N = np.array(fams, dtype=np.int64).reshape(-1, 3)
+    vol = math.prod(int(x) + 1 for x in size)
+    v = 0
+    for t in itertools.combinations(range(len(n)), 3):
+        det = abs(_det3(N[list(t)]))
+        if det == 0:
+            continue
+        full = n[t[0]] * n[t[1]] * n[t[2]]
+        v += full if any(bonly[k] for k in t) else min(full, det * vol)
     return v, 3 * v, BYTES_PER_VERTEX * v
 
 
