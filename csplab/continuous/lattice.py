@@ -230,7 +230,7 @@ def _exact(pts: NDArray[np.float64], limit: int) -> bool:
     g = gcd_fractions([f - lo[i % d] for i, f in enumerate(fr)])
     if g == 0:
         return True  # no extent: refused below with that message
-    return max((f - lo[i % d]) / g for i, f in enumerate(fr)) <= limit
+    return bool(max((f - lo[i % d]) / g for i, f in enumerate(fr)) <= limit)
 
 
 def _show(p: Sequence[float]) -> str:
