@@ -42,7 +42,7 @@ from csplab.constraints import Connected
 from csplab.continuous._geom import labels_at
 from csplab.continuous.lattice import Lattice
 from csplab.continuous.polyhedra import PolyhedralModel
-from csplab.continuous.space import Arrangement3
+from csplab.continuous.space import Arrangement3, check_budget3
 from csplab.continuous.surface import surface_of
 from csplab.continuous.user3d import UserConstraints3, allowed_states
 from csplab.errors import InputError
@@ -251,6 +251,8 @@ class ContinuousCSP3:
                     f"boundary {face}={lab}: label {lab} does not occur in the example"
                 )
         self.boundary = faces
+        # the region's estimate first: refused before the example's arrangement is built
+        check_budget3(self.lattice, size, max_memory, example.source)
         self.signatures = example_signatures3(example, self.lattice, index, max_memory)
         self.arrangement = Arrangement3(self.lattice, size, max_memory=max_memory,
                                         where=example.source)  # fmt: skip
