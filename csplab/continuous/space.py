@@ -244,7 +244,7 @@ def check_budget3(
         n = plane_counts(lattice, size)
         raise MemoryLimitError(
             f"{where}: {len(n)} plane families ({max(n)} planes in the densest) in {box} "
-            f"spacings make up to {v:.3g} vertices and {e:.3g} edges, about {_gib(need)} "
+            f"spacings make about {v:.3g} vertices and {e:.3g} edges, {_gib(need)} "
             f"(--max-memory {_gib(budget)}); a larger --spacing{hint} lowers it"
         )
     return need
