@@ -29,6 +29,9 @@ def region(args: argparse.Namespace, dim: int = 2) -> tuple[int, ...]:
     return tuple(shp)
 
 
+_UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
+
+
 def boundary_label(
     args: argparse.Namespace, example: PolygonModel | PolyhedralModel
 ) -> int | dict[str, int]:
@@ -125,7 +128,7 @@ def synthesize(
 ) -> int:
     """``csplab synthesize POLYGONS.json --size WxH`` (or a polyhedral ``MESH.obj --size
     AxBxC``)."""
-    from csplab.continuous.lattice import PlaneArrangement
+    from csplab.continuous.lattice import DIVISIONS, PlaneArrangement
     from csplab.continuous.synthesis import synthesize as run
     from csplab.solvers import solver_class
 
@@ -151,13 +154,15 @@ def synthesize(
     from csplab.limits import check_memory, memory_budget
 
     budget = memory_budget(getattr(args, "memory_limit", None))
-    need = estimate_peak(example, size, spacing=args.spacing, snap=args.snap, lines=args.lines)
-    check_memory(
-        need,
-        f"{example.name or args.model} --size {'x'.join(map(str, size))}",
-        "use a smaller --size or a larger --spacing",
-        budget=budget,
-    )
+    if dim == 2:  # a probe arrangement scaled up; 3D: estimate3 before any arrangement
+        need = estimate_peak(example, size, spacing=args.spacing, snap=args.snap,
+                             lines=args.lines)  # fmt: skip
+        check_memory(
+            need,
+            f"{example.name or args.model} --size {'x'.join(map(str, size))}",
+            "use a smaller --size or a larger --spacing",
+            budget=budget,
+        )
     restarts = 0 if cls.complete else args.restarts
     settings: dict[str, Any] = {}
     for key in ("order", "choice"):
@@ -175,6 +180,8 @@ def synthesize(
     _, seed = make_rng(args.seed)  # the seed the header prints: it reproduces every attempt
     common = dict(solver=args.solver, rng=seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts, fallback=fallback)  # fmt: skip
+    if dim == 3:  # the arrangement's estimate (Sec. 4.5.7) is refused over the budget
+        common["max_memory"] = int(budget)
     cons = user_constraints(args, example)
     if cls.takes("progress"):
         opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
@@ -195,6 +202,22 @@ def synthesize(
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
+    if dim == 3:
+        from csplab.continuous.space import estimate3
+
+        nv, ne, nb = estimate3(csp.lattice, size)
+        settings["estimate"] = f"~{nv} vertices, ~{ne} edges, ~{nb / 2**20:.0f} MiB"
+    lat = csp.lattice
+    if lat.derived:
+        settings["spacing"] = (
+            f"{spacing:g} (derived: the example's thinnest side / {DIVISIONS}, rounded down "
+            "to 1, 2 or 5 x 10^k)"
+        )
+    if lat.snapped:
+        settings["snap"] = (
+            f"largest vertex move {lat.snapped * spacing:.3g} ({lat.snapped:.2f} spacings)"
+            + (f", largest normal change {lat.normal_change:.2f} deg" if dim == 3 else "")
+        )
     fams = int((~A.boundary_only).sum())
     out = s.model
     polys = None if out is None else out.n_polygons

@@ -591,6 +591,7 @@ class CSPOptions(TypedDict, total=False):
     boundary: int | Mapping[str, int]
     lines: str
     constraints: UserConstraints3 | None
+    max_memory: int | None
 
 
 @overload
@@ -614,6 +615,7 @@ def continuous_csp(
     boundary: int | Mapping[str, int] = 0,
     lines: str = "lattice",
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
 ) -> ContinuousCSP | ContinuousCSP3:
     """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4), in either dimension.
 
@@ -642,6 +644,10 @@ def continuous_csp(
         :data:`~csplab.continuous.arrangement.LINES`).
     constraints : UserConstraints3, optional
         User constraints of thesis Sec. 4.6 (3D only).
+    max_memory : int, optional
+        Bytes (3D): refuse, before building it, an arrangement estimated larger
+        (:func:`~csplab.continuous.space.estimate3`); default a share of the memory
+        available.
 
     Returns
     -------
@@ -659,7 +665,7 @@ def continuous_csp(
         if lines != "lattice":
             raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")
         return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                              constraints=constraints)  # fmt: skip
+                              constraints=constraints, max_memory=max_memory)  # fmt: skip
     if constraints:
         raise InputError("polygon models (2D) take no user constraints yet")
     if isinstance(boundary, Mapping):

@@ -32,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
@@ -41,13 +42,13 @@ from csplab.constraints import Connected
 from csplab.continuous._geom import labels_at
 from csplab.continuous.lattice import Lattice
 from csplab.continuous.polyhedra import PolyhedralModel
-from csplab.continuous.space import Arrangement3
+from csplab.continuous.space import Arrangement3, check_budget3
 from csplab.continuous.surface import surface_of
 from csplab.continuous.user3d import UserConstraints3, allowed_states
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3"]
+__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3", "snapped3"]
 
 #: the region's faces; a point outside several takes the label of the first (the ground
 #: ``z-`` wins at the bottom edges)
@@ -123,17 +124,52 @@ def _local_labels(
     return out
 
 
+def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
+    """``example`` with every vertex rounded onto ``lattice`` (vertices that meet merged,
+    faces flattened to a segment dropped); refused in one line
+    (:class:`~csplab.errors.InputError`) when that breaks a solid (flattens it, turns it
+    inside out, makes two overlap)."""
+    solids = []
+    for sol in example.solids:
+        uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
+        uv, inv = np.unique(uv, axis=0, return_inverse=True)  # vertices that met: one
+        inv = inv.reshape(-1)
+        faces = []
+        for f in sol.faces:
+            ring = [int(inv[int(k)]) for k in f]
+            ring = [k for i, k in enumerate(ring) if k != ring[i - 1]] if len(ring) > 1 else ring
+            if len(set(ring)) >= 3:  # a face that snapping flattened to a segment is dropped
+                faces.append(ring)
+        solids.append({"label": int(sol.label), "vertices": lattice.to_world(uv).tolist(),
+                       "faces": faces})  # fmt: skip
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            return PolyhedralModel(solids, name=example.name, meta=example.meta,
+                                   source=example.source)  # fmt: skip
+    except (InputError, UserWarning) as e:
+        raise InputError(
+            f"{example.source}: snapping onto spacing {float(lattice.spacing):g} breaks it "
+            f"({str(e).splitlines()[0]}); pass a smaller --spacing"
+        ) from None
+
+
 def example_signatures3(
-    example: PolyhedralModel, lattice: Lattice, index: dict[int, int]
+    example: PolyhedralModel,
+    lattice: Lattice,
+    index: dict[int, int],
+    max_memory: int | None = None,
 ) -> set[Labeling]:
     """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
     of the central cells: vertices and edges of its own arrangement (its bounding box plus
-    one spacing), the faces next to those edges, and the solid interiors."""
+    one spacing), the faces next to those edges, and the solid interiors (``max_memory``
+    as for :class:`~csplab.continuous.space.Arrangement3`)."""
     pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
     lo = np.floor(lattice.to_lattice(pts).min(axis=0) + 1e-9)
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
     shift = 1.0 - lo
-    A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)))
+    A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)),
+                     max_memory=max_memory, where=example.source, hint="")  # fmt: skip
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
@@ -196,11 +232,16 @@ class ContinuousCSP3:
         snap: bool = False,
         boundary: int | Mapping[str, int] = 0,
         constraints: UserConstraints3 | None = None,
+        max_memory: int | None = None,
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
-        self.example = example
         self.lattice = Lattice.of_model(example, spacing, snap=snap)
+        if self.lattice.snapped:
+            example = snapped3(example, self.lattice)
+        #: the example as synthesized (its vertices snapped onto the lattice when they were not
+        #: on it; the checker compares the output with this)
+        self.example = example
         self.labels: tuple[int, ...] = (0, *example.labels)
         index = {b: i for i, b in enumerate(self.labels)}
         faces = _boundary_faces(boundary)
@@ -210,8 +251,11 @@ class ContinuousCSP3:
                     f"boundary {face}={lab}: label {lab} does not occur in the example"
                 )
         self.boundary = faces
-        self.signatures = example_signatures3(example, self.lattice, index)
-        self.arrangement = Arrangement3(self.lattice, size)
+        # the region's estimate first: refused before the example's arrangement is built
+        check_budget3(self.lattice, size, max_memory, example.source)
+        self.signatures = example_signatures3(example, self.lattice, index, max_memory)
+        self.arrangement = Arrangement3(self.lattice, size, max_memory=max_memory,
+                                        where=example.source)  # fmt: skip
         self._types(index)
         self.problem = self._problem()
         #: the user constraints of Sec. 4.6 (:mod:`csplab.continuous.user3d`), if any

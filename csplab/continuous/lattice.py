@@ -42,10 +42,12 @@ if TYPE_CHECKING:
     from csplab.continuous.polyhedra import PolyhedralModel
 
 __all__ = [
+    "DIVISIONS",
     "MAX_FAMILIES",
     "MAX_FAMILIES3",
     "Lattice",
     "PlaneArrangement",
+    "derived_spacing",
     "family_vectors",
     "gcd_fractions",
     "primitive3",
@@ -64,6 +66,58 @@ _DEN = 10**6  # largest denominator when reading a float coordinate as a rationa
 _REL = 1e-9  # a float coordinate is that rational if within this relative distance
 _SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
 _AXES3 = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+#: a derived spacing divides the example's thinnest side into at least this many spacings
+DIVISIONS = 4
+
+
+def derived_spacing(points: NDArray[np.float64]) -> float:
+    """The default spacing of an example whose coordinates have no exact common unit (CAD
+    floats): the smallest positive side of its bounding box divided by :data:`DIVISIONS`,
+    rounded down to 1, 2 or 5 times a power of ten (its thinnest feature spans at least four
+    spacings; a coarse lattice gives small integer normals, few plane families and few
+    planes; ``spacing=`` overrides it).
+
+    >>> derived_spacing(np.array([[0, 0, 0], [6, 4, 2.5]]))
+    0.5
+    >>> derived_spacing(np.array([[0.0, 0.0], [130.0, 45.0]]))
+    10.0
+    """
+    ext = np.ptp(np.asarray(points, dtype=np.float64), axis=0)
+    pos = ext[ext > 0]
+    if not pos.size or not np.isfinite(pos).all():
+        raise InputError("the example has no extent")
+    x = float(pos.min()) / DIVISIONS
+    e = math.floor(math.log10(x))
+    for m in (5, 2, 1):
+        if m * 10.0**e <= x * (1 + 1e-12):
+            return float(f"{m}e{e}")
+    return float(f"1e{e}")  # pragma: no cover - m = 1 always fits
+
+
+def _normal_change(
+    pts: NDArray[np.float64], ip: NDArray[np.int64], faces: Sequence[Sequence[int]]
+) -> float:
+    """The largest angle (degrees) between a polygon's Newell normal before (``pts``) and
+    after snapping (lattice points ``ip``); 180 for a polygon that snapping flattened."""
+
+    def newell(q: NDArray[np.float64]) -> NDArray[np.float64]:
+        nxt = np.roll(q, -1, axis=0)
+        return np.array([((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum(),
+                         ((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum(),
+                         ((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()])  # fmt: skip
+
+    worst = 0.0
+    for poly in faces:
+        a = newell(pts[list(poly)] - pts[list(poly)].mean(axis=0))
+        b = newell(ip[list(poly)].astype(np.float64))
+        na, nb = float(np.linalg.norm(a)), float(np.linalg.norm(b))
+        if na == 0:
+            continue
+        if nb == 0:
+            return 180.0
+        c = float(np.clip(a @ b / (na * nb), -1.0, 1.0))
+        worst = max(worst, math.degrees(math.acos(c)))
+    return worst
 
 
 def rational(x: float) -> Fraction:
@@ -163,6 +217,22 @@ def family_vectors(
     return tuple(sorted(normals))
 
 
+def _exact(pts: NDArray[np.float64], limit: int) -> bool:
+    """Whether every coordinate is a rational of denominator at most 10^6 and their common
+    unit spans the example in at most ``limit`` steps."""
+    fr = [rational(float(v)) for v in pts.ravel().tolist()]
+    if any(
+        abs(float(q) - v) > _REL * max(1.0, abs(v)) for q, v in zip(fr, pts.ravel(), strict=True)
+    ):
+        return False
+    d = pts.shape[1]
+    lo = [min(fr[a::d]) for a in range(d)]
+    g = gcd_fractions([f - lo[i % d] for i, f in enumerate(fr)])
+    if g == 0:
+        return True  # no extent: refused below with that message
+    return bool(max((f - lo[i % d]) / g for i, f in enumerate(fr)) <= limit)
+
+
 def _show(p: Sequence[float]) -> str:
     return "(" + ", ".join(f"{v:g}" for v in p) + ")"
 
@@ -187,12 +257,18 @@ class Lattice:
         positive, sorted).
     snapped : float, default 0.0
         The largest distance (in spacings) a vertex was moved by ``snap`` (0 when exact).
+    normal_change : float, default 0.0
+        The largest angle (degrees) by which snapping turned a face (3D).
+    derived : bool, default False
+        Whether the spacing is :func:`derived_spacing` (the example had no exact unit).
     """
 
     origin: tuple[Fraction, ...]
     spacing: Fraction
     vectors: tuple[tuple[int, ...], ...]
     snapped: float = 0.0
+    normal_change: float = 0.0
+    derived: bool = False
 
     @property
     def ndim(self) -> int:
@@ -230,8 +306,10 @@ class Lattice:
             The rings (2D, closed) or polygons (3D) of the example, as indices into
             ``points``; their edges or normals give the families (:func:`family_vectors`).
         spacing : float, optional
-            The spacing; default: the largest length of which every vertex coordinate,
-            less the origin's, is an integer multiple.
+            The spacing; default: the largest that puts every vertex on a lattice point
+            when the coordinates are exact rationals spanning at most ``max_extent`` of it
+            (the built-in examples), otherwise (CAD floats) :func:`derived_spacing`, with
+            the vertices snapped onto it.
         snap : bool, default False
             Accept vertices off the lattice of ``spacing`` (they are rounded onto it;
             :attr:`snapped` records how far).
@@ -258,6 +336,10 @@ class Lattice:
         d = int(np.shape(points)[1])
         pts = np.asarray(points, dtype=np.float64).reshape(-1, d)
         lo = pts.min(axis=0)
+        limit = MAX_EXTENT[d] if max_extent is None else max_extent
+        derived = False
+        if spacing is None and not _exact(pts, limit):
+            spacing, snap, derived = derived_spacing(pts), True, True
         if spacing is not None:
             if not (math.isfinite(spacing) and spacing > 0):
                 raise InputError(f"spacing must be a positive number, not {spacing!r}")
@@ -286,14 +368,14 @@ class Lattice:
                 f"lattice of spacing {float(s):g}; choose another spacing or snap=true"
             )
         ext = int(iu.max()) if iu.size else 0
-        limit = MAX_EXTENT[d] if max_extent is None else max_extent
         if ext > limit:
             raise InputError(
                 f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
                 f"{limit}); pass a larger spacing (with snap=true if vertices are off it)"
             )
         vectors = family_vectors(iu.astype(np.int64), faces, where)
-        return cls(origin, s, vectors, off if snap else 0.0)
+        turned = _normal_change(pts, iu.astype(np.int64), faces) if snap and d == 3 else 0.0
+        return cls(origin, s, vectors, off if snap else 0.0, turned, derived)
 
     @classmethod
     def of(

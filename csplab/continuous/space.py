@@ -55,7 +55,16 @@ if TYPE_CHECKING:  # types only: neither imports this module
     from csplab.continuous.polyhedra import PolyhedralModel
     from csplab.problem import Problem
 
-__all__ = ["MAX_FAMILIES3", "Arrangement3", "States3", "central_cells", "primitive3"]
+__all__ = [
+    "MAX_FAMILIES3",
+    "Arrangement3",
+    "States3",
+    "central_cells",
+    "check_budget3",
+    "estimate3",
+    "plane_counts",
+    "primitive3",
+]
 
 #: per vertex or edge type: its families, its states (a label per group of central cells)
 #: and the group of every central cell
@@ -127,6 +136,14 @@ def central_cells(
             o = np.argsort(ang)
             base = np.sign(N @ p).astype(np.int8)
             base[on] = 0
+            # step off the vertex by less than half its angular distance to any plane not
+            # through it, so each sample keeps the vertex's signs on those planes (a fixed
+            # step crossed planes of nearly parallel families: a sample filed under the
+            # wrong cell, and the cell's mean direction outside it)
+            off = np.ones(F, dtype=bool)
+            off[on] = False
+            gap = np.abs(N[off].astype(np.float64) @ pf) / nn[off]
+            step = min(1e-3, 0.5 * float(gap.min())) if gap.size else 1e-3
             for a in range(len(o)):
                 ta, tb = tang[o[a]], tang[o[(a + 1) % len(o)]]
                 b = ta + tb
@@ -137,7 +154,7 @@ def central_cells(
                 sig[on] = np.sign(N[on] @ b).astype(np.int8)
                 if (sig == 0).any():  # pragma: no cover - bisectors avoid the circles
                     continue
-                w = pf + 1e-3 * b
+                w = pf + step * b
                 found.setdefault(sig.tobytes(), []).append(w / np.linalg.norm(w))
     signs = np.array([np.frombuffer(k, dtype=np.int8) for k in sorted(found)], dtype=np.int8)
     dirs = np.array([np.mean(found[k], axis=0) for k in sorted(found)])
@@ -149,9 +166,94 @@ def central_cells(
     return signs, dirs
 
 
+#: peak bytes per vertex of :func:`estimate3` while building the arrangement and its CSP,
+#: the largest measured: 2,150 for the float tetrahedron (CAD STL) in 8x8x6 at its derived
+#: spacing 0.5 (6.1 GB peak RSS; its own arrangement estimated 2.84e6 vertices); 270 for
+#: the bevelled part at spacing 0.5 in 40x40x20 (298 MiB, 1.16e6 estimated)
+BYTES_PER_VERTEX = 2200
+
+
+def _gib(b: float) -> str:
+    return f"{b / 2**30:.1f} GiB" if b >= 2**29 else f"{b / 2**20:.0f} MiB"
+
+
+def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
+    """Planes of each family (:meth:`Lattice.families` order) in the box ``size``: every
+    integer ``k`` with ``n . x = k`` meeting the box, two for a boundary-only family."""
+    fams, bonly = lattice.families()
+    corners = np.array(list(itertools.product(*[(0, int(s)) for s in size])), dtype=np.int64)
+    out = []
+    for n, b in zip(fams, bonly, strict=True):
+        kc = corners @ np.array(n, dtype=np.int64)
+        out.append(2 if b else int(kc.max() - kc.min()) + 1)
+    return out
+
+
+def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
+    """Estimated vertices, edges and peak bytes of the arrangement of ``lattice`` in the
+    box ``size`` and of its CSP, before building anything.
+
+    Thesis Sec. 4.5.7: three planes with independent normals meet once, so families of
+    ``n_a, n_b, n_c`` planes give at most ``n_a n_b n_c`` vertices (``C(m, 3) n^3`` for
+    ``m`` families of ``n``). Most of those meeting points lie outside the box: the points
+    of a triple form a lattice of ``|det(N_a, N_b, N_c)|`` points per unit volume, so a
+    triple counts ``min(n_a n_b n_c, |det| (A + 1)(B + 1)(C + 1))`` (the full product when
+    one family is boundary-only). Each vertex starts at most three edges per triple through
+    it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
+
+    Examples
+    --------
+    >>> lat = Lattice.of_points(np.array([[0, 0, 0], [1, 1, 1.0]]), [])
+    >>> estimate3(lat, (2, 2, 2))[:2]     # boundary-only axis families: the 8 corners
+    (8, 24)
+    """
+    n = plane_counts(lattice, size)
+    fams, bonly = lattice.families()
+    N = np.array(fams, dtype=np.int64).reshape(-1, 3)
+    vol = math.prod(int(x) + 1 for x in size)
+    v = 0
+    for t in itertools.combinations(range(len(n)), 3):
+        det = abs(_det3(N[list(t)]))
+        if det == 0:
+            continue
+        full = n[t[0]] * n[t[1]] * n[t[2]]
+        v += full if any(bonly[k] for k in t) else min(full, det * vol)
+    return v, 3 * v, BYTES_PER_VERTEX * v
+
+
+def check_budget3(
+    lattice: Lattice,
+    size: Sequence[int],
+    max_memory: int | None,
+    where: str = "<model>",
+    hint: str = " or a smaller --size",
+) -> int:
+    """Refuse in one line (:class:`~csplab.errors.MemoryLimitError`) an arrangement whose
+    :func:`estimate3` exceeds ``max_memory`` bytes (default :data:`csplab.limits.MEMORY_SHARE` of
+    :func:`~csplab.problem.available_memory`; ``hint`` follows "a larger --spacing" in the
+    message); returns the estimated bytes."""
+    from csplab.errors import MemoryLimitError
+    from csplab.limits import MEMORY_SHARE, available_memory
+
+    v, e, need = estimate3(lattice, size)
+    budget = int(MEMORY_SHARE * available_memory()) if max_memory is None else int(max_memory)
+    if need > budget:
+        box = "x".join(str(int(s)) for s in size)
+        n = plane_counts(lattice, size)
+        raise MemoryLimitError(
+            f"{where}: {len(n)} plane families ({max(n)} planes in the densest) in {box} "
+            f"spacings make about {v:.3g} vertices and {e:.3g} edges, {_gib(need)} "
+            f"(the memory budget is {_gib(budget)}: --memory-limit); a larger --spacing{hint} "
+            "lowers it"
+        )
+    return need
+
+
 class Arrangement3(ArrangementGraph):
     """Vertices and edges of the planes of ``lattice``'s families in the box ``size``
-    (lattice units); see the module docstring.
+    (lattice units); see the module docstring. Refused before building when
+    :func:`estimate3` exceeds ``max_memory`` bytes (:func:`check_budget3`; ``where`` names
+    the example and ``hint`` the other remedy in the message).
 
     Attributes
     ----------
@@ -167,9 +269,18 @@ class Arrangement3(ArrangementGraph):
         along ``lines[edge_line]`` (a primitive integer direction).
     """
 
-    def __init__(self, lattice: Lattice, size: Sequence[int]) -> None:
+    def __init__(
+        self,
+        lattice: Lattice,
+        size: Sequence[int],
+        *,
+        max_memory: int | None = None,
+        where: str = "<model>",
+        hint: str = " or a smaller --size",
+    ) -> None:
         if len(size) != 3 or any(int(s) < 1 for s in size):
             raise InputError(f"the region must be AxBxC with positive sides, not {tuple(size)}")
+        check_budget3(lattice, size, max_memory, where, hint)
         self.lattice = lattice
         self.size = tuple(int(s) for s in size)
         fams, bonly = lattice.families()
@@ -182,6 +293,13 @@ class Arrangement3(ArrangementGraph):
         for t in triples:
             D = _lcm(D, abs(_det3(N[list(t)])))
         self.D = D
+        if math.prod(int(x) * D + 1 for x in self.size) >= 2**62:
+            raise InputError(
+                f"{where}: the planes of {F} families meet at points of denominator "
+                f"{D if D < 10**9 else f'~10^{len(str(D)) - 1}'}: their exact coordinates in "
+                f"{'x'.join(map(str, self.size))} spacings exceed 64-bit integers; a larger "
+                "--spacing (with --snap) gives simpler normals"
+            )
         ext = np.array(self.size, dtype=np.int64) * D
         corners = np.array(list(itertools.product(*[(0, s) for s in self.size])), dtype=np.int64)
         self.k_range: list[NDArray[np.int64]] = []

@@ -92,6 +92,7 @@ def synthesize(
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
     **options: Any,
 ) -> Synthesis[ContinuousCSP, PolygonModel]: ...
 
@@ -110,6 +111,7 @@ def synthesize(
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
     **options: Any,
 ) -> Synthesis[ContinuousCSP3, PolyhedralModel]: ...
 
@@ -127,6 +129,7 @@ def synthesize(
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
+    max_memory: int | None = None,
     **options: Any,
 ) -> Synthesis[Any, M]:
     """Continuous model synthesis (Alg. 4.1) of a polygon or polyhedral example.
@@ -144,7 +147,7 @@ def synthesize(
         Any registered solver name (``NAME:BACKEND`` too); ``options`` go to it.
     rng : int or numpy Generator, optional
         Seed (recorded in the result).
-    spacing, snap, boundary, lines, constraints
+    spacing, snap, boundary, lines, constraints, max_memory
         See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: 2D; per-face
         ``boundary`` and user ``constraints`` of thesis Sec. 4.6: 3D).
     restarts : int
@@ -194,7 +197,7 @@ def synthesize(
     """
     t0 = time.perf_counter()
     csp = continuous_csp(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                         lines=lines, constraints=constraints)  # fmt: skip
+                         lines=lines, constraints=constraints, max_memory=max_memory)  # fmt: skip
     t1 = time.perf_counter()
     result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
     t2 = time.perf_counter()

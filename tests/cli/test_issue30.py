@@ -290,7 +290,7 @@ def test_row12_continuous_estimate_refuses_in_a_second(capsys, monkeypatch, mode
     _no_work(monkeypatch, *builder)
     t0 = time.perf_counter()
     line = refused(capsys, "synthesize", model, "--size", size,
-                   words=(model, size, "GB", "--size", "--memory-limit"))  # fmt: skip
+                   words=(model, size, "memory budget", "--size", "--memory-limit"))  # fmt: skip
     assert time.perf_counter() - t0 < 10, line
 
 
