@@ -358,6 +358,14 @@ class Lattice:
             s = gcd_fractions([f[a] - origin[a] for f in fr for a in range(d)])
             if s == 0:
                 raise InputError(f"{where}: the example has no extent")
+        span = float(np.ptp(pts, axis=0).max()) if pts.size else 0.0
+        step = float(spacing) if spacing is not None else float(s)
+        if not step > 0 or not math.isfinite(span / step) or span / step > limit:
+            raise InputError(
+                f"{where}: the example spans {span / step if step > 0 else math.inf:.3g} "
+                f"spacings of {step:g} (more than {limit}); pass a larger spacing (with "
+                "snap=true if vertices are off it)"
+            )
         u = (pts - np.array([float(v) for v in origin])) / float(s)
         iu = np.rint(u)
         off = float(np.abs(u - iu).max()) if u.size else 0.0

@@ -500,3 +500,13 @@ def test_row12_count_bounds_its_states_by_the_memory_budget(capsys):
     argv = ("count", "castle", "--size", "12x12x6", "--method", "transfer", "--memory-limit")
     line = refused(capsys, *argv, "0.01", words=("--memory-limit", "--method ganak"))
     assert "max_states" not in line
+
+
+@pytest.mark.parametrize("model", ["triangle", "houses"])
+def test_row4_a_tiny_spacing_is_one_line(capsys, model):
+    """Row 4: ``--spacing 1e-9`` was ``ValueError: cannot convert float NaN to integer``."""
+    if model == "houses":
+        pytest.importorskip("trimesh")
+    size = "10x10" if model == "triangle" else "10x10x6"
+    refused(capsys, "synthesize", model, "--size", size, "--spacing", "1e-9",
+            words=(model, "spacings of 1e-09", "--spacing"))  # fmt: skip
