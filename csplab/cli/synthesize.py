@@ -105,11 +105,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="continuous models: round example vertices onto the --spacing lattice",
     )
-    p.add_argument(
-        "--max-memory",
-        help="continuous 3D models: refuse (one line with the estimate) an arrangement "
-        "estimated above this many bytes, e.g. 2G or 500M (default: half the available memory)",
-    )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     add_memory_limit_arg(p)
     p.add_argument("--time-limit", type=float, help="seconds")
