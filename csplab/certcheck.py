@@ -261,28 +261,11 @@ def _axes_of(order: str, ndim: int) -> tuple[int, ...]:
 def _arc_consistency(
     dom: dict[Cell, int], fwd: list[list[int]], bwd: list[list[int]]
 ) -> dict[Cell, int] | None:
-    """Revise every arc between cells of ``dom`` until nothing changes; ``None`` on a
-    wipe-out."""
-    changed = True
-    while changed:
-        changed = False
-        for c, dc in dom.items():
-            for d in range(len(c)):
-                for step, table in ((-1, fwd[d]), (1, bwd[d])):
-                    n = (*c[:d], c[d] + step, *c[d + 1 :])
-                    dn = dom.get(n)
-                    if dn is None:
-                        continue
-                    support = 0
-                    for b in _bits(dn):
-                        support |= table[b]
-                    new = dc & support
-                    if new != dc:
-                        if new == 0:
-                            return None
-                        dom[c] = dc = new
-                        changed = True
-    return dom
+    """Arc consistency between the cells of ``dom`` (by :func:`_small_ac`, the checker's one
+    arc consistency); ``None`` on a wipe-out."""
+    cells = list(dom)
+    out = _small_ac([dom[c] for c in cells], _arcs(cells), fwd, bwd, {})
+    return None if out is None else dict(zip(cells, out, strict=True))
 
 
 # ----------------------------------------------------------------------------- infallible
@@ -444,16 +427,22 @@ def _graph(
     ``(node, axis, node is the + neighbour)``; the node of cell ``i``; the nodes' cells."""
     known = set(key)
     nodes = [x for x in box if not (x in index and index[x] < i) or index[x] in known]
+    src = [index[x] if x in index and index[x] < i else -1 for x in nodes]
+    return src, _arcs(nodes), nodes.index(cell), nodes
+
+
+def _arcs(nodes: Sequence[Cell]) -> list[list[tuple[int, int, bool]]]:
+    """The arcs between grid-adjacent ``nodes``: per node, ``(other node, axis, other is the
+    + neighbour)``."""
     pos = {x: k for k, x in enumerate(nodes)}
     arcs: list[list[tuple[int, int, bool]]] = [[] for _ in nodes]
     for x, k in pos.items():
-        for d in range(len(cell)):
+        for d in range(len(x)):
             m = pos.get((*x[:d], x[d] + 1, *x[d + 1 :]))
             if m is not None:
                 arcs[k].append((m, d, True))
                 arcs[m].append((k, d, False))
-    src = [index[x] if x in index and index[x] < i else -1 for x in nodes]
-    return src, arcs, pos[cell], nodes
+    return arcs
 
 
 def _small_ac(
