@@ -238,6 +238,8 @@ def synthesize(
             from csplab.continuous.resemblance import resemblance3  # from the geometry alone
 
             d["resemblance"] = resemblance3(example, s.model).to_dict()
+        if s.bounded is not None:
+            d["bounding_volumes"] = s.bounded.describe()
         print(json.dumps(d))
     else:
         what = "edge directions" if dim == 2 else "face orientations"
@@ -249,6 +251,8 @@ def synthesize(
             f"edges, K={P.K}) with {r.solver} in {s.times['solve']:.3f} s, seed {seed}"
         )
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
+        if s.bounded is not None:  # Sec. 4.6.4: which parts became bounding volumes
+            print("  " + s.bounded.describe())
         for line in explain(r):
             print(line)
         # the solver's own count ("violations" of the CSP) is not the output's: the Eq. 4.1
@@ -340,7 +344,17 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     out = load_model(args.grid)
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
-    v = violations(example, out)
+    bounded = None
+    if isinstance(example, PolyhedralModel) and isinstance(out, PolyhedralModel):
+        from csplab.continuous.bounding import bounding_volumes
+
+        bounded = bounding_volumes(example)  # curved parts: checked through the proxy
+    if bounded is not None:
+        from csplab.continuous.boundcheck import bounded_violations
+
+        v = bounded_violations(bounded, out)
+    else:
+        v = violations(example, out)
     if isinstance(out, PolyhedralModel):  # the user constraints of Sec. 4.6, on the solids
         cons = user_constraints(args, example)
         if cons is not None:
@@ -353,6 +367,9 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     else:
         print(f"{len(v)} violations in {args.grid} ({len(out)} {out.parts}, labels "
               f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
+        if bounded is not None:
+            print(f"  {bounded.describe()}; checked: curved parts are moved and scaled "
+                  "originals, each box holds the mapped original, Eq. 4.1 on the proxy")
         if len(v):
             print(v.describe(args.limit))
     return 0 if len(v) == 0 else 1

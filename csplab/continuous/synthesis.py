@@ -26,6 +26,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any, Generic, TypeVar, overload
 
+from csplab.continuous.bounding import Bounded, bounding_volumes
 from csplab.continuous.check import violations
 from csplab.continuous.check3d import user_violations3
 from csplab.continuous.csp import ContinuousCSP, continuous_csp
@@ -64,6 +65,12 @@ class Synthesis(Generic[CSP, Model]):
         when it was not checked.
     times : dict of str to float, default {}
         The time of each phase in seconds (``csp``, ``solve``, ``geometry``, ``check``).
+    bounded : Bounded or None, default None
+        The bounding volumes of the example's curved parts (thesis Sec. 4.6.4), when the
+        CSP was built on their proxy example (:mod:`~csplab.continuous.bounding`).
+    proxy : PolyhedralModel or None, default None
+        With ``bounded``: the solved proxy output, before the original geometry went
+        back into its boxes (``model``); ``violations`` are the checker's on it.
     """
 
     result: Result
@@ -71,6 +78,8 @@ class Synthesis(Generic[CSP, Model]):
     model: Model | None
     violations: Violations
     times: dict[str, float] = field(default_factory=dict)
+    bounded: Bounded | None = None
+    proxy: Model | None = None
 
     @property
     def ok(self) -> bool:
@@ -93,6 +102,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    bounding: bool = True,
     **options: Any,
 ) -> Synthesis[ContinuousCSP, PolygonModel]: ...
 
@@ -112,6 +122,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    bounding: bool = True,
     **options: Any,
 ) -> Synthesis[ContinuousCSP3, PolyhedralModel]: ...
 
@@ -130,6 +141,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    bounding: bool = True,
     **options: Any,
 ) -> Synthesis[Any, M]:
     """Continuous model synthesis (Alg. 4.1) of a polygon or polyhedral example.
@@ -150,6 +162,12 @@ def synthesize(
     spacing, snap, boundary, lines, constraints, max_memory
         See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: 2D; per-face
         ``boundary`` and user ``constraints`` of thesis Sec. 4.6: 3D).
+    bounding : bool, default True
+        Replace the curved parts of a polyhedral example by bounding volumes (thesis
+        Sec. 4.6.4, :mod:`~csplab.continuous.bounding`): the CSP is built on the proxy
+        example (on the lattice of ``spacing``, or of the derived default), its output is
+        checked against the proxy, and the original geometry is substituted back into
+        every placed box of ``model``. An example without curved parts is unchanged.
     restarts : int
         Run an incomplete solver again with a fresh derived seed while it fails
         (:func:`csplab.solvers.solve`'s one restart loop; ``time_limit`` covers all).
@@ -196,6 +214,12 @@ def synthesize(
     ('solved', 0, (1,))
     """
     t0 = time.perf_counter()
+    bounded = None
+    if bounding and isinstance(example, PolyhedralModel):
+        bounded = bounding_volumes(example, spacing)
+        if bounded is not None:  # the proxy is on the lattice of bounded.spacing
+            spacing, snap = bounded.spacing, False
+            example = bounded.proxy
     csp = continuous_csp(example, size, spacing=spacing, snap=snap, boundary=boundary,
                          lines=lines, constraints=constraints, max_memory=max_memory)  # fmt: skip
     t1 = time.perf_counter()
@@ -216,7 +240,12 @@ def synthesize(
     if broken:
         result = replace(result, status="failed", stats={**result.stats, "broken": str(broken[0])})
     times = {"csp": t1 - t0, "solve": t2 - t1, "geometry": t3 - t2, "check": t4 - t3}
-    return Synthesis(result, csp, model, Violations([*defects, *broken]), times)
+    proxy = None
+    if bounded is not None and isinstance(model, PolyhedralModel):
+        proxy = model
+        model = bounded.reinsert(model)
+        times["reinsert"] = time.perf_counter() - t4
+    return Synthesis(result, csp, model, Violations([*defects, *broken]), times, bounded, proxy)
 
 
 def synthesize3(

@@ -1,0 +1,208 @@
+"""The check of an output whose curved parts went back into bounding volumes (thesis
+Sec. 4.6.4; :mod:`~csplab.continuous.bounding`).
+
+An output of synthesis through bounding volumes holds the example's curved geometry, which
+has far more face orientations than the planes the synthesis used; Eq. 4.1 is stated, and
+checked, on the *proxy*: :func:`bounded_violations` verifies, from the output's geometry
+alone (not from the synthesis, its CSP or its reinsertion code),
+
+1. **that every curved part of the output is a transformed original**: the output's curved
+   regions (found by the same definition as the example's,
+   :func:`~csplab.continuous.bounding.curved_regions`) each match one curved region of the
+   example moved and scaled per axis (same label and number of triangles, every vertex
+   within ``1e-7`` of the output's extent of the mapped original); a part's regions
+   placed by one map give one placed box ``Q`` (the map applied to the part's tight box:
+   the synthesis maps the tight box onto the placed copy of the lattice box), and each of
+   the part's regions must be there;
+2. **that the geometry inside each placed box is exactly the mapped original**: for every
+   label, the output's solids inside ``Q`` and the part's content mapped onto ``Q`` have
+   a symmetric difference of volume at most ``1e-6`` of ``Q`` (manifold3d Booleans);
+3. **Eq. 4.1 for the proxy**: the output with each ``Q`` emptied and filled with the two
+   pieces of the part's lattice box (mapped onto ``Q``) has no violation of
+   :func:`~csplab.continuous.check3d.violations3` against the proxy example. A box that
+   was not scaled as its part allows (uniformly, or equally across a cylinder's axis)
+   gives pieces whose cut face has an orientation the proxy lacks, so the scaling rule is
+   part of this check.
+
+The proxy example itself is built from the original by
+:func:`~csplab.continuous.bounding.bounding_volumes` (the definition of the bounding
+volumes, shared with the synthesis; the verdict of Eq. 4.1 is the independent checker's).
+
+Examples
+--------
+>>> import trimesh
+>>> from csplab.continuous.bounding import bounding_volumes
+>>> from csplab.continuous.polyhedra import PolyhedralModel
+>>> m = trimesh.creation.cylinder(radius=1.0, height=2.0, sections=16)
+>>> rod = PolyhedralModel([{"label": 1, "vertices": m.vertices.tolist(),
+...                         "faces": m.faces.tolist()}])
+>>> b = bounding_volumes(rod, spacing=0.5)
+>>> len(bounded_violations(b, rod))
+0
+>>> m.apply_scale([2.0, 1.0, 1.0])  # not a scaling the cylinder allows (x=y)
+>>> stretched = PolyhedralModel([{"label": 1, "vertices": m.vertices.tolist(),
+...                               "faces": m.faces.tolist()}])
+>>> len(bounded_violations(b, stretched)) > 0
+True
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from csplab.continuous.bounding import (
+    Bounded,
+    Feature,
+    axis_map,
+    curved_regions,
+    from_manifold,
+)
+from csplab.continuous.check3d import violations3
+from csplab.continuous.defects import Defect, Violations
+from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.deps import require
+
+__all__ = ["bounded_violations"]
+
+_POINT_TOL = 1e-7  # of the output's extent
+_VOLUME_TOL = 1e-6  # of the placed box's volume
+
+
+def _box(lo: NDArray[np.float64], hi: NDArray[np.float64]) -> Any:
+    man = require("manifold3d", "mesh", "checking bounding volumes")
+    return man.Manifold.cube(tuple(float(x) for x in hi - lo)).translate(
+        tuple(float(x) for x in lo))  # fmt: skip
+
+
+def _defect(kind: str, p: NDArray[np.float64], detail: str) -> Defect:
+    return Defect(kind, (float(p[0]), float(p[1])), detail)  # as check3d: (x, y)
+
+
+def bounded_violations(
+    bounded: Bounded,
+    output: PolyhedralModel,
+    *,
+    region: tuple[float, ...] | None = None,
+    outside: int | Mapping[str, int] = 0,
+) -> Violations:
+    """The defects of an output synthesized through bounding volumes (see the module
+    docstring): curved parts that are no transformed original (``"curved"``), boxes whose
+    content is not the original (``"content"``), and Eq. 4.1 on the proxy.
+
+    Parameters
+    ----------
+    bounded : Bounded
+        The example's bounding volumes (:func:`~csplab.continuous.bounding.
+        bounding_volumes` of the original example).
+    output : PolyhedralModel
+        The output, with the curved geometry substituted back.
+    region, outside
+        As for :func:`~csplab.continuous.check3d.violations3`.
+
+    Returns
+    -------
+    Violations
+        Empty when the output passes all three checks.
+    """
+    from scipy.spatial import cKDTree
+
+    man = require("manifold3d", "mesh", "checking bounding volumes")
+    defects: list[Defect] = []
+    if output.solids:
+        pts = np.concatenate([np.asarray(s.vertices) for s in output.solids])
+        tol = _POINT_TOL * max(1.0, float(np.ptp(pts, axis=0).max()))
+    else:
+        tol = _POINT_TOL
+    # 1. every curved region of the output: a part's region, mapped per axis
+    found: dict[tuple[int, tuple[float, ...]], tuple[Feature, Any, Any, set[int]]] = {}
+    for r in curved_regions(output):
+        rp = r.points
+        hit = None
+        for k, f in enumerate(bounded.features):
+            for j, g in enumerate(f.regions):
+                if g.label != r.label or len(g.triangles) != len(r.triangles):
+                    continue
+                move = axis_map(g.lo, g.hi, r.lo, r.hi)
+                gp = move(g.points)
+                if len(gp) != len(rp):
+                    continue
+                d1, _ = cKDTree(rp).query(gp)
+                d2, _ = cKDTree(gp).query(rp)
+                if max(float(d1.max()), float(d2.max())) <= tol:
+                    qlo, qhi = move(f.tight_lo), move(f.tight_hi)
+                    hit = (k, f, qlo, qhi, j)
+                    break
+            if hit:
+                break
+        if hit is None:
+            defects.append(_defect("curved", r.lo, (
+                f"a curved part of label {r.label} ({len(r.triangles)} triangles, "
+                f"{r.orientations} orientations) is no moved and scaled curved part of the "
+                "example")))  # fmt: skip
+            continue
+        k, f, qlo, qhi, j = hit
+        key = (k, tuple(np.round(np.concatenate([qlo, qhi]) / tol).tolist()))
+        found.setdefault(key, (f, qlo, qhi, set()))[3].add(j)
+    placed = []
+    for f, qlo, qhi, regions in found.values():
+        if len(regions) != len(f.regions):
+            defects.append(_defect("curved", qlo, (
+                f"a box holds {len(regions)} of the {len(f.regions)} curved regions of its "
+                "part")))  # fmt: skip
+        placed.append((f, qlo, qhi))
+    # 2. the content of every placed box, and the output with the boxes emptied
+    boxes = [_box(qlo, qhi) for _, qlo, qhi in placed]
+    los = np.array([q for _, q, _ in placed]).reshape(-1, 3)
+    his = np.array([q for _, _, q in placed]).reshape(-1, 3)
+    kept: list[Any] = []  # solids no box touches: as they are
+    touched: list[tuple[int, Any, NDArray[np.bool_]]] = []  # (label, manifold, boxes met)
+    for s in output.solids:
+        v = np.asarray(s.vertices, dtype=np.float64)
+        lo, hi = v.min(axis=0), v.max(axis=0)
+        meet = np.all(los < hi + tol, axis=1) & np.all(lo < his + tol, axis=1)
+        if meet.any():
+            touched.append((int(s.label), s.to_manifold(), meet))
+        else:
+            kept.append(s)
+    for k, ((f, qlo, qhi), box) in enumerate(zip(placed, boxes, strict=True)):
+        move = axis_map(f.tight_lo, f.tight_hi, qlo, qhi)
+        want = {int(b): c.warp_batch(move) for b, c in f.contents}
+        here: dict[int, list[Any]] = {}
+        for b, m, meet in touched:
+            if meet[k]:
+                here.setdefault(b, []).append(m)
+        for b in sorted(set(want) | set(here)):
+            have = (man.Manifold.batch_boolean(here[b], man.OpType.Add) ^ box
+                    if b in here else None)  # fmt: skip
+            w = want.get(b)
+            va = float(have.volume()) if have is not None else 0.0
+            vb = float(w.volume()) if w is not None else 0.0
+            both = float((have ^ w).volume()) if have is not None and w is not None else 0.0
+            diff = va + vb - 2 * both
+            if diff > _VOLUME_TOL * float(np.prod(qhi - qlo)):
+                defects.append(_defect("content", qlo, (
+                    f"label {b} inside the box {_show(qlo)}..{_show(qhi)} differs from the "
+                    f"mapped original by volume {diff:.3g}")))  # fmt: skip
+    new: list[dict[str, Any]] = []  # the touched solids without the boxes, and the pieces
+    for b, m, meet in touched:
+        cut = man.Manifold.batch_boolean([boxes[k] for k in np.flatnonzero(meet)],
+                                         man.OpType.Add)  # fmt: skip
+        new += from_manifold(m - cut, b)
+    for f, qlo, qhi in placed:
+        move = axis_map(f.box_lo, f.box_hi, qlo, qhi)  # Q is the placed lattice box
+        for lab, piece in zip(f.labels, f.pieces(), strict=True):
+            new += from_manifold(piece.warp_batch(move), lab)
+    rebuilt = PolyhedralModel(new, source=output.source).solids  # validated: closed, outward
+    proxy_out = PolyhedralModel.trusted([*kept, *rebuilt], name=output.name,
+                                        source=output.source)  # fmt: skip
+    defects += list(violations3(bounded.proxy, proxy_out, region=region, outside=outside))
+    return Violations(defects)
+
+
+def _show(p: NDArray[np.float64]) -> str:
+    return "(" + ", ".join(f"{float(x):.6g}" for x in p) + ")"
+
