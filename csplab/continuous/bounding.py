@@ -93,6 +93,7 @@ SMOOTH_DEGREES = 30.0
 FLAT_RADIANS = 1e-3
 #: a smooth region with at least this many face orientations is a curved part
 MIN_ORIENTATIONS = 6
+_SLIVER = 1e-9  # a Boolean's piece of less volume than this times its extent cubed: rounding
 _DECIMALS = 4  # unit normals rounded to this many decimals count as one orientation
 _EXTRA = "mesh"
 _AXES = "xyz"
@@ -245,7 +246,8 @@ def from_manifold(m: Any, label: int) -> list[dict[str, Any]]:
         g = part.to_mesh64() if hasattr(part, "to_mesh64") else part.to_mesh()
         v = np.asarray(g.vert_properties, dtype=np.float64)[:, :3]
         f = np.asarray(g.tri_verts, dtype=np.int64).reshape(-1, 3)
-        if len(f) and abs(float(part.volume())) > 0:
+        ext = np.ptp(v, axis=0) if len(v) else np.zeros(3)
+        if len(f) and abs(float(part.volume())) > _SLIVER * float(ext.max(initial=0.0)) ** 3:
             out.append({"label": int(label), "vertices": v.tolist(), "faces": f.tolist()})
     return out
 
