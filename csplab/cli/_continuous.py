@@ -349,7 +349,7 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         from csplab.continuous.bounding import bounding_volumes
 
         bounded = bounding_volumes(example)  # curved parts: checked through the proxy
-    if bounded is not None:
+    if bounded is not None and isinstance(out, PolyhedralModel):
         from csplab.continuous.boundcheck import bounded_violations
 
         v = bounded_violations(bounded, out)

@@ -43,7 +43,7 @@ Examples
 >>> b = bounding_volumes(rod, spacing=0.5)
 >>> len(bounded_violations(b, rod))
 0
->>> m.apply_scale([2.0, 1.0, 1.0])  # not a scaling the cylinder allows (x=y)
+>>> _ = m.apply_scale([2.0, 1.0, 1.0])  # not a scaling the cylinder allows (x=y)
 >>> stretched = PolyhedralModel([{"label": 1, "vertices": m.vertices.tolist(),
 ...                               "faces": m.faces.tolist()}])
 >>> len(bounded_violations(b, stretched)) > 0
@@ -92,8 +92,8 @@ def bounded_violations(
     bounded: Bounded,
     output: PolyhedralModel,
     *,
-    region: tuple[float, ...] | None = None,
-    outside: int | Mapping[str, int] = 0,
+    region: tuple[float, float, float, float, float, float] | None = None,
+    outside: Mapping[str, int] | None = None,
 ) -> Violations:
     """The defects of an output synthesized through bounding volumes (see the module
     docstring): labels the example lacks (``"label"``: a box left unfilled), curved parts

@@ -61,7 +61,7 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,7 +72,6 @@ from csplab.continuous.csp3d import snapped3
 from csplab.continuous.lattice import Lattice, derived_spacing
 from csplab.continuous.polyhedra import PolyhedralModel, Solid
 from csplab.deps import require
-from csplab.errors import InputError
 
 __all__ = [
     "FLAT_RADIANS",
@@ -259,7 +258,7 @@ def _manifold_of(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Any
     return man.Manifold(mesh)
 
 
-def _hull(points: Sequence[Sequence[float]]) -> Any:
+def _hull(points: NDArray[np.float64]) -> Any:
     return _manifold().Manifold.hull_points(np.asarray(points, dtype=np.float64))
 
 
@@ -373,8 +372,9 @@ class Bounded:
                 f"scales {f.scaling}"
             )
         n = len(self.features)
-        return (f"bounding volumes: {n} curved part{'s' if n != 1 else ''} of "
-                f"{self.example.name or self.example.source} -> box ({'; '.join(parts)})")  # fmt: skip
+        name = self.example.name or self.example.source
+        return (f"bounding volumes: {n} curved part{'s' if n != 1 else ''} of {name} -> "
+                f"box ({'; '.join(parts)})")  # fmt: skip
 
     @property
     def proxy_labels(self) -> frozenset[int]:
@@ -522,7 +522,9 @@ def bounding_volumes(
     Raises
     ------
     InputError
-        When the proxy cannot be put on the lattice (one line naming the example).
+        When the proxy cannot be put on the lattice of ``spacing`` (one line naming the
+        example; from :meth:`~csplab.continuous.lattice.Lattice.of_points` and
+        :func:`~csplab.continuous.csp3d.snapped3`).
     DependencyError
         When a package of the ``mesh`` extra is missing.
     """
