@@ -208,7 +208,12 @@ def synthesize(
         nv, ne, nb = estimate3(csp.lattice, size)
         settings["estimate"] = f"~{nv} vertices, ~{ne} edges, ~{nb / 2**20:.0f} MiB"
     lat = csp.lattice
-    if lat.derived:
+    if s.bounded is not None and args.spacing is None:  # the proxy's lattice: derived too
+        settings["spacing"] = (
+            f"{spacing:g} (derived from the example before its bounding volumes: its "
+            f"thinnest side / {DIVISIONS}, rounded down to 1, 2 or 5 x 10^k)"
+        )
+    elif lat.derived:
         settings["spacing"] = (
             f"{spacing:g} (derived: the example's thinnest side / {DIVISIONS}, rounded down "
             "to 1, 2 or 5 x 10^k)"
