@@ -48,6 +48,15 @@ geometry and no proxy label.
 
 What :mod:`~csplab.continuous.boundcheck` verifies of such an output is stated there.
 
+**Limits.** Boxes are axis-aligned: the curved part of a rotated mesh gets a larger box than
+its oriented one would be, and the ``axis`` kind needs a cylinder along a coordinate axis
+(others scale uniformly). A part's content is the whole original inside its tight box, so
+flat geometry there travels with the curved faces. ``csplab check`` rebuilds the proxy with
+the derived spacing: an output made with another ``--spacing`` is checked against another
+proxy. A lathe output of 40x40x20 spacings has about 800,000 triangles, more than
+``csplab check`` reads back (:data:`csplab.io.mesh_repair.MAX_FACES`); in Python,
+:func:`~csplab.continuous.boundcheck.bounded_violations` checks it in memory.
+
 Examples
 --------
 >>> from csplab.continuous.polyhedra import PolyhedralModel
