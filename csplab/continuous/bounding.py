@@ -243,28 +243,28 @@ def axis_map(
     return f
 
 
-def from_manifold(m: Any, label: int) -> list[dict[str, Any]]:
-    """The connected solids of a manifold3d ``Manifold`` as solid mappings of ``label``
-    (triangles, outward, no zero-area triangle), for
-    :class:`~csplab.continuous.polyhedra.PolyhedralModel`."""
+def _parts(m: Any) -> list[tuple[NDArray[np.float64], NDArray[np.int64]]]:
+    """The connected solids of a manifold3d ``Manifold``: ``(vertices, triangles)``."""
     out = []
     # simplify at manifold3d's own tolerance: a union of csplab's solids (polygons with
     # collinear points, so that neighbours share vertices) leaves zero-area triangles
     for part in m.simplify(0.0).decompose():
-        g = part.to_mesh64() if hasattr(part, "to_mesh64") else part.to_mesh()
-        v = np.asarray(g.vert_properties, dtype=np.float64)[:, :3]
-        f = np.asarray(g.tri_verts, dtype=np.int64).reshape(-1, 3)
+        g = part.to_mesh64()
+        # own, writable copies (manifold3d's buffers are read-only views)
+        v = np.array(np.asarray(g.vert_properties)[:, :3], dtype=np.float64, order="C")
+        f = np.array(np.asarray(g.tri_verts).reshape(-1, 3), dtype=np.int64, order="C")
         ext = np.ptp(v, axis=0) if len(v) else np.zeros(3)
         if len(f) and abs(float(part.volume())) > _SLIVER * float(ext.max(initial=0.0)) ** 3:
-            out.append({"label": int(label), "vertices": v.tolist(), "faces": f.tolist()})
+            out.append((v, f))
     return out
 
 
-def _manifold_of(vertices: NDArray[np.float64], faces: NDArray[np.int64]) -> Any:
-    man = _manifold()
-    mesh = man.Mesh64(vert_properties=np.ascontiguousarray(vertices, dtype=np.float64),
-                      tri_verts=np.ascontiguousarray(faces, dtype=np.uint64))  # fmt: skip
-    return man.Manifold(mesh)
+def from_manifold(m: Any, label: int) -> list[dict[str, Any]]:
+    """The connected solids of a manifold3d ``Manifold`` as solid mappings of ``label``
+    (triangles, outward, no zero-area triangle), for
+    :class:`~csplab.continuous.polyhedra.PolyhedralModel`."""
+    return [{"label": int(label), "vertices": v.tolist(), "faces": f.tolist()}
+            for v, f in _parts(m)]  # fmt: skip
 
 
 def _hull(points: NDArray[np.float64]) -> Any:
@@ -463,17 +463,15 @@ class Bounded:
             parts = [items[i][1] for i in members]
             ms = [p.to_manifold() if isinstance(p, Solid) else p for p in parts]
             joined = man.Manifold.batch_boolean(ms, man.OpType.Add)
-            solids += [_trusted_solid(d) for d in from_manifold(joined, items[members[0]][0])]
+            label = int(items[members[0]][0])
+            solids += [_trusted_solid(label, v, f) for v, f in _parts(joined)]
         meta = {**output.meta, "bounding volumes": len(self.features)}
         return PolyhedralModel.trusted(solids, name=output.name, meta=meta, source=output.source)
 
 
-def _trusted_solid(d: dict[str, Any]) -> Solid:
+def _trusted_solid(label: int, v: NDArray[np.float64], f: NDArray[np.int64]) -> Solid:
     """A solid of triangles from manifold3d (closed and outward by construction)."""
-    v = np.asarray(d["vertices"], dtype=np.float64)
-    f = np.asarray(d["faces"], dtype=np.int64).reshape(-1, 3)
-    return Solid(int(d["label"]), v, f, tuple(tuple(int(x) for x in t) for t in f),
-                 np.arange(len(f), dtype=np.int64))  # fmt: skip
+    return Solid(label, v, f, tuple(map(tuple, f.tolist())), np.arange(len(f), dtype=np.int64))
 
 
 def _axis(normals: NDArray[np.float64]) -> int:
