@@ -133,6 +133,7 @@ def bounded_violations(
     found: dict[tuple[int, tuple[float, ...]], tuple[Feature, Any, Any, set[int]]] = {}
     for r in curved_regions(output):
         rp = r.points
+        tree = cKDTree(rp)
         hit = None
         for k, f in enumerate(bounded.features):
             for j, g in enumerate(f.regions):
@@ -142,9 +143,8 @@ def bounded_violations(
                 gp = move(g.points)
                 if len(gp) != len(rp):
                     continue
-                d1, _ = cKDTree(rp).query(gp)
-                d2, _ = cKDTree(gp).query(rp)
-                if max(float(d1.max()), float(d2.max())) <= tol:
+                d, near = tree.query(gp)  # one to one: as many points, each its own
+                if float(d.max()) <= tol and len(np.unique(near)) == len(rp):
                     qlo, qhi = move(f.tight_lo), move(f.tight_hi)
                     hit = (k, f, qlo, qhi, j)
                     break
