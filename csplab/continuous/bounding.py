@@ -81,6 +81,7 @@ from csplab.continuous.csp3d import snapped3
 from csplab.continuous.lattice import Lattice, derived_spacing
 from csplab.continuous.polyhedra import PolyhedralModel, Solid
 from csplab.deps import require
+from csplab.errors import InputError
 
 __all__ = [
     "FLAT_RADIANS",
@@ -529,7 +530,8 @@ def bounding_volumes(
     Raises
     ------
     InputError
-        When the proxy cannot be put on the lattice of ``spacing`` (one line naming the
+        When ``spacing`` is not a positive number, or the proxy cannot be put on the
+        lattice of ``spacing`` (one line naming the
         example; from :meth:`~csplab.continuous.lattice.Lattice.of_points` and
         :func:`~csplab.continuous.csp3d.snapped3`).
     DependencyError
@@ -540,6 +542,8 @@ def bounding_volumes(
         return None
     pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
     s = float(spacing) if spacing is not None else derived_spacing(pts)
+    if not (math.isfinite(s) and s > 0):
+        raise InputError(f"spacing must be a positive number, not {spacing!r}")
     origin = pts.min(axis=0)
     tol = 1e-9 * max(1.0, float(np.abs(pts).max()))
     # parts: regions whose tight boxes meet, then boxes on the lattice that meet
