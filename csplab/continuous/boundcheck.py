@@ -36,7 +36,7 @@ Examples
 --------
 >>> import trimesh
 >>> from csplab.continuous.bounding import bounding_volumes
->>> from csplab.continuous.polyhedra import PolyhedralModel
+>>> from csplab.continuous.polyhedra import PolyhedralModel, Solid
 >>> m = trimesh.creation.cylinder(radius=1.0, height=2.0, sections=16)
 >>> rod = PolyhedralModel([{"label": 1, "vertices": m.vertices.tolist(),
 ...                         "faces": m.faces.tolist()}])
@@ -68,7 +68,7 @@ from csplab.continuous.bounding import (
 )
 from csplab.continuous.check3d import violations3
 from csplab.continuous.defects import Defect, Violations
-from csplab.continuous.polyhedra import PolyhedralModel
+from csplab.continuous.polyhedra import PolyhedralModel, Solid
 from csplab.deps import require
 
 __all__ = ["bounded_violations"]
@@ -131,6 +131,7 @@ def bounded_violations(
         tol = _POINT_TOL
     # 1. every curved region of the output: a part's region, mapped per axis
     found: dict[tuple[int, tuple[float, ...]], tuple[Feature, Any, Any, set[int]]] = {}
+    own = [[g.points for g in f.regions] for f in bounded.features]  # computed once
     for r in curved_regions(output):
         rp = r.points
         tree = cKDTree(rp)
@@ -140,7 +141,7 @@ def bounded_violations(
                 if g.label != r.label or len(g.triangles) != len(r.triangles):
                     continue
                 move = axis_map(g.lo, g.hi, r.lo, r.hi)
-                gp = move(g.points)
+                gp = move(own[k][j])
                 if len(gp) != len(rp):
                     continue
                 d, near = tree.query(gp)  # one to one: as many points, each its own
@@ -206,12 +207,17 @@ def bounded_violations(
         cut = man.Manifold.batch_boolean([boxes[k] for k in np.flatnonzero(meet)],
                                          man.OpType.Add)  # fmt: skip
         new += from_manifold(m - cut, b)
+    rebuilt = PolyhedralModel(new, source=output.source).solids  # validated: closed, outward
+    # the pieces: the proxy example's (validated) solids of the box's labels, moved and
+    # scaled onto Q (a positive scaling per axis keeps them closed and outward)
+    pieces: list[Solid] = []
     for f, qlo, qhi in placed:
         move = axis_map(f.box_lo, f.box_hi, qlo, qhi)  # Q is the placed lattice box
-        for lab, piece in zip(f.labels, f.pieces(), strict=True):
-            new += from_manifold(piece.warp_batch(move), lab)
-    rebuilt = PolyhedralModel(new, source=output.source).solids  # validated: closed, outward
-    proxy_out = PolyhedralModel.trusted([*kept, *rebuilt], name=output.name,
+        for p in bounded.proxy.solids:
+            if int(p.label) in f.labels:
+                pieces.append(Solid(p.label, move(p.vertices), p.faces, p.polygons,
+                                    p.face_polygon))  # fmt: skip
+    proxy_out = PolyhedralModel.trusted([*kept, *rebuilt, *pieces], name=output.name,
                                         source=output.source)  # fmt: skip
     defects += list(violations3(bounded.proxy, proxy_out, region=region, outside=outside))
     return Violations(defects)
