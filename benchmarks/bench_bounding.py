@@ -61,7 +61,8 @@ def run_part(name: str, size: str, folder: Path) -> None:
     took = time.perf_counter() - t
     lines = buf.getvalue().splitlines()
     head = lines[0] if lines else "(no output)"
-    bv = next((x.strip() for x in lines if "bounding volumes:" in x), "no bounding volumes")
+    bv = next((x.strip() for x in lines if x.strip().startswith("bounding volumes:")),
+              "no bounding volumes")  # fmt: skip
     verdict = "meets" if took <= TARGET_S else f"shortfall {took - TARGET_S:.1f} s"
     print(f"{name}: {took:.1f} s end to end (target <= {TARGET_S:.0f} s: {verdict}); "
           f"exit {code}; {head.split(' with ')[0]}")  # fmt: skip
