@@ -183,7 +183,7 @@ def synthesize(
     if dim == 3:  # the arrangement's estimate (Sec. 4.5.7) is refused over the budget
         common["max_memory"] = int(budget)
     cons = user_constraints(args, example)
-    if cls.takes("progress"):
+    if cls.option("progress") is not None:
         opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")

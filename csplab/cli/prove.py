@@ -1,5 +1,11 @@
 """``csplab prove``: prove that Alg. 3.1 never fails on an example (Alg. 3.6, Thm. 3.3.6).
 
+Enumerate every window state Alg. 3.6 can reach with the given region size (Sec. 3.3.7)
+and check that its catalog is never empty; then Alg. 3.1 never fails on the model, at any
+output size (Theorem 3.3.6). Examples (open grids) and tilesets (not periodic; their face
+rules apply). ``--certificate`` writes what the verdict rests on, for
+``csplab check-certificate``.
+
 Exit codes: 0 proven infallible, 1 refuted (fallible; the failing run is printed and can
 be saved with ``--out``), 3 undecided (not provable with this region, or the state budget
 ran out; the state count is printed), 2 bad input.
@@ -21,16 +27,6 @@ from csplab.cli._analysis import (
 )
 from csplab.cli.common import add_model_option, check_output_path
 from csplab.errors import InputError
-
-HELP = "prove a model infallible (Alg. 3.1 never fails) by region enumeration"
-DESCRIPTION = (
-    "Enumerate every window state Alg. 3.6 can reach with the given region "
-    "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
-    "fails on the model, at any output size (Theorem 3.3.6). Examples (open grids) and "
-    "tilesets (not periodic; their face rules apply). --certificate writes what the verdict rests "
-    "on, for `csplab check-certificate`. Exit 0 proven, 1 refuted (fallible), 3 undecided, "
-    "2 bad input."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -1,5 +1,10 @@
 """``csplab witness``: find a failing run of Alg. 3.1 (smallest size, shortest prefix).
 
+Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, memoised), then
+random runs on growing outputs within ``--time-limit``; shrink a failing run (output size
+first, then choices) and print it, its seed, the first choice outside the exact catalog C*
+and what was searched.
+
 Exit codes: 0 no failure exists up to ``--max-size`` (exhaustive), 1 a failing run was
 found (printed; ``--out`` saves it), 3 nothing found but the search was not exhaustive,
 2 bad input.
@@ -21,15 +26,6 @@ from csplab.cli._analysis import (
 )
 from csplab.cli.common import add_model_option
 from csplab.errors import InputError
-
-HELP = "find a failing run of Alg. 3.1 (or show none exists up to a size)"
-DESCRIPTION = (
-    "Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, "
-    "memoised), then random runs on growing outputs within --time-limit; shrink a failing "
-    "run (output size first, then choices) and print it, its seed, the first choice "
-    "outside the exact catalog C* and what was searched. Exit 0 no failure up to "
-    "--max-size (exhaustive), 1 failure found, 3 none found (not exhaustive)."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
