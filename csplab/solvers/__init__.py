@@ -206,7 +206,7 @@ def solvers_taking(option: str) -> list[str]:
     out = []
     for name in solver_names():
         try:
-            if solver_class(name).takes(option):
+            if solver_class(name).option(option) is not None:
                 out.append(name)
         except (ImportError, CsplabError):
             continue

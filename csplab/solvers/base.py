@@ -388,25 +388,10 @@ class Solver(ABC):
         Returns
         -------
         Option or None
-            The declaration, or ``None`` if the solver has no such option.
+            The declaration, or ``None`` if the solver has no such option (so
+            ``option(name) is not None`` asks whether the solver takes it).
         """
         return next((o for o in cls.options if o.name == name), None)
-
-    @classmethod
-    def takes(cls, name: str) -> bool:
-        """Whether the solver has option ``name``.
-
-        Parameters
-        ----------
-        name : str
-            An option name such as ``"order"`` or ``"time_limit"``.
-
-        Returns
-        -------
-        bool
-            ``True`` iff :attr:`options` declares it.
-        """
-        return cls.option(name) is not None
 
     @classmethod
     def validate(cls, options: Mapping[str, Any], backend: str | None = None) -> dict[str, Any]:
