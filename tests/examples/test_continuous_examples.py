@@ -14,12 +14,11 @@ from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 from csplab.examples.continuous import (
     CONTINUOUS_EXAMPLES,
-    continuous_example_names,
     load_polygon_example,
 )
 from csplab.solvers import solve
 
-NAMES = continuous_example_names()
+NAMES = list(CONTINUOUS_EXAMPLES)
 
 
 def _assert_valid(C: ContinuousCSP, example: PolygonModel, grid: np.ndarray) -> PolygonModel:
