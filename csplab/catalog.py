@@ -32,7 +32,8 @@ from __future__ import annotations
 
 import weakref
 from collections import deque
-from typing import Any, NamedTuple
+from collections.abc import Callable
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -549,6 +550,24 @@ def _check_catalog(problem: Problem, catalog: ArrayLike) -> NDArray[np.bool_]:
     return C
 
 
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _contract_of(twin: Callable[..., Any]) -> Callable[[_F], _F]:
+    """Decorator: append ``twin``'s sections from ``Parameters`` on to the decorated
+    function's docstring, for a second implementation of the same contract (its text is
+    written once; nothing when docstrings are stripped, ``python -OO``)."""
+
+    def give(f: _F) -> _F:
+        doc, contract = f.__doc__, twin.__doc__
+        if doc and contract and "    Parameters\n" in contract:
+            head = contract[contract.index("    Parameters\n") :]
+            f.__doc__ = doc.rstrip() + "\n\n" + head.rstrip() + "\n    "
+        return f
+
+    return give
+
+
 def propagate(
     problem: Problem, catalog: ArrayLike, changed: ArrayLike | None = None
 ) -> tuple[NDArray[np.bool_], bool]:
@@ -594,34 +613,14 @@ def assign(
     return propagate(problem, C, [cell])
 
 
+@_contract_of(propagate)
 def propagate_reference(
     problem: Problem, catalog: ArrayLike, changed: ArrayLike | None = None
 ) -> tuple[NDArray[np.bool_], bool]:
     """Slow, literal Alg. 3.2/3.3 (a stack of cells, statement 3.6 per neighbour).
 
-    Same contract as :func:`propagate`; used to test the compiled kernel.
-
-    Parameters
-    ----------
-    problem : Problem
-        The problem whose arcs are propagated.
-    catalog : bool array ``(n, K)`` or ``(*shape, K)``
-        Not modified.
-    changed : array of cell indices, optional
-        Cells whose entries were removed since the catalog was last consistent (default:
-        all cells). Propagation starts from these.
-
-    Returns
-    -------
-    catalog : bool array ``(n, K)``
-        The largest arc-consistent catalog inside the given one.
-    ok : bool
-        ``False`` if some cell lost every label (a wipe-out); the catalog is then partial.
-
-    Raises
-    ------
-    InputError
-        When ``catalog`` has neither shape ``(n, K)`` nor ``(*shape, K)``.
+    Same contract as :func:`propagate`, whose Parameters, Returns and Raises are appended
+    here (one text for the twins); used to test the compiled kernel.
     """
     C = _check_catalog(problem, catalog).copy()
     adj = reference_adjacency(problem)
