@@ -14,11 +14,12 @@ ran out; the state count is printed), 2 bad input.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from csplab.analysis import corner_condition, prove_infallible
 from csplab.cli._analysis import (
     ORDER_HELP,
+    add_witness_out,
+    check_witness_out,
     describe_run,
     load_analysis_model,
     print_verdict,
@@ -42,7 +43,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "face=label,...; a tileset's is its file's own",
     )
     p.add_argument("--expect-hash", help="re-check a proof: exit 3 unless the hash matches")
-    p.add_argument("--out", help="save the failing run as a .png picture or .json")
+    add_witness_out(p)
     p.add_argument(
         "--certificate",
         metavar="FILE",
@@ -53,10 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.out:
-        if Path(args.out).suffix not in (".png", ".json"):
-            raise InputError(f"--out {args.out}: use a .png picture or a .json file")
-        check_output_path(args.out, "--out")
+    check_witness_out(args.out)
     if args.certificate:
         check_output_path(args.certificate, "--certificate")
     E = load_analysis_model(args.model, args.model_option)

@@ -19,6 +19,8 @@ from csplab.analysis import find_failure
 from csplab.analysis.witness import searched
 from csplab.cli._analysis import (
     ORDER_HELP,
+    add_witness_out,
+    check_witness_out,
     describe_run,
     load_analysis_model,
     print_verdict,
@@ -48,7 +50,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--late", action="store_true",
                    help="look for a late failure: inconsistent while C is not empty")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of the random runs")
-    p.add_argument("--out", help="save the failing run as a .png picture or .json")
+    add_witness_out(p)
     p.add_argument("--json", action="store_true")
     add_model_option(p)
 
@@ -56,6 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit}: give a positive number of seconds")
+    check_witness_out(args.out)
     E = load_analysis_model(args.model, args.model_option)
     v = find_failure(
         E,
