@@ -61,7 +61,6 @@ class HybridSolver(Solver):
     alg31 = True
     complete = True
     requires = ("pysat",)
-    extra = "sat"
     description = (
         "Alg. 3.1; after a failure, binary search (SAT) for the first choice outside C*, "
         "redraw it from C*, resume"

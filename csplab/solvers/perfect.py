@@ -51,7 +51,6 @@ class PerfectSolver(Solver):
     alg31 = True
     complete = True
     requires = ("pysat",)
-    extra = "sat"
     description = "Alg. 3.1 choosing every label from the exact catalog C* (SAT-checked)"
     notes = "never fails on a satisfiable problem; the upper reference for success rates; costly"
     options = (

@@ -54,7 +54,6 @@ class SatSolver(Solver):
     constraints = "exact"
     complete = True
     requires = ("pysat",)
-    extra = "sat"
     description = (
         "CNF on the arc-consistent catalog, solved by python-sat (`sat:cadical195` default, "
         "`sat:glucose4`, … `csplab info` lists the backends)"
