@@ -55,7 +55,7 @@ def main() -> None:
     t0 = time.perf_counter()
     from csplab.continuous.csp import ContinuousCSP
     from csplab.engine.alg31 import jit_warmup
-    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
+    from csplab.examples.continuous import continuous_example_names, load_polygon_example
     from csplab.solvers import solve
 
     have_check = importlib.util.find_spec("csplab.continuous.check") is not None
@@ -77,7 +77,7 @@ def main() -> None:
     )
     print(header)
     print("-" * len(header))
-    names = args.examples or list(CONTINUOUS_EXAMPLES)
+    names = args.examples or continuous_example_names()
     for name in names:
         E = load_polygon_example(name)
         ref_per_vertex: float | None = None

@@ -96,7 +96,7 @@ def main() -> None:
     t0 = time.perf_counter()
     from csplab.continuous.csp3d import ContinuousCSP3
     from csplab.engine.alg31 import jit_warmup
-    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
+    from csplab.examples.continuous3d import load_polyhedral_example, polyhedral_example_names
 
     print(f"import {time.perf_counter() - t0:.2f} s, JIT warm-up {jit_warmup():.2f} s")
     _run("tetrahedron", (4, 4, 3), 0)  # warm the solver and geometry paths
@@ -112,7 +112,7 @@ def main() -> None:
     )
     print(header)
     print("-" * len(header))
-    names = args.examples or list(POLYHEDRAL_EXAMPLES)
+    names = args.examples or polyhedral_example_names()
     most: tuple[int, str] = (-1, "")
     heaviest = (-1, -1)  # (families, vertices of a 4x4x4 region): the largest arrangement
     for name in names:

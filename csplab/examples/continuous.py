@@ -8,8 +8,8 @@ properties (Alg. 3.1 success rates) are checked by ``tests/examples/test_continu
 
 Examples
 --------
->>> from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
->>> list(CONTINUOUS_EXAMPLES)[:2]
+>>> from csplab.examples.continuous import continuous_example_names, load_polygon_example
+>>> continuous_example_names()[:2]
 ['triangle', 'two_objects']
 >>> E = load_polygon_example("triangle")
 >>> E.labels, E.bounds
@@ -19,15 +19,14 @@ Examples
 from __future__ import annotations
 
 import json
-from collections.abc import Mapping
 from importlib import resources
-from importlib.resources.abc import Traversable
 
 from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 
 __all__ = [
     "CONTINUOUS_EXAMPLES",
+    "continuous_example_names",
     "load_polygon_example",
 ]
 
@@ -64,50 +63,20 @@ CONTINUOUS_EXAMPLES: dict[str, tuple[str, str]] = {
 }
 
 
-def example_file(
-    table: Mapping[str, tuple[str, str]], folder: str, kind: str, name: str
-) -> tuple[Traversable, str]:
-    """The packaged file of the built-in continuous example ``name`` of ``table`` (a table
-    name -> (file, description) of ``csplab/examples/FOLDER/``) and its source path.
-
-    The one lookup of :func:`load_polygon_example` and
-    :func:`~csplab.examples.continuous3d.load_polyhedral_example`.
-
-    Parameters
-    ----------
-    table : mapping of str to (str, str)
-        :data:`CONTINUOUS_EXAMPLES` or :data:`~csplab.examples.continuous3d.POLYHEDRAL_EXAMPLES`.
-    folder : str
-        The folder of ``csplab/examples/`` that holds the table's files.
-    kind : str
-        What the table holds, for the message (``"continuous"``, ``"polyhedral"``).
-    name : str
-        The example's name.
+def continuous_example_names() -> list[str]:
+    """Names of the built-in continuous examples.
 
     Returns
     -------
-    file : Traversable
-        The packaged file (:func:`importlib.resources.as_file` gives a path).
-    source : str
-        ``csplab/examples/FOLDER/FILE``, for messages.
-
-    Raises
-    ------
-    InputError
-        If ``name`` is not in ``table`` (the message lists the table's names).
+    list of str
+        In the order of :data:`CONTINUOUS_EXAMPLES`.
 
     Examples
     --------
-    >>> example_file(CONTINUOUS_EXAMPLES, "continuous", "continuous", "triangle")[1]
-    'csplab/examples/continuous/triangle.json'
+    >>> "fallible" in continuous_example_names()
+    True
     """
-    if name not in table:
-        raise InputError(
-            f"unknown {kind} example {name!r}; built-in {kind} examples: {', '.join(table)}"
-        )
-    fname = table[name][0]
-    ref = resources.files("csplab.examples").joinpath(folder, fname)
-    return ref, f"csplab/examples/{folder}/{fname}"
+    return list(CONTINUOUS_EXAMPLES)
 
 
 def load_polygon_example(name: str) -> PolygonModel:
@@ -116,7 +85,7 @@ def load_polygon_example(name: str) -> PolygonModel:
     Parameters
     ----------
     name : str
-        A key of :data:`CONTINUOUS_EXAMPLES`.
+        One of :func:`continuous_example_names`.
 
     Returns
     -------
@@ -138,6 +107,12 @@ def load_polygon_example(name: str) -> PolygonModel:
     ...
     csplab.errors.InputError: unknown continuous example 'square'; built-in continuous examples: ...
     """
-    ref, source = example_file(CONTINUOUS_EXAMPLES, "continuous", "continuous", name)
-    data = json.loads(ref.read_text(encoding="utf-8"))
-    return PolygonModel.from_json(data, name=name, source=source)
+    if name not in CONTINUOUS_EXAMPLES:
+        raise InputError(
+            f"unknown continuous example {name!r}; built-in continuous examples: "
+            f"{', '.join(CONTINUOUS_EXAMPLES)}"
+        )
+    fname = CONTINUOUS_EXAMPLES[name][0]
+    path = resources.files(__package__ or "csplab.examples").joinpath("continuous", fname)
+    data = json.loads(path.read_text(encoding="utf-8"))
+    return PolygonModel.from_json(data, name=name, source=f"csplab/examples/continuous/{fname}")

@@ -12,8 +12,8 @@ times against Table 1 are printed by ``benchmarks/bench_continuous3d.py``.
 
 Examples
 --------
->>> from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
->>> list(POLYHEDRAL_EXAMPLES)[:3]
+>>> from csplab.examples.continuous3d import load_polyhedral_example, polyhedral_example_names
+>>> polyhedral_example_names()[:3]
 ['tetrahedron', 'houses', 'skyscrapers']
 >>> E = load_polyhedral_example("houses")
 >>> E.name, E.labels, E.n_polygons
@@ -27,12 +27,13 @@ from importlib import resources
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
-from csplab.examples.continuous import CONTINUOUS_EXAMPLES, example_file, load_polygon_example
+from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
 
 __all__ = [
     "POLYHEDRAL_EXAMPLES",
     "load_continuous_example",
     "load_polyhedral_example",
+    "polyhedral_example_names",
 ]
 
 #: name -> (file in ``csplab/examples/continuous3d/``, one-line description)
@@ -74,13 +75,29 @@ POLYHEDRAL_EXAMPLES: dict[str, tuple[str, str]] = {
 }
 
 
+def polyhedral_example_names() -> list[str]:
+    """Names of the built-in polyhedral examples.
+
+    Returns
+    -------
+    list of str
+        In the order of :data:`POLYHEDRAL_EXAMPLES`.
+
+    Examples
+    --------
+    >>> "pentagons" in polyhedral_example_names()
+    True
+    """
+    return list(POLYHEDRAL_EXAMPLES)
+
+
 def load_polyhedral_example(name: str) -> PolyhedralModel:
     """Load a built-in polyhedral example by name.
 
     Parameters
     ----------
     name : str
-        A key of :data:`POLYHEDRAL_EXAMPLES`.
+        One of :func:`polyhedral_example_names`.
 
     Returns
     -------
@@ -104,10 +121,17 @@ def load_polyhedral_example(name: str) -> PolyhedralModel:
     """
     from csplab.io.meshes import read_obj_model
 
-    ref, source = example_file(POLYHEDRAL_EXAMPLES, "continuous3d", "polyhedral", name)
+    if name not in POLYHEDRAL_EXAMPLES:
+        raise InputError(
+            f"unknown polyhedral example {name!r}; built-in polyhedral examples: "
+            f"{', '.join(POLYHEDRAL_EXAMPLES)}"
+        )
+    fname, description = POLYHEDRAL_EXAMPLES[name]
+    source = f"csplab/examples/continuous3d/{fname}"
+    ref = resources.files(__package__ or "csplab.examples").joinpath("continuous3d", fname)
     with resources.as_file(ref) as path:
         M = read_obj_model(path, labels="materials")
-    meta = {**M.meta, "description": POLYHEDRAL_EXAMPLES[name][1]}
+    meta = {**M.meta, "description": description}
     return PolyhedralModel(M.solids, name=name, meta=meta, source=source)
 
 

@@ -11,7 +11,7 @@ from PIL import Image
 
 from csplab.cli import main
 from csplab.continuous import violations
-from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
+from csplab.examples.continuous import continuous_example_names, load_polygon_example
 from csplab.io.polygons import read_polygons_json, read_svg
 
 
@@ -21,7 +21,7 @@ def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
     return code, out, err
 
 
-@pytest.mark.parametrize("name", list(CONTINUOUS_EXAMPLES))
+@pytest.mark.parametrize("name", continuous_example_names())
 @pytest.mark.parametrize("solver", ["catalog", "blocks", "sat"])
 def test_every_builtin_with_catalog_blocks_sat(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], name: str, solver: str

@@ -19,12 +19,13 @@ from csplab.examples.build_continuous3d import EXAMPLES, write_all
 from csplab.examples.continuous3d import (
     POLYHEDRAL_EXAMPLES,
     load_polyhedral_example,
+    polyhedral_example_names,
 )
 
 pytest.importorskip("trimesh")
 pytest.importorskip("manifold3d")
 
-NAMES = list(POLYHEDRAL_EXAMPLES)
+NAMES = polyhedral_example_names()
 SIZE = (8, 8, 5)
 
 

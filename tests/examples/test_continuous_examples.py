@@ -14,11 +14,12 @@ from csplab.continuous.model import PolygonModel
 from csplab.errors import InputError
 from csplab.examples.continuous import (
     CONTINUOUS_EXAMPLES,
+    continuous_example_names,
     load_polygon_example,
 )
 from csplab.solvers import solve
 
-NAMES = list(CONTINUOUS_EXAMPLES)
+NAMES = continuous_example_names()
 
 
 def _assert_valid(C: ContinuousCSP, example: PolygonModel, grid: np.ndarray) -> PolygonModel:
