@@ -55,7 +55,7 @@ def _error(status: int, message: str) -> JSONResponse:
 
 
 def _hex(colors: NDArray[np.uint8]) -> list[str]:
-    return ["#%02x%02x%02x" % tuple(int(v) for v in c) for c in colors]
+    return ["#" + "".join(f"{int(v):02x}" for v in c) for c in colors]
 
 
 def label_colors(model: Any, K: int) -> NDArray[np.uint8]:
@@ -136,8 +136,8 @@ def _download(grid: NDArray[np.int32], model: Any, fmt: str, name: str) -> Respo
         p = Path(d) / f"{name}{fmt}"
         write_labels(grid, p, model=model, periodic=False)
         data = p.read_bytes()
-    return Response(data, media_type="application/octet-stream",
-                    headers={"content-disposition": f'attachment; filename="{name}{fmt}"'})  # fmt: skip
+    head = {"content-disposition": f'attachment; filename="{name}{fmt}"'}
+    return Response(data, media_type="application/octet-stream", headers=head)
 
 
 def create_app(
@@ -204,7 +204,7 @@ def create_app(
         from csplab.io.registry import output_extensions
         from csplab.solvers import available_solvers
 
-        files = []
+        files: list[str] = []
         for p in sorted(st.root.rglob("*"))[:5000]:
             if len(files) >= 200:
                 break
@@ -294,8 +294,10 @@ def create_app(
             raise InputError(f"brush must be one of {', '.join(BRUSHES)}, not {brush!r}")
         lab = _int(body, "label", None, 0, w.world.K - 1) if brush == "label" else None
         del label
-        out = await asyncio.to_thread(w.edit, str(brush), (x0, x1), (y0, y1), label=lab,
-                                      limit=L.edit_cells, time_limit=min(30.0, L.seconds))  # fmt: skip
+        out = await asyncio.to_thread(
+            w.edit, str(brush), (x0, x1), (y0, y1), label=lab, limit=L.edit_cells,
+            time_limit=min(30.0, L.seconds),
+        )  # fmt: skip
         out["edits"] = len(w.patches)
         return JSONResponse(json.loads(json.dumps(out)))
 
@@ -340,7 +342,8 @@ def create_app(
             if solver not in solver_names():
                 raise InputError(f"solver must be one of {', '.join(solver_names())}")
             argv = ["synthesize", spec, "--size", "x".join(map(str, size)), "--solver",
-                    str(solver), "--seed", str(seed), "--time-limit", str(seconds), "--json"]  # fmt: skip
+                    str(solver), "--seed", str(seed), "--time-limit", str(seconds),
+                    "--json"]  # fmt: skip
             cls = solver_class(str(solver))
             options = body.get("options") or {}
             if not isinstance(options, dict):
@@ -417,7 +420,8 @@ def create_app(
         p = job.folder / "result.npy"
         if not p.exists():
             raise InputError(f"run {job.id} has no label grid")
-        return np.load(p, allow_pickle=False).astype(np.int32), load_model(job.argv[1])
+        model: Any = load_model(job.argv[1])
+        return np.load(p, allow_pickle=False).astype(np.int32), model
 
     async def run_png(req: Request) -> Response:
         from csplab.render import render_png_bytes
@@ -426,7 +430,8 @@ def create_app(
         if (job.folder / "result.png").exists():
             return Response((job.folder / "result.png").read_bytes(), media_type="image/png")
         g, model = await asyncio.to_thread(job_grid, job)
-        data = await asyncio.to_thread(render_png_bytes, g, names=model.names, model=model)
+        names: Any = getattr(model, "names", None)
+        data = await asyncio.to_thread(render_png_bytes, g, names=names, model=model)
         return Response(data, media_type="image/png")
 
     async def run_glb(req: Request) -> Response:
@@ -463,7 +468,7 @@ def create_app(
         w = job.result.get("witness")
         if not isinstance(w, dict):
             raise InputError("the search found no failing run to replay")
-        model = await asyncio.to_thread(load_model, job.argv[1])
+        model: Any = await asyncio.to_thread(load_model, job.argv[1])
         steps = await asyncio.to_thread(replay, model, w)
         K = int(getattr(model, "K", 0) or len(model.names or ()))
         return JSONResponse({"witness": w, "steps": steps,

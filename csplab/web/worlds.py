@@ -188,8 +188,8 @@ class WorldSession:
                       allowed[None, :].copy())
                 for x, y in painted
             ])  # fmt: skip
-        seed = int(np.random.SeedSequence([self.world.seed, len(self.patches) + 1,
-                                           rx[0] & 0xFFFF, ry[0] & 0xFFFF]).generate_state(1)[0])  # fmt: skip
+        key = [self.world.seed, len(self.patches) + 1, rx[0] & 0xFFFF, ry[0] & 0xFFFF]
+        seed = int(np.random.SeedSequence(key).generate_state(1)[0])
         res = solve(sub, "catalog", rng=seed, restarts=10, fallback="auto",
                     order=self.world.order, choice=self.world.choice,
                     time_limit=time_limit)  # fmt: skip
