@@ -363,7 +363,9 @@ def create_app(
             argv += ["--out", "{OUT}/" + out]
             info.update(size=list(size), out=out, solver=solver)
         elif command in ("prove", "witness"):
-            argv = [command, spec, "--json", "--time-limit", str(seconds)]
+            argv = [command, spec, "--json"]
+            if command == "witness":  # prove is bounded by its state budget (--max-states)
+                argv += ["--time-limit", str(seconds)]
             order = body.get("order") or "scanline"
             if not isinstance(order, str) or not re.fullmatch(r"[a-z:\-]{1,20}", order):
                 raise InputError(f"order must be an order such as scanline, not {order!r}")
