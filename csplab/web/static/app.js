@@ -112,6 +112,10 @@ function toCell(sx, sy) {
   const c = $("map");
   return [Math.floor((sx - c.width / 2) / cellPx() + S.view.cx), Math.floor((c.height / 2 - sy) / cellPx() + S.view.cy)];
 }
+function chunkRect(i, j) {  // where chunk (i, j) is drawn: whole canvas pixels
+  const [X, Y] = S.world.chunk, [sx, sy] = toScreen(i * X, (j + 1) * Y);
+  return [Math.round(sx), Math.round(sy), X * cellPx(), Y * cellPx()];
+}
 function visibleChunks() {
   const w = S.world, c = $("map");
   const [x0, y1] = toCell(0, 0), [x1, y0] = toCell(c.width, c.height);
@@ -143,8 +147,8 @@ function drawMap() {
   const [X, Y] = S.world.chunk, px = cellPx();
   for (const [i, j] of visibleChunks()) {
     const e = chunkImage(i, j);
-    const [sx, sy] = toScreen(i * X, (j + 1) * Y);
-    if (e.ok) g.drawImage(e.img, Math.round(sx), Math.round(sy), X * px, Y * px);
+    const [sx, sy] = chunkRect(i, j);
+    if (e.ok) g.drawImage(e.img, sx, sy, X * px, Y * px);
     else { g.strokeStyle = "#445"; g.strokeRect(sx, sy, X * px, Y * px); }
   }
   if (S.rect) {
@@ -287,6 +291,7 @@ async function startRun(body) {
 }
 async function finished(id) {
   const r = await api(`/api/run/${id}`);
+  r.events = S.run ? S.run.events : [];
   S.run = r;
   $("bar").style.width = "100%";
   if (r.state === "error") { status(r.error, true); return; }
@@ -353,5 +358,7 @@ $("step-prev").onclick = () => { if (S.replay && S.step > 0) { S.step--; drawRep
 $("step-next").onclick = () => { if (S.replay && S.step < S.replay.steps.length - 1) { S.step++; drawReplay(); } };
 setupMap();
 setup3d();
+S.meshColors = () => V.colors || [];
+S.chunkRect = chunkRect;
 S.viewGlb = viewGlb; S.drawMap = drawMap; S.toScreen = toScreen; S.paint = paint; S.tab = tab;
 init().catch((e) => status(e.message, true));
