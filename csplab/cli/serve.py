@@ -28,10 +28,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from csplab.deps import require
     from csplab.web import serve
 
     if not 0 < args.port < 65536:
         raise InputError(f"--port must be 1..65535, not {args.port}")
+    for module in ("starlette", "uvicorn"):  # before the banner: one line when missing
+        require(module, "web", "csplab serve")
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(f"csplab: warning: serving on {args.host}: other machines can reach the page",
               file=sys.stderr)  # fmt: skip

@@ -26,21 +26,20 @@ import tempfile
 import threading
 from collections.abc import AsyncIterator, Awaitable, Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
-from starlette.applications import Starlette
-from starlette.exceptions import HTTPException
-from starlette.requests import Request
-from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
-from starlette.routing import Mount, Route
-from starlette.staticfiles import StaticFiles
 
 from csplab.errors import CsplabError, InputError
 from csplab.web.jobs import Jobs
 from csplab.web.safety import Limits, Refused, cross_site, inside
 from csplab.web.worlds import BRUSHES, WorldSession
+
+if TYPE_CHECKING:  # Starlette is the web extra: imported when an app is made
+    from starlette.applications import Starlette
+    from starlette.requests import Request
+    from starlette.responses import JSONResponse, Response
 
 __all__ = ["STATIC", "create_app"]
 
@@ -51,6 +50,8 @@ _NAME = re.compile(r"^[A-Za-z0-9_.\-/ ]{1,200}$")
 
 
 def _error(status: int, message: str) -> JSONResponse:
+    from starlette.responses import JSONResponse
+
     return JSONResponse({"error": message}, status_code=status)
 
 
@@ -127,6 +128,8 @@ def _region(req: Request, limit: int) -> tuple[tuple[int, int], tuple[int, int]]
 
 
 def _download(grid: NDArray[np.int32], model: Any, fmt: str, name: str) -> Response:
+    from starlette.responses import Response
+
     from csplab.io import write_labels
     from csplab.io.registry import output_extensions
 
@@ -168,6 +171,15 @@ def create_app(
     >>> c.get("/api/world/nope/chunk/0/0.png").json()
     {'error': 'no world nope (open one first)'}
     """
+    from csplab.deps import require
+
+    require("starlette", "web", "csplab serve")
+    from starlette.applications import Starlette
+    from starlette.exceptions import HTTPException
+    from starlette.responses import FileResponse, JSONResponse, Response, StreamingResponse
+    from starlette.routing import Mount, Route
+    from starlette.staticfiles import StaticFiles
+
     st = _State(Path(root), limits or Limits())
     L = st.limits
 

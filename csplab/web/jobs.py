@@ -113,6 +113,8 @@ class Jobs:
             job.result = json.loads(lines[-1]) if lines else None
         except json.JSONDecodeError:
             job.result = None
+        if isinstance(job.result, dict) and isinstance(job.result.get("out"), str):
+            job.result["out"] = Path(job.result["out"]).name  # not the server's folders
         if job.code == 2 or job.result is None:
             msg = [ln for ln in err.getvalue().splitlines() if "error" in ln]
             job.error = (msg[0] if msg else err.getvalue().strip()[:300]) or "the run failed"

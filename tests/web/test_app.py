@@ -15,13 +15,13 @@ import pytest
 
 pytest.importorskip("starlette")
 pytest.importorskip("httpx")
-from PIL import Image  # noqa: E402
-from starlette.testclient import TestClient  # noqa: E402
+from PIL import Image
+from starlette.testclient import TestClient
 
-from csplab.render import palette  # noqa: E402
-from csplab.web.app import create_app  # noqa: E402
-from csplab.web.safety import Limits  # noqa: E402
-from csplab.world import World  # noqa: E402
+from csplab.render import palette
+from csplab.web.app import create_app
+from csplab.web.safety import Limits
+from csplab.world import World
 
 J = {"content-type": "application/json"}
 
@@ -149,8 +149,8 @@ def test_cross_site_edits_are_refused(client: TestClient) -> None:
                     {"content-type": "text/plain"}]:  # fmt: skip
         r = client.post(f"/api/world/{wid}/edit", content=body, headers=headers)
         assert r.status_code == 403, headers
-    r = client.post(f"/api/world/{wid}/edit", content=body,
-                    headers={**J, "origin": "http://testserver", "sec-fetch-site": "same-origin"})  # fmt: skip
+    same = {**J, "origin": "http://testserver", "sec-fetch-site": "same-origin"}
+    r = client.post(f"/api/world/{wid}/edit", content=body, headers=same)
     assert r.status_code == 200
 
 
@@ -177,7 +177,8 @@ def test_runs_stream_their_progress_and_give_files(client: TestClient) -> None:
     assert g.shape == (12, 12) and from_example(load_example("loops"), (12, 12)).is_solution(g)
     bad = _finish(client, {"command": "synthesize", "model": "loops", "size": "8x8",
                            "solver": "catalog", "options": {"order": "nonsense"}})  # fmt: skip
-    assert bad["state"] == "error" and "nonsense" in bad["error"] and "Traceback" not in bad["error"]
+    assert bad["state"] == "error" and "nonsense" in bad["error"]
+    assert "Traceback" not in bad["error"]
 
 
 def test_a_3d_result_is_a_glb_of_the_model(client: TestClient) -> None:

@@ -14,7 +14,6 @@ import socket
 import threading
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -218,7 +217,8 @@ def test_a_3d_result_is_drawn_in_the_model_colours(page: Any) -> None:
 def test_path_escape_and_oversized_requests_are_refused(page: Any) -> None:
     script = """
     const done = arguments[arguments.length - 1];
-    const post = (url, body) => fetch(url, {method: 'POST', headers: {'content-type': 'application/json'}, body})
+    const json = {'content-type': 'application/json'};
+    const post = (url, body) => fetch(url, {method: 'POST', headers: json, body})
         .then(async r => [r.status, (await r.json()).error]);
     Promise.all([
         post('/api/run', JSON.stringify({command: 'prove', model: '../../../etc/passwd'})),
