@@ -29,7 +29,8 @@ def grid_glb(grid: NDArray[np.int32], model: Any = None) -> bytes:
     grid : int32 array ``[x, y, z]``
         The labels (``z`` up).
     model : ExampleModel or RuleSet, optional
-        Supplies the label colours, the empty label and voxel tiles.
+        Supplies the label colours (an example's: one colour per object, as
+        :func:`csplab.render.render` draws it), the empty label and voxel tiles.
 
     Returns
     -------
@@ -49,10 +50,18 @@ def grid_glb(grid: NDArray[np.int32], model: Any = None) -> bytes:
     """
     tm = require("trimesh", "mesh", "writing glTF")
     from csplab.io import write_labels
+    from csplab.io.obj import write_obj
+    from csplab.render import model_objects, object_colors
 
     with tempfile.TemporaryDirectory(prefix="csplab-glb-") as d:
         obj = Path(d) / "model.obj"
-        write_labels(grid, obj, model=model, periodic=False)
+        objects = model_objects(model) if model is not None else None
+        if objects is not None and not hasattr(model, "label_colors") \
+                and model.meta.get("colors") is None:  # fmt: skip
+            # labels of one object (a house's walls, roofs ...) in one colour, as pictures
+            write_obj(grid, obj, colors=object_colors(objects), names=model.names)
+        else:
+            write_labels(grid, obj, model=model, periodic=False)
         scene = tm.load(str(obj), force="scene", process=False)
         if not scene.geometry:
             from csplab.io.meshes import _empty_glb
