@@ -47,6 +47,8 @@ def grid_glb(grid: NDArray[np.int32], model: Any = None) -> bytes:
     >>> g = np.zeros((2, 1, 2), dtype=np.int32); g[0, 0, 0] = 1
     >>> grid_glb(g)[:4]
     b'glTF'
+    >>> grid_glb(np.zeros((2, 2, 2), dtype=np.int32))[:4]  # nothing but empty space
+    b'glTF'
     """
     tm = require("trimesh", "mesh", "writing glTF")
     from csplab.io import write_labels
@@ -63,10 +65,10 @@ def grid_glb(grid: NDArray[np.int32], model: Any = None) -> bytes:
         else:
             write_labels(grid, obj, model=model, periodic=False)
         scene = tm.load(str(obj), force="scene", process=False)
-        if not scene.geometry:
-            from csplab.io.meshes import _empty_glb
+        if not scene.geometry:  # all empty space: the empty scene of the solids' writer
+            from csplab.continuous.polyhedra import PolyhedralModel
 
-            return _empty_glb()
+            return solids_glb(PolyhedralModel([]))
         return bytes(scene.export(file_type="glb"))
 
 
