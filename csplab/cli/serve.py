@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-from pathlib import Path
 
 from csplab.errors import InputError
 
@@ -38,7 +37,5 @@ def run(args: argparse.Namespace) -> int:
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(f"csplab: warning: serving on {args.host}: other machines can reach the page",
               file=sys.stderr)  # fmt: skip
-    print(f"csplab: serving {Path.cwd()} on http://{args.host}:{args.port}/ (Ctrl-C stops)",
-          file=sys.stderr)  # fmt: skip
-    serve(".", host=args.host, port=args.port, model=args.model)
+    serve(".", host=args.host, port=args.port, model=args.model, banner=True)
     return 0

@@ -24,7 +24,7 @@ __all__ = ["serve"]
 
 
 def serve(root: str | Path = ".", *, host: str = "127.0.0.1", port: int = 8000,
-          model: str | None = None) -> None:  # fmt: skip
+          model: str | None = None, banner: bool = False) -> None:  # fmt: skip
     """Run the server until interrupted.
 
     Parameters
@@ -37,9 +37,13 @@ def serve(root: str | Path = ".", *, host: str = "127.0.0.1", port: int = 8000,
         The TCP port.
     model : str, optional
         The model the page selects first.
+    banner : bool
+        Print one line on stderr saying where the page is, once the app is made.
 
     Raises
     ------
+    InputError
+        When ``model`` is neither a built-in example nor a file under ``root``.
     DependencyError
         When Starlette or uvicorn (the ``web`` extra) is not installed.
     """
@@ -50,4 +54,9 @@ def serve(root: str | Path = ".", *, host: str = "127.0.0.1", port: int = 8000,
     from csplab.web.app import create_app
 
     app = create_app(root, start_model=model)
+    if banner:
+        import sys
+
+        print(f"csplab: serving {Path(root).resolve()} on http://{host}:{port}/ (Ctrl-C "
+              "stops)", file=sys.stderr, flush=True)  # fmt: skip
     uvicorn.run(app, host=host, port=port, log_level="warning")

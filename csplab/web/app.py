@@ -155,7 +155,14 @@ def create_app(
     limits : Limits, optional
         Request, output and run-time limits (default :class:`~csplab.web.safety.Limits`).
     start_model : str, optional
-        The model the page selects first.
+        The model the page selects first (a built-in name or a file under ``root``).
+
+    Raises
+    ------
+    InputError
+        When ``start_model`` is neither.
+    DependencyError
+        When Starlette (the ``web`` extra) is not installed.
 
     Returns
     -------
@@ -181,6 +188,10 @@ def create_app(
     from starlette.staticfiles import StaticFiles
 
     st = _State(Path(root), limits or Limits())
+    if start_model is not None:  # a bad name fails now, in one line, not on the page
+        spec = st.model_spec(start_model)
+        if Path(spec).is_absolute():
+            start_model = str(Path(spec).relative_to(st.root))
     L = st.limits
 
     def world_of(req: Request) -> WorldSession:
