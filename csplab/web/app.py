@@ -376,12 +376,16 @@ def create_app(
                     raise InputError(f"solver {solver} has no option {k!r}")
                 if v not in (None, ""):
                     argv += ["--option", f"{k}={v}"]
+            cons = body.get("constraints")
+            if cons:
+                argv += ["--constraints", str(inside(st.root, str(cons)))]
+                info["constraints"] = cons
             boundary = body.get("boundary", "auto" if len(size) == 3 else None)
             if boundary not in (None, "", "auto", "none"):
                 raise InputError("boundary must be auto or none")
             if boundary:
                 argv += ["--boundary", str(boundary)]
-            out = {"PolyhedralModel": "result.obj", "PolygonModel": "result.png"}.get(
+            out = {"PolyhedralModel": "result.obj", "PolygonModel": "result.json"}.get(
                 kind, "result.npy")
             argv += ["--out", "{OUT}/" + out]
             info.update(size=list(size), out=out, solver=solver)
@@ -432,9 +436,14 @@ def create_app(
 
     async def run_get(req: Request) -> Response:
         job = job_of(req)
+        from csplab.io.registry import output_extensions
+
+        kind = job.info.get("kind")
+        gives: Any = kind if kind in ("PolygonModel", "PolyhedralModel") else None
         return JSONResponse(json.loads(json.dumps({
             "id": job.id, "state": job.state, "command": job.argv[0], "info": job.info,
             "result": job.result, "error": job.error, "code": job.code,
+            "formats": output_extensions(gives=gives),
         }, default=str)))  # fmt: skip
 
     def job_grid(job: Any) -> tuple[NDArray[np.int32], Any]:
@@ -448,12 +457,32 @@ def create_app(
         model: Any = load_model(job.argv[1])
         return np.load(p, allow_pickle=False).astype(np.int32), model
 
+    def job_solids(job: Any) -> Any:
+        """A continuous run's output, read back from the file the command wrote."""
+        from csplab.io import read_model
+
+        for name in ("result.json", "result.obj"):
+            if job.state == "done" and (job.folder / name).exists():
+                return read_model(job.folder / name)
+        return None
+
+    def write_solids(model: Any, fmt: str) -> bytes:
+        from csplab.io.registry import output_format
+
+        with tempfile.TemporaryDirectory(prefix="csplab-dl-") as d:
+            p = Path(d) / f"result{fmt}"
+            gives: Any = type(model).__name__
+            output_format(p, gives=gives).write(model, p)
+            return p.read_bytes()
+
     async def run_png(req: Request) -> Response:
         from csplab.render import render_png_bytes
 
         job = job_of(req)
-        if (job.folder / "result.png").exists():
-            return Response((job.folder / "result.png").read_bytes(), media_type="image/png")
+        solids = await asyncio.to_thread(job_solids, job)
+        if solids is not None:
+            data = await asyncio.to_thread(write_solids, solids, ".png")
+            return Response(data, media_type="image/png")
         g, model = await asyncio.to_thread(job_grid, job)
         names: Any = getattr(model, "names", None)
         data = await asyncio.to_thread(render_png_bytes, g, names=names, model=model)
@@ -463,10 +492,8 @@ def create_app(
         from csplab.web.glb import grid_glb, solids_glb
 
         job = job_of(req)
-        if job.state == "done" and (job.folder / "result.obj").exists():
-            from csplab.io.meshes import read_obj_model
-
-            solids = await asyncio.to_thread(read_obj_model, job.folder / "result.obj")
+        solids = await asyncio.to_thread(job_solids, job)
+        if solids is not None and solids.ndim == 3:
             data = await asyncio.to_thread(solids_glb, solids)
         else:
             g, model = await asyncio.to_thread(job_grid, job)
@@ -478,10 +505,49 @@ def create_app(
         return Response(data, media_type="model/gltf-binary")
 
     async def run_download(req: Request) -> Response:
+        from csplab.io.registry import output_extensions
+
         job = job_of(req)
-        g, model = await asyncio.to_thread(job_grid, job)
         fmt = req.query_params.get("format", ".png")
-        return await asyncio.to_thread(_download, g, model, fmt, "result")
+        solids = await asyncio.to_thread(job_solids, job)
+        if solids is None:
+            g, model = await asyncio.to_thread(job_grid, job)
+            return await asyncio.to_thread(_download, g, model, fmt, "result")
+        kinds = output_extensions(gives=job.info["kind"])
+        if fmt not in kinds:
+            raise InputError(f"format must be one of {', '.join(kinds)}, not {fmt!r}")
+        data = await asyncio.to_thread(write_solids, solids, fmt)
+        head = {"content-disposition": f'attachment; filename="result{fmt}"'}
+        return Response(data, media_type="application/octet-stream", headers=head)
+
+    def job_problem(job: Any) -> tuple[Any, NDArray[np.int32]]:
+        from csplab.cli import build_parser
+        from csplab.cli.common import problem_from_args
+
+        g, model = job_grid(job)
+        args = build_parser(only="synthesize").parse_args(job.argv)
+        return problem_from_args(args, model), g
+
+    async def run_constraints(req: Request) -> Response:
+        from csplab.web.overlay import constraint_rows
+
+        job = job_of(req)
+        P, g = await asyncio.to_thread(job_problem, job)
+        return JSONResponse({"constraints": constraint_rows(P, g)})
+
+    async def run_constraints_png(req: Request) -> Response:
+        from csplab.render import render_png_bytes
+        from csplab.web.overlay import highlight
+
+        job = job_of(req)
+        P, g = await asyncio.to_thread(job_problem, job)
+        if g.ndim != 2:
+            raise InputError("constraints are drawn on 2D results")
+        _, model = await asyncio.to_thread(job_grid, job)
+        png = await asyncio.to_thread(render_png_bytes, g, names=getattr(model, "names", None),
+                                      model=model)  # fmt: skip
+        data = await asyncio.to_thread(highlight, png, P, g)
+        return Response(data, media_type="image/png")
 
     async def run_replay(req: Request) -> Response:
         from csplab.cli.common import load_model
@@ -542,6 +608,8 @@ def create_app(
         Route("/api/run/{jid}/result.glb", run_glb),
         Route("/api/run/{jid}/download", run_download),
         Route("/api/run/{jid}/replay", run_replay),
+        Route("/api/run/{jid}/constraints", run_constraints),
+        Route("/api/run/{jid}/constraints.png", run_constraints_png),
         Mount("/static", StaticFiles(directory=STATIC, follow_symlink=False), name="static"),
     ]
     handlers: dict[Any, Any] = {HTTPException: on_error, CsplabError: on_error,

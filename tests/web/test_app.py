@@ -30,6 +30,11 @@ J = {"content-type": "application/json"}
 def root(tmp_path_factory: pytest.TempPathFactory) -> Path:
     d = tmp_path_factory.mktemp("served")
     (d / "mine.grid").write_text((Path("csplab/examples/fig3_4a_column.grid")).read_text())
+    paths = ["path_x", "path_y", "corner_+x+y", "corner_-x+y", "corner_+x-y", "corner_-x-y"]
+    (d / "one_loop.json").write_text(json.dumps({"constraints": [
+        {"type": "connected", "labels": paths},
+        {"type": "count", "labels": ["path_x"], "min": 4, "max": 6},
+    ]}))  # fmt: skip
     outside = tmp_path_factory.mktemp("outside")
     (outside / "secret.grid").write_text("secret")
     os.symlink(outside / "secret.grid", d / "link.grid")
@@ -214,3 +219,35 @@ def test_progress_events_of_a_world_region(client: TestClient) -> None:
         list(progress_bar(range(3), total=3, desc="x", enabled=False))  # off: not reported
     assert seen[0] == ("chunks", 0, 6) and seen[-1] == ("chunks", 6, 6)
     assert time.monotonic() - t0 < 60
+
+
+def test_global_constraints_are_shown_on_the_result(client: TestClient) -> None:
+    r = _finish(client, {"command": "synthesize", "model": "loops", "size": "10x10", "seed": 2,
+                         "solver": "sat", "constraints": "one_loop.json"})  # fmt: skip
+    assert r["state"] == "done" and r["result"]["status"] == "solved", r
+    g = np.load(io.BytesIO(client.get(f"/api/run/{r['id']}/download?format=.npy").content))
+    rows = client.get(f"/api/run/{r['id']}/constraints").json()["constraints"]
+    assert [(c["kind"], c["holds"]) for c in rows] == [("connected", True), ("count", True)]
+    assert rows[0]["cells"] == int((g > 0).sum()) and 4 <= rows[1]["cells"] == int((g == 1).sum())
+    plain = np.asarray(Image.open(io.BytesIO(client.get(f"/api/run/{r['id']}/result.png").content)))
+    shown = np.asarray(Image.open(io.BytesIO(
+        client.get(f"/api/run/{r['id']}/constraints.png").content)).convert("RGB"))
+    s = plain.shape[1] // 10
+    for x, y in [(x, y) for x in range(10) for y in range(10)]:
+        at = ((9 - y) * s + s // 2, x * s + s // 2)
+        same = (plain[at][:3] == shown[at]).all()
+        assert same == bool(g[x, y] > 0), (x, y)  # the empty cells are faded
+    bad = client.post("/api/run", json={"command": "synthesize", "model": "loops",
+                                        "constraints": "../../etc/passwd"})  # fmt: skip
+    assert bad.status_code == 403
+
+
+def test_a_continuous_result_downloads_in_its_formats(client: TestClient) -> None:
+    r = _finish(client, {"command": "synthesize", "model": "two_objects", "size": "8x6",
+                         "seed": 1})  # fmt: skip
+    assert r["state"] == "done" and r["result"]["status"] == "solved", r
+    assert ".svg" in r["formats"] and ".npy" not in r["formats"]
+    svg = client.get(f"/api/run/{r['id']}/download?format=.svg")
+    assert svg.status_code == 200 and b"<svg" in svg.content
+    assert client.get(f"/api/run/{r['id']}/result.png").content[:4] == b"\x89PNG"
+    assert client.get(f"/api/run/{r['id']}/download?format=.npy").status_code == 400

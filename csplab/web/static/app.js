@@ -80,6 +80,7 @@ async function init() {
   fill($("brush"), S.meta.brushes.map((b) => [b, { label: "must be label", empty: "must stay empty", reroll: "re-synthesize" }[b] || b]));
   fill($("world-format"), S.meta.formats, ".png");
   fill($("run-format"), S.meta.formats, ".png");
+  fill($("constraints"), [["", "(none)"], ...S.meta.files.filter((f) => f.endsWith(".json")).map((f) => [f, f])], "");
   for (const b of document.querySelectorAll(".tab")) b.onclick = () => tab(b.dataset.tab);
   tab("map");
   S.ready = true;
@@ -300,10 +301,19 @@ async function finished(id) {
     const ok = res.status === "solved";
     status(`${res.outcome || res.status} in ${(res.time_s || 0).toFixed(2)} s with ${res.solver}`, !ok);
     $("verdict").textContent = JSON.stringify({ status: res.status, solver: res.solver, seed: res.seed, settings: res.settings }, null, 1);
+    fill($("run-format"), r.formats, r.formats.includes(".png") ? ".png" : r.formats[0]);
+    $("constraint-rows").innerHTML = "";
     if (!ok) { tab("result"); return; }
     const three = r.info.kind === "PolyhedralModel" || (r.info.size && r.info.size.length === 3);
-    if (three) await viewGlb(`/api/run/${id}/result.glb`);
-    else { $("result-img").src = `/api/run/${id}/result.png`; tab("result"); }
+    if (three) { await viewGlb(`/api/run/${id}/result.glb`); return; }
+    if (r.info.constraints) {
+      const c = await api(`/api/run/${id}/constraints`);
+      S.constraintRows = c.constraints;
+      $("constraint-rows").innerHTML = "<b>global constraints</b> (cells outside them faded):<br>" + c.constraints.map((x) =>
+        `${x.holds ? "✔" : "✘"} ${x.text}: ${x.cells} cells${x.breach ? " — " + x.breach : ""}`).join("<br>");
+      $("result-img").src = `/api/run/${id}/constraints.png`;
+    } else $("result-img").src = `/api/run/${id}/result.png`;
+    tab("result");
   } else {
     $("verdict").textContent = `${r.command}: ${res.message}`;
     status(res.message, res.holds === false && r.command === "prove");
@@ -314,7 +324,7 @@ async function finished(id) {
 function runBody(command) {
   return { command, model: $("model").value, seed: Number($("seed").value), time_limit: Number($("time-limit").value),
            size: $("size").value, solver: $("solver").value, options: optionValues($("solver-options")),
-           boundary: $("boundary").value || undefined, order: $("order").value, max_size: $("max-size").value || undefined };
+           boundary: $("boundary").value || undefined, constraints: $("constraints").value || undefined, order: $("order").value, max_size: $("max-size").value || undefined };
 }
 
 // ---- witness replay ------------------------------------------------------------------
