@@ -10,7 +10,8 @@ Routes (every ``/api`` answer is JSON; an error is ``{"error": "one line"}`` wit
   drawn with the label colours (or the tileset's pictures); ``POST .../edit``,
   ``POST .../undo``; ``GET .../download?region=X0:X1,Y0:Y1&format=.png`` any output
   format; ``GET .../model.glb?region=...`` a 3D world's region for the viewer;
-* ``POST /api/run``: ``synthesize``, ``prove`` or ``witness`` as the command line runs them;
+* ``POST /api/run``: ``synthesize``, ``world`` (a region, e.g. of a 3D world for the viewer),
+  ``prove`` or ``witness`` as the command line runs them;
   ``GET /api/run/ID/events`` its progress (server-sent events), ``GET /api/run/ID`` its
   result, ``.../result.png``, ``.../result.glb``, ``.../download?format=`` and
   ``.../replay`` (a witness step by step, the catalog emptying).
@@ -389,6 +390,19 @@ def create_app(
                 kind, "result.npy")
             argv += ["--out", "{OUT}/" + out]
             info.update(size=list(size), out=out, solver=solver)
+        elif command == "world":  # a region of an endless world, as `csplab world` makes it
+            chunk = _shape(body.get("chunk", "16x16x10"), "chunk", L.cells)
+            region = body.get("region", f"0:{2 * chunk[0]},0:{2 * chunk[1]}")
+            from csplab.cli.world import parse_region
+
+            xs, ys = parse_region(str(region))
+            n = (xs[1] - xs[0]) * (ys[1] - ys[0]) * math.prod(chunk[2:])
+            if n > L.cells * 16:
+                raise InputError(f"region of {n} cells is more than the limit {L.cells * 16}")
+            argv = ["world", spec, "--chunk", "x".join(map(str, chunk)), "--seed", str(seed),
+                    f"--region={xs[0]}:{xs[1]},{ys[0]}:{ys[1]}", "--out", "{OUT}/result.npy",
+                    "--json"]  # fmt: skip
+            info.update(size=[xs[1] - xs[0], ys[1] - ys[0], *chunk[2:]], out="result.npy")
         elif command in ("prove", "witness"):
             argv = [command, spec, "--json"]
             if command == "witness":  # prove is bounded by its state budget (--max-states)
@@ -404,7 +418,7 @@ def create_app(
                     argv += ["--max-size", str(ms)]
             info["order"] = order
         else:
-            raise InputError("command must be synthesize, prove or witness")
+            raise InputError("command must be synthesize, world, prove or witness")
         job = st.jobs.start(str(command), argv, info)
         return JSONResponse({"id": job.id})
 
@@ -525,6 +539,8 @@ def create_app(
         from csplab.cli.common import problem_from_args
 
         g, model = job_grid(job)
+        if job.argv[0] != "synthesize":
+            raise InputError(f"run {job.id} is not a synthesis")
         args = build_parser(only="synthesize").parse_args(job.argv)
         return problem_from_args(args, model), g
 

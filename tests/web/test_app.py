@@ -251,3 +251,13 @@ def test_a_continuous_result_downloads_in_its_formats(client: TestClient) -> Non
     assert svg.status_code == 200 and b"<svg" in svg.content
     assert client.get(f"/api/run/{r['id']}/result.png").content[:4] == b"\x89PNG"
     assert client.get(f"/api/run/{r['id']}/download?format=.npy").status_code == 400
+
+
+def test_a_world_region_streams_its_chunks(client: TestClient) -> None:
+    r = _finish(client, {"command": "world", "model": "fig3_4a", "chunk": "8x8", "seed": 3,
+                         "region": "-8:24,0:16"})  # fmt: skip
+    assert r["state"] == "done" and r["result"]["violations"] == 0, r
+    got = [(e["done"], e["total"]) for e in r["events"] if e["kind"] == "progress"]
+    assert got and got[-1] == (8, 8) and all(t == 8 for _, t in got)
+    g = np.load(io.BytesIO(client.get(f"/api/run/{r['id']}/download?format=.npy").content))
+    assert (g == World("fig3_4a", seed=3, chunk=(8, 8)).region((-8, 24), (0, 16))).all()

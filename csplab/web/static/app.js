@@ -91,6 +91,11 @@ async function openWorld() {
   status("opening the world ...");
   const body = { model: $("model").value, seed: Number($("seed").value), chunk: $("chunk").value,
                  ...optionValues($("world-options")) };
+  if ($("chunk").value.split("x").length === 3) {  // a 3D world: a region in the viewer
+    const [X, Y] = $("chunk").value.split("x").map(Number);
+    await startRun({ command: "world", model: body.model, seed: body.seed, chunk: body.chunk, region: `0:${2 * X},0:${2 * Y}` });
+    return;
+  }
   try {
     S.world = await api("/api/world", body);
   } catch (e) { status(e.message, true); return; }
@@ -297,7 +302,11 @@ async function finished(id) {
   $("bar").style.width = "100%";
   if (r.state === "error") { status(r.error, true); return; }
   const res = r.result || {};
-  if (r.command === "synthesize") {
+  if (r.command === "world") {
+    status(`world region ${r.info.size.join("x")}: ${res.chunks} chunks, ${res.violations} violations in ${res.seconds} s`, res.violations > 0);
+    fill($("run-format"), r.formats, ".png");
+    await viewGlb(`/api/run/${id}/result.glb`);
+  } else if (r.command === "synthesize") {
     const ok = res.status === "solved";
     status(`${res.outcome || res.status} in ${(res.time_s || 0).toFixed(2)} s with ${res.solver}`, !ok);
     $("verdict").textContent = JSON.stringify({ status: res.status, solver: res.solver, seed: res.seed, settings: res.settings }, null, 1);
