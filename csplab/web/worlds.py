@@ -75,6 +75,7 @@ class WorldSession:
         self.margin = int(margin)
         self.patches: list[Patch] = []
         self.lock = threading.Lock()  # a World and its caches serve one request at a time
+        self.editing = threading.Lock()  # edits (and undo) one at a time, on the latest state
 
     # -- reading ----------------------------------------------------------------------------
     def region(self, xs: tuple[int, int], ys: tuple[int, int]) -> NDArray[np.int32]:
@@ -150,6 +151,19 @@ class WorldSession:
             For an unknown brush, a label out of range, a 3D world or a rectangle over
             ``limit``.
         """
+        with self.editing:
+            return self._edit(brush, xs, ys, label, cells, limit, time_limit)
+
+    def _edit(
+        self,
+        brush: str,
+        xs: tuple[int, int],
+        ys: tuple[int, int],
+        label: int | None,
+        cells: list[tuple[int, int]] | None,
+        limit: int,
+        time_limit: float,
+    ) -> dict[str, Any]:
         from csplab.solvers import solve
 
         if brush not in BRUSHES:
@@ -215,7 +229,8 @@ class WorldSession:
 
     def undo(self) -> list[tuple[int, int]]:
         """Take back the last edit; returns the chunks it touched (empty: nothing to undo)."""
-        if not self.patches:
-            return []
-        p = self.patches.pop()
+        with self.editing:
+            if not self.patches:
+                return []
+            p = self.patches.pop()
         return sorted(self.world.chunks_in(p.xs, p.ys))

@@ -99,32 +99,34 @@ def fill(d: Any, id_: str, value: str) -> None:
     el.send_keys(value)
 
 
-_PIXELS = """
-const c = document.getElementById('map'), g = c.getContext('2d');
-const [x, y, w, h] = arguments;
-return Array.from(g.getImageData(x, y, w, h).data);
+_RECTS = """
+const S = window.csplab, c = document.getElementById('map'), [X, Y] = S.world.chunk;
+const out = [];
+const i0 = Math.floor(S.view.cx / X), j0 = Math.floor(S.view.cy / Y);
+for (let i = i0 - 8; i <= i0 + 8; i++) for (let j = j0 - 8; j <= j0 + 8; j++) {
+  const [x, y, w, h] = S.chunkRect(i, j);
+  if (x >= 0 && y >= 0 && x + w <= c.width && y + h <= c.height) out.push([i, j, x, y, w, h]);
+}
+return out;
 """
 
 
-def chunk_pixels(d: Any, i: int, j: int) -> np.ndarray | None:
-    """The canvas pixels of chunk (i, j) (None when not wholly visible)."""
-    x, y, w, h = d.execute_script(f"return window.csplab.chunkRect({i}, {j})")
-    W, H = d.execute_script("const c = document.getElementById('map'); return [c.width, c.height]")
-    if x < 0 or y < 0 or x + w > W or y + h > H:
-        return None
-    data = d.execute_script(_PIXELS, x, y, w, h)
-    return np.array(data, dtype=np.uint8).reshape(h, w, 4)[..., :3]
+def canvas(d: Any, id_: str = "map") -> np.ndarray:
+    """The canvas' pixels (RGB), read once as a PNG."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    url = d.execute_script(f"return document.getElementById('{id_}').toDataURL('image/png')")
+    png = base64.b64decode(url.split(",", 1)[1])
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"))
 
 
-def visible_chunks(d: Any) -> list[tuple[int, int]]:
-    X, Y = d.execute_script("return window.csplab.world.chunk")
-    cx, cy = d.execute_script("return [window.csplab.view.cx, window.csplab.view.cy]")
-    out = []
-    for i in range(int(cx // X) - 4, int(cx // X) + 5):
-        for j in range(int(cy // Y) - 4, int(cy // Y) + 5):
-            if chunk_pixels(d, i, j) is not None:
-                out.append((i, j))
-    return out
+def chunk_pixels(d: Any) -> dict[tuple[int, int], np.ndarray]:
+    """The pixels of every chunk drawn wholly inside the map."""
+    img = canvas(d)
+    return {(i, j): img[y : y + h, x : x + w] for i, j, x, y, w, h in d.execute_script(_RECTS)}
 
 
 def loaded(d: Any) -> None:
@@ -149,11 +151,9 @@ def test_pan_the_world_and_compare_chunks_with_world_chunk(page: Any) -> None:
     loaded(page)
     ref = World("loops", seed=4, chunk=(16, 16))
     cols = palette(ref.K)
-    chunks = visible_chunks(page)
-    assert len(chunks) >= 6
-    for i, j in chunks:
-        got = chunk_pixels(page, i, j)
-        assert got is not None
+    drawn = chunk_pixels(page)
+    assert len(drawn) >= 6
+    for (i, j), got in drawn.items():
         want = cols[ref.chunk(i, j)]  # [x, y] -> pixels, y up, 8 px per cell
         img = np.repeat(np.repeat(np.transpose(want, (1, 0, 2))[::-1], 8, 0), 8, 1)
         assert (got == img).all(), (i, j)
@@ -165,8 +165,8 @@ def test_paint_an_edit_then_exactly_the_expected_chunks_change(page: Any) -> Non
     if not page.execute_script("return !!(window.csplab.world)"):
         pytest.skip("the pan test opens the world")
     loaded(page)
-    chunks = visible_chunks(page)
-    before = {c: chunk_pixels(page, *c) for c in chunks}
+    before = chunk_pixels(page)
+    chunks = set(before)
     select(page, "tool", "brush")
     select(page, "brush", "label")
     select(page, "label", "1")
@@ -176,15 +176,16 @@ def test_paint_an_edit_then_exactly_the_expected_chunks_change(page: Any) -> Non
     edit = wait(page, "return window.csplab.lastEdit")
     assert edit["status"] == "solved", edit
     loaded(page)
-    after = {c: chunk_pixels(page, *c) for c in chunks}
+    after = chunk_pixels(page)
     differ = {c for c in chunks if not (before[c] == after[c]).all()}
-    assert differ == {tuple(c) for c in edit["changed"]} & set(chunks)
+    assert differ == {tuple(c) for c in edit["changed"]} & chunks
     assert differ and differ <= {tuple(c) for c in edit["touched"]}
     page.find_element("id", "undo").click()
     wait(page, "return window.csplab.lastUndo")
     loaded(page)
+    again = chunk_pixels(page)
     for c in chunks:
-        assert (chunk_pixels(page, *c) == before[c]).all(), c
+        assert (again[c] == before[c]).all(), c
     select(page, "tool", "pan")
 
 
@@ -197,13 +198,7 @@ def test_a_3d_result_is_drawn_in_the_model_colours(page: Any) -> None:
     page.find_element("id", "synthesize").click()
     wait(page, "return window.csplab.glbReady", timeout=120)
     time.sleep(0.3)
-    shot = page.execute_script("return document.getElementById('viewer').toDataURL('image/png')")
-    import base64
-    import io
-
-    from PIL import Image
-
-    img = np.asarray(Image.open(io.BytesIO(base64.b64decode(shot.split(",")[1]))).convert("RGB"))
+    img = canvas(page, "viewer")
     bg = np.array([0x20, 0x28, 0x30])
     fg = img[(np.abs(img.astype(int) - bg).sum(axis=-1) > 6)]
     assert len(fg) > 0.02 * img.shape[0] * img.shape[1]
