@@ -319,9 +319,17 @@ def create_app(
             raise InputError(f"brush must be one of {', '.join(BRUSHES)}, not {brush!r}")
         lab = _int(body, "label", None, 0, w.world.K - 1) if brush == "label" else None
         del label
+        cells = body.get("cells")  # a freehand stroke; default the whole rectangle
+        if cells is not None:
+            if not isinstance(cells, list) or not 0 < len(cells) <= L.edit_cells or not all(
+                isinstance(c, list) and len(c) == 2 and all(type(v) is int for v in c)
+                for c in cells
+            ):
+                raise InputError(f"cells must be 1..{L.edit_cells} [x, y] integer pairs")
+            cells = [(int(x), int(y)) for x, y in cells]
         out = await asyncio.to_thread(
-            w.edit, str(brush), (x0, x1), (y0, y1), label=lab, limit=L.edit_cells,
-            time_limit=min(30.0, L.seconds),
+            w.edit, str(brush), (x0, x1), (y0, y1), label=lab, cells=cells,
+            limit=L.edit_cells, time_limit=min(30.0, L.seconds),
         )  # fmt: skip
         out["edits"] = len(w.patches)
         return JSONResponse(json.loads(json.dumps(out)))

@@ -107,6 +107,22 @@ def test_an_edit_changes_only_the_chunks_around_it_and_undo_restores(client: Tes
     assert again == before
 
 
+def test_a_freehand_stroke_fixes_only_its_cells(client: TestClient) -> None:
+    wid = _world(client, seed=9)["id"]
+    stroke = [[10, 10], [11, 10], [12, 10]]
+    e = client.post(f"/api/world/{wid}/edit", json={"brush": "label", "label": 1, "x0": 10,
+                                                    "x1": 13, "y0": 10, "y1": 11,
+                                                    "cells": stroke}).json()  # fmt: skip
+    assert e["status"] == "solved", e
+    g = np.load(io.BytesIO(client.get(f"/api/world/{wid}/download?region=0:32,0:32&format=.npy")
+                           .content))  # fmt: skip
+    assert [int(g[x, y]) for x, y in stroke] == [1, 1, 1]
+    bad = client.post(f"/api/world/{wid}/edit", json={"brush": "label", "label": 1, "x0": 10,
+                                                      "x1": 13, "y0": 10, "y1": 11,
+                                                      "cells": [[30, 30]]})  # fmt: skip
+    assert bad.status_code == 400 and "outside the rectangle" in bad.json()["error"]
+
+
 def test_an_impossible_edit_is_refused_with_its_unsat_core(client: TestClient) -> None:
     wid = _world(client, seed=2)["id"]
     before = client.get(f"/api/world/{wid}/chunk/0/0.png").content

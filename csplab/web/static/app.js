@@ -162,6 +162,8 @@ function drawMap() {
     g.strokeStyle = "#ff0"; g.lineWidth = 2;
     g.strokeRect(sx, sy, (S.rect[1] - S.rect[0]) * px, (S.rect[3] - S.rect[2]) * px);
   }
+  g.fillStyle = "rgba(255,255,0,0.5)";
+  for (const [x, y] of S.stroke || []) { const [sx, sy] = toScreen(x, y + 1); g.fillRect(sx, sy, px, px); }
   g.fillStyle = "rgba(255,0,0,0.6)";
   for (const [x, y] of S.core) { const [sx, sy] = toScreen(x, y + 1); g.fillRect(sx, sy, px, px); }
   $("coords").textContent = `centre (${S.view.cx.toFixed(1)}, ${S.view.cy.toFixed(1)}), ${px} px/cell`;
@@ -178,6 +180,11 @@ function setupMap() {
     if ($("tool").value === "pan") {
       S.view.cx = drag.cx - (x - drag.x) / cellPx();
       S.view.cy = drag.cy + (y - drag.y) / cellPx();
+    } else if ($("tool").value === "paint") {
+      const [u, v] = toCell(x, y);
+      drag.stroke = drag.stroke || new Map([[String(drag.cell), drag.cell]]);
+      drag.stroke.set(`${u},${v}`, [u, v]);
+      S.stroke = [...drag.stroke.values()];
     } else {
       const [a, b] = drag.cell, [u, v] = toCell(x, y);
       S.rect = [Math.min(a, u), Math.max(a, u) + 1, Math.min(b, v), Math.max(b, v) + 1];
@@ -186,8 +193,14 @@ function setupMap() {
   });
   window.addEventListener("mouseup", async () => {
     const was = drag; drag = null;
-    if (!was || $("tool").value !== "brush" || !S.rect) return;
-    await paint(S.rect);
+    if (!was || !S.world) return;
+    if ($("tool").value === "paint") {
+      const cells = S.stroke || [was.cell];
+      const xs = cells.map((c) => c[0]), ys = cells.map((c) => c[1]);
+      S.rect = [Math.min(...xs), Math.max(...xs) + 1, Math.min(...ys), Math.max(...ys) + 1];
+      S.stroke = null;
+      await paint(S.rect, cells);
+    } else if ($("tool").value === "brush" && S.rect) await paint(S.rect);
   });
   c.addEventListener("wheel", (ev) => {
     ev.preventDefault();
@@ -205,8 +218,9 @@ function invalidate(chunks) {
   for (const [i, j] of chunks) { const k = `${i},${j}`; S.version.set(k, (S.version.get(k) || 0) + 1); }
   drawMap();
 }
-async function paint(rect) {
+async function paint(rect, cells) {
   const body = { brush: $("brush").value, label: Number($("label").value), x0: rect[0], x1: rect[1], y0: rect[2], y1: rect[3] };
+  if (cells) body.cells = cells;
   status("re-synthesizing around the edit ...");
   try {
     const r = await api(`/api/world/${S.world.id}/edit`, body);
@@ -374,6 +388,11 @@ $("prove").onclick = () => startRun(runBody("prove"));
 $("witness").onclick = () => startRun(runBody("witness"));
 $("run-download").onclick = () => { if (S.run && S.run.id) location.href = `/api/run/${S.run.id}/download?format=${$("run-format").value}`; };
 $("step-prev").onclick = () => { if (S.replay && S.step > 0) { S.step--; drawReplay(); } };
+$("step-play").onclick = () => {
+  if (!S.replay) return;
+  S.step = 0; drawReplay();
+  const t = setInterval(() => { if (S.step >= S.replay.steps.length - 1) { clearInterval(t); return; } S.step++; drawReplay(); }, 700);
+};
 $("step-next").onclick = () => { if (S.replay && S.step < S.replay.steps.length - 1) { S.step++; drawReplay(); } };
 setupMap();
 setup3d();
