@@ -43,6 +43,7 @@ COMMANDS: dict[str, str] = {
     "experiment": "csplab.cli.experiment",
     "baseline": "csplab.cli.baseline",
     "world": "csplab.cli.world",
+    "serve": "csplab.cli.serve",
 }
 
 
@@ -158,7 +159,7 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: object
 
 
 # commands that run csplab's numba kernels (the first run compiles them: one line on stderr)
-_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check", "check-certificate"}
+_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check", "check-certificate", "serve"}
 
 
 _ANNOUNCING = [False]
