@@ -93,6 +93,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = "auto",
     **options: Any,
 ) -> Synthesis[ContinuousCSP, PolygonModel]: ...
 
@@ -112,6 +113,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = "auto",
     **options: Any,
 ) -> Synthesis[ContinuousCSP3, PolyhedralModel]: ...
 
@@ -130,6 +132,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = "auto",
     **options: Any,
 ) -> Synthesis[Any, M]:
     """Continuous model synthesis (Alg. 4.1) of a polygon or polyhedral example.
@@ -150,6 +153,11 @@ def synthesize(
     spacing, snap, boundary, lines, constraints, max_memory
         See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: 2D; per-face
         ``boundary`` and user ``constraints`` of thesis Sec. 4.6: 3D).
+    ground : str or sequence of str or None, default "auto"
+        3D: the faces past which the example and the output continue (an infinite
+        ground, :func:`~csplab.continuous.csp3d.ground_faces`: ``"z-"``, ``"window"``
+        ...); ``"auto"``: the example's own declaration (``example.meta["ground"]``, as
+        the built-in examples have), else none; ``None``: none.
     restarts : int
         Run an incomplete solver again with a fresh derived seed while it fails
         (:func:`csplab.solvers.solve`'s one restart loop; ``time_limit`` covers all).
@@ -196,8 +204,11 @@ def synthesize(
     ('solved', 0, (1,))
     """
     t0 = time.perf_counter()
+    if ground == "auto":
+        ground = example.meta.get("ground") if isinstance(example, PolyhedralModel) else None
     csp = continuous_csp(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                         lines=lines, constraints=constraints, max_memory=max_memory)  # fmt: skip
+                         lines=lines, constraints=constraints, max_memory=max_memory,
+                         ground=ground)  # fmt: skip
     t1 = time.perf_counter()
     result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
     t2 = time.perf_counter()
@@ -206,7 +217,8 @@ def synthesize(
     region = csp.region()
     defects: list[Defect] = []
     if check and model is not None:
-        defects = list(violations(csp.example, model, region=region, outside=csp.boundary))
+        defects = list(violations(csp.example, model, region=region, outside=csp.boundary,
+                                  ground=getattr(csp, "ground", ())))  # fmt: skip
     broken: list[Defect] = []
     if constraints and isinstance(model, PolyhedralModel):
         d = len(region) // 2
