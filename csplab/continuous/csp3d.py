@@ -226,6 +226,8 @@ def example_signatures3(
     index: dict[int, int],
     max_memory: int | None = None,
     ground: Sequence[str] = (),
+    coverage: dict[Labeling, int] | None = None,
+    on_ground: dict[str, set[Labeling]] | None = None,
 ) -> set[Labeling]:
     """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
     of the central cells: vertices and edges of its own arrangement (its bounding box plus
@@ -233,7 +235,13 @@ def example_signatures3(
     as for :class:`~csplab.continuous.space.Arrangement3`). Past the faces of its bounding
     box named in ``ground`` the example continues: the label there is the one just inside
     (a solid standing on the box's bottom face goes on below it, so that face is no
-    surface)."""
+    surface). ``coverage``, if given, receives how much of the example each neighbourhood
+    covers: the number of vertices and edges of the arrangement inside the example's
+    bounding box where it occurs (volume, area, length or a count of corners, in plane
+    spacings). ``on_ground``, if given, receives per ``ground`` face the neighbourhoods
+    at the example's vertices and edges on that face of its box, and empty space (what
+    the output may have on the region's face: its bottom layer is like the example's, or
+    bare ground)."""
     pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
     lo = np.floor(lattice.to_lattice(pts).min(axis=0) + 1e-9)
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
@@ -245,10 +253,25 @@ def example_signatures3(
     clamp = (box.min(axis=0), box.max(axis=0), tuple(ground))
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
-    sigs |= set(_local_labels(A, A.vertex_positions(), A.on, tris, index, clamp))
+    vpos = A.vertex_positions()
+    vert_sigs = _local_labels(A, vpos, A.on, tris, index, clamp)
+    sigs |= set(vert_sigs)
     efam = A.edge_families()
-    edge_sigs = _local_labels(A, A.edge_positions(), efam, tris, index, clamp)
+    epos = A.edge_positions()
+    edge_sigs = _local_labels(A, epos, efam, tris, index, clamp)
     sigs |= set(edge_sigs)
+    tol = 1e-9
+    for pos, found in ((vpos, vert_sigs), (epos, edge_sigs)):
+        inside = ((pos >= clamp[0] - tol) & (pos <= clamp[1] + tol)).all(axis=1)
+        if coverage is not None:  # occurrences inside the example's box
+            for k in np.flatnonzero(inside).tolist():
+                coverage[found[k]] = coverage.get(found[k], 0) + 1
+        for face in ground if on_ground is not None else ():
+            a = "xyz".index(face[0])
+            at = clamp[1][a] if face[1] == "+" else clamp[0][a]
+            on = inside & (np.abs(pos[:, a] - at) <= tol)
+            seen = on_ground.setdefault(face, {(0,) * len(signs)})  # bare ground
+            seen.update(found[k] for k in np.flatnonzero(on))
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
     N = A.normals
@@ -338,8 +361,15 @@ class ContinuousCSP3:
         self.boundary = faces
         # the region's estimate first: refused before the example's arrangement is built
         check_budget3(self.lattice, size, max_memory, example.source)
+        #: how much of the example each neighbourhood covers (vertices and edges of its
+        #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
+        self.coverage: dict[Labeling, int] = {}
+        #: per ground face, the example's neighbourhoods on that face of its box: the only
+        #: ones a vertex or edge on that face of the region may take
+        self.on_ground: dict[str, set[Labeling]] = {}
         self.signatures = example_signatures3(example, self.lattice, index, max_memory,
-                                              self.ground)  # fmt: skip
+                                              self.ground, self.coverage,
+                                              self.on_ground)  # fmt: skip
         self.arrangement = Arrangement3(self.lattice, size, max_memory=max_memory,
                                         where=example.source)  # fmt: skip
         self._types(index)
@@ -357,10 +387,15 @@ class ContinuousCSP3:
         """The vertex and edge types (planes through them, region sides they lie on) with
         their states, cell groups and outside labels (Sec. 4.5.4)."""
         sig = np.array(sorted(self.signatures), dtype=np.int64)
+        cover = np.array([self.coverage.get(tuple(int(x) for x in r), 0) for r in sig.tolist()],
+                         dtype=np.float64)  # fmt: skip
         A = self.arrangement
         signs, _ = A.cells
         F, N = A.F, A.normals
         faces = self.boundary
+        sig_rows = [tuple(int(x) for x in r) for r in sig.tolist()]
+        on_face = {f: np.array([r in self.on_ground.get(f, ()) for r in sig_rows], dtype=bool)
+                   for f in self.ground}  # fmt: skip
         side_fam = [A.axis_family(a) for a in range(3)]
         _, dirs = A.cells
 
@@ -415,10 +450,21 @@ class ContinuousCSP3:
             req = out >= 0
             ok &= (local[:, req] == out[req]).all(axis=1)
             ok &= (local == local[:, mirror]).all(axis=1)  # past a ground face: continued
+            for face in self.ground:  # on a ground face: as the example on its box's face
+                a, hi = "xyz".index(face[0]), face[1] == "+"
+                if sides & ((2 if hi else 1) << (2 * a)):
+                    ok &= on_face[face]
             found = sorted({tuple(int(x) for x in row) for row in local[ok]},
                            key=lambda st: (any(st), st))  # fmt: skip
+            # Sec. 4.5.4's states, each weighted by the example it covers (+1: every state
+            # stays possible): the neighbourhoods that look like it here
+            w = dict.fromkeys(found, 1.0)
+            for row, c in zip(local[ok].tolist(), cover[ok].tolist(), strict=True):
+                w[tuple(row)] += c
+            weights.append(np.array([w[st] for st in found], dtype=np.float64))
             return found, (g, ng, out)
 
+        weights: list[NDArray[np.float64]] = []  # per vertex type, then per edge type
         # vertex types
         vside = A.on_side()
         vmask = A.on.astype(np.int64) @ (1 << np.arange(F, dtype=np.int64))
@@ -449,6 +495,8 @@ class ContinuousCSP3:
             st, (g, _, out) = states(fams, key & 63)
             self.etypes.append((fams, st, g))
             self.edge_outside.append(out)
+        #: per vertex type then edge type, the weight of each state (``choice="weighted"``)
+        self.state_weights = weights
 
     def _relation_maker(
         self, K: int
@@ -536,6 +584,13 @@ class ContinuousCSP3:
         used = [rels[i] for i in order_used.tolist()]
         arcs[:, 2] = renum[arcs[:, 2]]
         dom = dom[order]  # (the unordered copy is freed before the problem copies it)
+        # the weighted choice: one weight class per vertex and edge type
+        table = np.zeros((len(self.state_weights), K), dtype=np.float64)
+        for t, w in enumerate(self.state_weights):
+            table[t, : len(w)] = w
+        cls = np.empty(nv + ne, dtype=np.int64)
+        cls[self.var_vertex] = vtype
+        cls[self.var_edge] = len(self.vtypes) + etype
         return Problem(
             (nv + ne,), dom, np.stack(used), arcs,
             name=getattr(self.example, "name", "") or "continuous3d",
@@ -543,7 +598,7 @@ class ContinuousCSP3:
                   "spacing": float(self.lattice.spacing), "families": A.normals.tolist(),
                   "vertices": nv, "edges": ne, "boundary": dict(self.boundary),
                   "ground": list(self.ground)},
-            positions=pos[order],
+            positions=pos[order], value_weights=(table, cls),
         )  # fmt: skip
 
     def model(self, grid: ArrayLike, *, name: str = "") -> PolyhedralModel:
