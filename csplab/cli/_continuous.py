@@ -174,6 +174,11 @@ def synthesize(
             settings[key] = (
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
+    if dim == 3 and "choice" not in opts and cls.option("choice") is not None:
+        o = cls.option("choice")
+        if o is not None and (o.values is None or "weighted" in o.values):
+            settings["choice"] = ("weighted (continuous default: by how much of the example "
+                                  "each state covers; --choice uniform: the thesis')")
     settings["restarts"] = restarts
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
