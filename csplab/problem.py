@@ -574,7 +574,8 @@ class Problem:
         args: dict[str, Any] = dict(
             shape=self.shape, domains=self.domains, relations=self.relations, arcs=self.arcs,
             weights=self.weights, value_weights=self.value_weights, names=self.names,
-            relation_names=self.relation_names, unary=self.unary, base_domains=self.base_domains, name=self.name, meta=self.meta,
+            relation_names=self.relation_names, unary=self.unary,
+            base_domains=self.base_domains, name=self.name, meta=self.meta,
             positions=self.positions, constraints=self.constraints,
         )  # fmt: skip
         args.update(changes)

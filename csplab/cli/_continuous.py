@@ -211,8 +211,9 @@ def synthesize(
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
+    opened: tuple[str, ...] = getattr(csp, "ground", ())  # 3D only
     if dim == 3:
-        open_faces = ",".join(csp.ground) or "none"
+        open_faces = ",".join(opened) or "none"
         settings["ground"] = open_faces + (" (the example's)" if ground == "auto" else "")
     if dim == 3:
         from csplab.continuous.space import estimate3
@@ -246,11 +247,12 @@ def synthesize(
             outcome=outcome(r.status) if s.ok or r.status != "solved" else "not solved",
             proof=r.stats.get("proof") if r.status == "unsat" else None,
         )  # fmt: skip
-        if isinstance(example, PolyhedralModel) and isinstance(s.model, PolyhedralModel):
+        snapped = csp.example  # (as synthesized: its vertices on the lattice)
+        if isinstance(snapped, PolyhedralModel) and isinstance(s.model, PolyhedralModel):
             from csplab.continuous.resemblance import resemblance3  # from the geometry alone
 
-            floor = csp.region()[2] if "z-" in csp.ground else None  # the ground's height
-            d["resemblance"] = resemblance3(csp.example, s.model, ground=floor).to_dict()
+            floor = csp.region()[2] if "z-" in opened else None  # the ground's height
+            d["resemblance"] = resemblance3(snapped, s.model, ground=floor).to_dict()
         print(json.dumps(d))
     else:
         what = "edge directions" if dim == 2 else "face orientations"

@@ -266,7 +266,9 @@ def example_signatures3(
         if coverage is not None:  # occurrences inside the example's box
             for k in np.flatnonzero(inside).tolist():
                 coverage[found[k]] = coverage.get(found[k], 0) + 1
-        for face in ground if on_ground is not None else ():
+        for face in ground:
+            if on_ground is None:
+                break
             a = "xyz".index(face[0])
             at = clamp[1][a] if face[1] == "+" else clamp[0][a]
             on = inside & (np.abs(pos[:, a] - at) <= tol)

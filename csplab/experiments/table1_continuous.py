@@ -345,12 +345,10 @@ def _side_by_side(panels: list[tuple[str, Any]], path: Path) -> None:
     """The models' PNG previews in one row, each captioned (``None``: not solved)."""
     import tempfile
 
-    from PIL import Image, ImageDraw
+    from PIL import Image, ImageDraw, ImageFont
 
     from csplab.io.common import write_atomic
     from csplab.io.meshes import write_png
-
-    from PIL import ImageFont
 
     try:
         font: Any = ImageFont.load_default(size=22)

@@ -20,7 +20,7 @@ import pytest
 from csplab import _interp
 from csplab.continuous.check import violations
 from csplab.continuous.csp3d import WINDOW, ContinuousCSP3, ground_faces
-from csplab.continuous.resemblance import floating_solids, resemblance3
+from csplab.continuous.resemblance import floating_solids
 from csplab.continuous.synthesis import auto_ground, synthesize
 from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError
