@@ -149,7 +149,7 @@ class Table1Continuous(Experiment):
     )
     defaults: ClassVar[dict[str, Any]] = sweep_defaults(
         omit=("order", "choice", "periodic"),  # one setting per example (PAPER_TABLE1)
-        examples=list(PAPER_TABLE1), sizes_3d=dict(SIZES), solvers=["catalog"], seeds=3,
+        examples=list(PAPER_TABLE1), sizes_3d=dict(SIZES), solvers=["catalog"], seeds=2,
         restarts=10, boundary={}, time_limit=600.0, choices=["weighted", "uniform"],
         grounds=["auto", "none"],
     )  # fmt: skip
