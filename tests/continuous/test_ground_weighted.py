@@ -157,3 +157,17 @@ def test_weighted_is_the_continuous_default_and_uniform_differs() -> None:
     assert d.result.stats["choice"] == "weighted"
     assert np.array_equal(d.result.grid, w.result.grid)
     assert not np.array_equal(w.result.grid, u.result.grid)
+
+
+def test_blocks_carry_the_weights_to_workers() -> None:
+    """``blocks`` cuts subproblems (in process) or packs tasks (workers): both keep each
+    cell's weight class, so the same seed gives the same output whatever the workers."""
+    E = load_polyhedral_example("houses")
+    grids = []
+    for workers in (1, 2):
+        s = synthesize(E, (14, 14, 6), solver="blocks", rng=3, workers=workers)
+        assert s.ok and s.result.stats["choice"] == "weighted"
+        grids.append(np.asarray(s.result.grid))
+    assert np.array_equal(grids[0], grids[1])
+    u = synthesize(E, (14, 14, 6), solver="blocks", rng=3, choice="uniform")
+    assert not np.array_equal(grids[0], np.asarray(u.result.grid))
