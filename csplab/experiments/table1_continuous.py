@@ -142,10 +142,11 @@ def measure_synthesis3(trial: Trial, example: Any, problem: Any) -> dict[str, An
 
 class Table1Continuous(Experiment):
     name: ClassVar[str] = "table1_continuous"
-    title: ClassVar[str] = "Table 1 (2008 paper): input and output polygons and time"
+    title: ClassVar[str] = "Table 1 and Figs. 1, 10-13 (2008 paper): polygons, time, resemblance"
     description: ClassVar[str] = (
         "continuous 3D synthesis of the built-in polyhedral examples at sizes reaching the "
-        "paper's output polygons; phases, violations and previews"
+        "paper's output polygons, weighted and uniform choice, with and without the "
+        "example's ground; phases, violations, resemblance figures and previews"
     )
     defaults: ClassVar[dict[str, Any]] = sweep_defaults(
         omit=("order", "choice", "periodic"),  # one setting per example (PAPER_TABLE1)
