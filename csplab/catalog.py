@@ -120,12 +120,17 @@ class SupportTables(NamedTuple):
     full: NDArray[np.uint64]  #: ``(W,)`` bitset of every label
     sup: NDArray[np.uint64]  #: ``(2R, K, W)`` supports of each label
     supall: NDArray[np.uint64]  #: ``(2R, W)`` union of the supports of all labels
-    weights: NDArray[np.float64]  #: ``(K,)``
-    wlogw: NDArray[np.float64]  #: ``(K,)`` ``w log w`` (0 where ``w = 0``)
+    weights: NDArray[np.float64]  #: ``(T, K)`` per weight class
+    wlogw: NDArray[np.float64]  #: ``(T, K)`` ``w log w`` (0 where ``w = 0``)
+    #: ``(n,)`` each cell's weight class, or ``(1,)``: class 0 for every cell
+    wclass: NDArray[np.int64]
 
 
-def support_tables(relations: NDArray[np.bool_], weights: ArrayLike) -> SupportTables:
-    """The :class:`SupportTables` of ``relations`` (``(R, K, K)``) and label ``weights``."""
+def support_tables(
+    relations: NDArray[np.bool_], weights: ArrayLike, wclass: ArrayLike | None = None
+) -> SupportTables:
+    """The :class:`SupportTables` of ``relations`` (``(R, K, K)``) and label ``weights``
+    (``(K,)``, or ``(T, K)`` per weight class with each cell's class ``wclass``)."""
     R, K = relations.shape[0], relations.shape[1]
     W = words(K)
     both = np.empty((2 * R, K, K), dtype=bool)
@@ -134,10 +139,12 @@ def support_tables(relations: NDArray[np.bool_], weights: ArrayLike) -> SupportT
     sup = pack(both.reshape(2 * R * K, K)).reshape(2 * R, K, W)
     supall = pack(both.any(axis=1))  # (2R, W): union of supports of all labels
     full = pack(np.ones((1, K), dtype=bool))[0]
-    w = np.ascontiguousarray(np.asarray(weights, dtype=np.float64))
+    w = np.ascontiguousarray(np.asarray(weights, dtype=np.float64).reshape(-1, K))
     with np.errstate(divide="ignore", invalid="ignore"):
-        wlogw = np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0)
-    return SupportTables(full, sup, supall, w, wlogw)
+        wlogw = np.ascontiguousarray(np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0))
+    wc = np.zeros(1, dtype=np.int64) if wclass is None else np.ascontiguousarray(
+        np.asarray(wclass, dtype=np.int64).reshape(-1))  # fmt: skip
+    return SupportTables(full, sup, supall, w, wlogw, wc)
 
 
 class _Compiled:
@@ -165,7 +172,7 @@ class _Compiled:
             self.nbr = np.empty(ends, dtype=np.int64)
             self.sidx = np.empty(ends, dtype=np.int64)
             kern.arc_csr(np.ascontiguousarray(a, dtype=np.int64), self.ptr, self.nbr, self.sidx)
-        t = support_tables(problem.relations, problem.weights)
+        t = support_tables(problem.relations, *problem.weight_classes())
         self.sup, self.supall, self.full = t.sup, t.supall, t.full
         self.n, self.K, self.W = n, K, W
         #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
@@ -174,11 +181,11 @@ class _Compiled:
         self._doms: NDArray[np.uint64] | None = None  # packed_domains(), built on demand
         #: per weighting, the entropies (and weight sums) of that catalog
         self.entropies: dict[bool, tuple[Any, Any, Any]] = {}
-        self.weights, self.wlogw = t.weights, t.wlogw
+        self.weights, self.wlogw, self.wclass = t.weights, t.wlogw, t.wclass
         # the same arrays as one kernel argument
         self.arcs = kern.Arcs(
             self.full, self.ptr, self.nbr, self.sidx, self.sup, self.supall, self.weights,
-            self.wlogw,
+            self.wlogw, self.wclass,
         )  # fmt: skip
 
     def packed_domains(self, problem: Problem) -> NDArray[np.uint64]:
@@ -490,7 +497,8 @@ def solve_block_arrays(
         return np.ascontiguousarray(x, dtype=np.int64)
 
     local = kern.Arcs(tables.full, i64(block.lptr), i64(block.lnbr), i64(block.lsidx),
-                      tables.sup, tables.supall, tables.weights, tables.wlogw)  # fmt: skip
+                      tables.sup, tables.supall, tables.weights, tables.wlogw,
+                      tables.wclass)  # fmt: skip
     nb = block.dom0.shape[0]
     lgrid = np.empty(nb, dtype=np.int32)
     counters = np.zeros(4, dtype=np.int64)

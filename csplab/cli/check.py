@@ -35,6 +35,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help=f"grid file to check ({exts}: label ids kept; .vox: colour b + 1 = label b)",
     )
     add_constraints_arg(p)
+    p.add_argument(
+        "--ground",
+        default="auto",
+        help="polyhedral models: the faces past which example and output continue, as "
+        "synthesize --ground (the output's own box stands for its region); default auto: "
+        "the example's own",
+    )
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 

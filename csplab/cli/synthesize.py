@@ -104,6 +104,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="continuous models: round example vertices onto the --spacing lattice",
     )
+    p.add_argument(
+        "--ground",
+        default="auto",
+        help="polyhedral models: faces past which the example (its bounding box) and the "
+        "output (the region) continue, an infinite ground: z- (solids standing on the "
+        "bottom go on below it, none floats), a list such as z-,x-,x+, window (every face "
+        "but z+), none; default auto: the example's own (the built-in ones declare theirs)",
+    )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     add_memory_limit_arg(p)
     p.add_argument("--time-limit", type=float, help="seconds")
