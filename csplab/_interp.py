@@ -135,8 +135,14 @@ class Tables:
         flat = _ints(c.sup.reshape(S * self.K, -1))
         self.sup = [flat[s * self.K : (s + 1) * self.K] for s in range(S)]
         self.memo: list[dict[int, int]] = [{} for _ in range(S)]
-        self.weights: list[float] = c.weights.tolist()
-        self.wlogw: list[float] = c.wlogw.tolist()
+        #: per weight class, the label weights and ``w log w``; the class of each cell
+        self.weights: list[list[float]] = c.weights.tolist()
+        self.wlogw: list[list[float]] = c.wlogw.tolist()
+        self.wclass: list[int] = c.wclass.tolist()
+
+    def row(self, v: int) -> int:
+        """:func:`csplab._kernels.wrow`: the weight class of cell ``v``."""
+        return self.wclass[v] if len(self.wclass) > 1 else 0
 
     def support(self, s: int, d: int) -> int:
         """The labels supported across direction ``s`` by the domain ``d``."""
@@ -171,7 +177,8 @@ class _Keys:
 
     def removed(self, v: int, gone: int) -> None:
         if self.memo:
-            w, wl = self.T.weights, self.T.wlogw
+            r = self.T.row(v)
+            w, wl = self.T.weights[r], self.T.wlogw[r]
             for a in set_bits(gone):
                 self.sw[v] -= w[a]
                 self.swl[v] -= wl[a]
@@ -180,7 +187,7 @@ class _Keys:
         if self.memo and self.sw[v] > 1e-12:
             k = math.log(self.sw[v]) - self.swl[v] / self.sw[v] + 1e-6 * self.noise[v]
         else:
-            k = _entropy(self.T, d, self.weighted) + 1e-6 * self.noise[v]
+            k = _entropy(self.T, d, self.weighted, v) + 1e-6 * self.noise[v]
         self.key[v] = k
         heapq.heappush(self.entries, (k, v))
 
@@ -200,15 +207,16 @@ def set_bits(d: int) -> Iterator[int]:
         d ^= low
 
 
-def _entropy(T: Tables, d: int, weighted: bool) -> float:
-    """:func:`csplab._kernels.entropy_of` of the domain ``d``."""
+def _entropy(T: Tables, d: int, weighted: bool, v: int) -> float:
+    """:func:`csplab._kernels.entropy_of` of the domain ``d`` of cell ``v``."""
     if not weighted:
         c = d.bit_count()
         return math.log(c) if c > 0 else 0.0
     s = sl = 0.0
+    w, wl = T.weights[T.row(v)], T.wlogw[T.row(v)]
     for a in set_bits(d):
-        s += T.weights[a]
-        sl += T.wlogw[a]
+        s += w[a]
+        sl += wl[a]
     if s <= 0.0:
         cnt = d.bit_count()
         return math.log(cnt) if cnt > 0 else 0.0
@@ -303,19 +311,20 @@ def propagate(c: Any, bits: NDArray[np.uint64], prev: NDArray[np.uint64],
     return wiped
 
 
-def _choose(T: Tables, d: int, u: float, weighted: bool) -> int:
-    """:func:`csplab._kernels.choose_label` on the domain ``d``."""
+def _choose(T: Tables, d: int, u: float, weighted: bool, v: int) -> int:
+    """:func:`csplab._kernels.choose_label` on the domain ``d`` of cell ``v``."""
     if weighted:
+        w = T.weights[T.row(v)]
         tot = 0.0  # added in label order, as the kernel does (not sum(): 3.12 compensates)
         for a in set_bits(d):
-            tot += T.weights[a]
+            tot += w[a]
         if tot > 0.0:
             target = u * tot
             last = -1
             cum = 0.0
             for a in set_bits(d):
-                if T.weights[a] > 0.0:
-                    cum += T.weights[a]
+                if w[a] > 0.0:
+                    cum += w[a]
                     last = a
                     if cum > target:
                         return a
@@ -352,7 +361,7 @@ def alg31(
     code = _SOLVED
     while t < n:
         p = keys.pop() if keys is not None else order[t]
-        b = _choose(T, dom[p], us[t], weighted)
+        b = _choose(T, dom[p], us[t], weighted, p)
         if b < 0:
             state[2] = p
             code = _FAILED

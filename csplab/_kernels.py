@@ -90,8 +90,10 @@ class Arcs(NamedTuple):
     sidx: NDArray[np.int64]  #: support index of each arc end (``2r`` or ``2r + 1``)
     sup: NDArray[np.uint64]  #: ``(2R, K, W)`` supports of each label
     supall: NDArray[np.uint64]  #: ``(2R, W)`` union of the supports of all labels
-    weights: NDArray[np.float64]  #: ``(K,)`` label weights
-    wlogw: NDArray[np.float64]  #: ``(K,)`` ``w log w`` (0 where ``w = 0``)
+    weights: NDArray[np.float64]  #: ``(T, K)`` label weights per weight class
+    wlogw: NDArray[np.float64]  #: ``(T, K)`` ``w log w`` (0 where ``w = 0``)
+    #: ``(n,)`` the weight class (row of ``weights``) of each cell; ``(1,)``: class 0 for all
+    wclass: NDArray[np.int64]
 
 
 class AcState(NamedTuple):
@@ -254,6 +256,12 @@ def nth_label(dom: np.ndarray, v: int, j: int) -> int:
 
 
 @njit(cache=True)
+def wrow(wclass: np.ndarray, v: int) -> int:
+    """The weight class of cell ``v`` (``wclass`` of length 1: class 0 for every cell)."""
+    return wclass[v] if wclass.shape[0] > 1 else 0
+
+
+@njit(cache=True)
 def entropy_of(
     dom: np.ndarray, v: int, weights: np.ndarray, wlogw: np.ndarray, weighted: bool
 ) -> float:
@@ -377,7 +385,7 @@ def propagate(
     return _propagate(
         ac.dom, ac.prev, arcs.full, arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup, arcs.supall,
         ac.queue, ac.inq, start, nstart, ac.stats, hp.heap, hp.pos, hp.key, hsize, hp.noise,
-        arcs.weights, arcs.wlogw, weighted, hp.sw, hp.swl,
+        arcs.weights, arcs.wlogw, arcs.wclass, weighted, hp.sw, hp.swl,
     )  # fmt: skip
 
 
@@ -403,6 +411,7 @@ def _propagate(
     noise: np.ndarray,
     weights: np.ndarray,
     wlogw: np.ndarray,
+    wclass: np.ndarray,
     weighted: bool,
     sw: np.ndarray,
     swl: np.ndarray,
@@ -525,8 +534,8 @@ def _propagate(
                         while x:
                             a = w * 64 + ctz64(x)
                             x &= x - np.uint64(1)
-                            sw[v] -= weights[a]
-                            swl[v] -= wlogw[a]
+                            sw[v] -= weights[wrow(wclass, v), a]
+                            swl[v] -= wlogw[wrow(wclass, v), a]
                 if new:
                     empty = False
             if changed:
@@ -537,7 +546,8 @@ def _propagate(
                     if memo and sw[v] > 1e-12:
                         k = np.log(sw[v]) - swl[v] / sw[v] + 1e-6 * noise[v]
                     else:
-                        k = entropy_of(dom, v, weights, wlogw, weighted) + 1e-6 * noise[v]
+                        r = wrow(wclass, v)
+                        k = entropy_of(dom, v, weights[r], wlogw[r], weighted) + 1e-6 * noise[v]
                     heap_update(heap, hpos, hkey, hsize, v, k)
                 if not inq[v]:
                     inq[v] = True
@@ -623,6 +633,7 @@ def alg31(
     dom, prev, queue, inq, stats = ac.dom, ac.prev, ac.queue, ac.inq, ac.stats
     full, ptr, nbr, sidx = arcs.full, arcs.ptr, arcs.nbr, arcs.sidx
     sup, supall, weights, wlogw = arcs.sup, arcs.supall, arcs.weights, arcs.wlogw
+    wclass = arcs.wclass
     order, ustream, grid, state = run.order, run.ustream, run.grid, run.state
     trace_cell, trace_label = run.trace_cell, run.trace_label
     heap, hpos, hkey, noise, sw, swl = hp.heap, hp.pos, hp.key, hp.noise, hp.sw, hp.swl
@@ -639,7 +650,7 @@ def alg31(
             state[1] = hsize - 1
         else:
             p = order[t]
-        b = choose_label(dom, p, ustream[t], weights, weighted)
+        b = choose_label(dom, p, ustream[t], weights[wrow(wclass, p)], weighted)
         if b < 0:
             state[2] = p
             return _FAILED
@@ -661,7 +672,7 @@ def alg31(
             wiped = _propagate(
                 dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, 1, stats,
                 heap, hpos, hkey, state[1] if use_heap else 0, noise, weights, wlogw,
-                key_weighted, sw, swl,
+                wclass, key_weighted, sw, swl,
             )  # fmt: skip
             if wiped >= 0:
                 state[2] = wiped
@@ -899,7 +910,8 @@ def mac_search(
     return _mac_search(
         ac.dom, arcs.full, arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup, arcs.supall, ac.queue,
         ac.inq, se.stamp, se.state, se.tcell, se.tbits, se.lv_cell, se.lv_cand, se.lv_trail,
-        se.lv_scan, scan, se.order, arcs.weights, weighted, max_nodes, restart_fails,
+        se.lv_scan, scan, se.order, arcs.weights, arcs.wclass, weighted, max_nodes,
+        restart_fails,
         se.counters,
     )  # fmt: skip
 
@@ -910,7 +922,7 @@ def _mac_search(
     sup: np.ndarray, supall: np.ndarray, queue: np.ndarray, inq: np.ndarray,
     stamp: np.ndarray, state: np.ndarray, tcell: np.ndarray, tbits: np.ndarray,
     lv_cell: np.ndarray, lv_cand: np.ndarray, lv_trail: np.ndarray, lv_scan: np.ndarray,
-    scan: bool, order: np.ndarray, weights: np.ndarray, weighted: bool,
+    scan: bool, order: np.ndarray, weights: np.ndarray, wclass: np.ndarray, weighted: bool,
     max_nodes: int, restart_fails: int, counters: np.ndarray,
 ) -> int:  # fmt: skip
     """:func:`mac_search` with flat arguments."""
@@ -954,7 +966,7 @@ def _mac_search(
         if tcell.shape[0] - state[TLEN] < n + 1:
             return _GROW
         v = lv_cell[L]
-        b = _pick_label(lv_cand[L], weights, weighted, _rand(state))
+        b = _pick_label(lv_cand[L], weights[wrow(wclass, v)], weighted, _rand(state))
         wb = b // 64
         bit = np.uint64(1) << np.uint64(b - wb * 64)
         lv_cand[L, wb] &= ~bit
@@ -1294,12 +1306,13 @@ def block_alg31(
     """
     nb = dom0.shape[0]
     W = dom0.shape[1]
-    full, sup, supall, weights, wlogw = (
+    full, sup, supall, weights, wlogw, wclass = (
         local.full,
         local.sup,
         local.supall,
         local.weights,
         local.wlogw,
+        local.wclass,
     )
     zi = np.zeros(0, dtype=np.int64)
     zf = np.zeros(0, dtype=np.float64)
@@ -1330,7 +1343,7 @@ def block_alg31(
         if ok:
             wiped = _propagate(
                 dom, prev, full, local.ptr, local.nbr, local.sidx, sup, supall, queue, inq,
-                start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, False, zf, zf,
+                start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, wclass, False, zf, zf,
             )  # fmt: skip
             if wiped < 0:
                 if use_heap:
@@ -1340,6 +1353,7 @@ def block_alg31(
                     sw = np.empty(nb if key_weighted else 0, dtype=np.float64)
                     swl = np.empty(nb if key_weighted else 0, dtype=np.float64)
                     for i in range(nb):
+                        r = wrow(wclass, i)
                         if key_weighted:  # the sums the propagation keeps up to date
                             s = 0.0
                             sl = 0.0
@@ -1348,11 +1362,11 @@ def block_alg31(
                                 while x:
                                     a = w * 64 + ctz64(x)
                                     x &= x - np.uint64(1)
-                                    s += weights[a]
-                                    sl += wlogw[a]
+                                    s += weights[r, a]
+                                    sl += wlogw[r, a]
                             sw[i] = s
                             swl[i] = sl
-                        ent = entropy_of(dom, i, weights, wlogw, key_weighted)
+                        ent = entropy_of(dom, i, weights[r], wlogw[r], key_weighted)
                         hkey[i] = ent + 1e-6 * noise[i]
                     heap_build(hheap, hpos, hkey, nb)
                     hp = Heap(hheap, hpos, hkey, noise, sw, swl)
@@ -1416,8 +1430,9 @@ def blocks_sweep(
         lnbr = np.empty(max(deg, 1), dtype=np.int64)
         lsidx = np.empty(max(deg, 1), dtype=np.int64)
         k = block_catalog(arcs, doms, grid, cells, dom0, lptr, lnbr, lsidx)
+        lclass = arcs.wclass[cells].copy() if arcs.wclass.shape[0] > 1 else arcs.wclass
         local = Arcs(arcs.full, lptr, lnbr[:k].copy(), lsidx[:k].copy(), arcs.sup,
-                     arcs.supall, arcs.weights, arcs.wlogw)  # fmt: skip
+                     arcs.supall, arcs.weights, arcs.wlogw, lclass)  # fmt: skip
         lgrid = np.empty(nb, dtype=np.int32)
         if block_alg31(local, dom0, scan, retries, use_heap, weighted, key_weighted, rng,
                        lgrid, counters):  # fmt: skip

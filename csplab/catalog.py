@@ -32,7 +32,8 @@ from __future__ import annotations
 
 import weakref
 from collections import deque
-from typing import Any, NamedTuple
+from collections.abc import Callable
+from typing import Any, NamedTuple, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -119,12 +120,17 @@ class SupportTables(NamedTuple):
     full: NDArray[np.uint64]  #: ``(W,)`` bitset of every label
     sup: NDArray[np.uint64]  #: ``(2R, K, W)`` supports of each label
     supall: NDArray[np.uint64]  #: ``(2R, W)`` union of the supports of all labels
-    weights: NDArray[np.float64]  #: ``(K,)``
-    wlogw: NDArray[np.float64]  #: ``(K,)`` ``w log w`` (0 where ``w = 0``)
+    weights: NDArray[np.float64]  #: ``(T, K)`` per weight class
+    wlogw: NDArray[np.float64]  #: ``(T, K)`` ``w log w`` (0 where ``w = 0``)
+    #: ``(n,)`` each cell's weight class, or ``(1,)``: class 0 for every cell
+    wclass: NDArray[np.int64]
 
 
-def support_tables(relations: NDArray[np.bool_], weights: ArrayLike) -> SupportTables:
-    """The :class:`SupportTables` of ``relations`` (``(R, K, K)``) and label ``weights``."""
+def support_tables(
+    relations: NDArray[np.bool_], weights: ArrayLike, wclass: ArrayLike | None = None
+) -> SupportTables:
+    """The :class:`SupportTables` of ``relations`` (``(R, K, K)``) and label ``weights``
+    (``(K,)``, or ``(T, K)`` per weight class with each cell's class ``wclass``)."""
     R, K = relations.shape[0], relations.shape[1]
     W = words(K)
     both = np.empty((2 * R, K, K), dtype=bool)
@@ -133,10 +139,12 @@ def support_tables(relations: NDArray[np.bool_], weights: ArrayLike) -> SupportT
     sup = pack(both.reshape(2 * R * K, K)).reshape(2 * R, K, W)
     supall = pack(both.any(axis=1))  # (2R, W): union of supports of all labels
     full = pack(np.ones((1, K), dtype=bool))[0]
-    w = np.ascontiguousarray(np.asarray(weights, dtype=np.float64))
+    w = np.ascontiguousarray(np.asarray(weights, dtype=np.float64).reshape(-1, K))
     with np.errstate(divide="ignore", invalid="ignore"):
-        wlogw = np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0)
-    return SupportTables(full, sup, supall, w, wlogw)
+        wlogw = np.ascontiguousarray(np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0))
+    wc = np.zeros(1, dtype=np.int64) if wclass is None else np.ascontiguousarray(
+        np.asarray(wclass, dtype=np.int64).reshape(-1))  # fmt: skip
+    return SupportTables(full, sup, supall, w, wlogw, wc)
 
 
 class _Compiled:
@@ -164,7 +172,7 @@ class _Compiled:
             self.nbr = np.empty(ends, dtype=np.int64)
             self.sidx = np.empty(ends, dtype=np.int64)
             kern.arc_csr(np.ascontiguousarray(a, dtype=np.int64), self.ptr, self.nbr, self.sidx)
-        t = support_tables(problem.relations, problem.weights)
+        t = support_tables(problem.relations, *problem.weight_classes())
         self.sup, self.supall, self.full = t.sup, t.supall, t.full
         self.n, self.K, self.W = n, K, W
         #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
@@ -173,11 +181,11 @@ class _Compiled:
         self._doms: NDArray[np.uint64] | None = None  # packed_domains(), built on demand
         #: per weighting, the entropies (and weight sums) of that catalog
         self.entropies: dict[bool, tuple[Any, Any, Any]] = {}
-        self.weights, self.wlogw = t.weights, t.wlogw
+        self.weights, self.wlogw, self.wclass = t.weights, t.wlogw, t.wclass
         # the same arrays as one kernel argument
         self.arcs = kern.Arcs(
             self.full, self.ptr, self.nbr, self.sidx, self.sup, self.supall, self.weights,
-            self.wlogw,
+            self.wlogw, self.wclass,
         )  # fmt: skip
 
     def packed_domains(self, problem: Problem) -> NDArray[np.uint64]:
@@ -489,7 +497,8 @@ def solve_block_arrays(
         return np.ascontiguousarray(x, dtype=np.int64)
 
     local = kern.Arcs(tables.full, i64(block.lptr), i64(block.lnbr), i64(block.lsidx),
-                      tables.sup, tables.supall, tables.weights, tables.wlogw)  # fmt: skip
+                      tables.sup, tables.supall, tables.weights, tables.wlogw,
+                      tables.wclass)  # fmt: skip
     nb = block.dom0.shape[0]
     lgrid = np.empty(nb, dtype=np.int32)
     counters = np.zeros(4, dtype=np.int64)
@@ -549,6 +558,24 @@ def _check_catalog(problem: Problem, catalog: ArrayLike) -> NDArray[np.bool_]:
     return C
 
 
+_F = TypeVar("_F", bound=Callable[..., Any])
+
+
+def _contract_of(twin: Callable[..., Any]) -> Callable[[_F], _F]:
+    """Decorator: append ``twin``'s sections from ``Parameters`` on to the decorated
+    function's docstring, for a second implementation of the same contract (its text is
+    written once; nothing when docstrings are stripped, ``python -OO``)."""
+
+    def give(f: _F) -> _F:
+        doc, contract = f.__doc__, twin.__doc__
+        if doc and contract and "    Parameters\n" in contract:
+            head = contract[contract.index("    Parameters\n") :]
+            f.__doc__ = doc.rstrip() + "\n\n" + head.rstrip() + "\n    "
+        return f
+
+    return give
+
+
 def propagate(
     problem: Problem, catalog: ArrayLike, changed: ArrayLike | None = None
 ) -> tuple[NDArray[np.bool_], bool]:
@@ -594,34 +621,14 @@ def assign(
     return propagate(problem, C, [cell])
 
 
+@_contract_of(propagate)
 def propagate_reference(
     problem: Problem, catalog: ArrayLike, changed: ArrayLike | None = None
 ) -> tuple[NDArray[np.bool_], bool]:
     """Slow, literal Alg. 3.2/3.3 (a stack of cells, statement 3.6 per neighbour).
 
-    Same contract as :func:`propagate`; used to test the compiled kernel.
-
-    Parameters
-    ----------
-    problem : Problem
-        The problem whose arcs are propagated.
-    catalog : bool array ``(n, K)`` or ``(*shape, K)``
-        Not modified.
-    changed : array of cell indices, optional
-        Cells whose entries were removed since the catalog was last consistent (default:
-        all cells). Propagation starts from these.
-
-    Returns
-    -------
-    catalog : bool array ``(n, K)``
-        The largest arc-consistent catalog inside the given one.
-    ok : bool
-        ``False`` if some cell lost every label (a wipe-out); the catalog is then partial.
-
-    Raises
-    ------
-    InputError
-        When ``catalog`` has neither shape ``(n, K)`` nor ``(*shape, K)``.
+    Same contract as :func:`propagate`, whose Parameters, Returns and Raises are appended
+    here (one text for the twins); used to test the compiled kernel.
     """
     C = _check_catalog(problem, catalog).copy()
     adj = reference_adjacency(problem)

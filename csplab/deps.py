@@ -43,6 +43,8 @@ EXTRAS: dict[str, str] = {
     "mapbox_earcut": "mesh",
     "maxflow": "baselines",
     "skimage": "baselines",
+    "starlette": "web",
+    "uvicorn": "web",
 }
 
 

@@ -172,6 +172,12 @@ class Problem:
         ``(src, dst, relation)``: ``relations[r, label[src], label[dst]]`` must hold.
     weights : array_like of float, optional
         Per-label weights for weighted label choice and entropy (default: all ones).
+    value_weights : (array_like, array_like), optional
+        Weights per weight class instead, for problems whose values mean different things
+        in different cells (continuous synthesis: a value is a state of the cell's vertex
+        or edge type): a ``(T, K)`` table and each cell's class, ``(n,)`` ints in
+        ``0..T-1``. The weighted choice and entropy of a cell read its class's row
+        (:meth:`weight_classes`); ``weights`` then stays the default.
     names : sequence of str, optional
         Label names.
     relation_names : sequence of str, optional
@@ -215,6 +221,7 @@ class Problem:
         arcs: ArrayLike,
         *,
         weights: ArrayLike | None = None,
+        value_weights: tuple[ArrayLike, ArrayLike] | None = None,
         names: Sequence[str] | None = None,
         relation_names: Sequence[str] | None = None,
         unary: Sequence[Unary] = (),
@@ -260,6 +267,20 @@ class Problem:
         w = np.ones(K) if weights is None else np.array(weights, dtype=np.float64).reshape(-1)
         if w.shape != (K,) or not np.all(np.isfinite(w)) or np.any(w < 0):
             raise InputError(f"weights must be {K} finite non-negative numbers")
+        vw: tuple[NDArray[np.float64], NDArray[np.int64]] | None = None
+        if value_weights is not None:
+            tab = np.array(value_weights[0], dtype=np.float64)
+            cls = np.array(value_weights[1], dtype=np.int64).reshape(-1)
+            if tab.ndim != 2 or tab.shape[1] != K or not len(tab):
+                raise InputError(f"value_weights: the table must have shape (T, {K})")
+            if not np.all(np.isfinite(tab)) or np.any(tab < 0):
+                raise InputError("value_weights: weights must be finite non-negative numbers")
+            if cls.shape != (n,) or (n and (cls.min() < 0 or cls.max() >= len(tab))):
+                raise InputError(f"value_weights: one class in 0..{len(tab) - 1} per cell "
+                                 f"({n}) is needed")  # fmt: skip
+            tab.setflags(write=False)
+            cls.setflags(write=False)
+            vw = (tab, cls)
         if names is not None:
             names = tuple(str(s) for s in names)
             if len(names) != K:
@@ -281,6 +302,7 @@ class Problem:
         self.relations: NDArray[np.bool_] = rel
         self.arcs: NDArray[np.int64] = a
         self.weights: NDArray[np.float64] = w
+        self.value_weights: tuple[NDArray[np.float64], NDArray[np.int64]] | None = vw
         self.names: tuple[str, ...] | None = names
         self.relation_names: tuple[str, ...] | None = relation_names
         self.unary: tuple[Unary, ...] = tuple(unary)
@@ -290,6 +312,27 @@ class Problem:
         self.constraints: tuple[Constraint, ...] = tuple(constraints)
         for c in self.constraints:
             c.validate(self)
+
+    def weight_classes(self) -> tuple[NDArray[np.float64], NDArray[np.int64] | None]:
+        """The weights the weighted choice reads: a ``(T, K)`` table and each cell's class
+        (``value_weights``), or ``weights`` as a one-row table and ``None`` (every cell
+        class 0).
+
+        Returns
+        -------
+        table : float array ``(T, K)``
+        classes : int array ``(n,)`` or None
+
+        Examples
+        --------
+        >>> P = Problem((2,), [[1, 1], [1, 1]], [[[1, 1], [1, 1]]], [[0, 1, 0]],
+        ...             value_weights=([[1, 0], [0, 1]], [0, 1]))
+        >>> P.weight_classes()[0].tolist(), P.weight_classes()[1].tolist()
+        ([[1.0, 0.0], [0.0, 1.0]], [0, 1])
+        """
+        if self.value_weights is None:
+            return self.weights.reshape(1, -1), None
+        return self.value_weights
 
     # ------------------------------------------------------------------ sizes
     @property
@@ -530,8 +573,9 @@ class Problem:
         derived problem is built; a finished problem is never mutated)."""
         args: dict[str, Any] = dict(
             shape=self.shape, domains=self.domains, relations=self.relations, arcs=self.arcs,
-            weights=self.weights, names=self.names, relation_names=self.relation_names,
-            unary=self.unary, base_domains=self.base_domains, name=self.name, meta=self.meta,
+            weights=self.weights, value_weights=self.value_weights, names=self.names,
+            relation_names=self.relation_names, unary=self.unary,
+            base_domains=self.base_domains, name=self.name, meta=self.meta,
             positions=self.positions, constraints=self.constraints,
         )  # fmt: skip
         args.update(changes)
@@ -760,6 +804,8 @@ class Problem:
             self.relations,
             arcs,
             weights=self.weights,
+            value_weights=None if self.value_weights is None else (
+                self.value_weights[0], self.value_weights[1][idx]),
             names=self.names,
             relation_names=self.relation_names,
             name=self.name,

@@ -14,14 +14,45 @@ from __future__ import annotations
 
 import sys
 import threading
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 from typing import TypeVar
 
-__all__ = ["DELAY_S", "notice_after", "progress_bar"]
+__all__ = ["DELAY_S", "listen", "notice_after", "progress_bar"]
 
 T = TypeVar("T")
 DELAY_S = 2.0  # seconds before a bar appears
+Listener = Callable[[str, int, "int | None"], None]
+_LOCAL = threading.local()  # the listener of this thread (a web page following a run)
+
+
+@contextmanager
+def listen(callback: Listener) -> Iterator[None]:
+    """Send the bars of this thread to ``callback(desc, done, total)`` instead of stderr.
+
+    A web page follows a long run this way (:mod:`csplab.web` streams the counts as
+    server-sent events): while the ``with`` block runs, every :func:`progress_bar` that is
+    ``enabled`` in this thread calls ``callback`` once per item and draws nothing.
+
+    Parameters
+    ----------
+    callback : callable
+        ``callback(desc, done, total)``; ``total`` is ``None`` when unknown.
+
+    Examples
+    --------
+    >>> seen = []
+    >>> with listen(lambda d, n, t: seen.append((d, n, t))):
+    ...     _ = list(progress_bar("ab", total=2, desc="cells", enabled=True))
+    >>> seen
+    [('cells', 0, 2), ('cells', 1, 2), ('cells', 2, 2)]
+    """
+    old = getattr(_LOCAL, "callback", None)
+    _LOCAL.callback = callback
+    try:
+        yield
+    finally:
+        _LOCAL.callback = old
 
 
 def progress_bar(
@@ -30,6 +61,13 @@ def progress_bar(
     """``items`` with a bar on stderr when ``enabled`` (shown after :data:`DELAY_S`)."""
     if not enabled:
         yield from items
+        return
+    callback = getattr(_LOCAL, "callback", None)
+    if callback is not None:
+        callback(desc, 0, total)
+        for n, item in enumerate(items, start=1):
+            yield item
+            callback(desc, n, total)
         return
     from tqdm import tqdm
 

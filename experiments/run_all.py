@@ -74,6 +74,8 @@ RUNS: dict[str, tuple[str, dict[str, Any]]] = {
                 ["skyscrapers", "terrain", "fractals", "arches", "houses", "pentagons"], "20x20x8"
             ),
             "seeds": 2,
+            "choices": ["weighted"],
+            "grounds": ["auto"],
         },
     ),
     "constraints": ("constraints", {}),

@@ -59,6 +59,8 @@ CASES = {
     "synthesize asp": (["clingo"], "asp", ["synthesize", *S, "--solver", "asp"]),
     "experiment solver sat": (["pysat"], "sat", _experiment("--solver", "sat")),
     "experiment solver cpsat": (["ortools"], "cpsat", _experiment("--solver", "catalog,cpsat")),
+    "serve starlette": (["starlette"], "web", ["serve", "--port", "9"]),
+    "serve uvicorn": (["uvicorn"], "web", ["serve", "--port", "9"]),
     "experiment scheduler": (
         ["distributed"],
         "dask",

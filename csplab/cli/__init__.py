@@ -1,11 +1,14 @@
 """The ``csplab`` command line.
 
-Each subcommand lives in its own module, which declares ``HELP`` (one line), optionally
-``DESCRIPTION`` (or a ``description()`` function; ``RAW_DESCRIPTION = True`` keeps its
-layout), ``add_arguments(parser)`` and ``run(args) -> int``; :data:`COMMANDS` maps names to
-modules, and :func:`build_parser` builds every subparser the same way. Exit codes: 0 success,
-1 the algorithm failed / the problem is unsatisfiable / a check found problems,
-2 bad input (one line on stderr, no traceback).
+Each subcommand lives in its own module, which declares ``add_arguments(parser)`` and
+``run(args) -> int``; its docstring is its help, one text: the first line (the command's
+name in double backquotes, a colon, what it does) is the one-line help of ``csplab --help``,
+the whole docstring (what it does, its exit codes) the description of ``csplab NAME --help``.
+A ``HELP`` string, a ``DESCRIPTION`` string (``RAW_DESCRIPTION = True`` keeps its layout) or
+a ``description()`` function (a text computed when the parser is built) replaces them.
+:data:`COMMANDS` maps names to modules, and :func:`build_parser` builds every subparser the
+same way. Exit codes: 0 success, 1 the algorithm failed / the problem is unsatisfiable / a
+check found problems, 2 bad input (one line on stderr, no traceback).
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import re
 import sys
 import warnings
 from collections.abc import Sequence
+from types import ModuleType
 
 from csplab.cli.common import readable
 from csplab.errors import CsplabError
@@ -39,6 +43,7 @@ COMMANDS: dict[str, str] = {
     "experiment": "csplab.cli.experiment",
     "baseline": "csplab.cli.baseline",
     "world": "csplab.cli.world",
+    "serve": "csplab.cli.serve",
 }
 
 
@@ -76,6 +81,49 @@ def _attach_negative_values(words: list[str]) -> list[str]:
     return out
 
 
+_ROLE = re.compile(r":[a-z]+:`~?([^`]+)`")
+
+
+_SUMMARY = re.compile(r"``csplab [\w-]+``: (.*?)\.?$")
+
+
+def _summary(mod: ModuleType) -> str:
+    r"""A command's one-line help: ``HELP``, else its docstring's first line, after the name
+    it starts with (as in "``csplab NAME``: what it does.").
+
+    Examples
+    --------
+    >>> import types
+    >>> _summary(types.ModuleType("m", "``csplab m``: do ``x`` once.\n\nMore."))
+    'do `x` once'
+    """
+    if hasattr(mod, "HELP"):
+        return str(mod.HELP)
+    first = (mod.__doc__ or "").strip().partition("\n")[0]
+    m = _SUMMARY.match(first)
+    return (m.group(1) if m else first).replace("``", "`")
+
+
+def _description(mod: ModuleType) -> tuple[str | None, bool]:
+    r"""A command's ``--help`` text and whether its layout is kept: ``description()``, else
+    ``DESCRIPTION``, else the module docstring with its reST markup made plain.
+
+    Examples
+    --------
+    >>> import types
+    >>> m = types.ModuleType("m", "``csplab m``: see :func:`~csplab.solve`.\n\nExit 0.")
+    >>> _description(m)
+    ('`csplab m`: see `csplab.solve`.\n\nExit 0.', True)
+    """
+    if hasattr(mod, "description"):
+        return mod.description(), False
+    if hasattr(mod, "DESCRIPTION"):
+        return mod.DESCRIPTION, bool(getattr(mod, "RAW_DESCRIPTION", False))
+    if not mod.__doc__:
+        return None, False
+    return _ROLE.sub(r"`\1`", mod.__doc__.strip()).replace("``", "`"), True
+
+
 def build_parser(only: str | None = None) -> argparse.ArgumentParser:
     """The parser of every command; with ``only``, that command's parser in full and the
     others as bare names (their modules are not imported: a faster start)."""
@@ -93,14 +141,11 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             sub.add_parser(name)
             continue
         mod = importlib.import_module(modname)
-        desc = getattr(mod, "DESCRIPTION", None)
-        if hasattr(mod, "description"):
-            desc = mod.description()
-        raw = getattr(mod, "RAW_DESCRIPTION", False)
+        desc, raw = _description(mod)
         p = sub.add_parser(
             name,
-            help=mod.HELP,
-            description=desc or mod.HELP,
+            help=_summary(mod),
+            description=desc or _summary(mod),
             formatter_class=argparse.RawDescriptionHelpFormatter if raw else argparse.HelpFormatter,
         )
         mod.add_arguments(p)
@@ -114,7 +159,7 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: object
 
 
 # commands that run csplab's numba kernels (the first run compiles them: one line on stderr)
-_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check", "check-certificate"}
+_KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check", "check-certificate", "serve"}
 
 
 _ANNOUNCING = [False]

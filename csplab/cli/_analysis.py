@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from csplab.cli.common import load_model, model_options
+from csplab.cli.common import check_output_path, load_model, model_options
 from csplab.errors import InputError
 from csplab.example import ExampleModel
+from csplab.io.common import write_atomic
 from csplab.io.ruleset import RuleSet
 from csplab.result import Verdict
 
@@ -57,13 +59,26 @@ def witness_grid(w: dict[str, Any]) -> np.ndarray:
     return g
 
 
+def add_witness_out(p: argparse.ArgumentParser) -> None:
+    """``--out FILE``: where ``prove`` and ``witness`` save a failing run."""
+    p.add_argument("--out", help="save the failing run as a .png picture or .json")
+
+
+def check_witness_out(path: str | None) -> None:
+    """Refuse a bad ``--out`` (not ``.png`` or ``.json``, or not writable) before the work."""
+    if path:
+        if Path(path).suffix not in (".png", ".json"):
+            raise InputError(f"--out {path}: use a .png picture or a .json file")
+        check_output_path(path, "--out")
+
+
 def save_witness(w: dict[str, Any], path: str, example: ExampleModel | RuleSet) -> None:
+    """Write a failing run to ``path`` (checked by :func:`check_witness_out`): its JSON, or
+    a picture of its grid (atomically)."""
     p = Path(path)
     if p.suffix == ".json":
-        p.write_text(json.dumps(w, default=_plain, indent=1))
+        write_atomic(p, json.dumps(w, default=_plain, indent=1).encode("utf-8"))
         return
-    if p.suffix != ".png":
-        raise InputError(f"--out {path}: use a .png picture or a .json file")
     from csplab.render import save_png
 
     save_png(witness_grid(w), p, names=example.names)

@@ -147,6 +147,9 @@ def synthesize(
         raise InputError(f"--spacing must be positive, not {args.spacing}")
     if dim == 3 and args.lines != "lattice":
         raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
+    ground = getattr(args, "ground", "auto")
+    if dim == 2 and ground not in ("auto", "none", None):
+        raise InputError(f"--ground {ground}: a ground applies to polyhedral models (3D)")
     size = region(args, dim)
     boundary = boundary_label(args, example)
     fmt = polygon_output(args.out, gives=type(example).__name__, args=args)
@@ -171,6 +174,11 @@ def synthesize(
             settings[key] = (
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
+    if dim == 3 and "choice" not in opts and cls.option("choice") is not None:
+        o = cls.option("choice")
+        if o is not None and (o.values is None or "weighted" in o.values):
+            settings["choice"] = ("weighted (continuous default: by how much of the example "
+                                  "each state covers; --choice uniform: the thesis')")
     settings["restarts"] = restarts
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
@@ -179,11 +187,12 @@ def synthesize(
 
     _, seed = make_rng(args.seed)  # the seed the header prints: it reproduces every attempt
     common = dict(solver=args.solver, rng=seed, spacing=args.spacing, snap=args.snap,
-                  boundary=boundary, restarts=restarts, fallback=fallback)  # fmt: skip
+                  boundary=boundary, restarts=restarts, fallback=fallback,
+                  ground=ground if dim == 3 else None)  # fmt: skip
     if dim == 3:  # the arrangement's estimate (Sec. 4.5.7) is refused over the budget
         common["max_memory"] = int(budget)
     cons = user_constraints(args, example)
-    if cls.takes("progress"):
+    if cls.option("progress") is not None:
         opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
     if cons is not None and dim == 2:
         raise InputError("--constraints: polygon models (2D) take no user constraints yet")
@@ -202,6 +211,10 @@ def synthesize(
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
+    opened: tuple[str, ...] = getattr(csp, "ground", ())  # 3D only
+    if dim == 3:
+        open_faces = ",".join(opened) or "none"
+        settings["ground"] = open_faces + (" (the example's)" if ground == "auto" else "")
     if dim == 3:
         from csplab.continuous.space import estimate3
 
@@ -239,10 +252,15 @@ def synthesize(
             outcome=outcome(r.status) if s.ok or r.status != "solved" else "not solved",
             proof=r.stats.get("proof") if r.status == "unsat" else None,
         )  # fmt: skip
-        if isinstance(example, PolyhedralModel) and isinstance(s.model, PolyhedralModel):
+        snapped = csp.example  # (as synthesized: its vertices on the lattice)
+        if isinstance(snapped, PolyhedralModel) and isinstance(s.model, PolyhedralModel):
             from csplab.continuous.resemblance import resemblance3  # from the geometry alone
 
-            d["resemblance"] = resemblance3(example, s.model).to_dict()
+            floor = csp.region()[2] if "z-" in opened else None  # the ground's height
+            # through bounding volumes: the original example against the output with its
+            # curved geometry back (the proxy is what was synthesized, not what it resembles)
+            like = s.bounded.example if s.bounded is not None else snapped
+            d["resemblance"] = resemblance3(like, s.model, ground=floor).to_dict()
         if s.bounded is not None:
             d["bounding_volumes"] = s.bounded.describe()
         print(json.dumps(d))
@@ -349,6 +367,14 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     out = load_model(args.grid)
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
+    ground = getattr(args, "ground", "auto")
+    if ground == "auto":
+        ground = example.meta.get("ground") if isinstance(example, PolyhedralModel) else None
+    from csplab.continuous.csp3d import ground_faces
+
+    faces = ground_faces(ground)
+    if faces and not isinstance(out, PolyhedralModel):
+        raise InputError(f"--ground {ground}: a ground applies to polyhedral models (3D)")
     bounded = None
     if isinstance(example, PolyhedralModel) and isinstance(out, PolyhedralModel):
         from csplab.continuous.bounding import bounding_volumes
@@ -357,7 +383,10 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     if bounded is not None and isinstance(out, PolyhedralModel):
         from csplab.continuous.boundcheck import bounded_violations
 
-        v = bounded_violations(bounded, out)
+        region = out.bounds if faces and len(out) else None
+        v = bounded_violations(bounded, out, region=region, ground=faces)
+    elif faces and len(out):  # the output's box stands for its region (solids reach its faces)
+        v = violations(example, out, region=out.bounds, ground=faces)
     else:
         v = violations(example, out)
     if isinstance(out, PolyhedralModel):  # the user constraints of Sec. 4.6, on the solids

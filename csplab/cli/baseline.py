@@ -1,5 +1,11 @@
-"""``csplab baseline NAME MODEL --size ... --out FILE``: a baseline method on the same inputs
-as model synthesis (its output is an ordinary grid: ``csplab check`` counts its violations)."""
+"""``csplab baseline``: run a baseline (texture synthesis ...) on the inputs of model synthesis.
+
+Run a baseline method on an example grid and write its output grid, an ordinary grid:
+``csplab check MODEL OUT`` then counts the adjacency constraints it breaks. Baselines:
+texture (Efros & Leung 1999 sampling or Kwatra et al. 2003 graph-cut patches) on example
+grids; geometry (Lagae et al. 2004) and retarget (Wu et al.) on closed meshes, writing a
+mesh.
+"""
 
 from __future__ import annotations
 
@@ -14,19 +20,9 @@ from csplab.cli.common import (
     add_model_option,
     check_output_path,
     input_files,
-    load_model,
-    model_options,
+    model_from_args,
 )
 from csplab.errors import InputError
-
-HELP = "run a baseline the seeds compare against (texture synthesis ...) on an example"
-DESCRIPTION = (
-    "Run a baseline method on an example grid and write its output grid; `csplab check "
-    "MODEL OUT` then counts the adjacency constraints it breaks. Baselines: "
-    "texture (Efros & Leung 1999 sampling or Kwatra et al. 2003 graph-cut patches) on "
-    "example grids; geometry (Lagae et al. 2004) and retarget (Wu et al.) on closed meshes, "
-    "writing a mesh."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -61,7 +57,7 @@ def run(args: argparse.Namespace) -> int:
     from csplab.rng import make_rng
 
     b = BASELINES[args.name]
-    example = load_model(args.model, model_options(args.model_option))
+    example = model_from_args(args)
     if b.gives == "mesh":
         return _mesh(args, b, example)
     if not isinstance(example, ExampleModel):

@@ -18,10 +18,6 @@ from csplab.cli.explain import add_fixed_args, problem_with_fixed
 from csplab.engine.alg31 import CHOICES, ORDERS
 from csplab.errors import InputError
 
-HELP = "run Alg. 3.1 and report at each step whether the chosen label was in C*"
-DESCRIPTION = __doc__
-RAW_DESCRIPTION = True  # keep the docstring's layout in --help
-
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p, size_required=True)

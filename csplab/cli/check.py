@@ -1,4 +1,11 @@
-"""``csplab check``: count violations of a grid file against an example."""
+"""``csplab check``: count the violations of a grid or polygon output file against an example.
+
+Check a grid against an example model or a tileset's rules, or an output polygon model
+against a polygon example (Eq. 4.1 on the polygons).
+
+Exit codes: 0 consistent, 1 it violates something or has unassigned cells (-1 in the .npy
+of a failed or timed-out run), 2 bad input.
+"""
 
 from __future__ import annotations
 
@@ -9,21 +16,12 @@ from csplab.cli.common import (
     add_constraints_arg,
     add_problem_args,
     load_grid,
-    load_model,
-    model_options,
+    model_from_args,
     problem_from_args,
 )
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
-
-HELP = "count the violations of a grid file (or an output polygon file) against an example"
-DESCRIPTION = (
-    "Check a grid against an example model or a tileset's rules, or an output polygon "
-    "model against a polygon example (Eq. 4.1 on the polygons). Exit 0 when it is "
-    "consistent, 1 when it violates something or has unassigned cells (-1 in the .npy "
-    "of a failed or timed-out run)."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -37,6 +35,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help=f"grid file to check ({exts}: label ids kept; .vox: colour b + 1 = label b)",
     )
     add_constraints_arg(p)
+    p.add_argument(
+        "--ground",
+        default="auto",
+        help="polyhedral models: the faces past which example and output continue, as "
+        "synthesize --ground (the output's own box stands for its region); default auto: "
+        "the example's own",
+    )
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 
@@ -44,7 +49,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.limit < 0:
         raise InputError("--limit must be >= 0")
-    model = load_model(args.model, model_options(args.model_option))
+    model = model_from_args(args)
     if isinstance(model, PolygonModel | PolyhedralModel):
         from csplab.cli import _continuous
 

@@ -1,8 +1,14 @@
-"""``csplab check-certificate``: re-verify a certificate of ``csplab prove --certificate``.
+"""``csplab check-certificate``: re-verify an infallibility certificate without the prover.
 
-The check runs :mod:`csplab.certcheck`, which shares no code with the prover. Exit codes:
-0 valid, 1 invalid (the first defect is printed), 2 bad file (missing, not JSON, not a
-certificate) or a ``--model`` whose rules differ from the certificate's.
+A certificate of ``csplab prove --certificate`` for a proved verdict holds the closed set of
+Alg. 3.6 frame states: the check re-verifies the closure, the soundness of what each state
+records, every configuration and that no catalog is empty at a point. One for a refuted
+verdict holds a failing run of Alg. 3.1, which is replayed. With ``--model``, the
+certificate's rules must be that model's. The check runs :mod:`csplab.certcheck`, which
+shares no code with the prover.
+
+Exit codes: 0 valid, 1 invalid (the first defect is printed), 2 bad file (missing, not
+JSON, not a certificate) or a ``--model`` whose rules differ from the certificate's.
 """
 
 from __future__ import annotations
@@ -13,15 +19,6 @@ import time
 from csplab.certcheck import check_certificate, load_certificate
 from csplab.cli.common import add_model_option
 from csplab.errors import InputError
-
-HELP = "re-verify an infallibility certificate without the prover's code"
-DESCRIPTION = (
-    "Re-verify a certificate written by `csplab prove --certificate`: a proved verdict's "
-    "closed set of Alg. 3.6 frame states (closure, soundness of what each state records, "
-    "every configuration, no empty catalog at a point) or a refuted verdict's failing run "
-    "of Alg. 3.1 (replayed). With --model, the certificate's rules must be that model's. "
-    "Exit 0 valid, 1 invalid, 2 bad file."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -115,6 +115,23 @@ def load_model(spec: str, options: dict[str, Any] | None = None) -> Model:
     return model
 
 
+def model_from_args(args: argparse.Namespace) -> Model:
+    """The model of a command's ``MODEL`` argument, read with its ``--model-option`` values
+    (:func:`load_model`, :func:`model_options`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``model`` and ``model_option``.
+
+    Returns
+    -------
+    Model
+        The example model, rule set or continuous model.
+    """
+    return load_model(args.model, model_options(args.model_option))
+
+
 def input_files(args: argparse.Namespace) -> list[tuple[str, Path]]:
     """The files a command reads, as ``(role, path)`` pairs: the model (when it is a file,
     not a built-in name), every ``--constraints`` file, the grid ``check`` reads and a
@@ -357,8 +374,9 @@ def add_memory_limit_arg(p: argparse.ArgumentParser) -> None:
         "--memory-limit",
         type=float,
         metavar="GB",
+        # "%%": argparse %-formats help texts (a lone "%" made every --help a traceback)
         help="refuse, before the work, a run whose estimated peak memory is larger (default: "
-        f"{MEMORY_SHARE:.0%} of the machine's RAM, or the memory available when less)",
+        f"{MEMORY_SHARE:.0%}% of the machine's RAM, or the memory available when less)",
     )
 
 

@@ -1,4 +1,12 @@
-"""``csplab count``: the number of models consistent with an example (thesis Sec. 3.2)."""
+"""``csplab count``: count the models D_E(n) consistent with an example (thesis Sec. 3.2).
+
+Count exactly (Python integers) the models of a given size consistent with an example:
+transfer matrix over slices for models narrow in one or two axes, Ganak (#SAT) or SAT
+enumeration otherwise; ``--method approxmc`` gives an (epsilon, delta) approximation.
+
+Exit codes: 0 there is at least one model, 1 there is none, 3 ``--time-limit`` ran out
+first (undecided), 2 bad input.
+"""
 
 from __future__ import annotations
 
@@ -11,21 +19,11 @@ from csplab.cli.common import (
     add_memory_limit_arg,
     add_problem_args,
     check_time_limit,
-    load_model,
-    model_options,
+    model_from_args,
     problem_from_args,
 )
 from csplab.errors import InputError
 from csplab.example import ExampleModel
-
-HELP = "count the models consistent with an example: D_E(n) (Sec. 3.2)"
-DESCRIPTION = (
-    "Count exactly (Python integers) the models of a given size consistent "
-    "with an example: transfer matrix over slices for models narrow in one or two "
-    "axes, Ganak (#SAT) or SAT enumeration otherwise; --method approxmc gives an "
-    "(epsilon, delta) approximation. Exit 0 when there is at least one model, 1 when "
-    "there is none, 3 when --time-limit ran out first (undecided), 2 on bad input."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -98,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
     )
 
     time_limit = check_time_limit(args.time_limit)
-    example = load_model(args.model, model_options(args.model_option))
+    example = model_from_args(args)
     problem = problem_from_args(args, example)
     try:
         c = count_solutions(

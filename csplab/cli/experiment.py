@@ -60,7 +60,6 @@ _COMMON: dict[str, tuple[tuple[str, ...], dict[str, Any]]] = {
 }  # fmt: skip
 
 
-HELP = "run a thesis experiment (`csplab experiment list` lists them)"
 
 
 def description() -> str:

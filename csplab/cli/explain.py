@@ -1,5 +1,7 @@
-"""``csplab explain``: why is a problem unsatisfiable? A minimal conflicting set of its
-fixed cells, boundary faces and masks (an assumption core, shrunk by deletion).
+"""``csplab explain``: explain why a problem is unsatisfiable (minimal conflicting constraints).
+
+A minimal conflicting set of its fixed cells, boundary faces and masks (an assumption core,
+shrunk by deletion).
 
 Fixed cells come from ``--fixed FILE``: a ``.npy`` integer array of the output size with -1
 for free cells, or a text file with one cell per line, ``x y [z ...] label`` (``#``
@@ -20,13 +22,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.cli.common import add_problem_args, load_model, model_options, problem_from_args
+from csplab.cli.common import add_problem_args, model_from_args, problem_from_args
 from csplab.errors import FormatError, InputError
 from csplab.problem import Problem
-
-HELP = "explain why a problem is unsatisfiable (minimal conflicting constraints)"
-DESCRIPTION = __doc__
-RAW_DESCRIPTION = True  # keep the docstring's layout in --help
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -93,7 +91,7 @@ def problem_with_fixed(args: argparse.Namespace) -> tuple[Any, Problem]:
     """
     from csplab.grids import build_unary
 
-    model = load_model(args.model, model_options(args.model_option))
+    model = model_from_args(args)
     problem = problem_from_args(args, model)
     extra = []
     if getattr(args, "fixed", None):

@@ -1,11 +1,9 @@
-"""``csplab info``: solvers, their dependencies, the built-in examples and the file formats."""
+"""``csplab info``: list the solvers (whether installed), built-in examples and file formats."""
 
 from __future__ import annotations
 
 import argparse
 import json
-
-HELP = "list solvers (and whether they are installed), built-in examples and file formats"
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

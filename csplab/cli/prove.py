@@ -1,5 +1,11 @@
 """``csplab prove``: prove that Alg. 3.1 never fails on an example (Alg. 3.6, Thm. 3.3.6).
 
+Enumerate every window state Alg. 3.6 can reach with the given region size (Sec. 3.3.7)
+and check that its catalog is never empty; then Alg. 3.1 never fails on the model, at any
+output size (Theorem 3.3.6). Examples (open grids) and tilesets (not periodic; their face
+rules apply). ``--certificate`` writes what the verdict rests on, for
+``csplab check-certificate``.
+
 Exit codes: 0 proven infallible, 1 refuted (fallible; the failing run is printed and can
 be saved with ``--out``), 3 undecided (not provable with this region, or the state budget
 ran out; the state count is printed), 2 bad input.
@@ -8,11 +14,12 @@ ran out; the state count is printed), 2 bad input.
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
 from csplab.analysis import corner_condition, prove_infallible
 from csplab.cli._analysis import (
     ORDER_HELP,
+    add_witness_out,
+    check_witness_out,
     describe_run,
     load_analysis_model,
     print_verdict,
@@ -21,16 +28,6 @@ from csplab.cli._analysis import (
 )
 from csplab.cli.common import add_model_option, check_output_path
 from csplab.errors import InputError
-
-HELP = "prove a model infallible (Alg. 3.1 never fails) by region enumeration"
-DESCRIPTION = (
-    "Enumerate every window state Alg. 3.6 can reach with the given region "
-    "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
-    "fails on the model, at any output size (Theorem 3.3.6). Examples (open grids) and "
-    "tilesets (not periodic; their face rules apply). --certificate writes what the verdict rests "
-    "on, for `csplab check-certificate`. Exit 0 proven, 1 refuted (fallible), 3 undecided, "
-    "2 bad input."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -46,7 +43,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "face=label,...; a tileset's is its file's own",
     )
     p.add_argument("--expect-hash", help="re-check a proof: exit 3 unless the hash matches")
-    p.add_argument("--out", help="save the failing run as a .png picture or .json")
+    add_witness_out(p)
     p.add_argument(
         "--certificate",
         metavar="FILE",
@@ -57,10 +54,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.out:
-        if Path(args.out).suffix not in (".png", ".json"):
-            raise InputError(f"--out {args.out}: use a .png picture or a .json file")
-        check_output_path(args.out, "--out")
+    check_witness_out(args.out)
     if args.certificate:
         check_output_path(args.certificate, "--certificate")
     E = load_analysis_model(args.model, args.model_option)

@@ -1,4 +1,4 @@
-"""``csplab reduction``: the thesis' reductions, generated and checked.
+"""``csplab reduction``: the thesis' reductions to model consistency, generated and checked.
 
 ``csplab reduction planar3sat`` builds Theorem 3.3.4's incomplete model for a random planar
 3-SAT formula (Fig. 3.7); ``csplab reduction lba`` runs Theorem 5.2.4's construction for a
@@ -14,9 +14,6 @@ from typing import Any
 
 from csplab.cli.common import check_output_path
 from csplab.errors import InputError
-
-HELP = "Theorem 3.3.4 (planar 3-SAT) and 5.2.4 (LBA) reductions to model consistency"
-DESCRIPTION = "Generate and check the thesis' reductions to model consistency."
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

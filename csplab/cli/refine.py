@@ -1,5 +1,9 @@
 """``csplab refine``: look for an infallible refinement E_I of a fallible example (Sec. 3.3.8).
 
+Search label splits (rename the occurrences of a label whose neighbour in one direction
+lies in a set) for an example E_I with f(E_I) = E_F that the region prover shows
+infallible and whose models map onto the example's (Eq. 3.13, checked by enumeration).
+
 Exit codes: 0 found (E_I printed as a .grid file, or written with ``--out``), 3 none found
 within the search bounds, 2 bad input.
 """
@@ -11,14 +15,6 @@ import argparse
 from csplab.analysis import to_infallible
 from csplab.cli._analysis import ORDER_HELP, load_example_model, print_verdict
 from csplab.cli.common import add_model_option, check_output_path
-
-HELP = "split labels of a fallible example into an infallible one (Sec. 3.3.8)"
-DESCRIPTION = (
-    "Search label splits (rename the occurrences of a label whose neighbour "
-    "in one direction lies in a set) for an example E_I with f(E_I) = E_F that the "
-    "region prover shows infallible and whose models map onto the example's (Eq. 3.13, "
-    "checked by enumeration). Exit 0 found, 3 not found."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

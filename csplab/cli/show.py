@@ -3,8 +3,12 @@
 Example grids (the formats of :mod:`csplab.io.registry` that give an ``ExampleModel``) are
 drawn as coloured cells in 2D and as an isometric view of the non-empty cells in 3D; rule
 sets (tilesets and samples) as a sheet of their labels (tile pictures or colours, with
-names).
-``--tiles TILESET`` draws a result grid with a tileset's pictures.
+names); polygon models (continuous model synthesis) filled in their label colours.
+``--tiles TILESET`` draws a result grid with a tileset's pictures. Cells a failed or
+timed-out run left unassigned (-1 in its .npy) are drawn dark in 2D and left out in 3D.
+An existing picture is kept unless ``--force`` is given.
+
+Exit codes: 0 on success, 2 bad input.
 """
 
 from __future__ import annotations
@@ -19,16 +23,6 @@ from csplab.cli.common import add_model_option, check_output_path, load_model, m
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
-
-HELP = "write a PNG picture of a model file (grid, tileset, sample or polygons)"
-DESCRIPTION = (
-    "Write a PNG of any model file: 2D grids as cells, 3D grids as an "
-    "isometric rendering, tilesets as a sheet of their labels, polygon models (continuous "
-    "model synthesis) filled in their label colours. Cells a failed or "
-    "timed-out run left unassigned (-1 in its .npy) are drawn dark in 2D and left out in "
-    "3D. An existing picture is kept unless --force is given. Exit 0 on success, 2 on "
-    "bad input."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

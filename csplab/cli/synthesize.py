@@ -1,4 +1,15 @@
-"""``csplab synthesize``: build a model from an example and write it."""
+"""``csplab synthesize``: build a model from an example and write it.
+
+Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 or any registered
+solver); for a polygon example (.json, .svg), continuous model synthesis in a WxH region of
+line spacings, written as .json, .svg or .png. An incomplete solver (catalog, blocks) that
+gives up after its ``--restarts`` is followed by an exact one (``--fallback``), so a
+default run ends solved, or 'unsat' with the exact solver's proof, or 'not solved' when the
+time ran out.
+
+Exit codes: 0 solved, 1 not solved or unsat (the message and ``--json`` say which), 2 bad
+input.
+"""
 
 from __future__ import annotations
 
@@ -17,8 +28,7 @@ from csplab.cli.common import (
     fallback_setting,
     input_files,
     key_values,
-    load_model,
-    model_options,
+    model_from_args,
     not_written,
     outcome,
     problem_from_args,
@@ -27,17 +37,6 @@ from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
 from csplab.grids import parse_shape
-
-HELP = "synthesize a model from an example"
-DESCRIPTION = (
-    "Synthesize a model consistent with an example model (Alg. 3.1 or 3.4 "
-    "or any registered solver); for a polygon example (.json, .svg), continuous model "
-    "synthesis in a WxH region of line spacings, written as .json, .svg or .png. An "
-    "incomplete solver (catalog, blocks) that gives up after its --restarts is followed by "
-    "an exact one (--fallback), so a default run ends solved, or 'unsat' with the exact "
-    "solver's proof, or 'not solved' when the time ran out. Exit 0 when solved, 1 when not "
-    "solved or unsat (the message and --json say which), 2 on bad input."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -105,6 +104,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="continuous models: round example vertices onto the --spacing lattice",
     )
+    p.add_argument(
+        "--ground",
+        default="auto",
+        help="polyhedral models: faces past which the example (its bounding box) and the "
+        "output (the region) continue, an infinite ground: z- (solids standing on the "
+        "bottom go on below it, none floats), a list such as z-,x-,x+, window (every face "
+        "but z+), none; default auto: the example's own (the built-in ones declare theirs)",
+    )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     add_memory_limit_arg(p)
     p.add_argument("--time-limit", type=float, help="seconds")
@@ -157,7 +164,7 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
 
     name = args.solver.partition(":")[0]
     for flag in ("order", "choice", "block", "retries", "time_limit"):
-        if flag in opts and name in solver_names() and not solver_class(name).takes(flag):
+        if flag in opts and name in solver_names() and solver_class(name).option(flag) is None:
             raise InputError(
                 f"--{flag.replace('_', '-')} does not apply to --solver {name} "
                 f"(it applies to {', '.join(solvers_taking(flag))})"
@@ -192,7 +199,7 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
     settings["restarts"] = 0 if cls.complete else args.restarts
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
-    if cls.takes("progress"):
+    if cls.option("progress") is not None:
         opts.setdefault("progress", True)  # a bar on stderr once a run takes over 2 s
     return settings
 
@@ -229,7 +236,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--restarts must be >= 0")
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
-    example = load_model(args.model, model_options(args.model_option))
+    example = model_from_args(args)
     if isinstance(example, PolygonModel | PolyhedralModel):
         from csplab.cli import _continuous
 

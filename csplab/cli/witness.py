@@ -1,5 +1,10 @@
 """``csplab witness``: find a failing run of Alg. 3.1 (smallest size, shortest prefix).
 
+Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, memoised), then
+random runs on growing outputs within ``--time-limit``; shrink a failing run (output size
+first, then choices) and print it, its seed, the first choice outside the exact catalog C*
+and what was searched.
+
 Exit codes: 0 no failure exists up to ``--max-size`` (exhaustive), 1 a failing run was
 found (printed; ``--out`` saves it), 3 nothing found but the search was not exhaustive,
 2 bad input.
@@ -14,6 +19,8 @@ from csplab.analysis import find_failure
 from csplab.analysis.witness import searched
 from csplab.cli._analysis import (
     ORDER_HELP,
+    add_witness_out,
+    check_witness_out,
     describe_run,
     load_analysis_model,
     print_verdict,
@@ -21,15 +28,6 @@ from csplab.cli._analysis import (
 )
 from csplab.cli.common import add_model_option
 from csplab.errors import InputError
-
-HELP = "find a failing run of Alg. 3.1 (or show none exists up to a size)"
-DESCRIPTION = (
-    "Search every choice sequence of Alg. 3.1 on small outputs (exhaustive, "
-    "memoised), then random runs on growing outputs within --time-limit; shrink a failing "
-    "run (output size first, then choices) and print it, its seed, the first choice "
-    "outside the exact catalog C* and what was searched. Exit 0 no failure up to "
-    "--max-size (exhaustive), 1 failure found, 3 none found (not exhaustive)."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -52,7 +50,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--late", action="store_true",
                    help="look for a late failure: inconsistent while C is not empty")  # fmt: skip
     p.add_argument("--seed", type=int, default=0, help="seed of the random runs")
-    p.add_argument("--out", help="save the failing run as a .png picture or .json")
+    add_witness_out(p)
     p.add_argument("--json", action="store_true")
     add_model_option(p)
 
@@ -60,6 +58,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     if not (math.isfinite(args.time_limit) and args.time_limit > 0):
         raise InputError(f"--time-limit {args.time_limit}: give a positive number of seconds")
+    check_witness_out(args.out)
     E = load_analysis_model(args.model, args.model_option)
     v = find_failure(
         E,

@@ -1,4 +1,14 @@
-"""``csplab world``: a rectangle of an endless, chunked, seed-deterministic world."""
+"""``csplab world``: a rectangle of an endless, chunked, seed-deterministic world.
+
+Generate the region X0:X1,Y0:Y1 of an endless world of MODEL (:class:`csplab.World`):
+chunks of ``--chunk`` cells, infinite in x and y (a 3D world has the chunk's height), whose
+content depends only on the model, the seed, the settings and the coordinates -- not on
+the visit order, the number of ``--jobs`` or earlier runs. Blocks that random choice cannot
+complete are completed exactly (SAT with their border fixed). The stitched region is
+checked against the model (its violations are printed).
+
+Exit codes: 0 the region is consistent, 1 it has violations, 2 bad input.
+"""
 
 from __future__ import annotations
 
@@ -7,20 +17,9 @@ import json
 import re
 import time
 
-from csplab.cli.common import add_model_option, check_output_path, load_model, model_options
+from csplab.cli.common import add_model_option, check_output_path, model_from_args
 from csplab.errors import InputError
 from csplab.grids import parse_boundary, parse_shape
-
-HELP = "a region of an endless chunked world (modify in blocks on an unbounded lattice)"
-DESCRIPTION = (
-    "Generate the region X0:X1,Y0:Y1 of an endless world of MODEL (csplab.World): chunks of "
-    "--chunk cells, infinite in x and y (a 3D world has the chunk's height), whose content "
-    "depends only on the model, the seed, the settings and the coordinates -- not on the "
-    "visit order, the number of --jobs or earlier runs. Blocks that random choice cannot "
-    "complete are completed exactly (SAT with their border fixed). The stitched region is "
-    "checked against the model (its violations are printed; exit 1 if any). Exit 2 on bad "
-    "input."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -92,7 +91,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--jobs must be >= 1")
     if args.out:
         check_output_path(args.out, "--out")
-    model = load_model(args.model, model_options(args.model_option))
+    model = model_from_args(args)
     from csplab.io.registry import synthesis_defaults
 
     suggested, _ = synthesis_defaults(model)

@@ -53,7 +53,7 @@ True
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -94,6 +94,7 @@ def bounded_violations(
     *,
     region: tuple[float, float, float, float, float, float] | None = None,
     outside: Mapping[str, int] | None = None,
+    ground: Sequence[str] = (),
 ) -> Violations:
     """The defects of an output synthesized through bounding volumes (see the module
     docstring): labels the example lacks (``"label"``: a box left unfilled), curved parts
@@ -107,8 +108,8 @@ def bounded_violations(
         bounding_volumes` of the original example).
     output : PolyhedralModel
         The output, with the curved geometry substituted back.
-    region, outside
-        As for :func:`~csplab.continuous.check3d.violations3`.
+    region, outside, ground
+        As for :func:`~csplab.continuous.check3d.violations3` (Eq. 4.1 on the proxy).
 
     Returns
     -------
@@ -219,7 +220,8 @@ def bounded_violations(
                                     p.face_polygon))  # fmt: skip
     proxy_out = PolyhedralModel.trusted([*kept, *rebuilt, *pieces], name=output.name,
                                         source=output.source)  # fmt: skip
-    defects += list(violations3(bounded.proxy, proxy_out, region=region, outside=outside))
+    defects += list(violations3(bounded.proxy, proxy_out, region=region, outside=outside,
+                                ground=ground))
     return Violations(defects)
 
 

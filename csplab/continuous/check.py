@@ -251,6 +251,7 @@ def violations(
     *,
     region: Sequence[float] | None = None,
     outside: int | Mapping[str, int] = 0,
+    ground: Sequence[str] = (),
 ) -> Violations:
     """Every place where an output of either dimension breaks Eq. 4.1 w.r.t. its example.
 
@@ -269,6 +270,10 @@ def violations(
     outside : int or mapping of str to int, default 0
         The label around the region; in 3D also one per face (``{"z-": 1}``, faces not
         named being empty space, label 0).
+    ground : sequence of str, default ()
+        3D: the faces (``"z-"`` ...) past which the example (its bounding box) and the
+        output (``region``) continue, as a synthesis with a ground
+        (:class:`~csplab.continuous.csp3d.ContinuousCSP3`) has them.
 
     Returns
     -------
@@ -293,12 +298,14 @@ def violations(
         if isinstance(outside, Mapping):
             raise InputError("a polygon model has one label outside its region, not one per face")
         r2 = None if region is None else (region[0], region[1], region[2], region[3])
+        if ground:
+            raise InputError("a ground applies to polyhedral models (3D)")
         return violations2(example, model, region=r2, outside=outside)
     if isinstance(example, PolyhedralModel) and isinstance(model, PolyhedralModel):
         faces = outside if isinstance(outside, Mapping) else dict.fromkeys(_FACES, outside)
         r3 = None if region is None else (region[0], region[1], region[2], region[3], region[4],
                                           region[5])  # fmt: skip
-        return violations3(example, model, region=r3, outside=faces)
+        return violations3(example, model, region=r3, outside=faces, ground=ground)
     raise InputError(
         f"{model.source} is a {model.ndim}D model and the example {example.source} a "
         f"{example.ndim}D one"

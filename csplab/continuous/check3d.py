@@ -45,6 +45,7 @@ from numpy.typing import NDArray
 from csplab.continuous._geom import point_labels, points_on_segments
 from csplab.continuous.defects import Defect, Violations
 from csplab.continuous.polyhedra import PolyhedralModel, Solid
+from csplab.errors import InputError
 
 if TYPE_CHECKING:  # the constraints' data only: the checker reads them, as given
     from csplab.continuous.user3d import UserConstraints3
@@ -263,12 +264,14 @@ def _labelings(
     points: NDArray[np.float64], cells: tuple[NDArray[np.int8], NDArray[np.float64]],
     tris: list[tuple[int, NDArray[np.float64]]], planes: list[NDArray[np.float64]],
     normals: NDArray[np.float64], eps: float,
+    window: tuple[NDArray[np.float64], NDArray[np.float64], Sequence[str]] | None = None,
 ) -> NDArray[np.int64]:  # fmt: skip
     """``(len(points), cells)``: the label just off each point in each cell's direction.
 
     Only the planes through a point (``planes[f]``: the offsets of the model's faces of
     family ``f``) can change the label around it, so one query per group of cells that agree
-    on those planes suffices."""
+    on those planes suffices. ``window`` ``(lo, hi, faces)``: the model continues past
+    those faces of the box ``lo..hi`` (a ground): a query past one is taken just inside."""
     signs, dirs = cells
     scale = max(1.0, float(np.abs(points).max()) if len(points) else 1.0)
     through = np.zeros((len(points), len(normals)), dtype=bool)
@@ -298,7 +301,17 @@ def _labelings(
         rep = np.array([int(np.flatnonzero(g == j)[0]) for j in range(int(g.max()) + 1)])
         queries.append((points[idx][:, None, :] + eps * dirs[rep][None, :, :]).reshape(-1, 3))
         jobs.append((idx, rep, g))
-    lab_all = point_labels(np.concatenate(queries), tris) if queries else np.zeros(0, np.int64)
+    q = np.concatenate(queries) if queries else np.zeros((0, 3))
+    if window is not None:
+        lo, hi, faces = window
+        inward = 1e-3 * eps  # well inside the query's cell next to the face
+        for face in faces:
+            a = "xyz".index(face[0])
+            if face[1] == "-":
+                q[:, a] = np.maximum(q[:, a], lo[a] + inward * (1 + 0.29 * a))
+            else:
+                q[:, a] = np.minimum(q[:, a], hi[a] - inward * (1 + 0.29 * a))
+    lab_all = point_labels(q, tris) if queries else np.zeros(0, np.int64)
     pos = 0
     for idx, rep, g in jobs:
         lab = lab_all[pos : pos + len(idx) * len(rep)].reshape(len(idx), len(rep))
@@ -353,15 +366,23 @@ def violations3(
     region: tuple[float, float, float, float, float, float] | None = None,
     outside: Mapping[str, int] | None = None,
     dense: int = 8,
+    ground: Sequence[str] = (),
 ) -> Violations:
     """Every place where ``model`` breaks Eq. 4.1 w.r.t. ``example`` (see the module
     docstring); ``len() == 0`` means a valid output. ``region`` (``x0, y0, z0, x1, y1,
     z1``): only points in it are checked; outside it is empty space, or the labels
-    ``outside`` gives per face (``{"z-": 1}``: a ground below)."""
+    ``outside`` gives per face (``{"z-": 1}``: a ground below). ``ground``: faces (``"z-"``
+    ...) past which both models continue, the example past its bounding box and the output
+    past ``region`` (needed with a ground): what lies past such a face is what lies just
+    inside it, so a solid standing on the face has no surface there."""
     defects: list[Defect] = []
     solids: Solids = model
-    if region is not None and outside and any(outside.values()):
-        frame = PolyhedralModel(_frame(tuple(region), outside), merge_coplanar=False)
+    ground = tuple(ground)
+    if ground and region is None:
+        raise InputError("a ground needs the output's region")
+    if region is not None and outside and any(v for f, v in outside.items() if f not in ground):
+        fixed = {f: v for f, v in outside.items() if f not in ground}
+        frame = PolyhedralModel(_frame(tuple(region), fixed), merge_coplanar=False)
         solids = _Joined([*model.solids, *frame.solids], model)
     fams = _families(example, angle_tol)
     for b in solids.labels:
@@ -393,7 +414,10 @@ def violations3(
     E_tris, M_tris = _triangles(example), _triangles(solids)
     e_pts = _samples(example, dense)
     e_planes = _plane_offsets([example], N, angle_tol)
-    allowed = {tuple(r) for r in _labelings(e_pts, cells, E_tris, e_planes, N, eps).tolist()}
+    e_box = np.array(example.bounds[:3]), np.array(example.bounds[3:])
+    e_win = (*e_box, ground) if ground else None
+    allowed = {tuple(r) for r in _labelings(e_pts, cells, E_tris, e_planes, N, eps,
+                                            e_win).tolist()}  # fmt: skip
     allowed |= {(b,) * len(dirs) for b in (0, *example.labels)}
     m_pts = _samples(solids, 1)
     if region is not None:
@@ -402,7 +426,11 @@ def violations3(
         m_pts = m_pts[((m_pts >= r[:3] - t) & (m_pts <= r[3:] + t)).all(axis=1)]
     seen: set[tuple[int, ...]] = set()
     m_planes = _plane_offsets([solids], N, angle_tol)
-    m_arr = _labelings(m_pts, cells, M_tris, m_planes, N, eps)
+    m_win = None
+    if ground and region is not None:
+        m_win = (np.asarray(region[:3], dtype=np.float64), np.asarray(region[3:],
+                 dtype=np.float64), ground)  # fmt: skip
+    m_arr = _labelings(m_pts, cells, M_tris, m_planes, N, eps, m_win)
     # each distinct neighbourhood once, at its first point (in the points' order)
     rows = np.ascontiguousarray(m_arr.astype(np.int32))
     _, first = np.unique(rows.view(np.dtype((np.void, rows.dtype.itemsize * rows.shape[1]))),

@@ -50,7 +50,7 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
-from csplab.continuous.csp3d import ContinuousCSP3
+from csplab.continuous.csp3d import ContinuousCSP3, ground_faces
 from csplab.continuous.model import Polygon, PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -592,6 +592,7 @@ class CSPOptions(TypedDict, total=False):
     lines: str
     constraints: UserConstraints3 | None
     max_memory: int | None
+    ground: str | Sequence[str] | None
 
 
 @overload
@@ -616,6 +617,7 @@ def continuous_csp(
     lines: str = "lattice",
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = None,
 ) -> ContinuousCSP | ContinuousCSP3:
     """The CSP of continuous model synthesis (Alg. 4.1 steps 1-4), in either dimension.
 
@@ -648,6 +650,9 @@ def continuous_csp(
         Bytes (3D): refuse, before building it, an arrangement estimated larger
         (:func:`~csplab.continuous.space.estimate3`); default a share of the memory
         available.
+    ground : str or sequence of str, optional
+        3D: the faces past which the example and the output continue (an infinite ground,
+        :func:`~csplab.continuous.csp3d.ground_faces`); default none.
 
     Returns
     -------
@@ -665,7 +670,10 @@ def continuous_csp(
         if lines != "lattice":
             raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")
         return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                              constraints=constraints, max_memory=max_memory)  # fmt: skip
+                              constraints=constraints, max_memory=max_memory,
+                              ground=ground)  # fmt: skip
+    if ground_faces(ground):
+        raise InputError("a ground applies to polyhedral models (3D) for now")
     if constraints:
         raise InputError("polygon models (2D) take no user constraints yet")
     if isinstance(boundary, Mapping):

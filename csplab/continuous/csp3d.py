@@ -48,11 +48,73 @@ from csplab.continuous.user3d import UserConstraints3, allowed_states
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3", "snapped3"]
+__all__ = [
+    "FACE_ORDER",
+    "OPEN",
+    "WINDOW",
+    "ContinuousCSP3",
+    "example_signatures3",
+    "ground_faces",
+    "snapped3",
+]
 
 #: the region's faces; a point outside several takes the label of the first (the ground
 #: ``z-`` wins at the bottom edges)
 FACE_ORDER = ("z-", "z+", "x-", "x+", "y-", "y+")
+#: ``ground="window"``: every face but the sky, the example seen through a window onto an
+#: infinite ground
+WINDOW = ("z-", "x-", "x+", "y-", "y+")
+#: ``vertex_outside``/``edge_outside`` of a group past an open (ground) face: outside the
+#: region, its label the continuation of the one inside (not a fixed label)
+OPEN = -2
+#: how far inside an open face a point past it is located, in spacings per axis (distinct
+#: per axis, so that no plane whose normal mixes two axes passes through it)
+_INWARD = np.array([1.0, 1.37, 1.71]) * 1e-6
+
+
+def ground_faces(ground: str | Sequence[str] | None) -> tuple[str, ...]:
+    """The open faces of a ``ground`` declaration (see :class:`ContinuousCSP3`):
+    ``None``, ``""`` or ``"none"``: none; ``"window"``: :data:`WINDOW`; otherwise faces of
+    :data:`FACE_ORDER`, as a comma-separated string or a sequence; in that order.
+
+    Examples
+    --------
+    >>> ground_faces("z-"), ground_faces("x+,z-"), ground_faces(None)
+    (('z-',), ('z-', 'x+'), ())
+    >>> ground_faces("floor")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: ground: faces are z-, z+, x-, x+, y-, y+ (or window, none), not floor
+    """
+    if ground is None or (isinstance(ground, str) and ground.strip() in ("", "none")):
+        return ()
+    if isinstance(ground, str):
+        if ground.strip() == "window":
+            return WINDOW
+        items = [g.strip() for g in ground.split(",") if g.strip()]
+    else:
+        items = [str(g) for g in ground]
+    bad = [g for g in items if g not in FACE_ORDER]
+    if bad:
+        raise InputError(f"ground: faces are {', '.join(FACE_ORDER)} (or window, none), not "
+                         f"{', '.join(bad)}")  # fmt: skip
+    return tuple(f for f in FACE_ORDER if f in items)
+
+
+def _clamped(
+    points: NDArray[np.float64], lo: NDArray[np.float64], hi: NDArray[np.float64],
+    faces: Sequence[str],
+) -> NDArray[np.float64]:  # fmt: skip
+    """``points`` past an open face of the box ``lo..hi`` moved just inside it: the label
+    there is the continuation of the one at the face (the example as a window)."""
+    q = np.array(points, dtype=np.float64, copy=True)
+    for face in faces:
+        a = "xyz".index(face[0])
+        if face[1] == "-":
+            q[:, a] = np.maximum(q[:, a], lo[a] + _INWARD[a])
+        else:
+            q[:, a] = np.minimum(q[:, a], hi[a] - _INWARD[a])
+    return q
 
 
 def _boundary_faces(boundary: int | Mapping[str, int]) -> dict[str, int]:
@@ -95,9 +157,11 @@ def _local_labels(
     fams_on: NDArray[np.bool_],
     tris: list[tuple[int, NDArray[np.float64]]],
     index: dict[int, int],
+    clamp: tuple[NDArray[np.float64], NDArray[np.float64], Sequence[str]] | None = None,
 ) -> list[Labeling]:
     """Full labelings (over the central cells) of the neighbourhoods at ``points`` whose
-    planes are ``fams_on`` (per point), by point location just off each point."""
+    planes are ``fams_on`` (per point), by point location just off each point (``clamp``:
+    ``(lo, hi, faces)``, points past those faces of the box located just inside it)."""
     signs, dirs = A.cells
     eps = 1e-3 / (A.D * float(np.abs(A.normals).sum(axis=1).max()))
     cache: dict[bytes, tuple[NDArray[np.int64], int, NDArray[np.int64]]] = {}
@@ -112,6 +176,8 @@ def _local_labels(
         queries.append(points[i] + eps * dirs[rep])
         owners.append(i)
     q = np.concatenate(queries) if queries else np.zeros((0, 3))
+    if clamp is not None and clamp[2]:
+        q = _clamped(q, *clamp)
     lab = labels_at(q, tris)
     lab = np.array([index[int(b)] if b else 0 for b in lab], dtype=np.int64)
     out = []
@@ -159,11 +225,23 @@ def example_signatures3(
     lattice: Lattice,
     index: dict[int, int],
     max_memory: int | None = None,
+    ground: Sequence[str] = (),
+    coverage: dict[Labeling, int] | None = None,
+    on_ground: dict[str, set[Labeling]] | None = None,
 ) -> set[Labeling]:
     """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
     of the central cells: vertices and edges of its own arrangement (its bounding box plus
     one spacing), the faces next to those edges, and the solid interiors (``max_memory``
-    as for :class:`~csplab.continuous.space.Arrangement3`)."""
+    as for :class:`~csplab.continuous.space.Arrangement3`). Past the faces of its bounding
+    box named in ``ground`` the example continues: the label there is the one just inside
+    (a solid standing on the box's bottom face goes on below it, so that face is no
+    surface). ``coverage``, if given, receives how much of the example each neighbourhood
+    covers: the number of vertices and edges of the arrangement inside the example's
+    bounding box where it occurs (volume, area, length or a count of corners, in plane
+    spacings). ``on_ground``, if given, receives per ``ground`` face the neighbourhoods
+    at the example's vertices and edges on that face of its box, and empty space (what
+    the output may have on the region's face: its bottom layer is like the example's, or
+    bare ground)."""
     pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
     lo = np.floor(lattice.to_lattice(pts).min(axis=0) + 1e-9)
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
@@ -171,12 +249,31 @@ def example_signatures3(
     A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)),
                      max_memory=max_memory, where=example.source, hint="")  # fmt: skip
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
+    box = lattice.to_lattice(pts) + shift
+    clamp = (box.min(axis=0), box.max(axis=0), tuple(ground))
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
-    sigs |= set(_local_labels(A, A.vertex_positions(), A.on, tris, index))
+    vpos = A.vertex_positions()
+    vert_sigs = _local_labels(A, vpos, A.on, tris, index, clamp)
+    sigs |= set(vert_sigs)
     efam = A.edge_families()
-    edge_sigs = _local_labels(A, A.edge_positions(), efam, tris, index)
+    epos = A.edge_positions()
+    edge_sigs = _local_labels(A, epos, efam, tris, index, clamp)
     sigs |= set(edge_sigs)
+    tol = 1e-9
+    for pos, found in ((vpos, vert_sigs), (epos, edge_sigs)):
+        inside = ((pos >= clamp[0] - tol) & (pos <= clamp[1] + tol)).all(axis=1)
+        if coverage is not None:  # occurrences inside the example's box
+            for k in np.flatnonzero(inside).tolist():
+                coverage[found[k]] = coverage.get(found[k], 0) + 1
+        for face in ground:
+            if on_ground is None:
+                break
+            a = "xyz".index(face[0])
+            at = clamp[1][a] if face[1] == "+" else clamp[0][a]
+            on = inside & (np.abs(pos[:, a] - at) <= tol)
+            seen = on_ground.setdefault(face, {(0,) * len(signs)})  # bare ground
+            seen.update(found[k] for k in np.flatnonzero(on))
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
     N = A.normals
@@ -216,6 +313,12 @@ class ContinuousCSP3:
         Compact label index -> model label (0: empty space).
     signatures : set
         The example's neighbourhoods (full labelings of the central cells).
+    ground : tuple of str
+        The open faces (:func:`ground_faces`): the example is a window onto a world that
+        continues past these faces of its bounding box, and so does the output past these
+        faces of the region (a state there has outside the region what it has just
+        inside: a solid reaching the bottom stands on the ground). With ``("z-",)`` no
+        output solid floats where the example's solids stand on the bottom of its box.
     constraints : UserConstraints3 or None
         User constraints (thesis Sec. 4.6, :mod:`csplab.continuous.user3d`): the
         dimensional and large-scale ones restrict the problem's domains (every solver
@@ -233,6 +336,7 @@ class ContinuousCSP3:
         boundary: int | Mapping[str, int] = 0,
         constraints: UserConstraints3 | None = None,
         max_memory: int | None = None,
+        ground: str | Sequence[str] | None = None,
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
@@ -245,6 +349,12 @@ class ContinuousCSP3:
         self.labels: tuple[int, ...] = (0, *example.labels)
         index = {b: i for i, b in enumerate(self.labels)}
         faces = _boundary_faces(boundary)
+        self.ground = ground_faces(ground)
+        named = set(boundary) if isinstance(boundary, Mapping) else set()
+        both = [f for f in self.ground if f in named and faces[f]]
+        if both:
+            raise InputError(f"face {both[0]} is open (ground) and has boundary label "
+                             f"{faces[both[0]]}: give it one or the other")  # fmt: skip
         for face, lab in faces.items():
             if lab not in index:
                 raise InputError(
@@ -253,7 +363,15 @@ class ContinuousCSP3:
         self.boundary = faces
         # the region's estimate first: refused before the example's arrangement is built
         check_budget3(self.lattice, size, max_memory, example.source)
-        self.signatures = example_signatures3(example, self.lattice, index, max_memory)
+        #: how much of the example each neighbourhood covers (vertices and edges of its
+        #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
+        self.coverage: dict[Labeling, int] = {}
+        #: per ground face, the example's neighbourhoods on that face of its box: the only
+        #: ones a vertex or edge on that face of the region may take
+        self.on_ground: dict[str, set[Labeling]] = {}
+        self.signatures = example_signatures3(example, self.lattice, index, max_memory,
+                                              self.ground, self.coverage,
+                                              self.on_ground)  # fmt: skip
         self.arrangement = Arrangement3(self.lattice, size, max_memory=max_memory,
                                         where=example.source)  # fmt: skip
         self._types(index)
@@ -271,25 +389,57 @@ class ContinuousCSP3:
         """The vertex and edge types (planes through them, region sides they lie on) with
         their states, cell groups and outside labels (Sec. 4.5.4)."""
         sig = np.array(sorted(self.signatures), dtype=np.int64)
+        cover = np.array([self.coverage.get(tuple(int(x) for x in r), 0) for r in sig.tolist()],
+                         dtype=np.float64)  # fmt: skip
         A = self.arrangement
         signs, _ = A.cells
         F, N = A.F, A.normals
         faces = self.boundary
+        sig_rows = [tuple(int(x) for x in r) for r in sig.tolist()]
+        on_face = {f: np.array([r in self.on_ground.get(f, ()) for r in sig_rows], dtype=bool)
+                   for f in self.ground}  # fmt: skip
         side_fam = [A.axis_family(a) for a in range(3)]
+        _, dirs = A.cells
 
         def outside_groups(fams: NDArray[np.int64], sides: int, g: NDArray[np.int64],
-                           ng: int) -> NDArray[np.int64]:  # fmt: skip
-            """Per group: the compact label it must have outside the region, or -1 (inside);
-            a group outside several faces takes the first of ``FACE_ORDER``."""
+                           ng: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:  # fmt: skip
+            """Per group: the compact label it must have outside the region, -1 (inside) or
+            :data:`OPEN` (past open faces only); a group outside several fixed faces takes
+            the first of ``FACE_ORDER``. And per group the group it continues (itself
+            unless :data:`OPEN`): the one just inside the open faces it is past."""
             out = np.full(ng, -1, dtype=np.int64)
+            mirror = np.arange(ng, dtype=np.int64)
             for face in reversed(FACE_ORDER):
+                if face in self.ground:
+                    continue
                 a, hi = "xyz".index(face[0]), face[1] == "+"
                 bit = (2 if hi else 1) << (2 * a)
                 if sides & bit:
                     out[np.unique(g[signs[:, side_fam[a]] == (1 if hi else -1)])] = index[
                         faces[face]
                     ]
-            return out
+            for k in range(ng):
+                if out[k] >= 0:
+                    continue
+                c = int(np.flatnonzero(g == k)[0])
+                d = dirs[c].astype(np.float64).copy()
+                moved = False
+                for face in self.ground:
+                    a, hi = "xyz".index(face[0]), face[1] == "+"
+                    bit = (2 if hi else 1) << (2 * a)
+                    if sides & bit and signs[c, side_fam[a]] == (1 if hi else -1):
+                        d[a] = (-1.0 if hi else 1.0) * _INWARD[a] * float(np.abs(d).sum())
+                        moved = True
+                if not moved:
+                    continue
+                want = np.sign(N[fams] @ d)
+                match = np.flatnonzero((signs[:, fams] == want).all(axis=1))
+                if not match.size:  # a plane through the point and the inward direction
+                    raise InputError(f"{self.example.source}: no cell continues a ground "
+                                     f"face at planes {N[fams].tolist()}")  # fmt: skip
+                out[k] = OPEN
+                mirror[k] = int(g[match[0]])
+            return out, mirror
 
         def states(
             fams: NDArray[np.int64], sides: int
@@ -298,13 +448,25 @@ class ContinuousCSP3:
             rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
             local = sig[:, rep]  # (nsig, ng)
             ok = (sig == local[:, g]).all(axis=1)  # factors through these planes
-            out = outside_groups(fams, sides, g, ng)
+            out, mirror = outside_groups(fams, sides, g, ng)
             req = out >= 0
             ok &= (local[:, req] == out[req]).all(axis=1)
+            ok &= (local == local[:, mirror]).all(axis=1)  # past a ground face: continued
+            for face in self.ground:  # on a ground face: as the example on its box's face
+                a, hi = "xyz".index(face[0]), face[1] == "+"
+                if sides & ((2 if hi else 1) << (2 * a)):
+                    ok &= on_face[face]
             found = sorted({tuple(int(x) for x in row) for row in local[ok]},
                            key=lambda st: (any(st), st))  # fmt: skip
+            # Sec. 4.5.4's states, each weighted by the example it covers (+1: every state
+            # stays possible): the neighbourhoods that look like it here
+            w = dict.fromkeys(found, 1.0)
+            for row, c in zip(local[ok].tolist(), cover[ok].tolist(), strict=True):
+                w[tuple(row)] += c
+            weights.append(np.array([w[st] for st in found], dtype=np.float64))
             return found, (g, ng, out)
 
+        weights: list[NDArray[np.float64]] = []  # per vertex type, then per edge type
         # vertex types
         vside = A.on_side()
         vmask = A.on.astype(np.int64) @ (1 << np.arange(F, dtype=np.int64))
@@ -335,6 +497,8 @@ class ContinuousCSP3:
             st, (g, _, out) = states(fams, key & 63)
             self.etypes.append((fams, st, g))
             self.edge_outside.append(out)
+        #: per vertex type then edge type, the weight of each state (``choice="weighted"``)
+        self.state_weights = weights
 
     def _relation_maker(
         self, K: int
@@ -422,13 +586,21 @@ class ContinuousCSP3:
         used = [rels[i] for i in order_used.tolist()]
         arcs[:, 2] = renum[arcs[:, 2]]
         dom = dom[order]  # (the unordered copy is freed before the problem copies it)
+        # the weighted choice: one weight class per vertex and edge type
+        table = np.zeros((len(self.state_weights), K), dtype=np.float64)
+        for t, w in enumerate(self.state_weights):
+            table[t, : len(w)] = w
+        cls = np.empty(nv + ne, dtype=np.int64)
+        cls[self.var_vertex] = vtype
+        cls[self.var_edge] = len(self.vtypes) + etype
         return Problem(
             (nv + ne,), dom, np.stack(used), arcs,
             name=getattr(self.example, "name", "") or "continuous3d",
             meta={"continuous": True, "dim": 3, "size": list(A.size),
                   "spacing": float(self.lattice.spacing), "families": A.normals.tolist(),
-                  "vertices": nv, "edges": ne, "boundary": dict(self.boundary)},
-            positions=pos[order],
+                  "vertices": nv, "edges": ne, "boundary": dict(self.boundary),
+                  "ground": list(self.ground)},
+            positions=pos[order], value_weights=(table, cls),
         )  # fmt: skip
 
     def model(self, grid: ArrayLike, *, name: str = "") -> PolyhedralModel:
@@ -469,7 +641,7 @@ class ContinuousCSP3:
                 if not sel.size or not states:
                     continue
                 S = np.array(states, dtype=np.int64).reshape(len(states), -1)
-                inside = np.asarray(outside[t]) < 0
+                inside = np.asarray(outside[t]) == -1
                 touch = ((S == b) & inside[None, :]).any(axis=1)
                 out[np.ix_(var[sel], np.arange(len(states)))] = touch[None, :]
         out &= self.problem.domains
@@ -510,12 +682,13 @@ class ContinuousCSP3:
                 raise InputError(f"label {b} does not occur in the example")
         tris = _triangles(model, self.lattice, 0.0)
         grid = np.full(self.problem.n, -1, dtype=np.int32)
+        size = np.array(A.size, dtype=np.float64)
+        clamp = (np.zeros(3), size, self.ground)  # past a ground face: the continuation
         for pts, fams_on, types, tlist, var in (
             (A.vertex_positions(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
             (A.edge_positions(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
         ):
-            labs = _local_labels(A, pts, fams_on, tris, index)
-            size = np.array(A.size, dtype=np.float64)
+            labs = _local_labels(A, pts, fams_on, tris, index, clamp)
             for i, full in enumerate(labs):
                 _, st, g = tlist[int(types[i])]
                 ng = int(g.max()) + 1
@@ -528,6 +701,8 @@ class ContinuousCSP3:
                     c = int(np.flatnonzero(g == k)[0])
                     q = pts[i] + 1e-3 * dirs[c]
                     for face in FACE_ORDER:
+                        if face in self.ground:
+                            continue
                         a = "xyz".index(face[0])
                         if (q[a] > size[a]) if face[1] == "+" else (q[a] < 0):
                             local[k] = index[self.boundary[face]]

@@ -206,7 +206,8 @@ def floating_solids(model: PolyhedralModel, ground: float | None = None) -> list
 
 # ---------------------------------------------------------------------------- figures
 def resemblance3(
-    example: PolyhedralModel, output: PolyhedralModel, *, angle_tol: float = ANGLE_TOL
+    example: PolyhedralModel, output: PolyhedralModel, *, angle_tol: float = ANGLE_TOL,
+    ground: float | None = None,
 ) -> Resemblance:
     """The resemblance figures of ``output`` against ``example`` (module docstring).
 
@@ -216,6 +217,15 @@ def resemblance3(
         The example and a synthesized model (any polyhedral models).
     angle_tol : float
         Normals closer than this many radians are one face orientation.
+    ground : float, optional
+        The height of the output's ground (a solid whose lowest point is there rests on
+        it; a synthesis with a ground: the region's bottom); default the output's lowest
+        ``z``. The example's ground is its own lowest ``z``.
+
+    Returns
+    -------
+    Resemblance
+        The figures.
     """
     normals = _Normals(angle_tol)
     ex_kinds, ex_faces = edge_kinds(example, normals, grow=True)
@@ -232,6 +242,6 @@ def resemblance3(
         example_edge_kinds=len(ex_kinds),
         face_orientations=len(ex_faces & out_faces) / len(ex_faces) if ex_faces else 1.0,
         example_face_orientations=len(ex_faces),
-        floating=len(floating_solids(output)),
+        floating=len(floating_solids(output, ground)),
         example_floating=len(floating_solids(example)),
     )

@@ -399,7 +399,8 @@ class States3(Protocol):
     """The states of the 3D CSP on an arrangement, as
     :class:`~csplab.continuous.csp3d.ContinuousCSP3` builds them: per vertex and edge type
     its families, states and cell groups (``vtypes``, ``etypes``), the compact label each
-    group must have outside the region or -1 (``vertex_outside``, ``edge_outside``), each
+    group must have outside the region, -1 inside or -2 past a ground face (its label
+    continues the inside; ``vertex_outside``, ``edge_outside``), each
     vertex's and edge's type and problem variable. What the user constraints
     (:func:`~csplab.continuous.user3d.allowed_states`) and the surface tracing
     (:func:`~csplab.continuous.surface.surface_of`) read, without importing the CSP."""

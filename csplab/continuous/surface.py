@@ -101,7 +101,7 @@ def surface_of(self: States3, grid: ArrayLike, name: str = "") -> PolyhedralMode
     for t, (_, states, _) in enumerate(self.vtypes):
         sel = np.flatnonzero(self.vertex_type == t)
         if sel.size:
-            side = bool((np.asarray(self.vertex_outside[t]) >= 0).any())
+            side = bool((np.asarray(self.vertex_outside[t]) != -1).any())
             flat = np.array([len(set(st)) == 1 and (st[0] == 0 or not side) for st in states],
                             dtype=bool)  # fmt: skip
             uniform[sel] = flat[vstate[sel]]
@@ -112,7 +112,7 @@ def surface_of(self: States3, grid: ArrayLike, name: str = "") -> PolyhedralMode
     for t, (_, estates, _) in enumerate(self.etypes):
         sel = np.flatnonzero(self.edge_type == t)
         if sel.size:
-            side = bool((self.edge_outside[t] >= 0).any())
+            side = bool((self.edge_outside[t] != -1).any())
             flat = np.array([len(set(st)) == 1 and (st[0] == 0 or not side) for st in estates],
                             dtype=bool)  # fmt: skip
             eflat[sel] = flat[estate[sel]]
@@ -220,7 +220,7 @@ def surface_of(self: States3, grid: ArrayLike, name: str = "") -> PolyhedralMode
                 for col, out_arr in ((0, lab_a), (1, lab_b)):
                     g = gpm[m, col]
                     gc = np.maximum(g, 0)
-                    ok = (g >= 0) & (outside[gc] < 0)
+                    ok = (g >= 0) & (outside[gc] == -1)
                     out_arr[m] = np.where(ok, S[rows, gc], -1)
             diff = lab_a != lab_b
             labels = set(np.unique(np.concatenate([lab_a[diff], lab_b[diff]])).tolist()) - {-1, 0}

@@ -39,7 +39,43 @@ from csplab.result import Result
 from csplab.rng import RngLike
 from csplab.solvers import solve
 
-__all__ = ["Synthesis", "synthesize", "synthesize3"]
+__all__ = ["Synthesis", "auto_ground", "default_choice", "synthesize", "synthesize3"]
+
+
+def auto_ground(
+    example: PolygonModel | PolyhedralModel, boundary: int | Mapping[str, int] = 0
+) -> str | tuple[str, ...] | None:
+    """``ground="auto"``: the example's own ground (``example.meta["ground"]``, as the
+    built-in polyhedral examples declare it) but the faces that ``boundary`` gives a label
+    (an explicit boundary wins); ``None`` for polygon models and examples without one.
+
+    Examples
+    --------
+    >>> from csplab.examples.continuous3d import load_polyhedral_example
+    >>> E = load_polyhedral_example("terrain")
+    >>> auto_ground(E), auto_ground(E, {"z-": 1}), auto_ground(E, 2)
+    (('z-', 'x-', 'x+', 'y-', 'y+'), ('x-', 'x+', 'y-', 'y+'), None)
+    """
+    from csplab.continuous.csp3d import ground_faces
+
+    if not isinstance(example, PolyhedralModel) or not example.meta.get("ground"):
+        return None
+    if not isinstance(boundary, Mapping):
+        return None if boundary else ground_faces(example.meta["ground"])
+    return tuple(f for f in ground_faces(example.meta["ground"]) if not boundary.get(f))
+
+
+def default_choice(problem: Any, solver: str) -> str | None:
+    """The label choice continuous synthesis gives ``solver`` when the caller names none:
+    ``"weighted"`` when the problem weighs its values per cell (``value_weights``, the
+    3D CSP's coverage of the example) and the solver takes that choice, else ``None``
+    (the solver's own default)."""
+    from csplab.solvers import solver_class
+
+    if getattr(problem, "value_weights", None) is None:
+        return None
+    o = solver_class(solver.partition(":")[0]).option("choice")
+    return "weighted" if o is not None and (o.values is None or "weighted" in o.values) else None
 
 
 CSP = TypeVar("CSP")
@@ -102,6 +138,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = "auto",
     bounding: bool = True,
     **options: Any,
 ) -> Synthesis[ContinuousCSP, PolygonModel]: ...
@@ -122,6 +159,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = "auto",
     bounding: bool = True,
     **options: Any,
 ) -> Synthesis[ContinuousCSP3, PolyhedralModel]: ...
@@ -141,6 +179,7 @@ def synthesize(
     check: bool = True,
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
+    ground: str | Sequence[str] | None = "auto",
     bounding: bool = True,
     **options: Any,
 ) -> Synthesis[Any, M]:
@@ -162,6 +201,11 @@ def synthesize(
     spacing, snap, boundary, lines, constraints, max_memory
         See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: 2D; per-face
         ``boundary`` and user ``constraints`` of thesis Sec. 4.6: 3D).
+    ground : str or sequence of str or None, default "auto"
+        3D: the faces past which the example and the output continue (an infinite
+        ground, :func:`~csplab.continuous.csp3d.ground_faces`: ``"z-"``, ``"window"``
+        ...); ``"auto"``: the example's own declaration (``example.meta["ground"]``, as
+        the built-in examples have), else none; ``None``: none.
     bounding : bool, default True
         Replace the curved parts of a polyhedral example by bounding volumes (thesis
         Sec. 4.6.4, :mod:`~csplab.continuous.bounding`): the CSP is built on the proxy
@@ -175,7 +219,9 @@ def synthesize(
         Run the checker on the output (default; it is the truth, not the CSP).
     **options
         Solver options (``time_limit=``, ``order=``, ``block=`` ...), passed to
-        :func:`csplab.solvers.solve`.
+        :func:`csplab.solvers.solve`. ``choice`` defaults to ``"weighted"`` for a solver
+        that takes it when the CSP weighs its states (3D: by the example each state covers,
+        :func:`default_choice`); ``choice="uniform"`` is the thesis' choice.
 
     Returns
     -------
@@ -220,9 +266,16 @@ def synthesize(
         if bounded is not None:  # the proxy is on the lattice of bounded.spacing
             spacing, snap = bounded.spacing, False
             example = bounded.proxy
+    if ground == "auto":
+        ground = auto_ground(example, boundary)
     csp = continuous_csp(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                         lines=lines, constraints=constraints, max_memory=max_memory)  # fmt: skip
+                         lines=lines, constraints=constraints, max_memory=max_memory,
+                         ground=ground)  # fmt: skip
     t1 = time.perf_counter()
+    options = {**options}
+    choice = default_choice(csp.problem, solver)
+    if choice is not None and "choice" not in options:
+        options["choice"] = choice
     result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
     t2 = time.perf_counter()
     model = csp.model(result.grid) if result.ok else None
@@ -230,7 +283,8 @@ def synthesize(
     region = csp.region()
     defects: list[Defect] = []
     if check and model is not None:
-        defects = list(violations(csp.example, model, region=region, outside=csp.boundary))
+        defects = list(violations(csp.example, model, region=region, outside=csp.boundary,
+                                  ground=getattr(csp, "ground", ())))  # fmt: skip
     broken: list[Defect] = []
     if constraints and isinstance(model, PolyhedralModel):
         d = len(region) // 2

@@ -215,8 +215,8 @@ def allowed_states(csp: States3, c: UserConstraints3) -> NDArray[np.bool_]:
         dim.append((index[b], fam_of[n]))
     dom = np.array(csp.problem.domains, dtype=bool, copy=True)
     kinds = (
-        (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_positions()),
-        (csp.edge_type, csp.etypes, csp.var_edge, A.edge_positions()),
+        (csp.vertex_type, csp.vtypes, csp.var_vertex, A.vertex_positions(), csp.vertex_outside),
+        (csp.edge_type, csp.etypes, csp.var_edge, A.edge_positions(), csp.edge_outside),
     )
     # large-scale: per label, a boolean voxel grid
     grids: list[tuple[int, NDArray[np.bool_]]] = []
@@ -230,7 +230,7 @@ def allowed_states(csp: States3, c: UserConstraints3) -> NDArray[np.bool_]:
             grids.append((index[b], g))
     vox = np.array(c.voxel or (1, 1, 1), dtype=np.float64)
     eps = 1e-3 / (A.D * float(np.abs(A.normals).sum(axis=1).max()))
-    for types, tlist, var, pos in kinds:
+    for types, tlist, var, pos, outside in kinds:
         for t, (fams, states, gid) in enumerate(tlist):
             sel = np.flatnonzero(types == t)
             if not sel.size or not states:
@@ -240,8 +240,11 @@ def allowed_states(csp: States3, c: UserConstraints3) -> NDArray[np.bool_]:
             for bi, f in dim:
                 if f not in set(fams.tolist()):
                     continue
+                # only inside the region: past its side (a ground below) is no part of it
+                inside = np.asarray(outside[t]) == -1
                 plus = np.unique(gid[signs[:, f] > 0])
                 minus = np.unique(gid[signs[:, f] < 0])
+                plus, minus = plus[inside[plus]], minus[inside[minus]]
                 bad |= (S[:, plus] == bi).any(axis=1) & (S[:, minus] == bi).any(axis=1)
             rows = np.ones((len(sel), 1), dtype=bool) & ~bad[None, :]
             if grids:

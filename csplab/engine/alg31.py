@@ -241,9 +241,14 @@ def _entropies(eng: Propagator, weighted: bool) -> tuple[np.ndarray, np.ndarray,
         cnt = C.sum(axis=1)
         none = np.zeros(0, dtype=np.float64)
         return np.asarray(np.log(np.maximum(cnt, 1)), dtype=np.float64), none, none
-    w = eng.c.weights
-    s = C @ w
-    sl = C @ eng.c.wlogw
+    w, wl, wc = eng.c.weights, eng.c.wlogw, eng.c.wclass
+    if len(w) == 1:
+        s, sl = C @ w[0], C @ wl[0]
+    else:  # per weight class
+        s, sl = np.zeros(len(C)), np.zeros(len(C))
+        for t in np.unique(wc).tolist():
+            rows = wc == t
+            s[rows], sl[rows] = C[rows] @ w[t], C[rows] @ wl[t]
     cnt = C.sum(axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
         h = np.where(s > 0, np.log(np.where(s > 0, s, 1.0)) - sl / np.where(s > 0, s, 1.0),

@@ -544,10 +544,11 @@ class SatOracle(Closing):
 def preferred_labels(
     catalog: NDArray[np.bool_], weights: NDArray[np.float64] | None, rng: np.random.Generator
 ) -> NDArray[np.int64]:
-    """One random label per cell from ``catalog`` (weighted if ``weights``; -1 if empty)."""
+    """One random label per cell from ``catalog`` (weighted if ``weights``: ``(K,)``, or
+    ``(n, K)`` per cell; -1 if empty)."""
     n, K = catalog.shape
     w = np.ones(K) if weights is None else np.asarray(weights, dtype=np.float64)
-    ww = catalog * np.where(w > 0, w, 0.0)[None, :]
+    ww = catalog * (np.where(w > 0, w, 0.0)[None, :] if w.ndim == 1 else np.where(w > 0, w, 0.0))
     zero = ww.sum(axis=1) <= 0
     ww[zero] = catalog[zero]  # fall back to uniform when weights vanish
     cum = np.cumsum(ww, axis=1)

@@ -232,6 +232,9 @@ class BlockContext:
     #: cell order inside a block (``arange`` for the entropy orders)
     compiled: bool = False
     scan: NDArray[np.int64] | None = None
+    #: the problem's per-class weight table (:attr:`csplab.problem.Problem.value_weights`),
+    #: each block's classes travel with it
+    value_table: NDArray[np.float64] | None = None
 
 
 class CompiledTask(NamedTuple):
@@ -274,19 +277,27 @@ class BlockTask(NamedTuple):
     shape: tuple[int, ...]
     domains: NDArray[np.uint8]
     arcs: NDArray[np.int32]
+    #: each cell's weight class (problems with ``value_weights``), else None
+    classes: NDArray[np.int32] | None = None
 
 
 def pack_block(sub: Problem, block: int, sweep: int) -> BlockTask:
     """The :class:`BlockTask` of subproblem ``sub`` (built by :meth:`Problem.subproblem`)."""
+    cls = None if sub.value_weights is None else sub.value_weights[1].astype(np.int32)
     return BlockTask(
-        block, sweep, sub.shape, np.packbits(sub.domains, axis=1), sub.arcs.astype(np.int32)
+        block, sweep, sub.shape, np.packbits(sub.domains, axis=1), sub.arcs.astype(np.int32),
+        cls,
     )
 
 
 def _unpack(task: BlockTask, ctx: BlockContext) -> Problem:
     K = int(ctx.relations.shape[1])
     dom = np.unpackbits(task.domains, axis=1, count=K).astype(bool)
-    return Problem(task.shape, dom, ctx.relations, task.arcs, weights=ctx.weights)
+    vw = None
+    if ctx.value_table is not None and task.classes is not None:
+        vw = (ctx.value_table, task.classes)
+    return Problem(task.shape, dom, ctx.relations, task.arcs, weights=ctx.weights,
+                   value_weights=vw)  # fmt: skip
 
 
 _CONTEXT: BlockContext | None = None

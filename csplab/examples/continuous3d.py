@@ -30,6 +30,7 @@ from csplab.errors import InputError
 from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
 
 __all__ = [
+    "GROUNDS",
     "POLYHEDRAL_EXAMPLES",
     "load_continuous_example",
     "load_polyhedral_example",
@@ -75,6 +76,21 @@ POLYHEDRAL_EXAMPLES: dict[str, tuple[str, str]] = {
 }
 
 
+#: name -> the example's ground (:func:`~csplab.continuous.csp3d.ground_faces`): the faces
+#: of its bounding box past which it continues. The buildings, arches and fractals stand on
+#: the bottom of their box (``z-``: they go on below it, so no output solid floats); the
+#: terrain is a window onto an infinite ground slab (every face but the sky). Kept in the
+#: example's ``meta["ground"]``, which :func:`~csplab.continuous.synthesis.synthesize` reads.
+GROUNDS: dict[str, str] = {
+    "houses": "z-",
+    "skyscrapers": "z-",
+    "arches": "z-",
+    "terrain": "window",
+    "fractals": "z-",
+    "pentagons": "z-",
+}
+
+
 def polyhedral_example_names() -> list[str]:
     """Names of the built-in polyhedral examples.
 
@@ -102,7 +118,8 @@ def load_polyhedral_example(name: str) -> PolyhedralModel:
     Returns
     -------
     PolyhedralModel
-        The example, named ``name``; its ``meta`` holds the one-line ``"description"``.
+        The example, named ``name``; its ``meta`` holds the one-line ``"description"``
+        and, if it stands on one, its ``"ground"`` (:data:`GROUNDS`).
 
     Raises
     ------
@@ -132,6 +149,8 @@ def load_polyhedral_example(name: str) -> PolyhedralModel:
     with resources.as_file(ref) as path:
         M = read_obj_model(path, labels="materials")
     meta = {**M.meta, "description": description}
+    if name in GROUNDS:
+        meta["ground"] = GROUNDS[name]
     return PolyhedralModel(M.solids, name=name, meta=meta, source=source)
 
 

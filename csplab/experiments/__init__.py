@@ -13,7 +13,7 @@ Python entry point.
 ``table3_1``              k, output size and times per example and solver (Table 3.1)
 ``catalog_gap``           Alg. 3.1 choices outside the exact catalog C*
 ``sampling_bias``         label / 2×2-pattern frequencies vs exact uniform sampling
-``table1_continuous``     continuous 3D: Table 1 of the 2008 paper (polygons, time)
+``table1_continuous``     continuous 3D: Table 1, Figs. 1, 10-13 of the 2008 paper
 ``baselines``             model synthesis against texture synthesis (Fig. 5.1/5.2)
 ========================  ============================================================
 

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from csplab.deps import available
+from csplab.deps import EXTRAS, available
 from csplab.errors import (
     CsplabError,
     DependencyError,
@@ -53,6 +53,7 @@ __all__ = [
     "Option",
     "Solver",
     "available_solvers",
+    "extra_of",
     "get_solver",
     "markdown_table",
     "option_values",
@@ -141,6 +142,29 @@ def _missing(cls: type[Solver]) -> list[str]:
     return [m for m in cls.requires if not available(m)]
 
 
+def extra_of(cls: type[Solver]) -> str | None:
+    """The pip extra that installs what a solver ``requires``: the one table
+    :data:`csplab.deps.EXTRAS` (module -> extra) says it, not the solver.
+
+    Parameters
+    ----------
+    cls : type of Solver
+        A solver class.
+
+    Returns
+    -------
+    str or None
+        The extra of its first required module that has one; ``None`` when it requires
+        nothing.
+
+    Examples
+    --------
+    >>> [extra_of(solver_class(name)) for name in ("cpsat", "perfect", "catalog")]
+    ['cpsat', 'sat', None]
+    """
+    return next((EXTRAS[t] for m in cls.requires if (t := m.partition(".")[0]) in EXTRAS), None)
+
+
 def get_solver(spec: str) -> tuple[type[Solver], str | None]:
     """The solver class and backend for a spec such as ``"sat:glucose4"``; a missing
     dependency is one :class:`~csplab.errors.DependencyError` line naming the extra."""
@@ -150,7 +174,7 @@ def get_solver(spec: str) -> tuple[type[Solver], str | None]:
     if missing:
         raise DependencyError(
             f"solver {name!r} needs {', '.join(missing)}; install it with "
-            f"pip install 'csplab[{cls.extra or name}]'"
+            f"pip install 'csplab[{extra_of(cls) or name}]'"
         )
     return cls, backend
 
@@ -191,7 +215,7 @@ def available_solvers() -> list[dict[str, Any]]:
             "complete": cls.complete,
             "constraints": cls.constraints,
             "requires": list(cls.requires),
-            "extra": cls.extra,
+            "extra": extra_of(cls),
             "installed": not missing,
             "options": [_option_info(o) for o in cls.options],
         }
@@ -206,7 +230,7 @@ def solvers_taking(option: str) -> list[str]:
     out = []
     for name in solver_names():
         try:
-            if solver_class(name).takes(option):
+            if solver_class(name).option(option) is not None:
                 out.append(name)
         except (ImportError, CsplabError):
             continue

@@ -12,7 +12,8 @@ What it shows, in the order a solver does it:
    ``complete``, ``constraints``, ``description``, ``notes``, ``options`` built from the
    shared vocabulary (:func:`~csplab.solvers.base.order_option`,
    :data:`~csplab.solvers.base.TIME_LIMIT`), ``bench`` variants. A solver that needs a
-   package also sets ``requires`` and ``extra``; one with backends sets ``backends``.
+   package also sets ``requires`` (the extra that installs it comes from
+   ``csplab.deps.EXTRAS``); one with backends sets ``backends``.
 2. :meth:`TemplateSolver.run`: the options come validated in ``call``; every random number
    is drawn from ``call.rng``; the algorithm lives in the engine (:mod:`csplab.catalog`,
    :mod:`csplab.engine`), the solver only adapts it; the time limit is ``call.deadline``

@@ -591,7 +591,6 @@ class AspSolver(Solver):
     constraints = "exact"
     complete = True
     requires = ("clingo",)
-    extra = "asp"
     description = "answer-set programming with clingo (Karth & Smith 2017)"
     notes = (
         "one label per cell by a choice rule, one integrity constraint per (arc, label) "

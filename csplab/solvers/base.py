@@ -14,7 +14,8 @@ name          registry name (``csplab synthesize --solver NAME``)
 complete      can prove unsatisfiability (and never gives up on a satisfiable one)
 description   one line: the algorithm
 notes         a few sentences for the README table (defaults, measured facts)
-requires      importable modules it needs; ``extra`` the pip extra that installs them
+requires      importable modules it needs (the pip extra that installs them is derived
+              from :data:`csplab.deps.EXTRAS`: :func:`csplab.solvers.extra_of`)
 options       :class:`Option` declarations (use :func:`order_option`,
               :data:`CHOICE`, :data:`TIME_LIMIT` for the shared vocabulary)
 backends      a callable listing the ``name:backend`` values, or ``None``
@@ -369,7 +370,6 @@ class Solver(ABC):
     description: ClassVar[str]
     notes: ClassVar[str] = ""
     requires: ClassVar[tuple[str, ...]] = ()
-    extra: ClassVar[str | None] = None
     options: ClassVar[tuple[Option, ...]] = (TIME_LIMIT,)
     backends: ClassVar[Callable[[], list[str]] | None] = None
     bench: ClassVar[tuple[dict[str, Any], ...]] = ({},)
@@ -388,25 +388,10 @@ class Solver(ABC):
         Returns
         -------
         Option or None
-            The declaration, or ``None`` if the solver has no such option.
+            The declaration, or ``None`` if the solver has no such option (so
+            ``option(name) is not None`` asks whether the solver takes it).
         """
         return next((o for o in cls.options if o.name == name), None)
-
-    @classmethod
-    def takes(cls, name: str) -> bool:
-        """Whether the solver has option ``name``.
-
-        Parameters
-        ----------
-        name : str
-            An option name such as ``"order"`` or ``"time_limit"``.
-
-        Returns
-        -------
-        bool
-            ``True`` iff :attr:`options` declares it.
-        """
-        return cls.option(name) is not None
 
     @classmethod
     def validate(cls, options: Mapping[str, Any], backend: str | None = None) -> dict[str, Any]:

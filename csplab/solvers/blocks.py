@@ -479,7 +479,8 @@ def _run_sweep(
 
     step: Callable[[int], bool] = block_step
     units = range(len(boxes))
-    if completion is None and _compiled_sweep_applies(boxes, m, order, choice, soft):
+    if (completion is None and problem.value_weights is None
+            and _compiled_sweep_applies(boxes, m, order, choice, soft)):  # fmt: skip
         assert m is not None
         step = _chunk_step(problem, grid, boxes, m, rng, retries, order, choice, counters)
         units = range(0, len(boxes), _SWEEP_CHUNK)
@@ -578,7 +579,8 @@ def _run_waves(
     (flat) in place after each wave."""
     retries, sweeps, order, choice, deadline = plan
     root = int(rng.integers(2**63))
-    compiled = _compiled_sweep_applies(boxes, m, order, choice, None)
+    compiled = problem.value_weights is None and _compiled_sweep_applies(
+        boxes, m, order, choice, None)  # per-class weights: the subproblems carry them
     touching: Callable[[NDArray[np.int64]], NDArray[np.int64]] | None = None
     if not compiled:  # arc ids for the subproblems (the compiled blocks read the CSR rows)
         indptr, ids = _arc_index(problem)
@@ -592,8 +594,10 @@ def _run_waves(
     classes = wv.colour_classes(counts)
     assert sum(len(c) for c in classes) == len(boxes), "one block per lattice index"
     scan = _block_scan(m, order) if compiled and m is not None else None
+    vt = None if problem.value_weights is None else problem.value_weights[0]
     ctx = wv.BlockContext(problem.relations, problem.weights, retries, order, choice, root,
-                          size=problem.n * problem.K, compiled=compiled, scan=scan)  # fmt: skip
+                          size=problem.n * problem.K, compiled=compiled, scan=scan,
+                          value_table=vt)  # fmt: skip
     runner: wv.BlockRunner | None = None
     if scheduler is not None or workers > 1:
         runner = wv.BlockRunner(workers, ctx, scheduler)

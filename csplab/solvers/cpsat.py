@@ -146,7 +146,6 @@ class CpsatSolver(Solver):
     constraints = "exact"
     complete = True
     requires = ("ortools",)
-    extra = "cpsat"
     description = "OR-Tools CP-SAT"
     notes = (
         '`model="onehot"` (Booleans + the support clauses, default) or `"table"` '

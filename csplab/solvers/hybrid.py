@@ -20,10 +20,12 @@ the exact distribution checks this: ``tests/solvers/test_perfect_hybrid.py``.) S
 Examples
 --------
 >>> from csplab import ExampleModel, from_example, solve
->>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
->>> P = from_example(E, (5, 5), fixed={(4, 4): 1})
->>> r = solve(P, "hybrid", rng=3)
->>> r.status, r.stats["repairs"] >= 0
+>>> E = ExampleModel([[0, 0, 0, 2], [2, 0, 0, 1], [0, 1, 2, 1]])   # Alg. 3.1 fails on it
+>>> P = from_example(E, (8, 8))
+>>> solve(P, "catalog", rng=3).status
+'failed'
+>>> r = solve(P, "hybrid", rng=3)             # the same run, repaired where it failed
+>>> r.status, r.stats["repairs"] > 0
 ('solved', True)
 """
 
@@ -61,7 +63,6 @@ class HybridSolver(Solver):
     alg31 = True
     complete = True
     requires = ("pysat",)
-    extra = "sat"
     description = (
         "Alg. 3.1; after a failure, binary search (SAT) for the first choice outside C*, "
         "redraw it from C*, resume"

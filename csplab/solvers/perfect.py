@@ -16,10 +16,9 @@ negative units (C* only shrinks as the model grows), so every call has one assum
 Examples
 --------
 >>> from csplab import ExampleModel, from_example, solve
->>> E = ExampleModel([[0, 1, 0, 1], [1, 0, 1, 0]])
->>> P = from_example(E, (5, 5), fixed={(4, 4): 1})
->>> r = solve(P, "perfect", rng=3)
->>> r.status, r.stats["rejected"] >= 0
+>>> E = ExampleModel([[0, 0, 0, 2], [2, 0, 0, 1], [0, 1, 2, 1]])   # Alg. 3.1 fails on it
+>>> r = solve(from_example(E, (8, 8)), "perfect", rng=3)
+>>> r.status, r.stats["rejected"] > 0            # it met labels of C outside C*
 ('solved', True)
 """
 
@@ -51,7 +50,6 @@ class PerfectSolver(Solver):
     alg31 = True
     complete = True
     requires = ("pysat",)
-    extra = "sat"
     description = "Alg. 3.1 choosing every label from the exact catalog C* (SAT-checked)"
     notes = "never fails on a satisfiable problem; the upper reference for success rates; costly"
     options = (

@@ -54,7 +54,6 @@ class SatSolver(Solver):
     constraints = "exact"
     complete = True
     requires = ("pysat",)
-    extra = "sat"
     description = (
         "CNF on the arc-consistent catalog, solved by python-sat (`sat:cadical195` default, "
         "`sat:glucose4`, … `csplab info` lists the backends)"
@@ -109,7 +108,10 @@ class SatSolver(Solver):
                 stats["fail_cell"] = list(problem.coords(o.enc.wiped))
             else:
                 if choice != "none":
-                    w = problem.weights if choice == "weighted" else None
+                    w = None
+                    if choice == "weighted":  # per cell when the weights are per class
+                        tab, cls = problem.weight_classes()
+                        w = tab[0] if cls is None else tab[cls]
                     o.set_phases(preferred_labels(o.enc.catalog, w, rng))
                 status = o.solve(deadline=deadline)
                 stats.update(o.solver_stats())

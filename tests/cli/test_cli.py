@@ -3,7 +3,7 @@ import json
 import numpy as np
 import pytest
 
-from csplab.cli import main
+from csplab.cli import COMMANDS, main
 from csplab.examples import example_names, load_example
 
 
@@ -96,3 +96,15 @@ def test_info(capsys):
     d = json.loads(out)
     assert code == 0 and {s["name"] for s in d["solvers"]} >= {"catalog", "blocks"}
     assert "line" in d["examples"]
+
+
+@pytest.mark.parametrize("name", sorted(COMMANDS))
+def test_every_command_help(capsys, name):
+    # --help exits 0 with the command's description: its module docstring (or DESCRIPTION /
+    # description()); a stray '%' in an option's help used to crash argparse here
+    with pytest.raises(SystemExit) as e:
+        main([name, "--help"])
+    assert e.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"usage: csplab {name}")
+    assert "``" not in out and ":mod:" not in out

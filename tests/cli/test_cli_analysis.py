@@ -105,3 +105,14 @@ def test_refine_writes_an_infallible_example(tmp_path, capsys):
     assert (EI.labels == 9).sum() == 3
     assert run(capsys, "prove", str(out), "--order", "scan:yx")[0] == 0
     assert load_example("fig3_5a").K == 9
+
+
+@pytest.mark.parametrize("command", ["prove", "witness"])
+def test_bad_out_is_refused_before_the_search(capsys, tmp_path, command):
+    # one --out rule for both commands, checked before any work (witness used to search
+    # for up to --time-limit seconds and only then refuse the suffix)
+    code, out, err = run(capsys, command, "fig3_5a", "--out", str(tmp_path / "run.txt"))
+    assert code == 2 and out == "" and "use a .png picture or a .json file" in err
+    code, _, err = run(capsys, command, "fig3_5a", "--out", str(tmp_path / "no" / "run.json"))
+    assert code == 2 and "does not exist" in err
+
