@@ -102,6 +102,7 @@ SMOOTH_DEGREES = 30.0
 FLAT_RADIANS = 1e-3
 #: a smooth region with at least this many face orientations is a curved part
 MIN_ORIENTATIONS = 6
+_FLAT = 1e-6  # reinserted triangles lower than this share of the output's extent collapse
 _SLIVER = 1e-9  # a Boolean's piece of less volume than this times its extent cubed: rounding
 _DECIMALS = 4  # unit normals rounded to this many decimals count as one orientation
 _EXTRA = "mesh"
@@ -244,12 +245,13 @@ def axis_map(
     return f
 
 
-def _parts(m: Any) -> list[tuple[NDArray[np.float64], NDArray[np.int64]]]:
-    """The connected solids of a manifold3d ``Manifold``: ``(vertices, triangles)``."""
+def _parts(m: Any, flat: float = 0.0) -> list[tuple[NDArray[np.float64], NDArray[np.int64]]]:
+    """The connected solids of a manifold3d ``Manifold``: ``(vertices, triangles)``, with
+    triangles lower than ``flat`` collapsed (manifold3d's ``simplify``; at least its own
+    tolerance): a union of csplab's solids (polygons with collinear points, so that
+    neighbours share vertices) leaves zero-area and near-zero-area triangles."""
     out = []
-    # simplify at manifold3d's own tolerance: a union of csplab's solids (polygons with
-    # collinear points, so that neighbours share vertices) leaves zero-area triangles
-    for part in m.simplify(0.0).decompose():
+    for part in m.simplify(flat).decompose():
         g = part.to_mesh64()
         # own, writable copies (manifold3d's buffers are read-only views)
         v = np.array(np.asarray(g.vert_properties)[:, :3], dtype=np.float64, order="C")
@@ -456,6 +458,10 @@ class Bounded:
         groups: dict[int, list[int]] = {}
         for i in range(len(items)):
             groups.setdefault(root(i), []).append(i)
+        # as thin as the mesh readers' slivers (a height of 1e-6 of the model's extent):
+        # collapsed, so that the written output reads back without a repair
+        ext = np.ptp(np.concatenate([los, his]), axis=0).max() if placed else 0.0
+        flat = _FLAT * float(ext)
         solids: list[Solid] = []
         for members in groups.values():
             if len(members) == 1 and members[0] < len(kept):
@@ -465,7 +471,7 @@ class Bounded:
             ms = [p.to_manifold() if isinstance(p, Solid) else p for p in parts]
             joined = man.Manifold.batch_boolean(ms, man.OpType.Add)
             label = int(items[members[0]][0])
-            solids += [_trusted_solid(label, v, f) for v, f in _parts(joined)]
+            solids += [_trusted_solid(label, v, f) for v, f in _parts(joined, flat)]
         meta = {**output.meta, "bounding volumes": len(self.features)}
         return PolyhedralModel.trusted(solids, name=output.name, meta=meta, source=output.source)
 
