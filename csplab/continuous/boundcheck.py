@@ -14,9 +14,11 @@ alone (not from the synthesis, its CSP or its reinsertion code),
    example moved and scaled per axis (same label and number of triangles, every vertex
    within ``1e-6`` of the output's extent of the mapped original: the rounding of a file
    format, e.g. STL's float32, passes); a part's regions
-   placed by one map give one placed box ``Q`` (the map applied to the part's tight box:
-   the synthesis maps the tight box onto the placed copy of the lattice box), and each of
-   the part's regions must be there;
+   placed by one map give one placed box ``Q`` (the map applied to the part's lattice box,
+   as the synthesis maps the lattice box onto each placed copy), and each of
+   the part's regions must be there; where parts alike up to scale (holes of other radii)
+   match the same region, the part whose content the box holds (point 2) and whose box
+   lies on the lattice of the synthesis is the one;
 2. **that the geometry inside each placed box is exactly the mapped original**: for every
    label, the output's solids inside ``Q`` and the part's content mapped onto ``Q`` have
    a symmetric difference of volume at most the point tolerance times the surface of
@@ -130,13 +132,53 @@ def bounded_violations(
         tol = _POINT_TOL * max(1.0, float(np.ptp(pts, axis=0).max()))
     else:
         tol = _POINT_TOL
-    # 1. every curved region of the output: a part's region, mapped per axis
+    # the output's solids by bounding box, as manifold3d solids when a box needs them
+    slo = np.array([np.asarray(x.vertices).min(axis=0) for x in output.solids]).reshape(-1, 3)
+    shi = np.array([np.asarray(x.vertices).max(axis=0) for x in output.solids]).reshape(-1, 3)
+    cache: dict[int, Any] = {}
+
+    def meets(qlo: NDArray[np.float64], qhi: NDArray[np.float64]) -> NDArray[np.int64]:
+        return np.flatnonzero(np.all(slo < qhi + tol, axis=1) & np.all(qlo < shi + tol, axis=1))
+
+    def content_gap(f: Feature, qlo: NDArray[np.float64], qhi: NDArray[np.float64]) -> str:
+        """Why the output inside ``Q`` is not the part's content mapped onto it, or ""."""
+        move = axis_map(f.box_lo, f.box_hi, qlo, qhi)
+        want = {int(b): c.warp_batch(move) for b, c in f.contents}
+        here: dict[int, list[Any]] = {}
+        for i in meets(qlo, qhi).tolist():
+            if i not in cache:
+                cache[i] = output.solids[i].to_manifold()
+            here.setdefault(int(output.solids[i].label), []).append(cache[i])
+        box = _box(qlo, qhi)
+        ext = qhi - qlo
+        area = 2 * float(ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2])
+        for b in sorted(set(want) | set(here)):
+            have = (man.Manifold.batch_boolean(here[b], man.OpType.Add) ^ box
+                    if b in here else None)  # fmt: skip
+            w = want.get(b)
+            va = float(have.volume()) if have is not None else 0.0
+            vb = float(w.volume()) if w is not None else 0.0
+            both = float((have ^ w).volume()) if have is not None and w is not None else 0.0
+            diff = va + vb - 2 * both
+            if diff > tol * area:  # the surface moved by at most the point tolerance
+                return (f"label {b} inside the box {_show(qlo)}..{_show(qhi)} differs from "
+                        f"the mapped original by volume {diff:.3g}")  # fmt: skip
+        return ""
+
+    def on_lattice(qlo: NDArray[np.float64], qhi: NDArray[np.float64]) -> bool:
+        u = (np.concatenate([qlo, qhi]).reshape(2, 3) - bounded.origin) / bounded.spacing
+        return bool(np.abs(u - np.rint(u)).max() <= 1e-6)
+
+    # 1. every curved region of the output: a part's region, mapped per axis, whose box
+    # holds the part's content (parts alike up to scale, e.g. holes of other radii, match
+    # the same region: the content decides)
     found: dict[tuple[int, tuple[float, ...]], tuple[Feature, Any, Any, set[int]]] = {}
+    verdict: dict[tuple[int, tuple[float, ...]], str] = {}
     own = [[g.points for g in f.regions] for f in bounded.features]  # computed once
     for r in curved_regions(output):
         rp = r.points
         tree = cKDTree(rp)
-        hit = None
+        hits = []
         for k, f in enumerate(bounded.features):
             for j, g in enumerate(f.regions):
                 if g.label != r.label or len(g.triangles) != len(r.triangles):
@@ -147,19 +189,26 @@ def bounded_violations(
                     continue
                 d, near = tree.query(gp)  # one to one: as many points, each its own
                 if float(d.max()) <= tol and len(np.unique(near)) == len(rp):
-                    qlo, qhi = move(f.tight_lo), move(f.tight_hi)
-                    hit = (k, f, qlo, qhi, j)
-                    break
-            if hit:
-                break
-        if hit is None:
+                    qlo, qhi = move(f.box_lo), move(f.box_hi)
+                    key = (k, tuple(np.round(np.concatenate([qlo, qhi]) / tol).tolist()))
+                    hits.append((key, f, qlo, qhi, j))
+        if not hits:
             defects.append(_defect("curved", r.lo, (
                 f"a curved part of label {r.label} ({len(r.triangles)} triangles, "
                 f"{r.orientations} orientations) is no moved and scaled curved part of the "
                 "example")))  # fmt: skip
             continue
-        k, f, qlo, qhi, j = hit
-        key = (k, tuple(np.round(np.concatenate([qlo, qhi]) / tol).tolist()))
+        for key, f, qlo, qhi, _ in hits:
+            if key not in verdict:
+                verdict[key] = content_gap(f, qlo, qhi)
+        good = [h for h in hits if not verdict[h[0]]]
+        # of those, a box on the output's lattice (parts alike up to scale whose contents
+        # both fit: a smaller part's box lies off the lattice)
+        good.sort(key=lambda h: not on_lattice(h[2], h[3]))
+        if not good:
+            key, f, qlo, qhi, _ = hits[0]
+            defects.append(_defect("content", qlo, verdict[key]))
+        key, f, qlo, qhi, j = (good or hits)[0]
         found.setdefault(key, (f, qlo, qhi, set()))[3].add(j)
     placed = []
     for f, qlo, qhi, regions in found.values():
@@ -168,41 +217,18 @@ def bounded_violations(
                 f"a box holds {len(regions)} of the {len(f.regions)} curved regions of its "
                 "part")))  # fmt: skip
         placed.append((f, qlo, qhi))
-    # 2. the content of every placed box, and the output with the boxes emptied
+    # 2. the output with the boxes emptied, and the boxes' pieces
     boxes = [_box(qlo, qhi) for _, qlo, qhi in placed]
     los = np.array([q for _, q, _ in placed]).reshape(-1, 3)
     his = np.array([q for _, _, q in placed]).reshape(-1, 3)
     kept: list[Any] = []  # solids no box touches: as they are
     touched: list[tuple[int, Any, NDArray[np.bool_]]] = []  # (label, manifold, boxes met)
-    for s in output.solids:
-        v = np.asarray(s.vertices, dtype=np.float64)
-        lo, hi = v.min(axis=0), v.max(axis=0)
-        meet = np.all(los < hi + tol, axis=1) & np.all(lo < his + tol, axis=1)
+    for i, s in enumerate(output.solids):
+        meet = np.all(los < shi[i] + tol, axis=1) & np.all(slo[i] < his + tol, axis=1)
         if meet.any():
-            touched.append((int(s.label), s.to_manifold(), meet))
+            touched.append((int(s.label), cache.get(i) or s.to_manifold(), meet))
         else:
             kept.append(s)
-    for k, ((f, qlo, qhi), box) in enumerate(zip(placed, boxes, strict=True)):
-        move = axis_map(f.tight_lo, f.tight_hi, qlo, qhi)
-        want = {int(b): c.warp_batch(move) for b, c in f.contents}
-        here: dict[int, list[Any]] = {}
-        for b, m, meet in touched:
-            if meet[k]:
-                here.setdefault(b, []).append(m)
-        for b in sorted(set(want) | set(here)):
-            have = (man.Manifold.batch_boolean(here[b], man.OpType.Add) ^ box
-                    if b in here else None)  # fmt: skip
-            w = want.get(b)
-            va = float(have.volume()) if have is not None else 0.0
-            vb = float(w.volume()) if w is not None else 0.0
-            both = float((have ^ w).volume()) if have is not None and w is not None else 0.0
-            diff = va + vb - 2 * both
-            ext = qhi - qlo
-            area = 2 * float(ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2])
-            if diff > tol * area:  # the surface moved by at most the point tolerance
-                defects.append(_defect("content", qlo, (
-                    f"label {b} inside the box {_show(qlo)}..{_show(qhi)} differs from the "
-                    f"mapped original by volume {diff:.3g}")))  # fmt: skip
     new: list[dict[str, Any]] = []  # the touched solids without the boxes, and the pieces
     for b, m, meet in touched:
         cut = man.Manifold.batch_boolean([boxes[k] for k in np.flatnonzero(meet)],

@@ -39,9 +39,9 @@ remaining vertices are rounded onto the same lattice (:func:`~csplab.continuous.
 snapped3`, the pipeline's one snapping), so the proxy is on the lattice as it is.
 
 **Substituting back** (:meth:`Bounded.reinsert`). The *content* of a part is the
-original geometry inside its tight box (each solid intersected with it). Each output
+original geometry inside its lattice box (each solid intersected with it). Each output
 solid of a part's first label is one placed box ``Q`` (its bounding box); the content is
-mapped by the per-axis affine map taking the tight box onto ``Q`` (so the curved faces
+mapped by the per-axis affine map taking the lattice box onto ``Q`` (so the curved faces
 are the original's, moved and scaled as the box was), the box's labels are dropped and
 each label's solids are joined (manifold3d union), so the output holds the curved
 geometry and no proxy label.
@@ -50,7 +50,7 @@ What :mod:`~csplab.continuous.boundcheck` verifies of such an output is stated t
 
 **Limits.** Boxes are axis-aligned: the curved part of a rotated mesh gets a larger box than
 its oriented one would be, and the ``axis`` kind needs a cylinder along a coordinate axis
-(others scale uniformly). A part's content is the whole original inside its tight box, so
+(others scale uniformly). A part's content is the whole original inside its box, so
 flat geometry there travels with the curved faces. ``csplab check`` rebuilds the proxy with
 the derived spacing: an output made with another ``--spacing`` is checked against another
 proxy. A lathe output of 40x40x20 spacings has about 800,000 triangles, more than
@@ -310,7 +310,7 @@ class Feature:
     labels : (int, int)
         The proxy labels of the two pieces of the box.
     contents : tuple of (int, Any)
-        ``(label, manifold3d.Manifold)``: the original geometry inside the tight box.
+        ``(label, manifold3d.Manifold)``: the original geometry inside the lattice box.
     """
 
     regions: tuple[CurvedRegion, ...]
@@ -335,7 +335,7 @@ class Feature:
         return _pieces(self.box_lo, self.box_hi, self.axis)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Bounded:
     """An example whose curved parts became bounding volumes (see the module docstring).
 
@@ -349,12 +349,16 @@ class Bounded:
         The curved parts, in the order of their labels.
     spacing : float
         The lattice spacing the proxy is on.
+    origin : float array ``(3,)``
+        The lattice's origin (the example's lowest corner; synthesis outputs are on the
+        lattice of ``origin`` and ``spacing``).
     """
 
     example: PolyhedralModel
     proxy: PolyhedralModel
     features: tuple[Feature, ...]
     spacing: float
+    origin: NDArray[np.float64]
 
     def describe(self) -> str:
         """One line naming the parts that became bounding volumes.
@@ -419,13 +423,13 @@ class Bounded:
         -------
         PolyhedralModel
             The output without the boxes' labels: each box's content mapped onto it
-            (:func:`axis_map` from the tight box), each label's solids joined.
+            (:func:`axis_map` from the lattice box), each label's solids joined.
         """
         man = _manifold()
         kept = [s for s in output.solids if int(s.label) not in self.proxy_labels]
         placed: list[tuple[int, Any]] = []
         for f, lo, hi in self.placements(output):
-            move = axis_map(f.tight_lo, f.tight_hi, lo, hi)
+            move = axis_map(f.box_lo, f.box_hi, lo, hi)
             placed += [(label, c.warp_batch(move)) for label, c in f.contents]
         # a placed content is joined with the solids of its label that its box touches
         # (union-find over touching bounding boxes): the others stay as they are
@@ -571,12 +575,12 @@ def bounding_volumes(
     solids = [s_.to_manifold(f"{example.source}: solid {i}") for i, s_ in enumerate(example.solids)]
     features = []
     for k, (g, (tlo, thi), (blo, bhi)) in enumerate(zip(groups, tight, boxes, strict=True)):
-        tbox = man.Manifold.cube(tuple(float(x) for x in thi - tlo)).translate(
-            tuple(float(x) for x in tlo))
+        tbox = man.Manifold.cube(tuple(float(x) for x in bhi - blo)).translate(
+            tuple(float(x) for x in blo))
         contents = []
         for i, m in enumerate(solids):
             part = m ^ tbox
-            if part.volume() > 1e-12 * float(np.prod(thi - tlo)):
+            if part.volume() > 1e-12 * float(np.prod(bhi - blo)):
                 contents.append((int(example.solids[i].label), part))
         axis = _axis(np.concatenate([r.normals for r in g]))
         features.append(Feature(tuple(g), axis, tlo, thi, blo, bhi,
@@ -601,4 +605,4 @@ def bounding_volumes(
         for j, lab in enumerate(f.labels):
             names[str(lab)] = f"bounding volume {k}{'ab'[j]}"
     model.meta["label_names"] = names
-    return Bounded(example, model, tuple(features), s)
+    return Bounded(example, model, tuple(features), s, origin)
