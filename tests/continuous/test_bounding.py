@@ -197,3 +197,13 @@ def test_cli_names_the_parts_and_check_agrees(tmp_path, capsys):
     said = capsys.readouterr().out
     assert code == 0 and said.startswith("0 violations"), said
     assert "Eq. 4.1 on the proxy" in said
+
+
+@pytest.mark.parametrize("name", ["holes", "dome", "lathe"])
+def test_the_proxy_filled_back_is_the_original(name):
+    E = model(name)
+    b = bounding_volumes(E)
+    back = b.reinsert(b.proxy)  # every box of the example's own proxy: its own content
+    assert back.labels == E.labels
+    assert back.volume() == pytest.approx(E.volume(), rel=1e-6)
+    assert _has_normals(_unit_normals(back), _wall_normals(E), tol=1e-9)
