@@ -145,8 +145,7 @@ def synthesize(
         raise InputError("--out-partial: a failed continuous run has no partial polygons")
     if args.spacing is not None and not args.spacing > 0:
         raise InputError(f"--spacing must be positive, not {args.spacing}")
-    if dim == 3 and args.lines != "lattice":
-        raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
+    lines = "lattice" if dim == 2 and args.lines == "auto" else args.lines
     size = region(args, dim)
     boundary = boundary_label(args, example)
     fmt = polygon_output(args.out, gives=type(example).__name__, args=args)
@@ -156,7 +155,7 @@ def synthesize(
     budget = memory_budget(getattr(args, "memory_limit", None))
     if dim == 2:  # a probe arrangement scaled up; 3D: estimate3 before any arrangement
         need = estimate_peak(example, size, spacing=args.spacing, snap=args.snap,
-                             lines=args.lines)  # fmt: skip
+                             lines=lines)  # fmt: skip
         check_memory(
             need,
             f"{example.name or args.model} --size {'x'.join(map(str, size))}",
@@ -190,9 +189,9 @@ def synthesize(
     if cons is not None:
         settings["constraints"] = ", ".join(cons_summary(cons))
     if dim == 2:
-        settings["lines"] = args.lines
+        settings["lines"] = lines
     try:
-        s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
+        s = run(example, size, lines=lines, constraints=cons, **common, **opts)
     except InputError as e:  # the library names its arguments; the user typed flags
         raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem
@@ -206,6 +205,7 @@ def synthesize(
         from csplab.continuous.space import estimate3
 
         nv, ne, nb = estimate3(csp.lattice, size)
+        settings["planes"] = csp.lattice.planes + (" (auto)" if args.lines == "auto" else "")
         settings["estimate"] = f"~{nv} vertices, ~{ne} edges, ~{nb / 2**20:.0f} MiB"
     lat = csp.lattice
     if lat.derived:

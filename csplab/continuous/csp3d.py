@@ -169,7 +169,8 @@ def example_signatures3(
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
     shift = 1.0 - lo
     A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)),
-                     max_memory=max_memory, where=example.source, hint="")  # fmt: skip
+                     max_memory=max_memory, where=example.source, hint="",
+                     shift=tuple(int(x) for x in shift))  # fmt: skip
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
@@ -233,10 +234,11 @@ class ContinuousCSP3:
         boundary: int | Mapping[str, int] = 0,
         constraints: UserConstraints3 | None = None,
         max_memory: int | None = None,
+        planes: str = "auto",
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
-        self.lattice = Lattice.of_model(example, spacing, snap=snap)
+        self.lattice = Lattice.of_model(example, spacing, snap=snap, planes=planes)
         if self.lattice.snapped:
             example = snapped3(example, self.lattice)
         #: the example as synthesized (its vertices snapped onto the lattice when they were not

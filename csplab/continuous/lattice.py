@@ -44,10 +44,12 @@ if TYPE_CHECKING:
 __all__ = [
     "DIVISIONS",
     "MAX_FAMILIES",
+    "PLANES",
     "MAX_FAMILIES3",
     "Lattice",
     "PlaneArrangement",
     "derived_spacing",
+    "equal_steps",
     "family_vectors",
     "gcd_fractions",
     "primitive3",
@@ -68,6 +70,13 @@ _SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
 _AXES3 = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
 #: a derived spacing divides the example's thinnest side into at least this many spacings
 DIVISIONS = 4
+#: how the planes of a 3D family are spaced: ``lattice`` (``n . x = k`` for every integer
+#: ``k``: a family of normal ``n`` has ``|n|`` planes per spacing), ``equal`` (every
+#: family's planes about one spacing apart, the 2008 paper's Sec. 3.2 "we choose to space
+#: all the lines identically", through the example's own faces: :func:`equal_steps`), or
+#: ``auto`` (``equal`` for an example from real coordinates, whose spacing is derived;
+#: ``lattice`` for exact ones, the built-in examples)
+PLANES = ("auto", "lattice", "equal")
 
 
 def derived_spacing(points: NDArray[np.float64]) -> float:
@@ -217,6 +226,76 @@ def family_vectors(
     return tuple(sorted(normals))
 
 
+def _step_near(target: float, period: int) -> int:
+    """The divisor of ``period`` (any positive integer when ``period`` is 0) nearest to
+    ``target`` in ratio, at least 1."""
+    if period == 0:
+        return max(1, round(target))
+    divs = [d for d in range(1, math.isqrt(period) + 1) if period % d == 0]
+    divs += [period // d for d in divs]
+    return min(divs, key=lambda d: (abs(math.log(d / target)), d))
+
+
+def equal_steps(
+    ip: NDArray[np.int64], faces: Sequence[Sequence[int]], vectors: Sequence[Sequence[int]]
+) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """Equal plane spacing per family (3D): the planes of family ``n`` are ``n . x = k``
+    for the ``k`` with ``k % step == residue``, so ``step / |n|`` spacings apart.
+
+    ``step`` is the integer nearest to ``|n|`` (planes one spacing apart, as the 2008 paper
+    spaces its lines) among those that put every face of the example of that family on a
+    plane: the divisors of the gcd of the differences of their ``k`` (any step for a
+    family of one plane); ``residue`` is their ``k`` modulo ``step``. Since every example
+    vertex is a lattice point on the planes of all its faces, the example's vertices where
+    four or more planes meet (the pyramid apex, thesis Sec. 4.5.8) are vertices of the
+    arrangement, and so is every point of the region congruent to one (the families'
+    planes are periodic): Eq. 4.25 holds by construction, without solving for spacings.
+
+    Parameters
+    ----------
+    ip : int array ``(n, 3)``
+        The example's vertices as lattice points.
+    faces : sequence of sequence of int
+        Its polygons (vertex indices).
+    vectors : sequence of (int, int, int)
+        The families (:func:`family_vectors`).
+
+    Returns
+    -------
+    steps, residues : tuple of int
+        Per family of ``vectors``.
+
+    Examples
+    --------
+    >>> ip = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]])
+    >>> faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+    >>> equal_steps(ip, faces, family_vectors(ip, faces))   # (1, 1, 1): 4 = 2 * 2
+    ((1, 1, 1, 2), (0, 0, 0, 0))
+    """
+    ks: dict[tuple[int, ...], list[int]] = {tuple(v): [] for v in vectors}
+    for poly in faces:
+        q = ip[list(poly)]
+        nxt = np.roll(q, -1, axis=0)
+        n = (
+            int(((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum()),
+            int(((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum()),
+            int(((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()),
+        )
+        if n != (0, 0, 0):
+            p = primitive3(n)
+            ks.setdefault(p, []).append(int(np.dot(p, q[0])))
+    steps, residues = [], []
+    for v in vectors:
+        k = ks[tuple(v)]
+        period = 0
+        for x in k:
+            period = math.gcd(period, x - k[0])
+        st = _step_near(float(np.linalg.norm(v)), period)
+        steps.append(st)
+        residues.append(k[0] % st if k else 0)
+    return tuple(steps), tuple(residues)
+
+
 def _exact(pts: NDArray[np.float64], limit: int) -> bool:
     """Whether every coordinate is a rational of denominator at most 10^6 and their common
     unit spans the example in at most ``limit`` steps."""
@@ -261,6 +340,10 @@ class Lattice:
         The largest angle (degrees) by which snapping turned a face (3D).
     derived : bool, default False
         Whether the spacing is :func:`derived_spacing` (the example had no exact unit).
+    steps, residues : tuple of int, default ()
+        3D: per family of ``vectors``, its planes are ``n . x = k`` for the ``k`` with
+        ``k % step == residue`` (:func:`equal_steps`); empty: every integer ``k``
+        (``lattice`` planes).
     """
 
     origin: tuple[Fraction, ...]
@@ -269,6 +352,21 @@ class Lattice:
     snapped: float = 0.0
     normal_change: float = 0.0
     derived: bool = False
+    steps: tuple[int, ...] = ()
+    residues: tuple[int, ...] = ()
+
+    @property
+    def planes(self) -> str:
+        """How the planes of a family are spaced: ``equal`` or ``lattice`` (:data:`PLANES`)."""
+        return "equal" if self.steps else "lattice"
+
+    def plane_steps(self) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        """Step and residue of every family of :meth:`families` (1 and 0 for the lattice
+        planes and for the added axis families)."""
+        fams, _ = self.families()
+        st = dict(zip(self.vectors, self.steps, strict=True)) if self.steps else {}
+        rs = dict(zip(self.vectors, self.residues, strict=True)) if self.steps else {}
+        return (tuple(st.get(v, 1) for v in fams), tuple(rs.get(v, 0) for v in fams))
 
     @property
     def ndim(self) -> int:
@@ -295,6 +393,7 @@ class Lattice:
         snap: bool = False,
         max_extent: int | None = None,
         where: str = "<model>",
+        planes: str = "auto",
     ) -> Lattice:
         """The lattice of an example given as points and faces, in 2D or 3D.
 
@@ -318,6 +417,9 @@ class Lattice:
             dimension.
         where : str, default "<model>"
             What the example is called in error messages.
+        planes : {"auto", "lattice", "equal"}, default "auto"
+            3D: how each family's planes are spaced (:data:`PLANES`; ``auto`` is ``equal``
+            when the spacing is derived, the example being in real coordinates).
 
         Returns
         -------
@@ -329,10 +431,12 @@ class Lattice:
         InputError
             When ``spacing`` is not a positive number, a vertex has no exact rational form
             (without ``spacing``), the example has no extent, a vertex is off the lattice
-            without ``snap``, the example spans more than ``max_extent`` spacings, or it has
+            without ``snap``, the example spans more than ``max_extent`` spacings, it has
             more families than are supported (:data:`MAX_FAMILIES`,
-            :data:`MAX_FAMILIES3`).
+            :data:`MAX_FAMILIES3`), or ``planes`` is not one of :data:`PLANES`.
         """
+        if planes not in PLANES:
+            raise InputError(f"planes must be one of {', '.join(PLANES)}, not {planes!r}")
         d = int(np.shape(points)[1])
         pts = np.asarray(points, dtype=np.float64).reshape(-1, d)
         lo = pts.min(axis=0)
@@ -383,7 +487,11 @@ class Lattice:
             )
         vectors = family_vectors(iu.astype(np.int64), faces, where)
         turned = _normal_change(pts, iu.astype(np.int64), faces) if snap and d == 3 else 0.0
-        return cls(origin, s, vectors, off if snap else 0.0, turned, derived)
+        steps: tuple[int, ...] = ()
+        residues: tuple[int, ...] = ()
+        if d == 3 and (planes == "equal" or (planes == "auto" and derived)):
+            steps, residues = equal_steps(iu.astype(np.int64), faces, vectors)
+        return cls(origin, s, vectors, off if snap else 0.0, turned, derived, steps, residues)
 
     @classmethod
     def of(
@@ -437,6 +545,7 @@ class Lattice:
         spacing: float | None = None,
         *,
         snap: bool = False,
+        planes: str = "auto",
     ) -> Lattice:
         """The lattice of a polygon or polyhedral model.
 
@@ -451,6 +560,8 @@ class Lattice:
             The spacing; default: derived, as in :meth:`of_points`.
         snap : bool, default False
             Round vertices that are off the lattice of ``spacing`` onto it.
+        planes : {"auto", "lattice", "equal"}, default "auto"
+            3D plane spacing per family (:data:`PLANES`).
 
         Returns
         -------
@@ -464,7 +575,7 @@ class Lattice:
             ``snap``, an example too large or with too many families.
         """
         pts, faces = example.indexed_faces()
-        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source)
+        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source, planes=planes)
 
     def to_lattice(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """World coordinates to lattice coordinates.

@@ -63,6 +63,7 @@ __all__ = [
     "check_budget3",
     "estimate3",
     "plane_counts",
+    "plane_ks",
     "primitive3",
 ]
 
@@ -177,16 +178,34 @@ def _gib(b: float) -> str:
     return f"{b / 2**30:.1f} GiB" if b >= 2**29 else f"{b / 2**20:.0f} MiB"
 
 
-def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
-    """Planes of each family (:meth:`Lattice.families` order) in the box ``size``: every
-    integer ``k`` with ``n . x = k`` meeting the box, two for a boundary-only family."""
+def plane_ks(
+    lattice: Lattice, size: Sequence[int], shift: Sequence[int] = (0, 0, 0)
+) -> list[NDArray[np.int64]]:
+    """The planes ``n . x = k`` of each family (:meth:`Lattice.families` order) meeting the
+    box ``size`` (lattice units, the lattice moved by ``shift``): the ``k`` of its step and
+    residue (:meth:`Lattice.plane_steps`), the two sides for a boundary-only family."""
     fams, bonly = lattice.families()
+    steps, residues = lattice.plane_steps()
     corners = np.array(list(itertools.product(*[(0, int(s)) for s in size])), dtype=np.int64)
+    t = np.array([int(x) for x in shift], dtype=np.int64)
     out = []
-    for n, b in zip(fams, bonly, strict=True):
-        kc = corners @ np.array(n, dtype=np.int64)
-        out.append(2 if b else int(kc.max() - kc.min()) + 1)
+    for n, b, st, r in zip(fams, bonly, steps, residues, strict=True):
+        nv = np.array(n, dtype=np.int64)
+        kc = corners @ nv
+        lo, hi = int(kc.min()), int(kc.max())
+        if b:
+            out.append(np.array([lo, hi], dtype=np.int64))
+            continue
+        r0 = (r + int(nv @ t)) % st
+        first = lo + (r0 - lo) % st
+        out.append(np.arange(first, hi + 1, st, dtype=np.int64))
     return out
+
+
+def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
+    """Planes of each family (:meth:`Lattice.families` order) in the box ``size``
+    (:func:`plane_ks`)."""
+    return [len(k) for k in plane_ks(lattice, size)]
 
 
 def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
@@ -198,7 +217,8 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
     ``m`` families of ``n``). Most of those meeting points lie outside the box: the points
     of a triple form a lattice of ``|det(N_a, N_b, N_c)|`` points per unit volume, so a
     triple counts ``min(n_a n_b n_c, |det| (A + 1)(B + 1)(C + 1))`` (the full product when
-    one family is boundary-only). Each vertex starts at most three edges per triple through
+    one family is boundary-only; with equal planes, :meth:`Lattice.plane_steps`, that
+    density divided by the product of the three steps). Each vertex starts at most three edges per triple through
     it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
 
     Examples
@@ -209,6 +229,7 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
     """
     n = plane_counts(lattice, size)
     fams, bonly = lattice.families()
+    steps, _ = lattice.plane_steps()
     N = np.array(fams, dtype=np.int64).reshape(-1, 3)
     vol = math.prod(int(x) + 1 for x in size)
     v = 0
@@ -217,7 +238,8 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
         if det == 0:
             continue
         full = n[t[0]] * n[t[1]] * n[t[2]]
-        v += full if any(bonly[k] for k in t) else min(full, det * vol)
+        dense = -(-det * vol // (steps[t[0]] * steps[t[1]] * steps[t[2]]))
+        v += full if any(bonly[k] for k in t) else min(full, dense)
     return v, 3 * v, BYTES_PER_VERTEX * v
 
 
@@ -277,6 +299,7 @@ class Arrangement3(ArrangementGraph):
         max_memory: int | None = None,
         where: str = "<model>",
         hint: str = " or a smaller --size",
+        shift: Sequence[int] = (0, 0, 0),
     ) -> None:
         if len(size) != 3 or any(int(s) < 1 for s in size):
             raise InputError(f"the region must be AxBxC with positive sides, not {tuple(size)}")
@@ -301,13 +324,9 @@ class Arrangement3(ArrangementGraph):
                 "--spacing (with --snap) gives simpler normals"
             )
         ext = np.array(self.size, dtype=np.int64) * D
-        corners = np.array(list(itertools.product(*[(0, s) for s in self.size])), dtype=np.int64)
-        self.k_range: list[NDArray[np.int64]] = []
-        for f in range(F):
-            kc = corners @ N[f]
-            lo, hi = int(kc.min()), int(kc.max())
-            ks = np.array([lo, hi]) if bonly[f] else np.arange(lo, hi + 1)
-            self.k_range.append(ks.astype(np.int64))
+        self.k_range: list[NDArray[np.int64]] = plane_ks(lattice, self.size, shift)
+        steps, _ = lattice.plane_steps()
+        self.steps = np.array(steps, dtype=np.int64)
         keys = []
         stride = (ext + 1).astype(np.int64)
         for t in triples:
@@ -331,7 +350,7 @@ class Arrangement3(ArrangementGraph):
         s = XYZ @ N.T  # (nv, F)
         on = s % D == 0
         for f in range(F):
-            if bonly[f]:
+            if bonly[f] or self.steps[f] > 1:
                 on[:, f] &= np.isin(s[:, f] // D, self.k_range[f])
         self.on = on
         # edges: consecutive vertices on the line of two planes

@@ -88,7 +88,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
@@ -107,7 +107,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
@@ -125,7 +125,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
@@ -148,7 +148,7 @@ def synthesize(
     rng : int or numpy Generator, optional
         Seed (recorded in the result).
     spacing, snap, boundary, lines, constraints, max_memory
-        See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: 2D; per-face
+        See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: per family; per-face
         ``boundary`` and user ``constraints`` of thesis Sec. 4.6: 3D).
     restarts : int
         Run an incomplete solver again with a fresh derived seed while it fails
