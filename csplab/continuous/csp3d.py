@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.constraints import Connected
 from csplab.continuous._geom import labels_at
-from csplab.continuous.lattice import Lattice
+from csplab.continuous.lattice import Lattice, face_planes
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.space import Arrangement3, check_budget3
 from csplab.continuous.surface import surface_of
@@ -95,32 +95,52 @@ def _local_labels(
     fams_on: NDArray[np.bool_],
     tris: list[tuple[int, NDArray[np.float64]]],
     index: dict[int, int],
-) -> list[Labeling]:
-    """Full labelings (over the central cells) of the neighbourhoods at ``points`` whose
-    planes are ``fams_on`` (per point), by point location just off each point."""
+) -> NDArray[np.int64]:
+    """Full labelings ``(len(points), cells)`` over the central cells of the neighbourhoods
+    at ``points`` whose planes are ``fams_on`` (per point), by point location just off each
+    point (one query per group of cells; points with the same planes in one batch)."""
     signs, dirs = A.cells
+    out = np.zeros((len(points), len(signs)), dtype=np.int64)
+    if not len(points):
+        return out
     eps = 1e-3 / (A.D * float(np.abs(A.normals).sum(axis=1).max()))
-    cache: dict[bytes, tuple[NDArray[np.int64], int, NDArray[np.int64]]] = {}
-    queries, owners = [], []
-    for i, fo in enumerate(fams_on):
-        key = fo.tobytes()
-        if key not in cache:
-            g, ng = _groups(signs, np.flatnonzero(fo))
-            rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
-            cache[key] = (g, ng, rep)
-        g, ng, rep = cache[key]
-        queries.append(points[i] + eps * dirs[rep])
-        owners.append(i)
-    q = np.concatenate(queries) if queries else np.zeros((0, 3))
-    lab = labels_at(q, tris)
-    lab = np.array([index[int(b)] if b else 0 for b in lab], dtype=np.int64)
-    out = []
+    keys, inv = np.unique(fams_on, axis=0, return_inverse=True)
+    inv = inv.reshape(-1)
+    batches, queries = [], []
+    for u in range(len(keys)):
+        members = np.flatnonzero(inv == u)
+        g, ng = _groups(signs, np.flatnonzero(keys[u]))
+        rep = np.unique(g, return_index=True)[1]
+        queries.append((points[members][:, None, :] + eps * dirs[rep][None, :, :]).reshape(-1, 3))
+        batches.append((members, g, ng))
+    lab = labels_at(np.concatenate(queries), tris)
+    compact = np.zeros(max(index) + 1, dtype=np.int64)
+    for b, i in index.items():
+        compact[b] = i
+    lab = compact[lab]
     pos = 0
-    for fo in fams_on:
-        g, ng, _ = cache[fo.tobytes()]
-        local = lab[pos : pos + ng]
-        pos += ng
-        out.append(tuple(int(x) for x in local[g]))
+    for members, g, ng in batches:
+        local = lab[pos : pos + len(members) * ng].reshape(len(members), ng)
+        pos += len(members) * ng
+        out[members] = local[:, g]
+    return out
+
+
+def _on_faces(
+    A: Arrangement3, vertex: NDArray[np.int64], fams: NDArray[np.bool_],
+    planes: dict[tuple[int, ...], list[int]],
+) -> NDArray[np.bool_]:  # fmt: skip
+    """Which points (on the planes ``fams`` through the arrangement vertex ``vertex``) lie
+    on a plane of an example face (``planes``, :func:`~csplab.continuous.lattice.face_planes`
+    in the arrangement's frame): the only points whose neighbourhood is not one label."""
+    out = np.zeros(len(vertex), dtype=bool)
+    XYZ = np.stack([A.X[vertex], A.Y[vertex], A.Z[vertex]], axis=1)
+    for f, n in enumerate(A.normals.tolist()):
+        ks = planes.get(tuple(n))
+        if ks:
+            sel = fams[:, f] & ~out
+            kk = XYZ[sel] @ A.normals[f] // A.D
+            out[np.flatnonzero(sel)[np.isin(kk, ks)]] = True
     return out
 
 
@@ -130,8 +150,13 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
     (:class:`~csplab.errors.InputError`) when that breaks a solid (flattens it, turns it
     inside out, makes two overlap)."""
     solids = []
+    base = 0
     for sol in example.solids:
-        uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
+        if lattice.moved is not None:  # snapped by planes (the lattice's moved vertices)
+            uv = np.round(lattice.moved[base : base + len(sol.vertices)], 9)
+        else:
+            uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
+        base += len(sol.vertices)
         uv, inv = np.unique(uv, axis=0, return_inverse=True)  # vertices that met: one
         inv = inv.reshape(-1)
         faces = []
@@ -174,18 +199,25 @@ def example_signatures3(
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
-    sigs |= set(_local_labels(A, A.vertex_positions(), A.on, tris, index))
-    efam = A.edge_families()
-    edge_sigs = _local_labels(A, A.edge_positions(), efam, tris, index)
-    sigs |= set(edge_sigs)
+    # only points on a plane of an example face can see more than one label (the others'
+    # uniform neighbourhoods are the labelings above)
+    pts_, faces_ = example.indexed_faces()
+    planes = face_planes(lattice.to_lattice(pts_) + shift, faces_, lattice.vectors)
+    vsel = np.flatnonzero(_on_faces(A, np.arange(A.n_vertices), A.on, planes))
+    vsigs = _local_labels(A, A.vertex_positions()[vsel], A.on[vsel], tris, index)
+    sigs |= set(map(tuple, np.unique(vsigs, axis=0).tolist()))
+    efam_all = A.edge_families()
+    esel = np.flatnonzero(_on_faces(A, A.edge_src, efam_all, planes))
+    efam = efam_all[esel]
+    L = _local_labels(A, A.edge_positions()[esel], efam, tris, index)
+    sigs |= set(map(tuple, np.unique(L, axis=0).tolist()))
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
     N = A.normals
-    L = np.array(edge_sigs, dtype=np.int64).reshape(len(edge_sigs), len(signs))
     L, which = np.unique(L, axis=0, return_inverse=True)  # few distinct edge labelings
     which = which.reshape(-1)
     fmask = efam.astype(np.int64) @ (1 << np.arange(A.F, dtype=np.int64))
-    combo = np.stack([fmask, A.edge_line], axis=1)
+    combo = np.stack([fmask, A.edge_line[esel]], axis=1)
     uniq, inv = np.unique(combo, axis=0, return_inverse=True)
     inv = inv.reshape(-1)
     for k, (mask, line) in enumerate(uniq.tolist()):
@@ -239,7 +271,13 @@ class ContinuousCSP3:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
         self.lattice = Lattice.of_model(example, spacing, snap=snap, planes=planes)
-        if self.lattice.snapped:
+        if self.lattice.snapped and self.lattice.moved is not None:
+            try:
+                example = snapped3(example, self.lattice)
+            except InputError:  # moving the planes broke it: round the vertices instead
+                self.lattice = Lattice.of_model(example, spacing, snap=snap, planes=planes,
+                                                by_planes=False)  # fmt: skip
+        if self.lattice.snapped and self.lattice.moved is None:
             example = snapped3(example, self.lattice)
         #: the example as synthesized (its vertices snapped onto the lattice when they were not
         #: on it; the checker compares the output with this)
@@ -516,7 +554,7 @@ class ContinuousCSP3:
             (A.vertex_positions(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
             (A.edge_positions(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
         ):
-            labs = _local_labels(A, pts, fams_on, tris, index)
+            labs = _local_labels(A, pts, fams_on, tris, index).tolist()
             size = np.array(A.size, dtype=np.float64)
             for i, full in enumerate(labs):
                 _, st, g = tlist[int(types[i])]

@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import TYPE_CHECKING, Protocol
 
@@ -43,15 +43,23 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DIVISIONS",
+    "FIT_DEG",
+    "FIT_DEGS",
+    "MAX_DENOMINATOR",
     "MAX_FAMILIES",
+    "MERGE_DEG",
     "PLANES",
     "MAX_FAMILIES3",
     "Lattice",
     "PlaneArrangement",
     "derived_spacing",
     "equal_steps",
+    "face_planes",
     "family_vectors",
+    "denominator",
     "gcd_fractions",
+    "integer_normal",
+    "plane_snap",
     "primitive3",
     "rational",
 ]
@@ -70,6 +78,17 @@ _SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
 _AXES3 = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
 #: a derived spacing divides the example's thinnest side into at least this many spacings
 DIVISIONS = 4
+#: degrees: face normals of an example in real coordinates closer than this are one plane
+#: family (near-parallel normals merged; CAD exports differ in the 4th-6th decimal)
+MERGE_DEG = 1.0
+#: degrees: a family's normal is snapped to the smallest integer vector this close
+FIT_DEG = 2.0
+#: the tolerances tried in turn (:func:`plane_snap`) until the families' planes meet at
+#: points of denominator at most :data:`MAX_DENOMINATOR`
+FIT_DEGS = (FIT_DEG, 3.0, 4.0, 6.0, 8.0, 12.0)
+#: the largest common denominator of the points where three planes meet that snapping by
+#: planes accepts (exact coordinates stay small; fine denominators make dense arrangements)
+MAX_DENOMINATOR = 1000
 #: how the planes of a 3D family are spaced: ``lattice`` (``n . x = k`` for every integer
 #: ``k``: a family of normal ``n`` has ``|n|`` planes per spacing), ``equal`` (every
 #: family's planes about one spacing apart, the 2008 paper's Sec. 3.2 "we choose to space
@@ -226,6 +245,184 @@ def family_vectors(
     return tuple(sorted(normals))
 
 
+def face_planes(
+    points: NDArray[np.float64],
+    faces: Sequence[Sequence[int]],
+    vectors: Sequence[Sequence[int]],
+) -> dict[tuple[int, ...], list[int]]:
+    """The planes of the polygons ``faces`` of an example in lattice units ``points`` (3D)
+    whose faces lie on planes of the families ``vectors``: per family normal ``n``, the
+    sorted distinct integers ``k`` of their planes ``n . x = k`` (each polygon's family is
+    the one nearest its Newell normal).
+
+    >>> face_planes(np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2]]),
+    ...             [[0, 2, 1], [1, 2, 3]], [(0, 0, 1), (1, 1, 1)])
+    {(0, 0, 1): [0], (1, 1, 1): [2]}
+    """
+    V = np.array(vectors, dtype=np.float64).reshape(-1, 3)
+    unit = V / np.linalg.norm(V, axis=1, keepdims=True)
+    ks: dict[tuple[int, ...], set[int]] = {tuple(int(x) for x in v): set() for v in vectors}
+    pts = np.asarray(points, dtype=np.float64)
+    for poly in faces:
+        q = pts[list(poly)]
+        n = _newell(q)
+        if not np.linalg.norm(n) > 0 or not len(V):
+            continue
+        f = int(np.argmax(np.abs(unit @ n)))
+        ks[tuple(int(x) for x in vectors[f])].add(int(round(float(V[f] @ q.mean(axis=0)))))
+    return {p: sorted(k) for p, k in sorted(ks.items()) if k}
+
+
+def _newell(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The Newell normal of a polygon (twice its area vector), in floats."""
+    q = q - q.mean(axis=0)
+    nxt = np.roll(q, -1, axis=0)
+    return np.array([((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum(),
+                     ((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum(),
+                     ((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()])  # fmt: skip
+
+
+def _angle(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """The angle (degrees) between two lines of directions ``a`` and ``b``."""
+    c = abs(float(a @ b)) / (float(np.linalg.norm(a)) * float(np.linalg.norm(b)))
+    return math.degrees(math.acos(min(1.0, c)))
+
+
+def denominator(vectors: Sequence[Sequence[int]]) -> int:
+    """The least common multiple of ``|det|`` over every three independent integer
+    normals: the points where three planes ``n . x = k`` (integer ``k``) meet have
+    coordinates that are integers divided by it.
+
+    >>> denominator([(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1), (0, 1, 2)])
+    2
+    """
+    V = [tuple(int(x) for x in v) for v in vectors]
+    out = 1
+    for a, b, c in itertools.combinations(V, 3):
+        det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+               + a[2] * (b[0] * c[1] - b[1] * c[0]))  # fmt: skip
+        if det:
+            out = out * abs(det) // math.gcd(out, abs(det))
+    return out
+
+
+def integer_normal(u: Sequence[float], tol: float = FIT_DEG) -> tuple[int, int, int]:
+    """The primitive integer vector of smallest entries within ``tol`` degrees of the
+    direction ``u`` (the family normal that a face of normal ``u`` is snapped to).
+
+    >>> integer_normal([0.956, 0.292, 0.0])      # 17 degrees: (3, 1, 0) is 1.4 off
+    (3, 1, 0)
+    >>> integer_normal([0.0, -0.928, 0.371])
+    (0, 5, -2)
+    """
+    v = np.asarray(u, dtype=np.float64)
+    m = float(np.abs(v).max())
+    best = v
+    for c in range(1, 257):
+        w = np.rint(c * v / m)
+        if w.any() and _angle(w, v) <= tol:
+            best = w
+            break
+        best = w
+    return primitive3([int(x) for x in best])
+
+
+def plane_snap(
+    u: NDArray[np.float64], faces: Sequence[Sequence[int]], equal: bool
+) -> tuple[NDArray[np.float64], tuple[tuple[int, int, int], ...], tuple[int, ...],
+           tuple[int, ...], float] | None:  # fmt: skip
+    """Snap an example given in lattice units ``u`` (floats) by its planes, not its
+    vertices: face normals within :data:`MERGE_DEG` are one family (near-parallel normals
+    merged), each family's normal becomes a small integer vector within :data:`FIT_DEG`
+    (:func:`integer_normal`; a larger tolerance of :data:`FIT_DEGS` when the planes of
+    those would meet at points of denominator over :data:`MAX_DENOMINATOR`), each face's plane ``n . x = k`` moves to the nearest plane of
+    its family (every integer ``k``, or with ``equal`` the planes ``step`` apart, ``step``
+    the integer nearest ``|n|``, offset to fit the faces best), and each vertex to the
+    nearest point on the planes of its faces.
+
+    Returns ``(moved vertices, family normals, steps, residues, largest normal change in
+    degrees)``, or ``None`` when some vertex's planes do not meet at one point (more than
+    three planes at a vertex, thesis Sec. 4.5.8, that do not meet after snapping): the
+    caller then rounds the vertices onto the lattice instead, where every plane through a
+    lattice point meets the others there.
+    """
+    polys = [list(p) for p in faces]
+    normals, areas = [], []
+    for p in polys:
+        n = _newell(u[p])
+        normals.append(n)
+        areas.append(float(np.linalg.norm(n)))
+    generic = np.array([0.5773, 0.5774, 0.5775])
+    reps: list[NDArray[np.float64]] = []
+    cluster = [-1] * len(polys)
+    for i in sorted(range(len(polys)), key=lambda i: -areas[i]):
+        if areas[i] <= 0:
+            continue
+        n = normals[i] / areas[i]
+        if n @ generic < 0:
+            n = -n
+        for c, r in enumerate(reps):
+            if _angle(r, n) <= MERGE_DEG:
+                cluster[i] = c
+                reps[c] = reps[c] + n * areas[i]
+                break
+        else:
+            cluster[i] = len(reps)
+            reps.append(n * areas[i])
+    # the smallest tolerance whose integer normals meet at points of a small common
+    # denominator (thesis Sec. 4.5.8's second option: "modify the normals just enough so
+    # that the shapes better fit on a lattice"); the change is reported
+    for tol in FIT_DEGS:
+        fam_of = [integer_normal(r / np.linalg.norm(r), tol) for r in reps]
+        vectors = tuple(sorted(set(fam_of)))
+        if denominator([*vectors, *(a for a in _AXES3 if a not in vectors)]) <= MAX_DENOMINATOR:
+            break
+    if not reps:
+        return None
+    N = {v: np.array(v, dtype=np.float64) for v in vectors}
+    # each face's plane, and the grid of its family
+    kreal: dict[tuple[int, int, int], list[tuple[int, float]]] = {v: [] for v in vectors}
+    turned = 0.0
+    for i, p in enumerate(polys):
+        if cluster[i] < 0:
+            continue
+        v = fam_of[cluster[i]]
+        kreal[v].append((i, float(N[v] @ u[p].mean(axis=0))))
+        turned = max(turned, _angle(N[v], normals[i]))
+    steps, residues = [], []
+    face_k: dict[int, tuple[tuple[int, int, int], int]] = {}
+    for v in vectors:
+        st = max(1, round(float(np.linalg.norm(N[v])))) if equal else 1
+        ks = np.array([k for _, k in kreal[v]])
+
+        def err(r: int, ks: NDArray[np.float64] = ks, st: int = st) -> float:
+            return float(np.abs(ks - (np.rint((ks - r) / st) * st + r)).max())
+
+        r = min(range(st), key=err)
+        steps.append(st)
+        residues.append(r)
+        for i, k in kreal[v]:
+            face_k[i] = (v, int(round((k - r) / st)) * st + r)
+    # each vertex: the nearest point on its faces' planes
+    rows: list[list[tuple[tuple[int, int, int], int]]] = [[] for _ in range(len(u))]
+    for i, p in enumerate(polys):
+        if i in face_k:
+            for j in p:
+                if face_k[i] not in rows[j]:
+                    rows[j].append(face_k[i])
+    moved = u.astype(np.float64).copy()
+    for j, r in enumerate(rows):
+        if not r:
+            continue
+        A = np.array([N[v] for v, _ in r])
+        k = np.array([float(kk) for _, kk in r])
+        x = u[j] + np.linalg.pinv(A) @ (k - A @ u[j])
+        if np.abs(A @ x - k).max() > 1e-7 * max(1.0, float(np.abs(k).max())):
+            return None  # Sec. 4.5.8: these planes do not meet at one point
+        moved[j] = x
+    return moved, vectors, tuple(steps), tuple(residues), turned
+
+
 def _step_near(target: float, period: int) -> int:
     """The divisor of ``period`` (any positive integer when ``period`` is 0) nearest to
     ``target`` in ratio, at least 1."""
@@ -272,18 +469,7 @@ def equal_steps(
     >>> equal_steps(ip, faces, family_vectors(ip, faces))   # (1, 1, 1): 4 = 2 * 2
     ((1, 1, 1, 2), (0, 0, 0, 0))
     """
-    ks: dict[tuple[int, ...], list[int]] = {tuple(v): [] for v in vectors}
-    for poly in faces:
-        q = ip[list(poly)]
-        nxt = np.roll(q, -1, axis=0)
-        n = (
-            int(((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum()),
-            int(((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum()),
-            int(((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()),
-        )
-        if n != (0, 0, 0):
-            p = primitive3(n)
-            ks.setdefault(p, []).append(int(np.dot(p, q[0])))
+    ks = {tuple(v): [] for v in vectors} | face_planes(ip, faces, vectors)
     steps, residues = [], []
     for v in vectors:
         k = ks[tuple(v)]
@@ -344,6 +530,11 @@ class Lattice:
         3D: per family of ``vectors``, its planes are ``n . x = k`` for the ``k`` with
         ``k % step == residue`` (:func:`equal_steps`); empty: every integer ``k``
         (``lattice`` planes).
+    moved : float array ``(n, 3)``, optional
+        3D, snapped by planes (:func:`plane_snap`): the example's vertices (in the order
+        of :meth:`~csplab.continuous.polyhedra.PolyhedralModel.indexed_faces`) moved onto
+        their faces' planes, in lattice units; ``None``: snapping rounds them onto lattice
+        points.
     """
 
     origin: tuple[Fraction, ...]
@@ -354,6 +545,7 @@ class Lattice:
     derived: bool = False
     steps: tuple[int, ...] = ()
     residues: tuple[int, ...] = ()
+    moved: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
 
     @property
     def planes(self) -> str:
@@ -394,6 +586,7 @@ class Lattice:
         max_extent: int | None = None,
         where: str = "<model>",
         planes: str = "auto",
+        by_planes: bool = True,
     ) -> Lattice:
         """The lattice of an example given as points and faces, in 2D or 3D.
 
@@ -420,6 +613,11 @@ class Lattice:
         planes : {"auto", "lattice", "equal"}, default "auto"
             3D: how each family's planes are spaced (:data:`PLANES`; ``auto`` is ``equal``
             when the spacing is derived, the example being in real coordinates).
+        by_planes : bool, default True
+            3D: snap vertices that are off the lattice by their faces' planes
+            (:func:`plane_snap`: near-parallel normals merged, small integer normals) when
+            those meet at every vertex; otherwise (or ``False``) round them onto lattice
+            points.
 
         Returns
         -------
@@ -485,11 +683,20 @@ class Lattice:
                 f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
                 f"{limit}); pass a larger spacing (with snap=true if vertices are off it)"
             )
+        equal = d == 3 and (planes == "equal" or (planes == "auto" and derived))
+        if d == 3 and snap and by_planes and off > _SNAP_TOL:
+            ps = plane_snap(u, faces, equal)
+            if ps is not None:
+                moved, pvec, st, rs, pturn = ps
+                if len(set(pvec) | set(_AXES3)) <= MAX_FAMILIES3:
+                    move = float(np.linalg.norm(moved - u, axis=1).max())
+                    return cls(origin, s, pvec, move, pturn, derived,
+                               st if equal else (), rs if equal else (), moved)  # fmt: skip
         vectors = family_vectors(iu.astype(np.int64), faces, where)
         turned = _normal_change(pts, iu.astype(np.int64), faces) if snap and d == 3 else 0.0
         steps: tuple[int, ...] = ()
         residues: tuple[int, ...] = ()
-        if d == 3 and (planes == "equal" or (planes == "auto" and derived)):
+        if equal:
             steps, residues = equal_steps(iu.astype(np.int64), faces, vectors)
         return cls(origin, s, vectors, off if snap else 0.0, turned, derived, steps, residues)
 
@@ -546,6 +753,7 @@ class Lattice:
         *,
         snap: bool = False,
         planes: str = "auto",
+        by_planes: bool = True,
     ) -> Lattice:
         """The lattice of a polygon or polyhedral model.
 
@@ -562,6 +770,8 @@ class Lattice:
             Round vertices that are off the lattice of ``spacing`` onto it.
         planes : {"auto", "lattice", "equal"}, default "auto"
             3D plane spacing per family (:data:`PLANES`).
+        by_planes : bool, default True
+            3D: snap by the faces' planes where they meet (:meth:`of_points`).
 
         Returns
         -------
@@ -575,7 +785,8 @@ class Lattice:
             ``snap``, an example too large or with too many families.
         """
         pts, faces = example.indexed_faces()
-        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source, planes=planes)
+        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source, planes=planes,
+                             by_planes=by_planes)
 
     def to_lattice(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """World coordinates to lattice coordinates.

@@ -374,9 +374,12 @@ class Arrangement3(ArrangementGraph):
             dst.append(idx[1:][same])
             lid.append(np.full(int(same.sum()), li, dtype=np.int64))
         self.lines = np.array(sorted(lines, key=lines.__getitem__), dtype=np.int64).reshape(-1, 3)
-        e = np.stack([np.concatenate(src), np.concatenate(dst), np.concatenate(lid)], axis=1)
-        e = np.unique(e, axis=0)  # a line in three or more planes comes from several pairs
-        self.edge_src, self.edge_dst, self.edge_line = e[:, 0], e[:, 1], e[:, 2]
+        # a line in three or more planes comes from several pairs: one edge per (src, dst)
+        # (its line is the same), in (src, dst) order
+        a, b, c = (np.concatenate(x) if x else np.zeros(0, dtype=np.int64)
+                   for x in (src, dst, lid))  # fmt: skip
+        _, first = np.unique(a * max(1, self.n_vertices) + b, return_index=True)
+        self.edge_src, self.edge_dst, self.edge_line = a[first], b[first], c[first]
 
     @property
     def family_vectors(self) -> NDArray[np.int64]:
