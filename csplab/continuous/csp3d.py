@@ -153,11 +153,14 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
     base = 0
     for sol in example.solids:
         if lattice.moved is not None:  # snapped by planes (the lattice's moved vertices)
-            uv = np.round(lattice.moved[base : base + len(sol.vertices)], 9)
+            uv = lattice.moved[base : base + len(sol.vertices)]
         else:
             uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
         base += len(sol.vertices)
-        uv, inv = np.unique(uv, axis=0, return_inverse=True)  # vertices that met: one
+        # vertices that met: one
+        _, first, inv = np.unique(np.round(uv, 9), axis=0, return_index=True,
+                                  return_inverse=True)  # fmt: skip
+        uv = uv[first]
         inv = inv.reshape(-1)
         faces = []
         for f in sol.faces:
@@ -390,6 +393,27 @@ class ContinuousCSP3:
         rels: list[NDArray[np.bool_]] = []
         memo: dict[tuple[int, int, int, int], int] = {}
 
+        bits: dict[int, tuple[NDArray[np.int64], NDArray[np.int64]]] = {}
+        states: dict[tuple[str, int], NDArray[np.int64]] = {}
+
+        def packed(t: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+            """The signs of vertex type ``t``'s planes packed in an integer per cell, and
+            the first cell of each packed value (a lookup table)."""
+            if t not in bits:
+                vf = self.vtypes[t][0]
+                w = np.int64(1) << np.arange(len(vf), dtype=np.int64)
+                key = (signs[:, vf] > 0).astype(np.int64) @ w
+                first = np.full(1 << len(vf), -1, dtype=np.int64)
+                first[key[::-1]] = np.arange(len(signs))[::-1]
+                bits[t] = (w, first)
+            return bits[t]
+
+        def table(kind: str, t: int) -> NDArray[np.int64]:
+            if (kind, t) not in states:
+                st = (self.vtypes if kind == "v" else self.etypes)[t][1]
+                states[kind, t] = np.array(st, dtype=np.int64).reshape(len(st), -1)
+            return states[kind, t]
+
         def relation(t: int, line: int, sgn: int, et: int) -> int:
             k = (t, line, sgn, et)
             if k in memo:
@@ -400,21 +424,23 @@ class ContinuousCSP3:
             sr = np.sign(N @ r)
             # the full cell just off the edge in direction r: signs of the planes through
             # the vertex but not the edge from r, the edge's own planes free
-            target = {}
-            for c in range(len(signs)):
-                want = signs[c].copy()
-                away = [f for f in vf if sr[f] != 0]
-                want[away] = sr[away]
-                match = np.flatnonzero((signs[:, vf] == want[vf]).all(axis=1))
-                target[int(eg[c])] = int(vg[match[0]])
-            eidx = {st: i for i, st in enumerate(est)}
-            M = np.zeros((K, K), dtype=bool)
+            want = signs[:, vf].copy()
+            away = sr[vf] != 0
+            want[:, away] = sr[vf][away]
+            w, first = packed(t)
+            match = first[(want > 0).astype(np.int64) @ w]
             ne_groups = len(est[0]) if est else 0
-            for i, st in enumerate(vst):
-                induced = tuple(st[target[j]] for j in range(ne_groups))
-                jj = eidx.get(induced)
-                if jj is not None:
-                    M[i, jj] = True
+            target = np.zeros(ne_groups, dtype=np.int64)
+            target[eg] = vg[match]
+            M = np.zeros((K, K), dtype=bool)
+            if ne_groups and len(vst):
+                induced = table("v", t)[:, target]
+                E = table("e", et)
+                eidx = {row.tobytes(): i for i, row in enumerate(E)}
+                for i, row in enumerate(induced):
+                    jj = eidx.get(row.tobytes())
+                    if jj is not None:
+                        M[i, jj] = True
             kb = M.tobytes()
             if kb not in rel_ids:
                 rel_ids[kb] = len(rels)
@@ -432,11 +458,9 @@ class ContinuousCSP3:
         nst = max(len(t[1]) for t in (*self.vtypes, *self.etypes))
         K = self.K = nst
         nv, ne = A.n_vertices, A.n_edges
-        dom = np.zeros((nv + ne, K), dtype=bool)
-        vn = np.array([len(t[1]) for t in self.vtypes])
-        en = np.array([len(t[1]) for t in self.etypes])
-        dom[:nv] = np.arange(K)[None, :] < vn[vtype][:, None]
-        dom[nv:] = np.arange(K)[None, :] < en[etype][:, None]
+        vn = np.array([len(t[1]) for t in self.vtypes], dtype=np.int64)
+        en = np.array([len(t[1]) for t in self.etypes], dtype=np.int64)
+        nvals = np.concatenate([vn[vtype], en[etype]])  # values of each variable
         # relations per (vertex type, ray, edge type)
         relation, rels = self._relation_maker(K)
         pos = np.concatenate([A.vertex_positions(), A.edge_positions()])
@@ -461,7 +485,7 @@ class ContinuousCSP3:
         renum[order_used] = np.arange(len(order_used))
         used = [rels[i] for i in order_used.tolist()]
         arcs[:, 2] = renum[arcs[:, 2]]
-        dom = dom[order]  # (the unordered copy is freed before the problem copies it)
+        dom = np.arange(K)[None, :] < nvals[order][:, None]
         return Problem(
             (nv + ne,), dom, np.stack(used), arcs,
             name=getattr(self.example, "name", "") or "continuous3d",
