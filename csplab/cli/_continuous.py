@@ -340,6 +340,14 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     out = load_model(args.grid)
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
+    snapped = ""
+    if isinstance(example, PolyhedralModel):  # compared with the example synthesis uses
+        from csplab.continuous.csp3d import as_synthesized
+
+        lat, example = as_synthesized(example)
+        if lat.snapped:
+            snapped = (f" (snapped onto its planes of spacing {float(lat.spacing):g}, as "
+                       "synthesize does with default settings)")  # fmt: skip
     v = violations(example, out)
     if isinstance(out, PolyhedralModel):  # the user constraints of Sec. 4.6, on the solids
         cons = user_constraints(args, example)
@@ -352,7 +360,7 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         print(json.dumps({"violations": len(v), **v.counts(), out.parts: len(out)}))
     else:
         print(f"{len(v)} violations in {args.grid} ({len(out)} {out.parts}, labels "
-              f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
+              f"{list(out.labels)}) against {example.name or args.model}{snapped}")  # fmt: skip
         if len(v):
             print(v.describe(args.limit))
     return 0 if len(v) == 0 else 1

@@ -48,7 +48,7 @@ from csplab.continuous.user3d import UserConstraints3, allowed_states
 from csplab.errors import InputError
 from csplab.problem import Problem
 
-__all__ = ["FACE_ORDER", "ContinuousCSP3", "example_signatures3", "snapped3"]
+__all__ = ["FACE_ORDER", "ContinuousCSP3", "as_synthesized", "example_signatures3", "snapped3"]
 
 #: the region's faces; a point outside several takes the label of the first (the ground
 #: ``z-`` wins at the bottom edges)
@@ -182,6 +182,52 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
         ) from None
 
 
+def as_synthesized(
+    example: PolyhedralModel,
+    spacing: float | None = None,
+    *,
+    snap: bool = False,
+    planes: str = "auto",
+) -> tuple[Lattice, PolyhedralModel]:
+    """The lattice of ``example`` and the example as synthesis uses it: snapped onto the
+    lattice when its vertices are off it (by its planes, :func:`~csplab.continuous.lattice.
+    plane_snap`, or, when moving the planes breaks a solid, by rounding its vertices),
+    else unchanged. What :class:`ContinuousCSP3` synthesizes from and ``csplab check``
+    compares an output with.
+
+    Parameters
+    ----------
+    example : PolyhedralModel
+        The example.
+    spacing : float, optional
+        The plane spacing (default: derived, :meth:`Lattice.of_points`).
+    snap : bool, default False
+        Snap vertices that are off the lattice of ``spacing``.
+    planes : {"auto", "lattice", "equal"}, default "auto"
+        Plane spacing per family (:data:`~csplab.continuous.lattice.PLANES`).
+
+    Returns
+    -------
+    lattice : Lattice
+    example : PolyhedralModel
+        The example on the lattice's planes.
+
+    Raises
+    ------
+    InputError
+        As :meth:`Lattice.of_model`, or when snapping breaks a solid either way.
+    """
+    lat = Lattice.of_model(example, spacing, snap=snap, planes=planes)
+    if lat.snapped and lat.moved is not None:
+        try:
+            return lat, snapped3(example, lat)
+        except InputError:  # moving the planes broke it: round the vertices instead
+            lat = Lattice.of_model(example, spacing, snap=snap, planes=planes, by_planes=False)
+    if lat.snapped:
+        return lat, snapped3(example, lat)
+    return lat, example
+
+
 def example_signatures3(
     example: PolyhedralModel,
     lattice: Lattice,
@@ -273,15 +319,7 @@ class ContinuousCSP3:
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
-        self.lattice = Lattice.of_model(example, spacing, snap=snap, planes=planes)
-        if self.lattice.snapped and self.lattice.moved is not None:
-            try:
-                example = snapped3(example, self.lattice)
-            except InputError:  # moving the planes broke it: round the vertices instead
-                self.lattice = Lattice.of_model(example, spacing, snap=snap, planes=planes,
-                                                by_planes=False)  # fmt: skip
-        if self.lattice.snapped and self.lattice.moved is None:
-            example = snapped3(example, self.lattice)
+        self.lattice, example = as_synthesized(example, spacing, snap=snap, planes=planes)
         #: the example as synthesized (its vertices snapped onto the lattice when they were not
         #: on it; the checker compares the output with this)
         self.example = example
