@@ -340,11 +340,16 @@ def plane_snap(
     the integer nearest ``|n|``, offset to fit the faces best), and each vertex to the
     nearest point on the planes of its faces.
 
+    A vertex of more than three families (the apex of a pyramid, thesis Sec. 4.5.8) is
+    pinned to its nearest lattice point and its faces' planes pass through it: planes of
+    integer ``k`` meet at every lattice point, so such vertices exist in the arrangement
+    (with ``equal`` planes, each family's step divides the differences of its pinned
+    planes, so the periodic planes keep them).
+
     Returns ``(moved vertices, family normals, steps, residues, largest normal change in
-    degrees)``, or ``None`` when some vertex's planes do not meet at one point (more than
-    three planes at a vertex, thesis Sec. 4.5.8, that do not meet after snapping): the
-    caller then rounds the vertices onto the lattice instead, where every plane through a
-    lattice point meets the others there.
+    degrees)``, or ``None`` when some vertex's planes still do not meet at one point (a
+    face between two pinned vertices that put it on different planes): the caller then
+    rounds the vertices onto the lattice instead.
     """
     polys = [list(p) for p in faces]
     normals, areas = [], []
@@ -389,20 +394,46 @@ def plane_snap(
         v = fam_of[cluster[i]]
         kreal[v].append((i, float(N[v] @ u[p].mean(axis=0))))
         turned = max(turned, _angle(N[v], normals[i]))
+    # Sec. 4.5.8: a vertex of more than three families is pinned to its nearest lattice
+    # point, where planes of every family with integer k meet; its faces' planes go
+    # through it (a face between two pinned vertices that disagree: None)
+    fam_i = {i: fam_of[c] for i, c in enumerate(cluster) if c >= 0}
+    vfams: list[set[tuple[int, int, int]]] = [set() for _ in range(len(u))]
+    for i, p in enumerate(polys):
+        if i in fam_i:
+            for j in p:
+                vfams[j].add(fam_i[i])
+    pinned = {j: np.rint(u[j]) for j, fs in enumerate(vfams) if len(fs) > 3}
+    fixed: dict[int, int] = {}
+    for i, p in enumerate(polys):
+        if i not in fam_i:
+            continue
+        for j in p:
+            if j in pinned:
+                k = int(round(float(N[fam_i[i]] @ pinned[j])))
+                if fixed.setdefault(i, k) != k:
+                    return None
     steps, residues = [], []
     face_k: dict[int, tuple[tuple[int, int, int], int]] = {}
     for v in vectors:
-        st = max(1, round(float(np.linalg.norm(N[v])))) if equal else 1
         ks = np.array([k for _, k in kreal[v]])
+        pins = sorted({fixed[i] for i, _ in kreal[v] if i in fixed})
+        if equal:
+            period = 0
+            for x in pins:
+                period = math.gcd(period, x - pins[0])
+            st = _step_near(float(np.linalg.norm(N[v])), period)
+        else:
+            st = 1
 
         def err(r: int, ks: NDArray[np.float64] = ks, st: int = st) -> float:
             return float(np.abs(ks - (np.rint((ks - r) / st) * st + r)).max())
 
-        r = min(range(st), key=err)
+        r = pins[0] % st if pins else min(range(st), key=err)
         steps.append(st)
         residues.append(r)
         for i, k in kreal[v]:
-            face_k[i] = (v, int(round((k - r) / st)) * st + r)
+            face_k[i] = (v, fixed[i] if i in fixed else int(round((k - r) / st)) * st + r)
     # each vertex: the nearest point on its faces' planes
     rows: list[list[tuple[tuple[int, int, int], int]]] = [[] for _ in range(len(u))]
     for i, p in enumerate(polys):
