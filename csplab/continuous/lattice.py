@@ -47,16 +47,16 @@ __all__ = [
     "FIT_DEGS",
     "MAX_DENOMINATOR",
     "MAX_FAMILIES",
+    "MAX_FAMILIES3",
     "MERGE_DEG",
     "PLANES",
-    "MAX_FAMILIES3",
     "Lattice",
     "PlaneArrangement",
+    "denominator",
     "derived_spacing",
     "equal_steps",
     "face_planes",
     "family_vectors",
-    "denominator",
     "gcd_fractions",
     "integer_normal",
     "plane_snap",
@@ -269,7 +269,7 @@ def face_planes(
         if not np.linalg.norm(n) > 0 or not len(V):
             continue
         f = int(np.argmax(np.abs(unit @ n)))
-        ks[tuple(int(x) for x in vectors[f])].add(int(round(float(V[f] @ q.mean(axis=0)))))
+        ks[tuple(int(x) for x in vectors[f])].add(round(float(V[f] @ q.mean(axis=0))))
     return {p: sorted(k) for p, k in sorted(ks.items()) if k}
 
 
@@ -335,10 +335,11 @@ def plane_snap(
     vertices: face normals within :data:`MERGE_DEG` are one family (near-parallel normals
     merged), each family's normal becomes a small integer vector within :data:`FIT_DEG`
     (:func:`integer_normal`; a larger tolerance of :data:`FIT_DEGS` when the planes of
-    those would meet at points of denominator over :data:`MAX_DENOMINATOR`), each face's plane ``n . x = k`` moves to the nearest plane of
-    its family (every integer ``k``, or with ``equal`` the planes ``step`` apart, ``step``
-    the integer nearest ``|n|``, offset to fit the faces best), and each vertex to the
-    nearest point on the planes of its faces.
+    those would meet at points of denominator over :data:`MAX_DENOMINATOR`), each face's
+    plane ``n . x = k`` moves to the nearest plane of its family (every integer ``k``, or
+    with ``equal`` the planes ``step`` apart, ``step`` the integer nearest ``|n|``, offset
+    to fit the faces best), and each vertex to the nearest point on the planes of its
+    faces.
 
     A vertex of more than three families (the apex of a pyramid, thesis Sec. 4.5.8) is
     pinned to its nearest lattice point and its faces' planes pass through it: planes of
@@ -378,7 +379,7 @@ def plane_snap(
     # denominator (thesis Sec. 4.5.8's second option: "modify the normals just enough so
     # that the shapes better fit on a lattice"); the change is reported
     for tol in FIT_DEGS:
-        fam_of = [integer_normal(r / np.linalg.norm(r), tol) for r in reps]
+        fam_of = [integer_normal((r / np.linalg.norm(r)).tolist(), tol) for r in reps]
         vectors = tuple(sorted(set(fam_of)))
         if denominator([*vectors, *(a for a in _AXES3 if a not in vectors)]) <= MAX_DENOMINATOR:
             break
@@ -410,13 +411,14 @@ def plane_snap(
             continue
         for j in p:
             if j in pinned:
-                k = int(round(float(N[fam_i[i]] @ pinned[j])))
+                k = round(float(N[fam_i[i]] @ pinned[j]))
                 if fixed.setdefault(i, k) != k:
                     return None
-    steps, residues = [], []
+    steps: list[int] = []
+    residues: list[int] = []
     face_k: dict[int, tuple[tuple[int, int, int], int]] = {}
     for v in vectors:
-        ks = np.array([k for _, k in kreal[v]])
+        kv = np.array([kr for _, kr in kreal[v]], dtype=np.float64)
         pins = sorted({fixed[i] for i, _ in kreal[v] if i in fixed})
         if equal:
             period = 0
@@ -426,14 +428,14 @@ def plane_snap(
         else:
             st = 1
 
-        def err(r: int, ks: NDArray[np.float64] = ks, st: int = st) -> float:
-            return float(np.abs(ks - (np.rint((ks - r) / st) * st + r)).max())
+        def err(res: int, kv: NDArray[np.float64] = kv, st: int = st) -> float:
+            return float(np.abs(kv - (np.rint((kv - res) / st) * st + res)).max())
 
-        r = pins[0] % st if pins else min(range(st), key=err)
+        res = pins[0] % st if pins else min(range(st), key=err)
         steps.append(st)
-        residues.append(r)
-        for i, k in kreal[v]:
-            face_k[i] = (v, fixed[i] if i in fixed else int(round((k - r) / st)) * st + r)
+        residues.append(res)
+        for i, kr in kreal[v]:
+            face_k[i] = (v, fixed[i] if i in fixed else round((kr - res) / st) * st + res)
     # each vertex: the nearest point on its faces' planes
     rows: list[list[tuple[tuple[int, int, int], int]]] = [[] for _ in range(len(u))]
     for i, p in enumerate(polys):
@@ -442,13 +444,13 @@ def plane_snap(
                 if face_k[i] not in rows[j]:
                     rows[j].append(face_k[i])
     moved = u.astype(np.float64).copy()
-    for j, r in enumerate(rows):
-        if not r:
+    for j, row in enumerate(rows):
+        if not row:
             continue
-        A = np.array([N[v] for v, _ in r])
-        k = np.array([float(kk) for _, kk in r])
-        x = u[j] + np.linalg.pinv(A) @ (k - A @ u[j])
-        if np.abs(A @ x - k).max() > 1e-7 * max(1.0, float(np.abs(k).max())):
+        A = np.array([N[v] for v, _ in row])
+        kk = np.array([float(x) for _, x in row])
+        x = u[j] + np.linalg.pinv(A) @ (kk - A @ u[j])
+        if np.abs(A @ x - kk).max() > 1e-7 * max(1.0, float(np.abs(kk).max())):
             return None  # Sec. 4.5.8: these planes do not meet at one point
         moved[j] = x
     return moved, vectors, tuple(steps), tuple(residues), turned
@@ -500,7 +502,8 @@ def equal_steps(
     >>> equal_steps(ip, faces, family_vectors(ip, faces))   # (1, 1, 1): 4 = 2 * 2
     ((1, 1, 1, 2), (0, 0, 0, 0))
     """
-    ks = {tuple(v): [] for v in vectors} | face_planes(ip, faces, vectors)
+    ks: dict[tuple[int, ...], list[int]] = {tuple(v): [] for v in vectors}
+    ks |= face_planes(ip.astype(np.float64), faces, vectors)
     steps, residues = [], []
     for v in vectors:
         k = ks[tuple(v)]

@@ -218,8 +218,8 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
     of a triple form a lattice of ``|det(N_a, N_b, N_c)|`` points per unit volume, so a
     triple counts ``min(n_a n_b n_c, |det| (A + 1)(B + 1)(C + 1))`` (the full product when
     one family is boundary-only; with equal planes, :meth:`Lattice.plane_steps`, that
-    density divided by the product of the three steps). Each vertex starts at most three edges per triple through
-    it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
+    density divided by the product of the three steps). Each vertex starts at most three
+    edges per triple through it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
 
     Examples
     --------
