@@ -69,6 +69,33 @@ def _boundary_faces(boundary: int | Mapping[str, int]) -> dict[str, int]:
 Labeling = tuple[int, ...]
 
 
+def _dense_unique(key: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """``np.unique(key, return_inverse=True)`` of non-negative integers of a small range,
+    without sorting (a table over the range)."""
+    if not key.size:
+        return key.astype(np.int64), np.zeros(0, dtype=np.int64)
+    top = int(key.max()) + 1
+    if key.min() < 0 or top > 4 * key.size + 1024:
+        u, inv = np.unique(key, return_inverse=True)
+        return u.astype(np.int64), inv.reshape(-1).astype(np.int64)
+    present = np.zeros(top, dtype=bool)
+    present[key] = True
+    rank = np.cumsum(present) - 1
+    return np.flatnonzero(present).astype(np.int64), rank[key].astype(np.int64)
+
+
+def _unique_rows(a: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """``np.unique(a, axis=0, return_inverse=True)`` of small non-negative integer rows
+    (compact labels), faster: rows as bytes."""
+    if not len(a) or a.shape[1] == 0 or a.min() < 0 or a.max() > 255:
+        u, inv = np.unique(a, axis=0, return_inverse=True)
+        return u, inv.reshape(-1)
+    b = np.ascontiguousarray(a.astype(np.uint8))
+    v = b.view(np.dtype((np.void, b.shape[1]))).reshape(-1)
+    _, first, inv = np.unique(v, return_index=True, return_inverse=True)
+    return a[first], inv.reshape(-1)
+
+
 def _groups(signs: NDArray[np.int8], fams: NDArray[np.int64]) -> tuple[NDArray[np.int64], int]:
     """Group id of each full cell by its signs on ``fams`` (the local cells there)."""
     if fams.size == 0:
@@ -104,8 +131,9 @@ def _local_labels(
     if not len(points):
         return out
     eps = 1e-3 / (A.D * float(np.abs(A.normals).sum(axis=1).max()))
-    keys, inv = np.unique(fams_on, axis=0, return_inverse=True)
-    inv = inv.reshape(-1)
+    F = fams_on.shape[1]
+    code, inv = _dense_unique(fams_on.astype(np.int64) @ (np.int64(1) << np.arange(F)))
+    keys = (code[:, None] >> np.arange(F)) & 1 > 0
     batches, queries = [], []
     for u in range(len(keys)):
         members = np.flatnonzero(inv == u)
@@ -254,17 +282,16 @@ def example_signatures3(
     planes = face_planes(lattice.to_lattice(pts_) + shift, faces_, lattice.vectors)
     vsel = np.flatnonzero(_on_faces(A, np.arange(A.n_vertices), A.on, planes))
     vsigs = _local_labels(A, A.vertex_positions()[vsel], A.on[vsel], tris, index)
-    sigs |= set(map(tuple, np.unique(vsigs, axis=0).tolist()))
+    sigs |= set(map(tuple, _unique_rows(vsigs)[0].tolist()))
     efam_all = A.edge_families()
     esel = np.flatnonzero(_on_faces(A, A.edge_src, efam_all, planes))
     efam = efam_all[esel]
     L = _local_labels(A, A.edge_positions()[esel], efam, tris, index)
-    sigs |= set(map(tuple, np.unique(L, axis=0).tolist()))
+    L, which = _unique_rows(L)  # few distinct edge labelings
+    sigs |= set(map(tuple, L.tolist()))
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
     N = A.normals
-    L, which = np.unique(L, axis=0, return_inverse=True)  # few distinct edge labelings
-    which = which.reshape(-1)
     fmask = efam.astype(np.int64) @ (1 << np.arange(A.F, dtype=np.int64))
     combo = np.stack([fmask, A.edge_line[esel]], axis=1)
     uniq, inv = np.unique(combo, axis=0, return_inverse=True)
@@ -390,7 +417,7 @@ class ContinuousCSP3:
         vside = A.on_side()
         vmask = A.on.astype(np.int64) @ (1 << np.arange(F, dtype=np.int64))
         vkeys, vtype = np.unique((vmask << 6) | vside, return_inverse=True)
-        vtype = vtype.reshape(-1)
+        vtype = vtype.reshape(-1).astype(np.int64)
         self.vertex_type = vtype
         self.vtypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
         self.vertex_outside: list[NDArray[np.int64]] = []
@@ -510,15 +537,17 @@ class ContinuousCSP3:
         for end, sgn, k in ((A.edge_src, 1, 0), (A.edge_dst, -1, 1)):
             nl, nt = len(A.lines), len(self.etypes)
             key = (vtype[end].astype(np.int64) * nl + A.edge_line) * nt + etype
-            uniq, inv = np.unique(key, return_inverse=True)
+            uniq, inv = _dense_unique(key)
             rid = np.array([relation(int(c // (nl * nt)), int(c // nt % nl), sgn, int(c % nt))
                             for c in uniq.tolist()], dtype=np.int64)  # fmt: skip
             arcs[k::2, 0] = var[end]
             arcs[k::2, 1] = var[nv:]
             arcs[k::2, 2] = rid[inv.reshape(-1)]
         # relations numbered by first use along the arcs (edge by edge, as always)
-        _, first = np.unique(arcs[:, 2], return_index=True)
-        order_used = np.unique(arcs[:, 2])[np.argsort(first)]
+        first = np.full(len(rels), len(arcs), dtype=np.int64)
+        first[arcs[::-1, 2]] = np.arange(len(arcs) - 1, -1, -1)  # the first use wins
+        used_ids = np.flatnonzero(first < len(arcs))
+        order_used = used_ids[np.argsort(first[used_ids], kind="stable")]
         renum = np.full(len(rels), -1, dtype=np.int64)
         renum[order_used] = np.arange(len(order_used))
         used = [rels[i] for i in order_used.tolist()]

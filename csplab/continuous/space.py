@@ -335,9 +335,12 @@ class Arrangement3(ArrangementGraph):
             adj = _adj3(M)
             m = D // det
             gg, hh = np.meshgrid(self.k_range[t[1]], self.k_range[t[2]], indexing="ij")
-            kg, kh = gg.ravel(), hh.ravel()
-            for kf in self.k_range[t[0]].tolist():
-                P = (adj[:, 0:1] * kf + adj[:, 1:2] * kg + adj[:, 2:3] * kh) * m
+            base = adj[:, 1:2] * gg.ravel() + adj[:, 2:3] * hh.ravel()  # (3, G)
+            kfs = self.k_range[t[0]]
+            chunk = max(1, 1_000_000 // max(1, base.shape[1]))  # planes of f at once
+            for c0 in range(0, len(kfs), chunk):
+                kc = kfs[c0 : c0 + chunk]
+                P = ((adj[:, 0:1, None] * kc[None, None, :] + base[:, :, None]) * m).reshape(3, -1)
                 ok = ((P >= 0) & (P <= ext[:, None])).all(axis=0)
                 if ok.any():
                     q = P[:, ok]
