@@ -587,8 +587,14 @@ class Lattice:
         return "equal" if self.steps else "lattice"
 
     def plane_steps(self) -> tuple[tuple[int, ...], tuple[int, ...]]:
-        """Step and residue of every family of :meth:`families` (1 and 0 for the lattice
-        planes and for the added axis families)."""
+        """Step and residue of every family of :meth:`families`.
+
+        Returns
+        -------
+        steps, residues : tuple of int
+            Per family, its planes are ``n . x = k`` with ``k % step == residue`` (1 and 0
+            for the lattice planes and for the added axis families).
+        """
         fams, _ = self.families()
         st = dict(zip(self.vectors, self.steps, strict=True)) if self.steps else {}
         rs = dict(zip(self.vectors, self.residues, strict=True)) if self.steps else {}
