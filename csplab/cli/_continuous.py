@@ -344,10 +344,12 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     if isinstance(example, PolyhedralModel):  # compared with the example synthesis uses
         from csplab.continuous.csp3d import as_synthesized
 
-        lat, example = as_synthesized(example)
+        lat, example = as_synthesized(example, args.spacing, snap=args.snap, planes=args.lines)
         if lat.snapped:
             snapped = (f" (snapped onto its planes of spacing {float(lat.spacing):g}, as "
-                       "synthesize does with default settings)")  # fmt: skip
+                       "synthesize does with these settings)")  # fmt: skip
+    elif args.spacing is not None or args.snap or args.lines != "auto":
+        raise InputError("--spacing, --snap and --lines of check apply to polyhedral models")
     v = violations(example, out)
     if isinstance(out, PolyhedralModel):  # the user constraints of Sec. 4.6, on the solids
         cons = user_constraints(args, example)
