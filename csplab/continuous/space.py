@@ -403,9 +403,17 @@ class Arrangement3(ArrangementGraph):
         return out
 
     def edge_families(self) -> NDArray[np.bool_]:
-        """``(n_edges, F)``: the families with a plane containing each edge."""
-        u = self.lines[self.edge_line]
-        out: NDArray[np.bool_] = (u @ self.normals.T == 0) & self.on[self.edge_src]
+        """``(n_edges, F)``: the families with a plane containing each edge (computed once,
+        read-only)."""
+        return self._edge_families
+
+    @cached_property
+    def _edge_families(self) -> NDArray[np.bool_]:
+        # a line lies in a family's planes when its direction is orthogonal to the normal
+        # (per line, not per edge) and its edge's first vertex is on one of them
+        along = self.lines @ self.normals.T == 0  # (lines, F)
+        out: NDArray[np.bool_] = along[self.edge_line] & self.on[self.edge_src]
+        out.setflags(write=False)
         return out
 
     @cached_property
