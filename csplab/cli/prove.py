@@ -1,8 +1,11 @@
-"""``csplab prove``: prove that Alg. 3.1 never fails on an example (Alg. 3.6, Thm. 3.3.6).
+"""``csplab prove``: decide whether Alg. 3.1 can fail on a model (Alg. 3.6, Thm. 3.3.6).
 
-Exit codes: 0 proven infallible, 1 refuted (fallible; the failing run is printed and can
-be saved with ``--out``), 3 undecided (not provable with this region, or the state budget
-ran out; the state count is printed), 2 bad input.
+By default (``--region auto``) it runs :func:`~csplab.analysis.decide.decide_infallibility`:
+regions of growing size and reach, refined by Alg. 3.6's real failures, and a search for a
+failing run of Alg. 3.1, within ``--time-limit``. With ``--region RxS`` it runs that one
+region proof. Exit codes: 0 proven infallible, 1 refuted (fallible; the failing run is
+printed and can be saved with ``--out``), 3 undecided (not provable with this region, or
+the state budget or time ran out; the state count is printed), 2 bad input.
 """
 
 from __future__ import annotations
@@ -11,6 +14,7 @@ import argparse
 from pathlib import Path
 
 from csplab.analysis import corner_condition, prove_infallible
+from csplab.analysis.decide import decide_infallibility
 from csplab.cli._analysis import (
     ORDER_HELP,
     describe_run,
@@ -19,14 +23,16 @@ from csplab.cli._analysis import (
     save_certificate,
     save_witness,
 )
-from csplab.cli.common import add_model_option, check_output_path
+from csplab.cli.common import add_model_option, check_output_path, check_time_limit
 from csplab.errors import InputError
 
-HELP = "prove a model infallible (Alg. 3.1 never fails) by region enumeration"
+HELP = "decide whether Alg. 3.1 can fail on a model: a proof (Alg. 3.6) or a failing run"
 DESCRIPTION = (
-    "Enumerate every window state Alg. 3.6 can reach with the given region "
-    "size (Sec. 3.3.7) and check that its catalog is never empty; then Alg. 3.1 never "
-    "fails on the model, at any output size (Theorem 3.3.6). Examples (open grids) and "
+    "Enumerate every window state Alg. 3.6 can reach with a region size (Sec. 3.3.7) and "
+    "check that its catalog is never empty; then Alg. 3.1 never fails on the model, at any "
+    "output size (Theorem 3.3.6). --region auto (default) tries growing regions, refined by "
+    "Alg. 3.6's real failures, and searches for a failing run of Alg. 3.1, within "
+    "--time-limit. Examples (open grids) and "
     "tilesets (not periodic; their face rules apply). --certificate writes what the verdict rests "
     "on, for `csplab check-certificate`. Exit 0 proven, 1 refuted (fallible), 3 undecided, "
     "2 bad input."
@@ -35,7 +41,21 @@ DESCRIPTION = (
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("model", metavar="MODEL", help="built-in example, example or tileset file")
-    p.add_argument("--region", default="2", help="region size per axis, e.g. 3x2 (default 2)")
+    p.add_argument(
+        "--region", default="auto",
+        help="region size per axis, e.g. 3x2, or auto (default): growing regions and a "
+        "failure search",
+    )  # fmt: skip
+    p.add_argument(
+        "--back", default="1",
+        help="with --region: how far each region reaches before its point, per axis "
+        "(default 1, Alg. 3.7's region)",
+    )  # fmt: skip
+    p.add_argument(
+        "--time-limit", type=float, default=600.0,
+        help="with --region auto: seconds for the decision (default 600)",
+    )  # fmt: skip
+    p.add_argument("--seed", type=int, default=0, help="seed of the failure search (auto)")
     p.add_argument("--order", default="scanline", help=ORDER_HELP)
     p.add_argument("--history", default="1", help="extra frame cells per axis (default 1)")
     p.add_argument("--max-states", type=int, default=5_000_000, help="state budget")
@@ -72,12 +92,30 @@ def run(args: argparse.Namespace) -> int:
     history: int | list[int] = hist[0] if len(hist) == 1 else hist
     if args.max_states < 1:
         raise InputError("--max-states must be positive")
-    v = prove_infallible(
-        E, args.region, order=args.order, history=history, max_states=args.max_states,
-        certificate=bool(args.certificate), boundary=args.boundary,
-    )  # fmt: skip
+    if str(args.region).lower() == "auto":
+        check_time_limit(args.time_limit)
+        if not isinstance(history, int):
+            raise InputError("--region auto takes one --history value for every axis")
+        v = decide_infallibility(
+            E, order=args.order, boundary=args.boundary, time_limit=args.time_limit,
+            history=history, max_states=args.max_states, rng=args.seed,
+            certificate=bool(args.certificate),
+        )  # fmt: skip
+    else:
+        try:
+            bk = [int(t) for t in str(args.back).lower().split("x")]
+        except ValueError:
+            raise InputError(f"--back {args.back!r} is not of the form 2 or 2x1") from None
+        v = prove_infallible(
+            E, args.region, order=args.order, history=history, max_states=args.max_states,
+            certificate=bool(args.certificate), boundary=args.boundary,
+            back=bk[0] if len(bk) == 1 else bk,
+        )  # fmt: skip
     cert = (v.witness or {}).pop("certificate", None) if args.certificate else None
     print_verdict(v, args.json)
+    if "method" in v.stats and not args.json:
+        print(f"  method: {v.stats['method']} ({v.stats['time_s']:.2f} s, "
+              f"{len(v.stats['attempts'])} regions tried)")  # fmt: skip
     if cert is not None:
         save_certificate(cert, args.certificate)
         if not args.json:
