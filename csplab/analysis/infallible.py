@@ -4,7 +4,7 @@ An example model E is *infallible* (thesis Sec. 3.3.7) when Alg. 3.1, run in a g
 order, can never fail on it, whatever the output size and whatever labels it draws.
 
 Reading of Sec. 3.3.7 used here (the seed text lost subscripts; see
-``papers/merrell-2009-thesis/infallibility.md``)
+``papers/merrell-2009-thesis/infallibility_reading.md``)
 ---------------------------------------------------------------------------------------
 *Scan orders.* A scan visits cells lexicographically with the axes in a fixed order
 (outermost first): ``"scanline"`` is Alg. 3.1's loop (x outermost), ``"scan:yx"`` the
