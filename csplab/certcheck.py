@@ -306,9 +306,11 @@ def _check_closed(
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
     nstates = 0
-    union: dict[tuple[int, int, int], int] = {}  # support sets, shared by every step
+    # shared by every configuration: support sets, frames (configurations that differ only
+    # in which frame edges lie on a face have the same frame) and catalogs
+    memo = _Memo()
     for c, (_, _, a, b) in zip(configs, got, strict=True):
-        nstates += _check_config(c, region, back, axes, fwd, bwd, used, face_rules, a, b, union)
+        nstates += _check_config(c, region, back, axes, fwd, bwd, used, face_rules, a, b, memo)
     rtxt = "x".join(map(str, region)) + (
         "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
     )
@@ -330,10 +332,59 @@ def _check_config(
     face_rules: list[FaceRule],
     at_lo: tuple[bool, ...],
     at_hi: tuple[bool, ...],
-    union: dict[tuple[int, int, int], int],
+    memo: _Memo,
 ) -> int:
     lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
+    keys = [list(k) for k in conf["keys"]]
+    where = f"configuration lower={list(lo)} upper={list(hi)}"
+    fkey = (lo, hi, tuple(map(tuple, keys)))
+    frame = memo.frames.get(fkey)
+    if frame is None:
+        frame = memo.frames[fkey] = (
+            len(memo.frames), _frame_graphs(lo, hi, ext, keys, region, back, axes, where)
+        )
+    gid, graphs = frame
+    n = len(graphs)
+
+    def base(x: Cell) -> int:
+        on = frozenset(
+            {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
+            | {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
+        )
+        dom = memo.domains.get(on)
+        if dom is None:
+            dom = memo.domains[on] = _domain(face_rules, set(on), used)
+        return dom
+
+    bases = [tuple(base(x) for x in g[3]) for g in graphs]
+    return _check_states(conf, keys, graphs, bases, gid, fwd, bwd, used, memo, where)
+
+
+class _Memo:
+    """What the configurations of one certificate share."""
+
+    def __init__(self) -> None:
+        self.union: dict[tuple[int, int, int], int] = {}
+        self.frames: dict[Any, tuple[int, list[_Graph]]] = {}
+        self.domains: dict[frozenset[str], int] = {}
+        self.catalogs: dict[Any, list[int]] = {}
+
+
+_Graph = tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]
+
+
+def _frame_graphs(
+    lo: Cell,
+    hi: Cell,
+    ext: Cell,
+    keys: list[list[int]],
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+    where: str,
+) -> list[_Graph]:
+    """The frame of a configuration, its ``keys`` verified, as one small graph per step."""
 
     def order_key(c: Cell) -> Cell:
         return tuple(c[a] for a in axes)
@@ -342,8 +393,6 @@ def _check_config(
     cells = [c for c in cells if order_key(c) < order_key(lo)] + [lo]
     index = {c: i for i, c in enumerate(cells)}
     n = len(cells)
-    keys = [list(k) for k in conf["keys"]]
-    where = f"configuration lower={list(lo)} upper={list(hi)}"
     if len(keys) != n or keys[0]:
         raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
     boxes: list[list[Cell]] = []
@@ -363,14 +412,23 @@ def _check_config(
             if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
                 raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
         boxes.append(box)
-    graphs = [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
+    return [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
 
-    def base(x: Cell) -> int:
-        on = {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
-        on |= {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
-        return _domain(face_rules, on, used)
 
-    bases = [[base(x) for x in g[3]] for g in graphs]
+def _check_states(
+    conf: Mapping[str, Any],
+    keys: list[list[int]],
+    graphs: list[_Graph],
+    bases: list[tuple[int, ...]],
+    gid: int,
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    memo: _Memo,
+    where: str,
+) -> int:
+    """The states of a configuration: present at the start, closed, never an empty point."""
+    n = len(graphs)
     by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
     try:
         for i, labs in conf["states"]:
@@ -393,15 +451,16 @@ def _check_config(
         src_at = [pos[j] for j in src if j >= 0]
         nxt_at = [-1 if j == i else pos[j] for j in keys[i + 1]] if i + 1 < n else []
         later = by_step[i + 1] if i + 1 < n else set()
-        memo: dict[tuple[int, ...], list[int]] = {}
+        cats = memo.catalogs
+        here = (gid, i, bases[i])
         for labs in by_step[i]:
             mk = tuple([labs[k] for k in src_at])
-            cat = memo.get(mk)
+            cat = cats.get((here, mk))
             if cat is None:
                 it = iter(mk)
                 dom = [b0 if j < 0 else 1 << next(it) for j, b0 in zip(src, bases[i], strict=True)]
-                out = _small_ac(dom, arcs, fwd, bwd, union)
-                cat = memo[mk] = [] if out is None else list(_bits(out[target]))
+                out = _small_ac(dom, arcs, fwd, bwd, memo.union)
+                cat = cats[(here, mk)] = [] if out is None else list(_bits(out[target]))
             if i == n - 1:
                 if not cat:
                     raise _Invalid(
