@@ -345,7 +345,6 @@ def _check_config(
             len(memo.frames), _frame_graphs(lo, hi, ext, keys, region, back, axes, where)
         )
     gid, graphs = frame
-    n = len(graphs)
 
     def base(x: Cell) -> int:
         on = frozenset(
