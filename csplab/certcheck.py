@@ -452,7 +452,20 @@ def _check_states(
         later = by_step[i + 1] if i + 1 < n else set()
         cats = memo.catalogs
         here = (gid, i, bases[i])
+        # the labels of cell i that agree with its labelled neighbours: a superset of its
+        # catalog (arc consistency only removes more), enough when every one leads on
+        near = [(pos[src[v]], bwd[d] if plus else fwd[d]) for v, d, plus in arcs[target]
+                if src[v] >= 0]  # fmt: skip
+        base_t = bases[i][target]
         for labs in by_step[i]:
+            if i < n - 1:
+                fc = base_t
+                for k, table in near:
+                    fc &= table[labs[k]]
+                if all(
+                    tuple([b if k < 0 else labs[k] for k in nxt_at]) in later for b in _bits(fc)
+                ):
+                    continue
             mk = tuple([labs[k] for k in src_at])
             cat = cats.get((here, mk))
             if cat is None:

@@ -1,7 +1,7 @@
 """Infallibility table: verdict, method, time and certificate size for every grid model.
 
-For every built-in grid example and every rule set of the anchor data (``--example``
-overrides), at the thesis' boundaries (``none``; ``auto`` = ground and empty space, for
+For every built-in grid example, the repository's tileset test files and every rule set of
+the anchor data (``--example`` overrides), at the thesis' boundaries (``none``; ``auto`` = ground and empty space, for
 examples: a tileset has its file's own) and in Alg. 3.1's scan order (``scanline``; the 2D
 thesis figures also in their own ``scan:yx``), one trial runs
 :func:`~csplab.analysis.decide.decide_infallibility` within ``time_limit`` and then
@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import statistics
 import time
 from pathlib import Path
@@ -54,28 +55,36 @@ THESIS_2D = ("fig3_1a", "fig3_1b", "line", "fig3_1d", "fig3_4a", *HAND_DECIDED, 
 
 def anchor_rule_sets(root: Path | None = None) -> list[str]:
     """The rule sets of the anchor data (``../shared/anchors-data`` from the working
-    directory or the repository), sorted; empty when the data are absent.
+    directory or from the repository, or two levels up), sorted; empty when absent.
 
     Examples
     --------
     >>> isinstance(anchor_rule_sets(Path("/nonexistent")), list)
     True
     """
+    repo = Path(__file__).resolve().parents[2]
     roots = [root] if root is not None else [
         Path("..") / "shared" / "anchors-data",
-        Path(__file__).resolve().parents[2].parent / "shared" / "anchors-data",
+        repo.parent / "shared" / "anchors-data",
+        repo.parents[1] / "shared" / "anchors-data",  # a worktree one level deeper
     ]  # fmt: skip
     for r in roots:
         if r.is_dir():
             files = [p for p in r.rglob("*") if p.suffix in (".json", ".xml") and p.is_file()]
-            return sorted(str(p) for p in files)
+            return sorted(os.path.relpath(p) for p in files)
     return []
+
+
+# the repository's own tileset test files (WFC simple tiled 2D and 3D, POMS, DeBroglie)
+OWN_TILESETS = ("pipes.xml", "pipes3d.xml", "tiny_poms.json", "tiny_debroglie.json")
 
 
 def _default_examples() -> list[str]:
     from csplab.examples import example_info
 
-    return [name for name, _ in example_info()] + anchor_rule_sets()
+    data = Path(__file__).resolve().parents[2] / "tests" / "io" / "data"
+    own = [os.path.relpath(data / f) for f in OWN_TILESETS if (data / f).is_file()]
+    return [name for name, _ in example_info()] + own + anchor_rule_sets()
 
 
 class Infallibility(Experiment):
