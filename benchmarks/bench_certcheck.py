@@ -53,9 +53,9 @@ def main(specs: list[str]) -> int:
         worst = max(worst, ratio)
         verdict = "proved" if v.holds else "refuted"
         tag = "meets" if ratio <= 0.1 else f"shortfall x{ratio / 0.1:.1f}"
-        print(f"{spec:24} {verdict:8} {find:8.2f} {one:11.2f} {check:8.2f} {ratio:10.3f}  {tag}"
-              f"  ({check / one:.2f} of one proof)" if v.holds else
-              f"{spec:24} {verdict:8} {find:8.2f} {'':11} {check:8.2f} {ratio:10.3f}  {tag}")  # fmt: skip
+        ref = f"{one:11.2f}" if v.holds else " " * 11
+        tail = f"  ({check / one:.2f} of one proof)" if v.holds else ""
+        print(f"{spec:24} {verdict:8} {find:8.2f} {ref} {check:8.2f} {ratio:10.3f}  {tag}{tail}")
     print(f"worst check/find {worst:.3f}: " + ("meets" if worst <= 0.1 else "shortfall"))
     return 0
 

@@ -342,7 +342,8 @@ def _check_config(
     frame = memo.frames.get(fkey)
     if frame is None:
         frame = memo.frames[fkey] = (
-            len(memo.frames), _frame_graphs(lo, hi, ext, keys, region, back, axes, where)
+            len(memo.frames),
+            _frame_graphs(lo, hi, ext, keys, region, back, axes, where),
         )
     gid, graphs = frame
 

@@ -40,7 +40,12 @@ import time
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from csplab.analysis.infallible import proof_scope, prove_infallible, scan_axes
+from csplab.analysis.infallible import (
+    proof_scope,
+    prove_infallible,
+    run_certificate,
+    scan_axes,
+)
 from csplab.analysis.witness import find_failure
 from csplab.errors import InputError
 from csplab.example import ExampleModel
@@ -259,19 +264,11 @@ def _refuted(
     certificate: bool,
     boundary: Mapping[str, int] | str | None,
 ) -> Verdict:
-    from csplab.analysis.infallible import Rules, _certificate, face_rules_of
-
     run = dict(ff.witness or {})
     wit: dict[str, Any] = {"alg31": run}
     if last is not None and last.witness and "alg36" in last.witness:
         wit["alg36"] = last.witness["alg36"]
     stats = dict(ff.stats)
     if certificate:
-        face_rules = face_rules_of(example, boundary)
-        crun = dict(run)
-        if face_rules:
-            crun["boundary"] = "auto"
-        wit["certificate"] = _certificate(
-            example, Rules.of(example), face_rules, "fallible", stats, {"run": crun}
-        )
+        wit["certificate"] = run_certificate(example, run, stats, boundary)
     return Verdict(False, wit, stats, f"fallible: {ff.message}")

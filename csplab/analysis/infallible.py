@@ -102,6 +102,7 @@ __all__ = [
     "prove_infallible",
     "region_box",
     "region_catalog",
+    "run_certificate",
     "scan_axes",
 ]
 
@@ -886,6 +887,36 @@ def _certificate(
         "prover": {k: stats[k] for k in ("time_s", "states", "configs") if k in stats},
         **body,
     }
+
+
+def run_certificate(
+    example: ExampleModel | RuleSet,
+    run: Mapping[str, Any],
+    stats: Mapping[str, Any],
+    boundary: Mapping[str, int] | str | None = None,
+) -> dict[str, Any]:
+    """A "fallible" certificate of a failing run of Alg. 3.1 (a witness of
+    :func:`~csplab.analysis.witness.find_failure`), for :mod:`csplab.certcheck`.
+
+    Parameters
+    ----------
+    example : ExampleModel or RuleSet
+    run : mapping
+        ``shape``, ``order`` and ``choices`` of the run.
+    stats : mapping
+        The search's figures (``time_s`` is recorded as the prover's time).
+    boundary : mapping, "auto", "none" or None
+        An example's boundary, as given to the search (a tileset's is its own).
+
+    Returns
+    -------
+    dict
+    """
+    face_rules = face_rules_of(example, boundary)
+    body = dict(run)
+    if face_rules:  # the run's boundary is the certificate's face rules
+        body["boundary"] = "auto"
+    return _certificate(example, Rules.of(example), face_rules, "fallible", stats, {"run": body})
 
 
 def _refute_size(ndim: int) -> tuple[int, ...]:

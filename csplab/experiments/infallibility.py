@@ -1,9 +1,9 @@
 """Infallibility table: verdict, method, time and certificate size for every grid model.
 
 For every built-in grid example, the repository's tileset test files and every rule set of
-the anchor data (``--example`` overrides), at the thesis' boundaries (``none``; ``auto`` = ground and empty space, for
-examples: a tileset has its file's own) and in Alg. 3.1's scan order (``scanline``; the 2D
-thesis figures also in their own ``scan:yx``), one trial runs
+the anchor data (``--example`` overrides), at the thesis' boundaries (``none``; ``auto`` =
+ground and empty space, for examples: a tileset has its file's own) and in Alg. 3.1's scan
+order (``scanline``; the 2D thesis figures also in their own ``scan:yx``), one trial runs
 :func:`~csplab.analysis.decide.decide_infallibility` within ``time_limit`` and then
 checks what the verdict rests on, with code that shares nothing with the prover:
 
