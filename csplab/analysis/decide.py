@@ -13,8 +13,9 @@ that stops at the first verdict:
 * **refutation** -- a failing run of Alg. 3.1. A realised Alg. 3.6 failure whose labels
   Alg. 3.1 also allows is one; otherwise :func:`~csplab.analysis.witness.find_failure`
   (every run on small outputs, then seeded random runs on growing outputs up to
-  ``max_size``, shrunk to the smallest output and fewest choices) gets a share of the
-  time after the first region and the rest at the end. A refutation is as good as its
+  ``max_size``, shrunk to the smallest output and fewest choices) runs in slices between
+  the region attempts (3 s, then twice as long each time the ladder has spent as long) and
+  gets the rest of the time at the end. A refutation is as good as its
   replay: :func:`~csplab.analysis.witness.replay` and ``csplab check-certificate`` re-run it.
 
 A verdict names its method (``stats["method"]``): ``"region RxS (Alg. 3.6)"``,
@@ -201,13 +202,14 @@ def decide_infallibility(
                                   method=method)  # fmt: skip
         return v
 
-    def search(share: float, seed: int) -> Verdict | None:
+    def search(seconds: float) -> Verdict | None:
         left = deadline - time.perf_counter()
         if left < 1.0:
             return None
+        first = not searches  # small outputs exhaustively once; then random runs only
         ff = find_failure(
-            example, order=order, max_size=max_size, rng=seed, boundary=bnd,
-            time_limit=max(1.0, share * left),
+            example, order=order, max_size=max_size, rng=rng + len(searches), boundary=bnd,
+            time_limit=max(1.0, min(seconds, left)), **({} if first else {"exhaustive_cells": 0}),
         )  # fmt: skip
         searches.append({
             k: ff.stats.get(k) for k in ("random_runs", "exhaustive_sizes", "states", "time_s")
@@ -216,7 +218,7 @@ def decide_infallibility(
             return ff
         return None
 
-    tried_search = False
+    slice_s, last_search = 3.0, t0
     ladder_end = t0 + 0.7 * float(time_limit)  # the rest: the failure search
     for i, (r, b, hist) in enumerate(ladder):
         if time.perf_counter() > ladder_end:
@@ -240,12 +242,15 @@ def decide_infallibility(
         a36 = wit.get("alg36") or {}
         if a36.get("realized"):
             spurious.append((r, b, tuple(a36["run"]["shape"])))
-        if not tried_search:  # a first look for a real failure, before larger regions
-            tried_search = True
-            ff = search(0.15, rng)
+        # slices of failure search between the attempts, each twice as long as the last,
+        # once the ladder has spent as long as the last slice (at most 15 % of what is left)
+        now = time.perf_counter()
+        if not searches or now - last_search >= slice_s:
+            ff = search(min(slice_s, 0.15 * (deadline - now)))
+            last_search, slice_s = time.perf_counter(), 2 * slice_s
             if ff is not None:
                 return done(_refuted(example, ff, v, certificate, boundary), "failure search")
-    ff = search(1.0, rng + 1)
+    ff = search(deadline - time.perf_counter())
     if ff is not None:
         return done(_refuted(example, ff, None, certificate, boundary), "failure search")
     bounded = [s["message"] for s in searches if s["holds"] is True]

@@ -141,6 +141,9 @@ def run(args: argparse.Namespace) -> int:
             print(describe_run(w["run"], E))
     if args.out and w is not None:
         save_witness(w if v.holds is False else w.get("run", w), args.out, E)
-    if v.holds is None and not args.json:
+    if v.holds is None and not args.json and "method" not in v.stats:
         print(f"  states enumerated: {v.stats.get('states', 0)}")
+    elif v.holds is None and not args.json:
+        for line in v.stats["attempts"][-3:]:
+            print(f"  last regions tried: {line}")
     return 1 if v.holds is False else 3
