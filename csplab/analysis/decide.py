@@ -206,10 +206,11 @@ def decide_infallibility(
         left = deadline - time.perf_counter()
         if left < 1.0:
             return None
-        first = not searches  # small outputs exhaustively once; then random runs only
+        # small outputs exhaustively once (find_failure's default), then random runs only
+        later: dict[str, Any] = {"exhaustive_cells": 0} if searches else {}
         ff = find_failure(
             example, order=order, max_size=max_size, rng=rng + len(searches), boundary=bnd,
-            time_limit=max(1.0, min(seconds, left)), **({} if first else {"exhaustive_cells": 0}),
+            time_limit=max(1.0, min(seconds, left)), **later,
         )  # fmt: skip
         searches.append({
             k: ff.stats.get(k) for k in ("random_runs", "exhaustive_sizes", "states", "time_s")
