@@ -48,10 +48,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-
-import numpy as np
 
 SAT_TARGET_S = 1.0
 CPSAT_TARGET_X = 2.0
@@ -238,10 +238,18 @@ def cpsat_target(size: str, limit: float, models: list[str]) -> None:
                 status = "unsat"
         took = time.perf_counter() - t
         x = took / sat
-        verdict = "meets" if status == "solved" and x <= CPSAT_TARGET_X else (
-            f"SHORT: {x:.1f}x" if status == "solved" else f"SHORT: {status} after {took:.0f} s")
-        print(f"  cpsat {name:<26} {status:<8} {took:6.2f} s (build {build:5.2f} s) = "
-              f"{x:5.1f}x sat: target <= {CPSAT_TARGET_X:.0f}x {verdict}", flush=True)
+        verdict = (
+            "meets"
+            if status == "solved" and x <= CPSAT_TARGET_X
+            else (
+                f"SHORT: {x:.1f}x" if status == "solved" else f"SHORT: {status} after {took:.0f} s"
+            )
+        )
+        print(
+            f"  cpsat {name:<26} {status:<8} {took:6.2f} s (build {build:5.2f} s) = "
+            f"{x:5.1f}x sat: target <= {CPSAT_TARGET_X:.0f}x {verdict}",
+            flush=True,
+        )
 
 
 def main() -> None:

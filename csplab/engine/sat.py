@@ -120,7 +120,6 @@ def free_at_exit(on: bool = True) -> None:
     _EXIT["on"] = int(bool(on))
 
 
-
 def backends() -> list[str]:
     """The pysat backends the ``sat`` solver accepts (``sat:NAME``)."""
     return list(_SUPPORTED)
