@@ -16,8 +16,6 @@ reference) and CP-SAT models:
 
 * ``onehot``: csplab's ``cpsat`` default (one Boolean per label, support clauses as
   ``BoolOr``);
-* ``onehot supports=forward``: half the clauses (CP-SAT built here from the forward-only
-  support encoding, otherwise as ``onehot``);
 * ``table``: csplab's ``cpsat model=table`` (integer cell variables, ``AddAllowedAssignments``
   per arc with the relation's pairs);
 * ``table-ac``: the same on the arc-consistent reduced problem only (domains = the catalog,
@@ -163,38 +161,7 @@ def model_element(cp_model: Any, P: Any, C: np.ndarray, pref: np.ndarray) -> tup
     return m, lambda vals: np.asarray(vals[: P.n], dtype=np.int32)
 
 
-def model_onehot_forward(cp_model: Any, P: Any, C: np.ndarray, pref: np.ndarray) -> tuple[Any, Any]:
-    """One-hot Booleans, exactly one per cell, forward-only support clauses as ``BoolOr``."""
-    from csplab.cnf import encode
-
-    enc = encode(P, supports="forward")
-    m = cp_model.CpModel()
-    xs = [m.NewBoolVar("") for _ in range(enc.nvars)]
-    nalo = int(enc.stats["alo_clauses"])
-    nsup = enc.nclauses - nalo
-    for i in range(nsup):
-        cl = enc.clause(i)
-        m.AddBoolOr([xs[x - 1] if x > 0 else ~xs[-x - 1] for x in cl.tolist()])
-    for v in range(P.n):
-        vs = enc.cell_vars(v)
-        if vs.size:
-            m.AddExactlyOne([xs[x - 1] for x in vs.tolist()])
-    hint = np.zeros(enc.nvars + 1, dtype=np.int64)
-    ok = enc.var[np.arange(P.n), np.maximum(pref, 0)]
-    hint[ok[ok > 0]] = 1
-    m.proto.solution_hint.vars.extend(range(enc.nvars))
-    m.proto.solution_hint.values.extend(hint[1:].tolist())
-
-    def read(vals: np.ndarray) -> np.ndarray:
-        truth = np.zeros(enc.nvars + 1, dtype=bool)
-        truth[1:] = np.asarray(vals[: enc.nvars]) > 0
-        return enc.decode(truth)[0].reshape(-1)
-
-    return m, read
-
-
 MODELS: dict[str, Callable[..., tuple[Any, Any]]] = {
-    "onehot supports=forward": model_onehot_forward,
     "table-ac": model_table_ac,
     "element": model_element,
 }
