@@ -133,6 +133,8 @@ def _independent_clauses(P, enc, supports, amo):
     single = C.sum(axis=1) == 1
     out = []
     for a, b, r in P.arcs.tolist():
+        if a == b:
+            continue  # a loop restricts the cell's own labels: arc consistency did that
         dirs = [(a, b, P.relations[r])]
         if supports == "both":
             dirs.append((b, a, P.relations[r].T))
