@@ -16,6 +16,8 @@ reference) and CP-SAT models:
 
 * ``onehot``: csplab's ``cpsat`` default (one Boolean per label, support clauses as
   ``BoolOr``);
+* ``onehot-forward``: the same model on the forward-only support clauses (half of them;
+  unit propagation weaker than arc consistency);
 * ``table``: csplab's ``cpsat model=table`` (integer cell variables, ``AddAllowedAssignments``
   per arc with the relation's pairs);
 * ``table-ac``: the same on the arc-consistent reduced problem only (domains = the catalog,
@@ -161,7 +163,18 @@ def model_element(cp_model: Any, P: Any, C: np.ndarray, pref: np.ndarray) -> tup
     return m, lambda vals: np.asarray(vals[: P.n], dtype=np.int32)
 
 
+def model_onehot_forward(cp_model: Any, P: Any, C: np.ndarray, pref: np.ndarray) -> tuple[Any, Any]:
+    """csplab's one-hot model (same serializer) on the forward-only support clauses."""
+    from csplab.cnf import encode
+    from csplab.solvers.cpsat import CpsatSolver
+
+    m = cp_model.CpModel()
+    read, _, _ = CpsatSolver._onehot(m, encode(P, supports="forward"), pref, None)
+    return m, read
+
+
 MODELS: dict[str, Callable[..., tuple[Any, Any]]] = {
+    "onehot-forward": model_onehot_forward,
     "table-ac": model_table_ac,
     "element": model_element,
 }
