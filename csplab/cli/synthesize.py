@@ -256,10 +256,15 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
     fallback = None if solver_complete(args.solver) or args.fallback == "none" else args.fallback
     from csplab import _jit
+    from csplab.engine.sat import free_at_exit
 
     compiling = _jit.compile_seconds()
-    result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
-                   fallback=fallback, **opts)  # fmt: skip
+    free_at_exit()  # the command ends after this solve: the OS frees a large SAT solver
+    try:
+        result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
+                       fallback=fallback, **opts)  # fmt: skip
+    finally:
+        free_at_exit(False)
     compiling = _jit.compile_seconds() - compiling  # numba's one-time cost, not the solve's
     wrote = None
     if out_format is not None and (result.ok or args.out_partial):
