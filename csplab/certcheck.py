@@ -18,9 +18,11 @@ with ``op`` one of keep / remove / force / add and ``where`` a face (``"x-"``), 
 but a face (``"!x-"``) or every cell (``"*"``): a cell's domain is the labels in use, edited
 by each rule that applies to it.
 
-*infallible*: ``region``, ``order``, ``axes`` (outermost first), ``history`` and
-``configs``, one per position of a point relative to the output's lower edges (distance
-``0 .. 1 + history``, the last meaning "at least") and upper edges (``0 .. region - 2``),
+*infallible*: ``region``, ``order``, ``axes`` (outermost first), ``history``, ``back``
+(optional, default 1 per axis: the region of a cell ``c`` is the box ``c - back .. c +
+region - 2``, clipped) and ``configs``, one per position of a point relative to the
+output's lower edges (distance ``0 .. back + history``, the last meaning "at least") and
+upper edges (``0 .. region - 2``),
 and -- with face rules -- whether the frame's first (``at_lower``) and last
 (``at_upper``) cell on each axis lies on the output's face (always when the frame is
 clipped there, both ways otherwise; without face rules, only when clipped).
@@ -258,16 +260,6 @@ def _axes_of(order: str, ndim: int) -> tuple[int, ...]:
     raise _Invalid(f"order {order!r} is not a scan order over {ndim} axes")
 
 
-def _arc_consistency(
-    dom: dict[Cell, int], fwd: list[list[int]], bwd: list[list[int]]
-) -> dict[Cell, int] | None:
-    """Arc consistency between the cells of ``dom`` (by :func:`_small_ac`, the checker's one
-    arc consistency); ``None`` on a wipe-out."""
-    cells = list(dom)
-    out = _small_ac([dom[c] for c in cells], _arcs(cells), fwd, bwd, {})
-    return None if out is None else dict(zip(cells, out, strict=True))
-
-
 # ----------------------------------------------------------------------------- infallible
 
 
@@ -286,13 +278,16 @@ def _check_closed(
         raise _Invalid("region needs at least 2 cells on every axis of the rules")
     if any(h < 0 for h in history):
         raise _Invalid("history must be non-negative")
+    back = [int(t) for t in cert.get("back", [1] * ndim)]
+    if len(back) != ndim or any(b < 1 for b in back):
+        raise _Invalid("back needs a value of at least 1 on every axis")
     if _axes_of(str(cert["order"]), ndim) != axes:
         raise _Invalid("axes do not match the order")
     both = (False, True) if face_rules else (False,)
     want = set()
-    for lo in itertools.product(*[range(2 + h) for h in history]):
+    for lo in itertools.product(*[range(1 + b + h) for b, h in zip(back, history, strict=True)]):
         for hi in itertools.product(*[range(r - 1) for r in region]):
-            at_lo = [(True,) if lo[d] < 1 + history[d] else both for d in range(ndim)]
+            at_lo = [(True,) if lo[d] < back[d] + history[d] else both for d in range(ndim)]
             at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
             for a in itertools.product(*at_lo):
                 for b in itertools.product(*at_hi):
@@ -302,7 +297,7 @@ def _check_closed(
         (
             tuple(c["lower"]), tuple(c["upper"]),
             tuple(bool(t) for t in c.get("at_lower", [])) or tuple(
-                lo < 1 + h for lo, h in zip(c["lower"], history, strict=True)),
+                lo < b + h for lo, b, h in zip(c["lower"], back, history, strict=True)),
             tuple(bool(t) for t in c.get("at_upper", [])) or tuple(
                 hi < r - 2 for hi, r in zip(c["upper"], region, strict=True)),
         )
@@ -311,9 +306,14 @@ def _check_closed(
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
     nstates = 0
+    # shared by every configuration: support sets, frames (configurations that differ only
+    # in which frame edges lie on a face have the same frame) and catalogs
+    memo = _Memo()
     for c, (_, _, a, b) in zip(configs, got, strict=True):
-        nstates += _check_config(c, region, axes, fwd, bwd, used, face_rules, a, b)
-    rtxt = "x".join(map(str, region))
+        nstates += _check_config(c, region, back, axes, fwd, bwd, used, face_rules, a, b, memo)
+    rtxt = "x".join(map(str, region)) + (
+        "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
+    )
     return (
         f"valid: {nstates} states in {len(configs)} configurations are closed under Alg. 3.6 "
         f"with {rtxt} regions ({cert['order']}) and no catalog of a point is empty: "
@@ -324,6 +324,7 @@ def _check_closed(
 def _check_config(
     conf: Mapping[str, Any],
     region: list[int],
+    back: list[int],
     axes: tuple[int, ...],
     fwd: list[list[int]],
     bwd: list[list[int]],
@@ -331,9 +332,59 @@ def _check_config(
     face_rules: list[FaceRule],
     at_lo: tuple[bool, ...],
     at_hi: tuple[bool, ...],
+    memo: _Memo,
 ) -> int:
     lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
+    keys = [list(k) for k in conf["keys"]]
+    where = f"configuration lower={list(lo)} upper={list(hi)}"
+    fkey = (lo, hi, tuple(map(tuple, keys)))
+    frame = memo.frames.get(fkey)
+    if frame is None:
+        frame = memo.frames[fkey] = (
+            len(memo.frames),
+            _frame_graphs(lo, hi, ext, keys, region, back, axes, where),
+        )
+    gid, graphs = frame
+
+    def base(x: Cell) -> int:
+        on = frozenset(
+            {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
+            | {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
+        )
+        dom = memo.domains.get(on)
+        if dom is None:
+            dom = memo.domains[on] = _domain(face_rules, set(on), used)
+        return dom
+
+    bases = [tuple(base(x) for x in g[3]) for g in graphs]
+    return _check_states(conf, keys, graphs, bases, gid, fwd, bwd, used, memo, where)
+
+
+class _Memo:
+    """What the configurations of one certificate share."""
+
+    def __init__(self) -> None:
+        self.union: dict[tuple[int, int, int], int] = {}
+        self.frames: dict[Any, tuple[int, list[_Graph]]] = {}
+        self.domains: dict[frozenset[str], int] = {}
+        self.catalogs: dict[Any, list[int]] = {}
+
+
+_Graph = tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]
+
+
+def _frame_graphs(
+    lo: Cell,
+    hi: Cell,
+    ext: Cell,
+    keys: list[list[int]],
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+    where: str,
+) -> list[_Graph]:
+    """The frame of a configuration, its ``keys`` verified, as one small graph per step."""
 
     def order_key(c: Cell) -> Cell:
         return tuple(c[a] for a in axes)
@@ -342,8 +393,6 @@ def _check_config(
     cells = [c for c in cells if order_key(c) < order_key(lo)] + [lo]
     index = {c: i for i, c in enumerate(cells)}
     n = len(cells)
-    keys = [list(k) for k in conf["keys"]]
-    where = f"configuration lower={list(lo)} upper={list(hi)}"
     if len(keys) != n or keys[0]:
         raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
     boxes: list[list[Cell]] = []
@@ -353,7 +402,7 @@ def _check_config(
         if i + 1 < n and not set(keys[i + 1]) <= set(keys[i]) | {i}:
             raise _Invalid(f"{where}: keys[{i + 1}] records a label step {i} forgot")
         box = list(itertools.product(*[
-            range(max(0, c[d] - 1), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
+            range(max(0, c[d] - back[d]), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
             for d in range(len(c))
         ]))  # fmt: skip
         inbox = set(box)
@@ -363,14 +412,23 @@ def _check_config(
             if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
                 raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
         boxes.append(box)
-    graphs = [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
+    return [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
 
-    def base(x: Cell) -> int:
-        on = {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
-        on |= {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
-        return _domain(face_rules, on, used)
 
-    bases = [[base(x) for x in g[3]] for g in graphs]
+def _check_states(
+    conf: Mapping[str, Any],
+    keys: list[list[int]],
+    graphs: list[_Graph],
+    bases: list[tuple[int, ...]],
+    gid: int,
+    fwd: list[list[int]],
+    bwd: list[list[int]],
+    used: int,
+    memo: _Memo,
+    where: str,
+) -> int:
+    """The states of a configuration: present at the start, closed, never an empty point."""
+    n = len(graphs)
     by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
     try:
         for i, labs in conf["states"]:
@@ -386,7 +444,6 @@ def _check_config(
             raise _Invalid(f"{where}: a state at step {i} has a label not in use")
     if () not in by_step[0]:
         raise _Invalid(f"{where}: no start state")
-    union: dict[tuple[int, int, int], int] = {}
     for i in range(n):
         src, arcs, target, _ = graphs[i]
         pos = {j: k for k, j in enumerate(keys[i])}
@@ -394,22 +451,36 @@ def _check_config(
         src_at = [pos[j] for j in src if j >= 0]
         nxt_at = [-1 if j == i else pos[j] for j in keys[i + 1]] if i + 1 < n else []
         later = by_step[i + 1] if i + 1 < n else set()
-        memo: dict[tuple[int, ...], int] = {}
+        cats = memo.catalogs
+        here = (gid, i, bases[i])
+        # the labels of cell i that agree with its labelled neighbours: a superset of its
+        # catalog (arc consistency only removes more), enough when every one leads on
+        near = [(pos[src[v]], bwd[d] if plus else fwd[d]) for v, d, plus in arcs[target]
+                if src[v] >= 0]  # fmt: skip
+        base_t = bases[i][target]
         for labs in by_step[i]:
+            if i < n - 1:
+                fc = base_t
+                for k, table in near:
+                    fc &= table[labs[k]]
+                if all(
+                    tuple([b if k < 0 else labs[k] for k in nxt_at]) in later for b in _bits(fc)
+                ):
+                    continue
             mk = tuple([labs[k] for k in src_at])
-            cat = memo.get(mk)
+            cat = cats.get((here, mk))
             if cat is None:
                 it = iter(mk)
                 dom = [b0 if j < 0 else 1 << next(it) for j, b0 in zip(src, bases[i], strict=True)]
-                out = _small_ac(dom, arcs, fwd, bwd, union)
-                cat = memo[mk] = 0 if out is None else out[target]
+                out = _small_ac(dom, arcs, fwd, bwd, memo.union)
+                cat = cats[(here, mk)] = [] if out is None else list(_bits(out[target]))
             if i == n - 1:
-                if cat == 0:
+                if not cat:
                     raise _Invalid(
                         f"{where}: the point's catalog is empty in state {[i, list(labs)]}"
                     )
                 continue
-            for b in _bits(cat):
+            for b in cat:
                 nxt = tuple([b if k < 0 else labs[k] for k in nxt_at])
                 if nxt not in later:
                     raise _Invalid(
@@ -451,10 +522,15 @@ def _small_ac(
     fwd: list[list[int]],
     bwd: list[list[int]],
     union: dict[tuple[int, int, int], int],
+    start: Sequence[int] | None = None,
 ) -> list[int] | None:
-    """Arc consistency (a work list of nodes) on a small graph; ``None`` on a wipe-out."""
-    queue = list(range(len(dom)))
-    waiting = [True] * len(dom)
+    """Arc consistency (a work list of nodes) on a small graph; ``None`` on a wipe-out.
+    ``start``: the nodes whose domains changed since the domains were last arc consistent
+    (default: all)."""
+    queue = list(range(len(dom))) if start is None else list(start)
+    waiting = [False] * len(dom)
+    for u in queue:
+        waiting[u] = True
     while queue:
         u = queue.pop()
         waiting[u] = False
@@ -515,10 +591,12 @@ def _check_run(
         rules_here = [("force", f, 1 << int(bnd[f])) for f in order if f in bnd]
     else:
         raise _Invalid("run: boundary must be 'auto' or map faces to labels")
-    start = {c: _domain(rules_here, faces(c), used) for c in cells}
-    if any(v == 0 for v in start.values()):
+    first = [_domain(rules_here, faces(c), used) for c in cells]
+    if any(v == 0 for v in first):
         return "valid: Alg. 3.1 fails before its first choice (a boundary cell has no label)"
-    dom = _arc_consistency(start, fwd, bwd)
+    arcs = _arcs(cells)
+    union: dict[tuple[int, int, int], int] = {}
+    dom = _small_ac(first, arcs, fwd, bwd, union)
     if dom is None:
         return "valid: Alg. 3.1 fails before its first choice (the grid has no solution)"
     choices = list(run["choices"])
@@ -528,10 +606,11 @@ def _check_run(
             raise _Invalid(f"run: choice {k + 1} is at {list(c)}, the scan visits {cells[k]}")
         if label is None:  # a run that stops at an empty catalog: it is wiped out before
             raise _Invalid(f"run: choice {k + 1} claims an empty catalog, which is not")
-        if not dom[c] >> int(label) & 1:
+        if not dom[k] >> int(label) & 1:
             raise _Invalid(f"run: choice {k + 1} ({label} at {list(c)}) is not in its catalog")
-        dom[c] = 1 << int(label)
-        dom = _arc_consistency(dom, fwd, bwd)
+        dom[k] = 1 << int(label)
+        # the domains were arc consistent before: revising from the changed cell suffices
+        dom = _small_ac(dom, arcs, fwd, bwd, union, start=[k])
         if dom is None:
             rest = choices[k + 1 :]  # at most the cell found empty, marked [cell, None]
             if rest and (len(rest) > 1 or rest[0][1] is not None):

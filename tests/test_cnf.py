@@ -124,3 +124,54 @@ def test_fixed_cell_that_forces_the_board_leaves_no_variables():
     enc = encode(P, amo="pairwise")
     assert enc.ok and enc.nx == 0 and enc.nclauses == 0  # one label forces the checkerboard
     assert P.is_solution(enc.const.reshape(P.shape))
+
+
+def _independent_clauses(P, enc, supports, amo):
+    """The clauses of the support encoding, built cell by cell in plain Python from the
+    problem's relations and the encoding's variable map (shares no code with encode)."""
+    var, C = enc.var, enc.catalog
+    single = C.sum(axis=1) == 1
+    out = []
+    for a, b, r in P.arcs.tolist():
+        if a == b:
+            continue  # a loop restricts the cell's own labels: arc consistency did that
+        dirs = [(a, b, P.relations[r])]
+        if supports == "both":
+            dirs.append((b, a, P.relations[r].T))
+        for v, u, T in dirs:
+            if single[v]:
+                continue
+            for lab in np.flatnonzero(C[v]).tolist():
+                sup = [c for c in np.flatnonzero(C[u]).tolist() if T[lab, c]]
+                if len(sup) == int(C[u].sum()):
+                    continue  # covered by u's at-least-one clause (or u is a constant)
+                out.append((-int(var[v, lab]), *sorted(int(var[u, c]) for c in sup)))
+    alo = [tuple(int(x) for x in var[v][var[v] > 0]) for v in range(P.n) if not single[v]]
+    return out, alo
+
+
+@given(csp_problems(max_side=3), st.sampled_from(["both", "forward"]),
+       st.sampled_from(["lazy", "seqcounter", "pairwise"]))  # fmt: skip
+def test_flat_layout_holds_supports_then_alo_then_amo(P, supports, amo):
+    """The flat arrays written in place: support clauses (as a multiset, equal to an
+    independent construction), then one at-least-one clause per open cell in cell order,
+    then the at-most-one clauses of ``amo_clauses``, with ``starts`` matching."""
+    enc = encode(P, supports=supports, amo=amo)
+    if not enc.ok:
+        return
+    assert enc.starts[0] == 0 and enc.starts[-1] == enc.lits.size
+    assert np.all(np.diff(enc.starts) >= 1)
+    cls = [tuple(c) for c in enc.clauses()]
+    ns, na = enc.stats["support_clauses"], enc.stats["alo_clauses"]
+    sup, alo = _independent_clauses(P, enc, supports, amo)
+    got = sorted((c[0], *sorted(c[1:])) for c in cls[:ns])
+    assert got == sorted(sup)
+    assert cls[ns : ns + na] == alo
+    rest = cls[ns + na :]
+    if amo == "lazy":
+        assert rest == [] and enc.nvars == enc.nx
+    else:
+        lits, lens, top = amo_clauses(enc.var, enc.var > 0, amo, enc.nx)
+        st_ = np.concatenate([[0], np.cumsum(lens)])
+        assert rest == [tuple(lits[a:b].tolist()) for a, b in itertools.pairwise(st_)]
+        assert enc.nvars == top

@@ -4,7 +4,7 @@ An example model E is *infallible* (thesis Sec. 3.3.7) when Alg. 3.1, run in a g
 order, can never fail on it, whatever the output size and whatever labels it draws.
 
 Reading of Sec. 3.3.7 used here (the seed text lost subscripts; see
-``papers/merrell-2009-thesis/infallibility.md``)
+``papers/merrell-2009-thesis/infallibility_reading.md``)
 ---------------------------------------------------------------------------------------
 *Scan orders.* A scan visits cells lexicographically with the axes in a fixed order
 (outermost first): ``"scanline"`` is Alg. 3.1's loop (x outermost), ``"scan:yx"`` the
@@ -102,6 +102,7 @@ __all__ = [
     "prove_infallible",
     "region_box",
     "region_catalog",
+    "run_certificate",
     "scan_axes",
 ]
 
@@ -232,16 +233,26 @@ def parse_region(region: Sequence[int] | str | int, ndim: int) -> tuple[int, ...
 
 
 def region_box(
-    p: Sequence[int], shape: Sequence[int], region: Sequence[int]
+    p: Sequence[int],
+    shape: Sequence[int],
+    region: Sequence[int],
+    back: Sequence[int] | None = None,
 ) -> tuple[Coords, Coords]:
     """The region of Alg. 3.7 at ``p``: inclusive ``(lo, hi)`` corners, clipped to ``shape``.
+
+    ``back`` (default 1 per axis, Alg. 3.7's ``p - 1``) is how far the region reaches
+    before ``p``: a region reaching further back still holds every ``p - e_d``, so
+    Theorem 3.3.6 holds for it too, and it sees more of what was assigned.
 
     Examples
     --------
     >>> region_box((0, 3), (5, 5), (3, 2))
     ((0, 2), (1, 3))
+    >>> region_box((2, 3), (5, 5), (3, 2), back=(2, 1))
+    ((0, 2), (3, 3))
     """
-    lo = tuple(max(0, int(pd) - 1) for pd in p)
+    bk = (1,) * len(p) if back is None else back
+    lo = tuple(max(0, int(pd) - int(b)) for pd, b in zip(p, bk, strict=True))
     hi = tuple(
         min(int(n) - 1, int(pd) + int(rd) - 2) for pd, n, rd in zip(p, shape, region, strict=True)
     )
@@ -299,6 +310,7 @@ class _Walk:
         cells: list[Coords],
         region: Coords,
         base: Callable[[Coords], int] | None = None,
+        back: Coords | None = None,
     ) -> None:
         self.ext, self.cells, self.region = ext, cells, region
         index = {c: i for i, c in enumerate(cells)}
@@ -309,7 +321,7 @@ class _Walk:
         self.bases: list[list[int] | None] = []
         relfixed: list[list[int]] = []
         for i, c in enumerate(cells):
-            lo, hi = region_box(c, ext, region)
+            lo, hi = region_box(c, ext, region, back)
             box = list(itertools.product(*[range(a, b + 1) for a, b in zip(lo, hi, strict=True)]))
             inbox = set(box)
 
@@ -391,18 +403,19 @@ Edges = tuple[tuple[bool, ...], tuple[bool, ...]]
 
 
 def _configs(
-    ndim: int, region: Coords, history: Coords, faces: bool = False
+    ndim: int, region: Coords, history: Coords, faces: bool = False, back: Coords | None = None
 ) -> Iterator[tuple[Coords, Coords, Edges]]:
     """Positions of a point: distances to the lower edges (the last value meaning "at
     least"), to the upper edges (likewise), and whether the frame's first / last cell on
     each axis is on the output's edge (always when the frame is clipped there; both ways
     otherwise, when the file has face rules)."""
-    lo_ranges = [range(2 + history[d]) for d in range(ndim)]
+    bk = (1,) * ndim if back is None else back
+    lo_ranges = [range(1 + bk[d] + history[d]) for d in range(ndim)]
     hi_ranges = [range(region[d] - 1) for d in range(ndim)]
     for lo in itertools.product(*lo_ranges):
         for hi in itertools.product(*hi_ranges):
             opts_lo = [
-                (True,) if lo[d] < 1 + history[d] else ((False, True) if faces else (False,))
+                (True,) if lo[d] < bk[d] + history[d] else ((False, True) if faces else (False,))
                 for d in range(ndim)
             ]
             opts_hi = [
@@ -421,6 +434,7 @@ def _frame(
     region: Coords,
     edges: Edges | None = None,
     face_domain: Callable[[frozenset[str]], int] | None = None,
+    back: Coords | None = None,
 ) -> tuple[_Walk, Coords, Coords]:
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     q = lo
@@ -436,7 +450,7 @@ def _frame(
             on |= {AXIS_NAMES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
             return face_domain(frozenset(on))
 
-    return _Walk(ext, cells, region, base), ext, q
+    return _Walk(ext, cells, region, base, back), ext, q
 
 
 def prove_infallible(
@@ -450,6 +464,8 @@ def prove_infallible(
     refute: bool = True,
     certificate: bool = False,
     boundary: Mapping[str, int] | str | None = None,
+    time_limit: float | None = None,
+    back: Sequence[int] | int = 1,
 ) -> Verdict:
     """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
 
@@ -483,6 +499,12 @@ def prove_infallible(
         :func:`~csplab.grids.auto_boundary`, the ground and empty space, whatever the
         output size; ``synthesize`` falls back to Merrell's rule where that has no
         solution). A tileset's boundary is its file's own.
+    time_limit : float, optional
+        Seconds for the enumeration; past them the verdict is undecided, as when the
+        state budget runs out.
+    back : int or sequence
+        How far each region reaches before its point, per axis (Alg. 3.7: 1). Larger
+        values see more of the assigned cells (:func:`region_box`).
 
     Raises
     ------
@@ -521,11 +543,16 @@ def prove_infallible(
     hist = (int(history),) * ndim if isinstance(history, int) else tuple(int(h) for h in history)
     if len(hist) != ndim or any(h < 0 for h in hist):
         raise InputError(f"history needs {ndim} non-negative values, got {history!r}")
-    rtxt = "x".join(map(str, r))
+    bk = (int(back),) * ndim if isinstance(back, int) else tuple(int(b) for b in back)
+    if len(bk) != ndim or any(b < 1 for b in bk):
+        raise InputError(f"back needs {ndim} values of at least 1, got {back!r}")
+    btxt = "" if set(bk) == {1} else "x".join(map(str, bk))
+    rtxt = "x".join(map(str, r)) + (f" (back {btxt})" if btxt else "")
     stats: dict[str, Any] = {
         "region": list(r),
         "order": order,
         "history": list(hist),
+        "back": list(bk),
         "configs": 0,
         "states": 0,
         "windows": 0,
@@ -533,16 +560,21 @@ def prove_infallible(
     }
     digest = hashlib.sha256()
     digest.update(repr((example.hash(), r, order, hist)).encode())
+    if set(bk) != {1}:
+        digest.update(repr(bk).encode())
     if face_rules:
         digest.update(repr(face_rules).encode())
     failure: dict[str, Any] | None = None
     closed: list[dict[str, Any]] = []
+    deadline = None if time_limit is None else t0 + float(time_limit)
     try:
-        for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules)):
-            walk, ext, q = _frame(lo, hi, axes, r, edges, face_domain)
+        for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules), bk):
+            walk, ext, q = _frame(lo, hi, axes, r, edges, face_domain, bk)
             stats["configs"] += 1
             seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
-            fail, nstates, windows = _enumerate(rules, walk, max_states - stats["states"], seen)
+            fail, nstates, windows = _enumerate(
+                rules, walk, max_states - stats["states"], seen, deadline
+            )
             if seen is not None:
                 closed.append({
                     "lower": list(lo), "upper": list(hi),
@@ -568,7 +600,12 @@ def prove_infallible(
             None,
             None,
             stats,
-            f"undecided: state budget {max_states} reached with {rtxt} regions "
+            (
+                "undecided: time limit reached"
+                if deadline is not None and time.perf_counter() > deadline
+                else f"undecided: state budget {max_states} reached"
+            )
+            + f" with {rtxt} regions "
             f"({stats['states']} states, {stats['configs']} configurations)",
         )
     stats["time_s"] = time.perf_counter() - t0
@@ -584,14 +621,14 @@ def prove_infallible(
         proof: dict[str, Any] = {
             "scope": _scope(face_rules),
             "sha256": h,
-            "recheck": f"csplab prove {name} --region {rtxt} --order {order} "
-            f"--history {hs} --expect-hash {h}",
+            "recheck": f"csplab prove {name} --region {'x'.join(map(str, r))} --order {order} "
+            f"--history {hs} " + (f"--back {btxt} " if btxt else "") + f"--expect-hash {h}",
         }
         if certificate:
             proof["certificate"] = _certificate(
                 example, rules, face_rules, "infallible", stats,
                 {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
-                 "configs": closed},
+                 "back": list(bk), "configs": closed},
             )  # fmt: skip
         return Verdict(
             True,
@@ -606,7 +643,7 @@ def prove_infallible(
     failure["realized"] = False
     if realize:
         prefer = {tuple(c): b for c, b in failure["frame"]}
-        real = _realize(rules, failure, r, axes, prefer, order)
+        real = _realize(rules, failure, r, axes, prefer, order, bk)
         if real is not None:
             failure["realized"] = True
             failure["run"] = real
@@ -852,6 +889,36 @@ def _certificate(
     }
 
 
+def run_certificate(
+    example: ExampleModel | RuleSet,
+    run: Mapping[str, Any],
+    stats: Mapping[str, Any],
+    boundary: Mapping[str, int] | str | None = None,
+) -> dict[str, Any]:
+    """A "fallible" certificate of a failing run of Alg. 3.1 (a witness of
+    :func:`~csplab.analysis.witness.find_failure`), for :mod:`csplab.certcheck`.
+
+    Parameters
+    ----------
+    example : ExampleModel or RuleSet
+    run : mapping
+        ``shape``, ``order`` and ``choices`` of the run.
+    stats : mapping
+        The search's figures (``time_s`` is recorded as the prover's time).
+    boundary : mapping, "auto", "none" or None
+        An example's boundary, as given to the search (a tileset's is its own).
+
+    Returns
+    -------
+    dict
+    """
+    face_rules = face_rules_of(example, boundary)
+    body = dict(run)
+    if face_rules:  # the run's boundary is the certificate's face rules
+        body["boundary"] = "auto"
+    return _certificate(example, Rules.of(example), face_rules, "fallible", stats, {"run": body})
+
+
 def _refute_size(ndim: int) -> tuple[int, ...]:
     return {1: (8,), 2: (5, 4), 3: (3, 2, 2)}.get(ndim, (2,) * ndim)
 
@@ -860,7 +927,11 @@ _R = TypeVar("_R")
 
 
 def _enumerate(
-    rules: Rules, walk: _Walk, budget: int, seen: set[tuple[int, tuple[int, ...]]] | None = None
+    rules: Rules,
+    walk: _Walk,
+    budget: int,
+    seen: set[tuple[int, tuple[int, ...]]] | None = None,
+    deadline: float | None = None,
 ) -> tuple[list[int] | None, int, set[tuple[int, ...]]]:
     """DFS over the frame's labellings; returns (failing labels or None, states, windows).
     ``seen`` (if given) receives the memoised states ``(step, key labels)``."""
@@ -874,7 +945,7 @@ def _enumerate(
         windows.add((*(labels[j] for j in src_q), cat))
         return list(labels) if cat == 0 else None
 
-    fail, states = _dfs(rules, walk, budget, at_last, seen=seen)
+    fail, states = _dfs(rules, walk, budget, at_last, seen=seen, deadline=deadline)
     return fail, states, windows
 
 
@@ -885,6 +956,7 @@ def _dfs(
     found: Callable[[int, int, list[int]], _R | None],
     first: Mapping[int, int] | None = None,
     seen: set[tuple[int, tuple[int, ...]]] | None = None,
+    deadline: float | None = None,
 ) -> tuple[_R | None, int]:
     """Depth-first search over the labellings of ``walk``'s cells in order, memoised on the
     labels later steps still see (``walk.key_at``); raises :class:`_Budget` past ``budget``
@@ -894,7 +966,8 @@ def _dfs(
     labels cell ``i`` may take, ``found(i, cat, labels)`` is what the search returns, if
     not ``None``; the search ends at the last cell. Labels are tried in increasing order,
     ``first[i]`` (if possible) first. Returns what was found (or ``None``) and the number
-    of states visited (``seen``, if given, collects them)."""
+    of states visited (``seen``, if given, collects them). Past ``deadline`` (a
+    ``time.perf_counter()`` value) it raises :class:`_Budget` too."""
     if seen is None:
         seen = set()
     labels: list[int] = []
@@ -906,6 +979,8 @@ def _dfs(
             return None
         seen.add(key)
         if len(seen) > budget:
+            raise _Budget
+        if deadline is not None and not len(seen) & 1023 and time.perf_counter() > deadline:
             raise _Budget
         cat = walk.catalog(rules, i, labels)
         res = found(i, cat, labels)
@@ -978,11 +1053,12 @@ def _alg36_search(
     prefer: Mapping[Coords, int],
     stop: Coords | None,
     max_states: int,
+    back: Coords | None = None,
 ) -> tuple[list[list[Any]] | None, int]:
     cells = _scan_cells(shp, axes)
     if stop is not None:
         cells = cells[: cells.index(stop) + 1]
-    walk = _Walk(shp, cells, r)
+    walk = _Walk(shp, cells, r, None, back)
 
     def dead_end(i: int, cat: int, labels: list[int]) -> list[list[Any]] | None:
         if cat:
@@ -1002,6 +1078,7 @@ def _realize(
     axes: tuple[int, ...],
     prefer: Mapping[Coords, int],
     order: str,
+    back: Coords | None = None,
 ) -> dict[str, Any] | None:
     """A concrete run of Alg. 3.6 failing at the window's point (or earlier), if one exists
     on the window's output or one a little larger at the lower edges."""
@@ -1022,7 +1099,7 @@ def _realize(
         pp = tuple(p[d] + shift[d] for d in range(ndim))
         pref = {tuple(c[d] + shift[d] for d in range(ndim)): b for c, b in prefer.items()}
         try:
-            run, _ = _alg36_search(rules, shp, r, axes, pref, pp, 200_000)
+            run, _ = _alg36_search(rules, shp, r, axes, pref, pp, 200_000, back)
         except _Budget:
             continue
         if run is not None:

@@ -145,11 +145,10 @@ def synthesize(
         raise InputError("--out-partial: a failed continuous run has no partial polygons")
     if args.spacing is not None and not args.spacing > 0:
         raise InputError(f"--spacing must be positive, not {args.spacing}")
-    if dim == 3 and args.lines != "lattice":
-        raise InputError("--lines applies to 2D polygon models (3D planes: lattice only)")
     ground = getattr(args, "ground", "auto")
     if dim == 2 and ground not in ("auto", "none", None):
         raise InputError(f"--ground {ground}: a ground applies to polyhedral models (3D)")
+    lines = "lattice" if dim == 2 and args.lines == "auto" else args.lines
     size = region(args, dim)
     boundary = boundary_label(args, example)
     fmt = polygon_output(args.out, gives=type(example).__name__, args=args)
@@ -159,7 +158,7 @@ def synthesize(
     budget = memory_budget(getattr(args, "memory_limit", None))
     if dim == 2:  # a probe arrangement scaled up; 3D: estimate3 before any arrangement
         need = estimate_peak(example, size, spacing=args.spacing, snap=args.snap,
-                             lines=args.lines)  # fmt: skip
+                             lines=lines)  # fmt: skip
         check_memory(
             need,
             f"{example.name or args.model} --size {'x'.join(map(str, size))}",
@@ -199,9 +198,9 @@ def synthesize(
     if cons is not None:
         settings["constraints"] = ", ".join(cons_summary(cons))
     if dim == 2:
-        settings["lines"] = args.lines
+        settings["lines"] = lines
     try:
-        s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
+        s = run(example, size, lines=lines, constraints=cons, **common, **opts)
     except InputError as e:  # the library names its arguments; the user typed flags
         raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem
@@ -219,6 +218,7 @@ def synthesize(
         from csplab.continuous.space import estimate3
 
         nv, ne, nb = estimate3(csp.lattice, size)
+        settings["planes"] = csp.lattice.planes + (" (auto)" if args.lines == "auto" else "")
         settings["estimate"] = f"~{nv} vertices, ~{ne} edges, ~{nb / 2**20:.0f} MiB"
     lat = csp.lattice
     if s.bounded is not None and args.spacing is None:  # the proxy's lattice: derived too
@@ -367,6 +367,24 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     out = load_model(args.grid)
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
+    bounded = None
+    if isinstance(example, PolyhedralModel) and isinstance(out, PolyhedralModel):
+        from csplab.continuous.bounding import bounding_volumes
+
+        # curved parts: checked through the proxy (on its own lattice, not snapped again)
+        bounded = bounding_volumes(example, args.spacing)
+    snapped = ""
+    if isinstance(example, PolyhedralModel) and bounded is None:  # as synthesis uses it
+        from csplab.continuous.csp3d import as_synthesized
+
+        lat, example = as_synthesized(example, args.spacing, snap=args.snap, planes=args.lines)
+        if lat.snapped:
+            snapped = (f" (snapped onto its planes of spacing {float(lat.spacing):g}, as "
+                       "synthesize does with these settings)")  # fmt: skip
+    elif not isinstance(example, PolyhedralModel) and (
+        args.spacing is not None or args.snap or args.lines != "auto"
+    ):
+        raise InputError("--spacing, --snap and --lines of check apply to polyhedral models")
     ground = getattr(args, "ground", "auto")
     if ground == "auto":
         ground = example.meta.get("ground") if isinstance(example, PolyhedralModel) else None
@@ -375,11 +393,6 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     faces = ground_faces(ground)
     if faces and not isinstance(out, PolyhedralModel):
         raise InputError(f"--ground {ground}: a ground applies to polyhedral models (3D)")
-    bounded = None
-    if isinstance(example, PolyhedralModel) and isinstance(out, PolyhedralModel):
-        from csplab.continuous.bounding import bounding_volumes
-
-        bounded = bounding_volumes(example)  # curved parts: checked through the proxy
     if bounded is not None and isinstance(out, PolyhedralModel):
         from csplab.continuous.boundcheck import bounded_violations
 
@@ -400,7 +413,7 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         print(json.dumps({"violations": len(v), **v.counts(), out.parts: len(out)}))
     else:
         print(f"{len(v)} violations in {args.grid} ({len(out)} {out.parts}, labels "
-              f"{list(out.labels)}) against {example.name or args.model}")  # fmt: skip
+              f"{list(out.labels)}) against {example.name or args.model}{snapped}")  # fmt: skip
         if bounded is not None:
             print(f"  {bounded.describe()}; checked: curved parts are moved and scaled "
                   "originals, each box holds the mapped original, Eq. 4.1 on the proxy")

@@ -42,6 +42,19 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "synthesize --ground (the output's own box stands for its region); default auto: "
         "the example's own",
     )
+    p.add_argument(
+        "--spacing",
+        type=float,
+        help="polyhedral examples: the plane spacing the output was synthesized with (the "
+        "example is compared as synthesize snaps it; default: derived, as synthesize)",
+    )
+    p.add_argument("--snap", action="store_true", help="polyhedral examples: as synthesize --snap")
+    p.add_argument(
+        "--lines",
+        choices=("auto", "lattice", "equal"),
+        default="auto",
+        help="polyhedral examples: as synthesize --lines (how the example's faces were snapped)",
+    )
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
 
@@ -54,6 +67,8 @@ def run(args: argparse.Namespace) -> int:
         from csplab.cli import _continuous
 
         return _continuous.check(args, model)
+    if args.spacing is not None or args.snap or args.lines != "auto":
+        raise InputError("--spacing, --snap and --lines apply to continuous (polyhedral) models")
     grid = load_grid(args.grid, model.ndim, model)
     problem = problem_from_args(args, model, shape=tuple(grid.shape))
     unassigned = int((grid < 0).sum())

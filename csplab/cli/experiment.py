@@ -99,7 +99,10 @@ def _experiment_parser(exp: Any) -> argparse.ArgumentParser:
     h.add_argument(
         "--store", help="SQLite results store (default results/csplab-experiments.sqlite)"
     )
-    h.add_argument("--out", help="report directory (default results/NAME)")
+    h.add_argument(
+        "--out",
+        help=f"report directory (default {exp.default_out or Path('results') / exp.name})",
+    )
     h.add_argument("--report-only", action="store_true", help="run nothing; report the store")
     h.add_argument(
         "--rerun", action="store_true", help="forget this sweep's stored trials and run them again"
@@ -164,7 +167,8 @@ def run(args: argparse.Namespace) -> int:
         check_time_limit(overrides["time_limit"])
     # output paths before the work: the report folder and the store (ResultsStore checks
     # that an existing store is an intact SQLite database when it opens it)
-    check_output_dir(a.out if a.out else Path("results") / exp.name, "--out")
+    check_output_dir(a.out if a.out else Path(exp.default_out or Path("results") / exp.name),
+                     "--out")  # fmt: skip
     store = Path(a.store) if a.store else Path(ex.DEFAULT_STORE)
     if store.is_dir():
         raise InputError(f"--store {store} is a folder, not a file")

@@ -1,4 +1,15 @@
-"""``csplab serve``: the web page (see :mod:`csplab.web`)."""
+"""``csplab serve``: a local web page to see, explore and edit models (pannable world, 3D viewer).
+
+Serve a web page on http://HOST:PORT/ (see :mod:`csplab.web`) to choose a built-in example
+or a model file in the current directory, a solver and its options; pan and zoom an endless
+world (chunks load as the view moves), paint edits that are re-synthesized locally (undo,
+download in any output format), look at 3D results in a three.js viewer, follow long runs
+and see the infallibility verdict, a witness replayed step by step and the UNSAT core of a
+refused edit. Binds 127.0.0.1 unless --host says otherwise; reads only files under the
+current directory. Needs the web extra: pip install 'csplab[web]'.
+
+Exit codes: 0 the server stopped, 2 bad input.
+"""
 
 from __future__ import annotations
 
@@ -6,17 +17,6 @@ import argparse
 import sys
 
 from csplab.errors import InputError
-
-HELP = "a local web page to see, explore and edit models (pannable world, 3D viewer)"
-DESCRIPTION = (
-    "Serve a web page on http://HOST:PORT/ to choose a built-in example or a model file in "
-    "the current directory, a solver and its options; pan and zoom an endless world (chunks "
-    "load as the view moves), paint edits that are re-synthesized locally (undo, download "
-    "in any output format), look at 3D results in a three.js viewer, follow long runs and "
-    "see the infallibility verdict, a witness replayed step by step and the UNSAT core of "
-    "a refused edit. Binds 127.0.0.1 unless --host says otherwise; reads only files under "
-    "the current directory. Needs the web extra: pip install 'csplab[web]'."
-)
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:

@@ -93,11 +93,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument(
         "--lines",
-        choices=("lattice", "equal"),
-        default="lattice",
-        help="continuous models: 'lattice' puts every family's lines through every lattice "
-        "point (exact corners anywhere; sloped families are denser), 'equal' spaces every "
-        "family's lines about one spacing apart (as the 2008 paper)",
+        choices=("auto", "lattice", "equal"),
+        default="auto",
+        help="continuous models: 'lattice' puts every family's lines (planes) through every "
+        "lattice point (exact corners anywhere; sloped families are denser), 'equal' spaces "
+        "every family's lines (planes) about one spacing apart (as the 2008 paper; in 3D "
+        "through the example's faces); 'auto' (default): lattice in 2D, in 3D equal for a "
+        "mesh in real coordinates (derived spacing), lattice for exact ones",
     )
     p.add_argument(
         "--snap",
@@ -241,7 +243,7 @@ def run(args: argparse.Namespace) -> int:
         from csplab.cli import _continuous
 
         return _continuous.synthesize(args, example, _options(args))
-    if args.spacing is not None or args.snap or args.lines != "lattice":
+    if args.spacing is not None or args.snap or args.lines != "auto":
         raise InputError("--spacing, --snap and --lines apply to continuous (polygon) models only")
     _check_grid_memory(args, example)
     problem = problem_from_args(args, example)
@@ -254,10 +256,15 @@ def run(args: argparse.Namespace) -> int:
         raise InputError(f"--out-partial: {args.out} cannot hold unassigned cells")
     fallback = None if solver_complete(args.solver) or args.fallback == "none" else args.fallback
     from csplab import _jit
+    from csplab.engine.sat import free_at_exit
 
     compiling = _jit.compile_seconds()
-    result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
-                   fallback=fallback, **opts)  # fmt: skip
+    free_at_exit()  # the command ends after this solve: the OS frees a large SAT solver
+    try:
+        result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
+                       fallback=fallback, **opts)  # fmt: skip
+    finally:
+        free_at_exit(False)
     compiling = _jit.compile_seconds() - compiling  # numba's one-time cost, not the solve's
     wrote = None
     if out_format is not None and (result.ok or args.out_partial):

@@ -175,23 +175,30 @@ def _one_ray(
     return _first_hits(q, t, lab, start, items, float(lo[0]), float(lo[1]), h, nx, ny, tol)
 
 
-def _solid_angles(p: NDArray[np.float64], tri: NDArray[np.float64]) -> NDArray[np.float64]:
+@njit(cache=True, parallel=True)
+def _solid_angles(
+    p: NDArray[np.float64], tri: NDArray[np.float64]
+) -> NDArray[np.float64]:  # pragma: no cover - compiled
     """Signed solid angles ``(len(p),)`` of the triangles ``tri`` ``(m, 3, 3)`` summed, seen
-    from the points ``p`` (Van Oosterom & Strackee)."""
-    out = np.zeros(len(p))
-    step = max(1, 200_000 // max(1, len(tri)))  # points per chunk: about 2e5 pairs
-    for start in range(0, len(p), step):
-        q = p[start : start + step, None, None, :]
-        r = tri[None, :, :, :] - q  # (P, m, 3, 3)
-        ln = np.linalg.norm(r, axis=3)
-        a, b, c = r[:, :, 0], r[:, :, 1], r[:, :, 2]
-        la, lb, lc = ln[:, :, 0], ln[:, :, 1], ln[:, :, 2]
-        num = np.einsum("pmi,pmi->pm", a, np.cross(b, c))
-        ab = np.einsum("pmi,pmi->pm", a, b)
-        ac = np.einsum("pmi,pmi->pm", a, c)
-        bc = np.einsum("pmi,pmi->pm", b, c)
-        den = la * lb * lc + ab * lc + ac * lb + bc * la
-        out[start : start + step] = 2 * np.arctan2(num, den).sum(axis=1)
+    from the points ``p`` (Van Oosterom & Strackee), one point per thread."""
+    n, m = p.shape[0], tri.shape[0]
+    out = np.zeros(n)
+    for i in prange(n):
+        acc = 0.0
+        for j in range(m):
+            ax, ay, az = tri[j, 0, 0] - p[i, 0], tri[j, 0, 1] - p[i, 1], tri[j, 0, 2] - p[i, 2]
+            bx, by, bz = tri[j, 1, 0] - p[i, 0], tri[j, 1, 1] - p[i, 1], tri[j, 1, 2] - p[i, 2]
+            cx, cy, cz = tri[j, 2, 0] - p[i, 0], tri[j, 2, 1] - p[i, 1], tri[j, 2, 2] - p[i, 2]
+            la = np.sqrt(ax * ax + ay * ay + az * az)
+            lb = np.sqrt(bx * bx + by * by + bz * bz)
+            lc = np.sqrt(cx * cx + cy * cy + cz * cz)
+            num = ax * (by * cz - bz * cy) + ay * (bz * cx - bx * cz) + az * (bx * cy - by * cx)
+            ab = ax * bx + ay * by + az * bz
+            ac = ax * cx + ay * cy + az * cz
+            bc = bx * cx + by * cy + bz * cz
+            den = la * lb * lc + ab * lc + ac * lb + bc * la
+            acc += 2.0 * np.arctan2(num, den)
+        out[i] = acc
     return out
 
 
@@ -213,7 +220,8 @@ def labels_at(
         inside = cand[((points[cand] >= lo) & (points[cand] <= hi)).all(axis=1)]
         if not inside.size:
             continue
-        w = _solid_angles(points[inside], tri) / (4 * np.pi)
+        w = _solid_angles(np.ascontiguousarray(points[inside], dtype=np.float64),
+                          np.ascontiguousarray(tri, dtype=np.float64)) / (4 * np.pi)  # fmt: skip
         lab[inside[w > 0.5]] = b
     return lab
 

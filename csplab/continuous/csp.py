@@ -614,7 +614,7 @@ def continuous_csp(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     constraints: UserConstraints3 | None = None,
     max_memory: int | None = None,
     ground: str | Sequence[str] | None = None,
@@ -641,9 +641,11 @@ def continuous_csp(
     boundary : int or mapping of str to int, default 0
         The label outside the region (0: empty space); in 3D also one per face
         (``{"z-": 1}``).
-    lines : {"lattice", "equal"}, default "lattice"
-        Line spacing per family (2D only,
-        :data:`~csplab.continuous.arrangement.LINES`).
+    lines : {"auto", "lattice", "equal"}, default "auto"
+        Line (plane) spacing per family: in 2D
+        :data:`~csplab.continuous.arrangement.LINES` (``auto``: ``lattice``), in 3D
+        :data:`~csplab.continuous.lattice.PLANES` (``auto``: ``equal`` planes for an
+        example in real coordinates, ``lattice`` for exact ones).
     constraints : UserConstraints3, optional
         User constraints of thesis Sec. 4.6 (3D only).
     max_memory : int, optional
@@ -662,18 +664,17 @@ def continuous_csp(
     Raises
     ------
     InputError
-        When a 3D example gets ``lines`` other than ``"lattice"``, or a 2D one gets user
-        ``constraints`` or a per-face ``boundary``; the CSP classes raise it for a bad
-        size, example or boundary label.
+        When a 2D example gets user ``constraints`` or a per-face ``boundary``; the CSP
+        classes raise it for a bad size, example, ``lines`` or boundary label.
     """
     if isinstance(example, PolyhedralModel):
-        if lines != "lattice":
-            raise InputError("lines applies to 2D polygon models (3D planes: lattice only)")
         return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
                               constraints=constraints, max_memory=max_memory,
-                              ground=ground)  # fmt: skip
+                              ground=ground, planes=lines)  # fmt: skip
     if ground_faces(ground):
         raise InputError("a ground applies to polyhedral models (3D) for now")
+    if lines == "auto":
+        lines = "lattice"
     if constraints:
         raise InputError("polygon models (2D) take no user constraints yet")
     if isinstance(boundary, Mapping):

@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.constraints import Connected
 from csplab.continuous._geom import labels_at
-from csplab.continuous.lattice import Lattice
+from csplab.continuous.lattice import Lattice, face_planes
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.space import Arrangement3, check_budget3
 from csplab.continuous.surface import surface_of
@@ -53,6 +53,7 @@ __all__ = [
     "OPEN",
     "WINDOW",
     "ContinuousCSP3",
+    "as_synthesized",
     "example_signatures3",
     "ground_faces",
     "snapped3",
@@ -131,6 +132,33 @@ def _boundary_faces(boundary: int | Mapping[str, int]) -> dict[str, int]:
 Labeling = tuple[int, ...]
 
 
+def _dense_unique(key: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """``np.unique(key, return_inverse=True)`` of non-negative integers of a small range,
+    without sorting (a table over the range)."""
+    if not key.size:
+        return key.astype(np.int64), np.zeros(0, dtype=np.int64)
+    top = int(key.max()) + 1
+    if key.min() < 0 or top > 4 * key.size + 1024:
+        u, inv = np.unique(key, return_inverse=True)
+        return u.astype(np.int64), inv.reshape(-1).astype(np.int64)
+    present = np.zeros(top, dtype=bool)
+    present[key] = True
+    rank = np.cumsum(present) - 1
+    return np.flatnonzero(present).astype(np.int64), rank[key].astype(np.int64)
+
+
+def _unique_rows(a: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """``np.unique(a, axis=0, return_inverse=True)`` of small non-negative integer rows
+    (compact labels), faster: rows as bytes."""
+    if not len(a) or a.shape[1] == 0 or a.min() < 0 or a.max() > 255:
+        u, inv = np.unique(a, axis=0, return_inverse=True)
+        return u, inv.reshape(-1)
+    b = np.ascontiguousarray(a.astype(np.uint8))
+    v = b.view(np.dtype((np.void, b.shape[1]))).reshape(-1)
+    _, first, inv = np.unique(v, return_index=True, return_inverse=True)
+    return a[first], inv.reshape(-1)
+
+
 def _groups(signs: NDArray[np.int8], fams: NDArray[np.int64]) -> tuple[NDArray[np.int64], int]:
     """Group id of each full cell by its signs on ``fams`` (the local cells there)."""
     if fams.size == 0:
@@ -158,35 +186,58 @@ def _local_labels(
     tris: list[tuple[int, NDArray[np.float64]]],
     index: dict[int, int],
     clamp: tuple[NDArray[np.float64], NDArray[np.float64], Sequence[str]] | None = None,
-) -> list[Labeling]:
-    """Full labelings (over the central cells) of the neighbourhoods at ``points`` whose
-    planes are ``fams_on`` (per point), by point location just off each point (``clamp``:
-    ``(lo, hi, faces)``, points past those faces of the box located just inside it)."""
+) -> NDArray[np.int64]:
+    """Full labelings ``(len(points), cells)`` over the central cells of the neighbourhoods
+    at ``points`` whose planes are ``fams_on`` (per point), by point location just off each
+    point (one query per group of cells; points with the same planes in one batch;
+    ``clamp``: ``(lo, hi, faces)``, points past those faces of the box located just inside
+    it)."""
     signs, dirs = A.cells
+    out = np.zeros((len(points), len(signs)), dtype=np.int64)
+    if not len(points):
+        return out
     eps = 1e-3 / (A.D * float(np.abs(A.normals).sum(axis=1).max()))
-    cache: dict[bytes, tuple[NDArray[np.int64], int, NDArray[np.int64]]] = {}
-    queries, owners = [], []
-    for i, fo in enumerate(fams_on):
-        key = fo.tobytes()
-        if key not in cache:
-            g, ng = _groups(signs, np.flatnonzero(fo))
-            rep = np.array([int(np.flatnonzero(g == k)[0]) for k in range(ng)])
-            cache[key] = (g, ng, rep)
-        g, ng, rep = cache[key]
-        queries.append(points[i] + eps * dirs[rep])
-        owners.append(i)
-    q = np.concatenate(queries) if queries else np.zeros((0, 3))
+    F = fams_on.shape[1]
+    code, inv = _dense_unique(fams_on.astype(np.int64) @ (np.int64(1) << np.arange(F)))
+    keys = (code[:, None] >> np.arange(F)) & 1 > 0
+    batches, queries = [], []
+    for u in range(len(keys)):
+        members = np.flatnonzero(inv == u)
+        g, ng = _groups(signs, np.flatnonzero(keys[u]))
+        rep = np.unique(g, return_index=True)[1]
+        queries.append((points[members][:, None, :] + eps * dirs[rep][None, :, :]).reshape(-1, 3))
+        batches.append((members, g, ng))
+    q = np.concatenate(queries)
     if clamp is not None and clamp[2]:
         q = _clamped(q, *clamp)
     lab = labels_at(q, tris)
-    lab = np.array([index[int(b)] if b else 0 for b in lab], dtype=np.int64)
-    out = []
+    compact = np.zeros(max(index) + 1, dtype=np.int64)
+    for b, i in index.items():
+        compact[b] = i
+    lab = compact[lab]
     pos = 0
-    for fo in fams_on:
-        g, ng, _ = cache[fo.tobytes()]
-        local = lab[pos : pos + ng]
-        pos += ng
-        out.append(tuple(int(x) for x in local[g]))
+    for members, g, ng in batches:
+        local = lab[pos : pos + len(members) * ng].reshape(len(members), ng)
+        pos += len(members) * ng
+        out[members] = local[:, g]
+    return out
+
+
+def _on_faces(
+    A: Arrangement3, vertex: NDArray[np.int64], fams: NDArray[np.bool_],
+    planes: dict[tuple[int, ...], list[int]],
+) -> NDArray[np.bool_]:  # fmt: skip
+    """Which points (on the planes ``fams`` through the arrangement vertex ``vertex``) lie
+    on a plane of an example face (``planes``, :func:`~csplab.continuous.lattice.face_planes`
+    in the arrangement's frame): the only points whose neighbourhood is not one label."""
+    out = np.zeros(len(vertex), dtype=bool)
+    XYZ = np.stack([A.X[vertex], A.Y[vertex], A.Z[vertex]], axis=1)
+    for f, n in enumerate(A.normals.tolist()):
+        ks = planes.get(tuple(n))
+        if ks:
+            sel = fams[:, f] & ~out
+            kk = XYZ[sel] @ A.normals[f] // A.D
+            out[np.flatnonzero(sel)[np.isin(kk, ks)]] = True
     return out
 
 
@@ -196,9 +247,17 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
     (:class:`~csplab.errors.InputError`) when that breaks a solid (flattens it, turns it
     inside out, makes two overlap)."""
     solids = []
+    base = 0
     for sol in example.solids:
-        uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
-        uv, inv = np.unique(uv, axis=0, return_inverse=True)  # vertices that met: one
+        if lattice.moved is not None:  # snapped by planes (the lattice's moved vertices)
+            uv = lattice.moved[base : base + len(sol.vertices)]
+        else:
+            uv = np.rint(lattice.to_lattice(np.asarray(sol.vertices, dtype=np.float64)))
+        base += len(sol.vertices)
+        # vertices that met: one
+        _, first, inv = np.unique(np.round(uv, 9), axis=0, return_index=True,
+                                  return_inverse=True)  # fmt: skip
+        uv = uv[first]
         inv = inv.reshape(-1)
         faces = []
         for f in sol.faces:
@@ -218,6 +277,52 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
             f"{example.source}: snapping onto spacing {float(lattice.spacing):g} breaks it "
             f"({str(e).splitlines()[0]}); pass a smaller --spacing"
         ) from None
+
+
+def as_synthesized(
+    example: PolyhedralModel,
+    spacing: float | None = None,
+    *,
+    snap: bool = False,
+    planes: str = "auto",
+) -> tuple[Lattice, PolyhedralModel]:
+    """The lattice of ``example`` and the example as synthesis uses it: snapped onto the
+    lattice when its vertices are off it (by its planes, :func:`~csplab.continuous.lattice.
+    plane_snap`, or, when moving the planes breaks a solid, by rounding its vertices),
+    else unchanged. What :class:`ContinuousCSP3` synthesizes from and ``csplab check``
+    compares an output with.
+
+    Parameters
+    ----------
+    example : PolyhedralModel
+        The example.
+    spacing : float, optional
+        The plane spacing (default: derived, :meth:`Lattice.of_points`).
+    snap : bool, default False
+        Snap vertices that are off the lattice of ``spacing``.
+    planes : {"auto", "lattice", "equal"}, default "auto"
+        Plane spacing per family (:data:`~csplab.continuous.lattice.PLANES`).
+
+    Returns
+    -------
+    lattice : Lattice
+    example : PolyhedralModel
+        The example on the lattice's planes.
+
+    Raises
+    ------
+    InputError
+        As :meth:`Lattice.of_model`, or when snapping breaks a solid either way.
+    """
+    lat = Lattice.of_model(example, spacing, snap=snap, planes=planes)
+    if lat.snapped and lat.moved is not None:
+        try:
+            return lat, snapped3(example, lat)
+        except InputError:  # moving the planes broke it: round the vertices instead
+            lat = Lattice.of_model(example, spacing, snap=snap, planes=planes, by_planes=False)
+    if lat.snapped:
+        return lat, snapped3(example, lat)
+    return lat, example
 
 
 def example_signatures3(
@@ -247,41 +352,60 @@ def example_signatures3(
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
     shift = 1.0 - lo
     A = Arrangement3(lattice, tuple(int(h - l) + 2 for l, h in zip(lo, hi, strict=True)),
-                     max_memory=max_memory, where=example.source, hint="")  # fmt: skip
+                     max_memory=max_memory, where=example.source, hint="",
+                     shift=tuple(int(x) for x in shift))  # fmt: skip
     tris = [(b, t + shift) for b, t in _triangles(example, lattice, 0.0)]
     box = lattice.to_lattice(pts) + shift
     clamp = (box.min(axis=0), box.max(axis=0), tuple(ground))
     signs, _ = A.cells
     sigs: set[Labeling] = {(b,) * len(signs) for b in (0, *index.values())}
+    # only points on a plane of an example face can see more than one label (the others'
+    # uniform neighbourhoods are the labelings above)
+    pts_, faces_ = example.indexed_faces()
+    planes = face_planes(lattice.to_lattice(pts_) + shift, faces_, lattice.vectors)
     vpos = A.vertex_positions()
-    vert_sigs = _local_labels(A, vpos, A.on, tris, index, clamp)
-    sigs |= set(vert_sigs)
-    efam = A.edge_families()
+    von = _on_faces(A, np.arange(A.n_vertices), A.on, planes)
+    vsel = np.flatnonzero(von)
+    vsigs = _local_labels(A, vpos[vsel], A.on[vsel], tris, index, clamp)
+    sigs |= set(map(tuple, _unique_rows(vsigs)[0].tolist()))
+    efam_all = A.edge_families()
     epos = A.edge_positions()
-    edge_sigs = _local_labels(A, epos, efam, tris, index, clamp)
-    sigs |= set(edge_sigs)
-    tol = 1e-9
-    for pos, found in ((vpos, vert_sigs), (epos, edge_sigs)):
-        inside = ((pos >= clamp[0] - tol) & (pos <= clamp[1] + tol)).all(axis=1)
-        if coverage is not None:  # occurrences inside the example's box
-            for k in np.flatnonzero(inside).tolist():
-                coverage[found[k]] = coverage.get(found[k], 0) + 1
-        for face in ground:
-            if on_ground is None:
-                break
-            a = "xyz".index(face[0])
-            at = clamp[1][a] if face[1] == "+" else clamp[0][a]
-            on = inside & (np.abs(pos[:, a] - at) <= tol)
-            seen = on_ground.setdefault(face, {(0,) * len(signs)})  # bare ground
-            seen.update(found[k] for k in np.flatnonzero(on))
+    eon = _on_faces(A, A.edge_src, efam_all, planes)
+    esel = np.flatnonzero(eon)
+    efam = efam_all[esel]
+    Lall = _local_labels(A, epos[esel], efam, tris, index, clamp)
+    L, which = _unique_rows(Lall)  # few distinct edge labelings
+    sigs |= set(map(tuple, L.tolist()))
+    if coverage is not None or (ground and on_ground is not None):
+        compact = np.zeros(max(index) + 1, dtype=np.int64)
+        for b, i in index.items():
+            compact[b] = i
+        tol = 1e-9
+        for pos, on, found in ((vpos, von, vsigs), (epos, eon, Lall)):
+            inside = ((pos >= clamp[0] - tol) & (pos <= clamp[1] + tol)).all(axis=1)
+            # every point inside the box: its labeling (uniform off the face planes)
+            rows = np.empty((len(pos), len(signs)), dtype=np.int64)
+            rows[on] = found
+            off = np.flatnonzero(inside & ~on)
+            rows[off] = compact[labels_at(pos[off], tris)][:, None]
+            if coverage is not None:  # occurrences inside the example's box
+                u, inv = _unique_rows(rows[inside])
+                counts = np.bincount(inv, minlength=len(u))
+                for r, c in zip(map(tuple, u.tolist()), counts.tolist(), strict=True):
+                    coverage[r] = coverage.get(r, 0) + int(c)
+            for face in ground:
+                if on_ground is None:
+                    break
+                a = "xyz".index(face[0])
+                at = clamp[1][a] if face[1] == "+" else clamp[0][a]
+                at_face = inside & (np.abs(pos[:, a] - at) <= tol)
+                seen = on_ground.setdefault(face, {(0,) * len(signs)})  # bare ground
+                seen.update(map(tuple, _unique_rows(rows[at_face])[0].tolist()))
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
     N = A.normals
-    L = np.array(edge_sigs, dtype=np.int64).reshape(len(edge_sigs), len(signs))
-    L, which = np.unique(L, axis=0, return_inverse=True)  # few distinct edge labelings
-    which = which.reshape(-1)
     fmask = efam.astype(np.int64) @ (1 << np.arange(A.F, dtype=np.int64))
-    combo = np.stack([fmask, A.edge_line], axis=1)
+    combo = np.stack([fmask, A.edge_line[esel]], axis=1)
     uniq, inv = np.unique(combo, axis=0, return_inverse=True)
     inv = inv.reshape(-1)
     for k, (mask, line) in enumerate(uniq.tolist()):
@@ -337,12 +461,11 @@ class ContinuousCSP3:
         constraints: UserConstraints3 | None = None,
         max_memory: int | None = None,
         ground: str | Sequence[str] | None = None,
+        planes: str = "auto",
     ) -> None:
         if not example.solids:
             raise InputError(f"{example.source}: an example needs at least one solid")
-        self.lattice = Lattice.of_model(example, spacing, snap=snap)
-        if self.lattice.snapped:
-            example = snapped3(example, self.lattice)
+        self.lattice, example = as_synthesized(example, spacing, snap=snap, planes=planes)
         #: the example as synthesized (its vertices snapped onto the lattice when they were not
         #: on it; the checker compares the output with this)
         self.example = example
@@ -471,7 +594,7 @@ class ContinuousCSP3:
         vside = A.on_side()
         vmask = A.on.astype(np.int64) @ (1 << np.arange(F, dtype=np.int64))
         vkeys, vtype = np.unique((vmask << 6) | vside, return_inverse=True)
-        vtype = vtype.reshape(-1)
+        vtype = vtype.reshape(-1).astype(np.int64)
         self.vertex_type = vtype
         self.vtypes: list[tuple[NDArray[np.int64], list[Labeling], NDArray[np.int64]]] = []
         self.vertex_outside: list[NDArray[np.int64]] = []
@@ -514,6 +637,27 @@ class ContinuousCSP3:
         rels: list[NDArray[np.bool_]] = []
         memo: dict[tuple[int, int, int, int], int] = {}
 
+        bits: dict[int, tuple[NDArray[np.int64], NDArray[np.int64]]] = {}
+        states: dict[tuple[str, int], NDArray[np.int64]] = {}
+
+        def packed(t: int) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+            """The signs of vertex type ``t``'s planes packed in an integer per cell, and
+            the first cell of each packed value (a lookup table)."""
+            if t not in bits:
+                vf = self.vtypes[t][0]
+                w = np.int64(1) << np.arange(len(vf), dtype=np.int64)
+                key = (signs[:, vf] > 0).astype(np.int64) @ w
+                first = np.full(1 << len(vf), -1, dtype=np.int64)
+                first[key[::-1]] = np.arange(len(signs))[::-1]
+                bits[t] = (w, first)
+            return bits[t]
+
+        def table(kind: str, t: int) -> NDArray[np.int64]:
+            if (kind, t) not in states:
+                st = (self.vtypes if kind == "v" else self.etypes)[t][1]
+                states[kind, t] = np.array(st, dtype=np.int64).reshape(len(st), -1)
+            return states[kind, t]
+
         def relation(t: int, line: int, sgn: int, et: int) -> int:
             k = (t, line, sgn, et)
             if k in memo:
@@ -524,21 +668,23 @@ class ContinuousCSP3:
             sr = np.sign(N @ r)
             # the full cell just off the edge in direction r: signs of the planes through
             # the vertex but not the edge from r, the edge's own planes free
-            target = {}
-            for c in range(len(signs)):
-                want = signs[c].copy()
-                away = [f for f in vf if sr[f] != 0]
-                want[away] = sr[away]
-                match = np.flatnonzero((signs[:, vf] == want[vf]).all(axis=1))
-                target[int(eg[c])] = int(vg[match[0]])
-            eidx = {st: i for i, st in enumerate(est)}
-            M = np.zeros((K, K), dtype=bool)
+            want = signs[:, vf].copy()
+            away = sr[vf] != 0
+            want[:, away] = sr[vf][away]
+            w, first = packed(t)
+            match = first[(want > 0).astype(np.int64) @ w]
             ne_groups = len(est[0]) if est else 0
-            for i, st in enumerate(vst):
-                induced = tuple(st[target[j]] for j in range(ne_groups))
-                jj = eidx.get(induced)
-                if jj is not None:
-                    M[i, jj] = True
+            target = np.zeros(ne_groups, dtype=np.int64)
+            target[eg] = vg[match]
+            M = np.zeros((K, K), dtype=bool)
+            if ne_groups and len(vst):
+                induced = table("v", t)[:, target]
+                E = table("e", et)
+                eidx = {row.tobytes(): i for i, row in enumerate(E)}
+                for i, row in enumerate(induced):
+                    jj = eidx.get(row.tobytes())
+                    if jj is not None:
+                        M[i, jj] = True
             kb = M.tobytes()
             if kb not in rel_ids:
                 rel_ids[kb] = len(rels)
@@ -556,11 +702,9 @@ class ContinuousCSP3:
         nst = max(len(t[1]) for t in (*self.vtypes, *self.etypes))
         K = self.K = nst
         nv, ne = A.n_vertices, A.n_edges
-        dom = np.zeros((nv + ne, K), dtype=bool)
-        vn = np.array([len(t[1]) for t in self.vtypes])
-        en = np.array([len(t[1]) for t in self.etypes])
-        dom[:nv] = np.arange(K)[None, :] < vn[vtype][:, None]
-        dom[nv:] = np.arange(K)[None, :] < en[etype][:, None]
+        vn = np.array([len(t[1]) for t in self.vtypes], dtype=np.int64)
+        en = np.array([len(t[1]) for t in self.etypes], dtype=np.int64)
+        nvals = np.concatenate([vn[vtype], en[etype]])  # values of each variable
         # relations per (vertex type, ray, edge type)
         relation, rels = self._relation_maker(K)
         pos = np.concatenate([A.vertex_positions(), A.edge_positions()])
@@ -572,20 +716,22 @@ class ContinuousCSP3:
         for end, sgn, k in ((A.edge_src, 1, 0), (A.edge_dst, -1, 1)):
             nl, nt = len(A.lines), len(self.etypes)
             key = (vtype[end].astype(np.int64) * nl + A.edge_line) * nt + etype
-            uniq, inv = np.unique(key, return_inverse=True)
+            uniq, inv = _dense_unique(key)
             rid = np.array([relation(int(c // (nl * nt)), int(c // nt % nl), sgn, int(c % nt))
                             for c in uniq.tolist()], dtype=np.int64)  # fmt: skip
             arcs[k::2, 0] = var[end]
             arcs[k::2, 1] = var[nv:]
             arcs[k::2, 2] = rid[inv.reshape(-1)]
         # relations numbered by first use along the arcs (edge by edge, as always)
-        _, first = np.unique(arcs[:, 2], return_index=True)
-        order_used = np.unique(arcs[:, 2])[np.argsort(first)]
+        first = np.full(len(rels), len(arcs), dtype=np.int64)
+        first[arcs[::-1, 2]] = np.arange(len(arcs) - 1, -1, -1)  # the first use wins
+        used_ids = np.flatnonzero(first < len(arcs))
+        order_used = used_ids[np.argsort(first[used_ids], kind="stable")]
         renum = np.full(len(rels), -1, dtype=np.int64)
         renum[order_used] = np.arange(len(order_used))
         used = [rels[i] for i in order_used.tolist()]
         arcs[:, 2] = renum[arcs[:, 2]]
-        dom = dom[order]  # (the unordered copy is freed before the problem copies it)
+        dom = np.arange(K)[None, :] < nvals[order][:, None]
         # the weighted choice: one weight class per vertex and edge type
         table = np.zeros((len(self.state_weights), K), dtype=np.float64)
         for t, w in enumerate(self.state_weights):
@@ -688,7 +834,7 @@ class ContinuousCSP3:
             (A.vertex_positions(), A.on, self.vertex_type, self.vtypes, self.var_vertex),
             (A.edge_positions(), A.edge_families(), self.edge_type, self.etypes, self.var_edge),
         ):
-            labs = _local_labels(A, pts, fams_on, tris, index, clamp)
+            labs = _local_labels(A, pts, fams_on, tris, index, clamp).tolist()
             for i, full in enumerate(labs):
                 _, st, g = tlist[int(types[i])]
                 ng = int(g.max()) + 1

@@ -28,7 +28,7 @@ from __future__ import annotations
 import itertools
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import TYPE_CHECKING, Protocol
 
@@ -43,13 +43,23 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DIVISIONS",
+    "FIT_DEG",
+    "FIT_DEGS",
+    "MAX_DENOMINATOR",
     "MAX_FAMILIES",
     "MAX_FAMILIES3",
+    "MERGE_DEG",
+    "PLANES",
     "Lattice",
     "PlaneArrangement",
+    "denominator",
     "derived_spacing",
+    "equal_steps",
+    "face_planes",
     "family_vectors",
     "gcd_fractions",
+    "integer_normal",
+    "plane_snap",
     "primitive3",
     "rational",
 ]
@@ -68,6 +78,24 @@ _SNAP_TOL = 1e-6  # a vertex is on the lattice if within this many spacings
 _AXES3 = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
 #: a derived spacing divides the example's thinnest side into at least this many spacings
 DIVISIONS = 4
+#: degrees: face normals of an example in real coordinates closer than this are one plane
+#: family (near-parallel normals merged; CAD exports differ in the 4th-6th decimal)
+MERGE_DEG = 1.0
+#: degrees: a family's normal is snapped to the smallest integer vector this close
+FIT_DEG = 2.0
+#: the tolerances tried in turn (:func:`plane_snap`) until the families' planes meet at
+#: points of denominator at most :data:`MAX_DENOMINATOR`
+FIT_DEGS = (FIT_DEG, 3.0, 4.0, 6.0, 8.0, 12.0)
+#: the largest common denominator of the points where three planes meet that snapping by
+#: planes accepts (exact coordinates stay small; fine denominators make dense arrangements)
+MAX_DENOMINATOR = 1000
+#: how the planes of a 3D family are spaced: ``lattice`` (``n . x = k`` for every integer
+#: ``k``: a family of normal ``n`` has ``|n|`` planes per spacing), ``equal`` (every
+#: family's planes about one spacing apart, the 2008 paper's Sec. 3.2 "we choose to space
+#: all the lines identically", through the example's own faces: :func:`equal_steps`), or
+#: ``auto`` (``equal`` for an example from real coordinates, whose spacing is derived;
+#: ``lattice`` for exact ones, the built-in examples)
+PLANES = ("auto", "lattice", "equal")
 
 
 def derived_spacing(points: NDArray[np.float64]) -> float:
@@ -217,6 +245,277 @@ def family_vectors(
     return tuple(sorted(normals))
 
 
+def face_planes(
+    points: NDArray[np.float64],
+    faces: Sequence[Sequence[int]],
+    vectors: Sequence[Sequence[int]],
+) -> dict[tuple[int, ...], list[int]]:
+    """The planes of the polygons ``faces`` of an example in lattice units ``points`` (3D)
+    whose faces lie on planes of the families ``vectors``: per family normal ``n``, the
+    sorted distinct integers ``k`` of their planes ``n . x = k`` (each polygon's family is
+    the one nearest its Newell normal).
+
+    >>> face_planes(np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0], [0, 0, 2]]),
+    ...             [[0, 2, 1], [1, 2, 3]], [(0, 0, 1), (1, 1, 1)])
+    {(0, 0, 1): [0], (1, 1, 1): [2]}
+    """
+    V = np.array(vectors, dtype=np.float64).reshape(-1, 3)
+    unit = V / np.linalg.norm(V, axis=1, keepdims=True)
+    ks: dict[tuple[int, ...], set[int]] = {tuple(int(x) for x in v): set() for v in vectors}
+    pts = np.asarray(points, dtype=np.float64)
+    for poly in faces:
+        q = pts[list(poly)]
+        n = _newell(q)
+        if not np.linalg.norm(n) > 0 or not len(V):
+            continue
+        f = int(np.argmax(np.abs(unit @ n)))
+        ks[tuple(int(x) for x in vectors[f])].add(round(float(V[f] @ q.mean(axis=0))))
+    return {p: sorted(k) for p, k in sorted(ks.items()) if k}
+
+
+def _newell(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The Newell normal of a polygon (twice its area vector), in floats."""
+    q = q - q.mean(axis=0)
+    nxt = np.roll(q, -1, axis=0)
+    return np.array([((q[:, 1] - nxt[:, 1]) * (q[:, 2] + nxt[:, 2])).sum(),
+                     ((q[:, 2] - nxt[:, 2]) * (q[:, 0] + nxt[:, 0])).sum(),
+                     ((q[:, 0] - nxt[:, 0]) * (q[:, 1] + nxt[:, 1])).sum()])  # fmt: skip
+
+
+def _angle(a: NDArray[np.float64], b: NDArray[np.float64]) -> float:
+    """The angle (degrees) between two lines of directions ``a`` and ``b``."""
+    c = abs(float(a @ b)) / (float(np.linalg.norm(a)) * float(np.linalg.norm(b)))
+    return math.degrees(math.acos(min(1.0, c)))
+
+
+def denominator(vectors: Sequence[Sequence[int]]) -> int:
+    """The least common multiple of ``|det|`` over every three independent integer
+    normals: the points where three planes ``n . x = k`` (integer ``k``) meet have
+    coordinates that are integers divided by it.
+
+    >>> denominator([(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 1), (0, 1, 2)])
+    2
+    """
+    V = [tuple(int(x) for x in v) for v in vectors]
+    out = 1
+    for a, b, c in itertools.combinations(V, 3):
+        det = (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+               + a[2] * (b[0] * c[1] - b[1] * c[0]))  # fmt: skip
+        if det:
+            out = out * abs(det) // math.gcd(out, abs(det))
+    return out
+
+
+def integer_normal(u: Sequence[float], tol: float = FIT_DEG) -> tuple[int, int, int]:
+    """The primitive integer vector of smallest entries within ``tol`` degrees of the
+    direction ``u`` (the family normal that a face of normal ``u`` is snapped to).
+
+    >>> integer_normal([0.956, 0.292, 0.0])      # 17 degrees: (3, 1, 0) is 1.4 off
+    (3, 1, 0)
+    >>> integer_normal([0.0, -0.928, 0.371])
+    (0, 5, -2)
+    """
+    v = np.asarray(u, dtype=np.float64)
+    m = float(np.abs(v).max())
+    best = v
+    for c in range(1, 257):
+        w = np.rint(c * v / m)
+        if w.any() and _angle(w, v) <= tol:
+            best = w
+            break
+        best = w
+    return primitive3([int(x) for x in best])
+
+
+def plane_snap(
+    u: NDArray[np.float64], faces: Sequence[Sequence[int]], equal: bool
+) -> tuple[NDArray[np.float64], tuple[tuple[int, int, int], ...], tuple[int, ...],
+           tuple[int, ...], float] | None:  # fmt: skip
+    """Snap an example given in lattice units ``u`` (floats) by its planes, not its
+    vertices: face normals within :data:`MERGE_DEG` are one family (near-parallel normals
+    merged), each family's normal becomes a small integer vector within :data:`FIT_DEG`
+    (:func:`integer_normal`; a larger tolerance of :data:`FIT_DEGS` when the planes of
+    those would meet at points of denominator over :data:`MAX_DENOMINATOR`), each face's
+    plane ``n . x = k`` moves to the nearest plane of its family (every integer ``k``, or
+    with ``equal`` the planes ``step`` apart, ``step`` the integer nearest ``|n|``, offset
+    to fit the faces best), and each vertex to the nearest point on the planes of its
+    faces.
+
+    A vertex of more than three families (the apex of a pyramid, thesis Sec. 4.5.8) is
+    pinned to its nearest lattice point and its faces' planes pass through it: planes of
+    integer ``k`` meet at every lattice point, so such vertices exist in the arrangement
+    (with ``equal`` planes, each family's step divides the differences of its pinned
+    planes, so the periodic planes keep them).
+
+    Returns ``(moved vertices, family normals, steps, residues, largest normal change in
+    degrees)``, or ``None`` when some vertex's planes still do not meet at one point (a
+    face between two pinned vertices that put it on different planes): the caller then
+    rounds the vertices onto the lattice instead.
+    """
+    polys = [list(p) for p in faces]
+    normals, areas = [], []
+    for p in polys:
+        n = _newell(u[p])
+        normals.append(n)
+        areas.append(float(np.linalg.norm(n)))
+    generic = np.array([0.5773, 0.5774, 0.5775])
+    reps: list[NDArray[np.float64]] = []
+    cluster = [-1] * len(polys)
+    for i in sorted(range(len(polys)), key=lambda i: -areas[i]):
+        if areas[i] <= 0:
+            continue
+        n = normals[i] / areas[i]
+        if n @ generic < 0:
+            n = -n
+        for c, r in enumerate(reps):
+            if _angle(r, n) <= MERGE_DEG:
+                cluster[i] = c
+                reps[c] = reps[c] + n * areas[i]
+                break
+        else:
+            cluster[i] = len(reps)
+            reps.append(n * areas[i])
+    # the smallest tolerance whose integer normals meet at points of a small common
+    # denominator (thesis Sec. 4.5.8's second option: "modify the normals just enough so
+    # that the shapes better fit on a lattice"); the change is reported
+    for tol in FIT_DEGS:
+        fam_of = [integer_normal((r / np.linalg.norm(r)).tolist(), tol) for r in reps]
+        vectors = tuple(sorted(set(fam_of)))
+        if denominator([*vectors, *(a for a in _AXES3 if a not in vectors)]) <= MAX_DENOMINATOR:
+            break
+    if not reps:
+        return None
+    N = {v: np.array(v, dtype=np.float64) for v in vectors}
+    # each face's plane, and the grid of its family
+    kreal: dict[tuple[int, int, int], list[tuple[int, float]]] = {v: [] for v in vectors}
+    turned = 0.0
+    for i, p in enumerate(polys):
+        if cluster[i] < 0:
+            continue
+        v = fam_of[cluster[i]]
+        kreal[v].append((i, float(N[v] @ u[p].mean(axis=0))))
+        turned = max(turned, _angle(N[v], normals[i]))
+    # Sec. 4.5.8: a vertex of more than three families is pinned to its nearest lattice
+    # point, where planes of every family with integer k meet; its faces' planes go
+    # through it (a face between two pinned vertices that disagree: None)
+    fam_i = {i: fam_of[c] for i, c in enumerate(cluster) if c >= 0}
+    vfams: list[set[tuple[int, int, int]]] = [set() for _ in range(len(u))]
+    for i, p in enumerate(polys):
+        if i in fam_i:
+            for j in p:
+                vfams[j].add(fam_i[i])
+    pinned = {j: np.rint(u[j]) for j, fs in enumerate(vfams) if len(fs) > 3}
+    fixed: dict[int, int] = {}
+    for i, p in enumerate(polys):
+        if i not in fam_i:
+            continue
+        for j in p:
+            if j in pinned:
+                k = round(float(N[fam_i[i]] @ pinned[j]))
+                if fixed.setdefault(i, k) != k:
+                    return None
+    steps: list[int] = []
+    residues: list[int] = []
+    face_k: dict[int, tuple[tuple[int, int, int], int]] = {}
+    for v in vectors:
+        kv = np.array([kr for _, kr in kreal[v]], dtype=np.float64)
+        pins = sorted({fixed[i] for i, _ in kreal[v] if i in fixed})
+        if equal:
+            period = 0
+            for x in pins:
+                period = math.gcd(period, x - pins[0])
+            st = _step_near(float(np.linalg.norm(N[v])), period)
+        else:
+            st = 1
+
+        def err(res: int, kv: NDArray[np.float64] = kv, st: int = st) -> float:
+            return float(np.abs(kv - (np.rint((kv - res) / st) * st + res)).max())
+
+        res = pins[0] % st if pins else min(range(st), key=err)
+        steps.append(st)
+        residues.append(res)
+        for i, kr in kreal[v]:
+            face_k[i] = (v, fixed[i] if i in fixed else round((kr - res) / st) * st + res)
+    # each vertex: the nearest point on its faces' planes
+    rows: list[list[tuple[tuple[int, int, int], int]]] = [[] for _ in range(len(u))]
+    for i, p in enumerate(polys):
+        if i in face_k:
+            for j in p:
+                if face_k[i] not in rows[j]:
+                    rows[j].append(face_k[i])
+    moved = u.astype(np.float64).copy()
+    for j, row in enumerate(rows):
+        if not row:
+            continue
+        A = np.array([N[v] for v, _ in row])
+        kk = np.array([float(x) for _, x in row])
+        x = u[j] + np.linalg.pinv(A) @ (kk - A @ u[j])
+        if np.abs(A @ x - kk).max() > 1e-7 * max(1.0, float(np.abs(kk).max())):
+            return None  # Sec. 4.5.8: these planes do not meet at one point
+        moved[j] = x
+    return moved, vectors, tuple(steps), tuple(residues), turned
+
+
+def _step_near(target: float, period: int) -> int:
+    """The divisor of ``period`` (any positive integer when ``period`` is 0) nearest to
+    ``target`` in ratio, at least 1."""
+    if period == 0:
+        return max(1, round(target))
+    divs = [d for d in range(1, math.isqrt(period) + 1) if period % d == 0]
+    divs += [period // d for d in divs]
+    return min(divs, key=lambda d: (abs(math.log(d / target)), d))
+
+
+def equal_steps(
+    ip: NDArray[np.int64], faces: Sequence[Sequence[int]], vectors: Sequence[Sequence[int]]
+) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """Equal plane spacing per family (3D): the planes of family ``n`` are ``n . x = k``
+    for the ``k`` with ``k % step == residue``, so ``step / |n|`` spacings apart.
+
+    ``step`` is the integer nearest to ``|n|`` (planes one spacing apart, as the 2008 paper
+    spaces its lines) among those that put every face of the example of that family on a
+    plane: the divisors of the gcd of the differences of their ``k`` (any step for a
+    family of one plane); ``residue`` is their ``k`` modulo ``step``. Since every example
+    vertex is a lattice point on the planes of all its faces, the example's vertices where
+    four or more planes meet (the pyramid apex, thesis Sec. 4.5.8) are vertices of the
+    arrangement, and so is every point of the region congruent to one (the families'
+    planes are periodic): Eq. 4.25 holds by construction, without solving for spacings.
+
+    Parameters
+    ----------
+    ip : int array ``(n, 3)``
+        The example's vertices as lattice points.
+    faces : sequence of sequence of int
+        Its polygons (vertex indices).
+    vectors : sequence of (int, int, int)
+        The families (:func:`family_vectors`).
+
+    Returns
+    -------
+    steps, residues : tuple of int
+        Per family of ``vectors``.
+
+    Examples
+    --------
+    >>> ip = np.array([[0, 0, 0], [4, 0, 0], [0, 4, 0], [0, 0, 4]])
+    >>> faces = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]]
+    >>> equal_steps(ip, faces, family_vectors(ip, faces))   # (1, 1, 1): 4 = 2 * 2
+    ((1, 1, 1, 2), (0, 0, 0, 0))
+    """
+    ks: dict[tuple[int, ...], list[int]] = {tuple(v): [] for v in vectors}
+    ks |= face_planes(ip.astype(np.float64), faces, vectors)
+    steps, residues = [], []
+    for v in vectors:
+        k = ks[tuple(v)]
+        period = 0
+        for x in k:
+            period = math.gcd(period, x - k[0])
+        st = _step_near(float(np.linalg.norm(v)), period)
+        steps.append(st)
+        residues.append(k[0] % st if k else 0)
+    return tuple(steps), tuple(residues)
+
+
 def _exact(pts: NDArray[np.float64], limit: int) -> bool:
     """Whether every coordinate is a rational of denominator at most 10^6 and their common
     unit spans the example in at most ``limit`` steps."""
@@ -261,6 +560,15 @@ class Lattice:
         The largest angle (degrees) by which snapping turned a face (3D).
     derived : bool, default False
         Whether the spacing is :func:`derived_spacing` (the example had no exact unit).
+    steps, residues : tuple of int, default ()
+        3D: per family of ``vectors``, its planes are ``n . x = k`` for the ``k`` with
+        ``k % step == residue`` (:func:`equal_steps`); empty: every integer ``k``
+        (``lattice`` planes).
+    moved : float array ``(n, 3)``, optional
+        3D, snapped by planes (:func:`plane_snap`): the example's vertices (in the order
+        of :meth:`~csplab.continuous.polyhedra.PolyhedralModel.indexed_faces`) moved onto
+        their faces' planes, in lattice units; ``None``: snapping rounds them onto lattice
+        points.
     """
 
     origin: tuple[Fraction, ...]
@@ -269,6 +577,28 @@ class Lattice:
     snapped: float = 0.0
     normal_change: float = 0.0
     derived: bool = False
+    steps: tuple[int, ...] = ()
+    residues: tuple[int, ...] = ()
+    moved: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def planes(self) -> str:
+        """How the planes of a family are spaced: ``equal`` or ``lattice`` (:data:`PLANES`)."""
+        return "equal" if self.steps else "lattice"
+
+    def plane_steps(self) -> tuple[tuple[int, ...], tuple[int, ...]]:
+        """Step and residue of every family of :meth:`families`.
+
+        Returns
+        -------
+        steps, residues : tuple of int
+            Per family, its planes are ``n . x = k`` with ``k % step == residue`` (1 and 0
+            for the lattice planes and for the added axis families).
+        """
+        fams, _ = self.families()
+        st = dict(zip(self.vectors, self.steps, strict=True)) if self.steps else {}
+        rs = dict(zip(self.vectors, self.residues, strict=True)) if self.steps else {}
+        return (tuple(st.get(v, 1) for v in fams), tuple(rs.get(v, 0) for v in fams))
 
     @property
     def ndim(self) -> int:
@@ -295,6 +625,8 @@ class Lattice:
         snap: bool = False,
         max_extent: int | None = None,
         where: str = "<model>",
+        planes: str = "auto",
+        by_planes: bool = True,
     ) -> Lattice:
         """The lattice of an example given as points and faces, in 2D or 3D.
 
@@ -318,6 +650,14 @@ class Lattice:
             dimension.
         where : str, default "<model>"
             What the example is called in error messages.
+        planes : {"auto", "lattice", "equal"}, default "auto"
+            3D: how each family's planes are spaced (:data:`PLANES`; ``auto`` is ``equal``
+            when the spacing is derived, the example being in real coordinates).
+        by_planes : bool, default True
+            3D: snap vertices that are off the lattice by their faces' planes
+            (:func:`plane_snap`: near-parallel normals merged, small integer normals) when
+            those meet at every vertex; otherwise (or ``False``) round them onto lattice
+            points.
 
         Returns
         -------
@@ -329,10 +669,12 @@ class Lattice:
         InputError
             When ``spacing`` is not a positive number, a vertex has no exact rational form
             (without ``spacing``), the example has no extent, a vertex is off the lattice
-            without ``snap``, the example spans more than ``max_extent`` spacings, or it has
+            without ``snap``, the example spans more than ``max_extent`` spacings, it has
             more families than are supported (:data:`MAX_FAMILIES`,
-            :data:`MAX_FAMILIES3`).
+            :data:`MAX_FAMILIES3`), or ``planes`` is not one of :data:`PLANES`.
         """
+        if planes not in PLANES:
+            raise InputError(f"planes must be one of {', '.join(PLANES)}, not {planes!r}")
         d = int(np.shape(points)[1])
         pts = np.asarray(points, dtype=np.float64).reshape(-1, d)
         lo = pts.min(axis=0)
@@ -381,9 +723,22 @@ class Lattice:
                 f"{where}: the example spans {ext} spacings of {float(s):g} (more than "
                 f"{limit}); pass a larger spacing (with snap=true if vertices are off it)"
             )
+        equal = d == 3 and (planes == "equal" or (planes == "auto" and derived))
+        if d == 3 and snap and by_planes and off > _SNAP_TOL:
+            ps = plane_snap(u, faces, equal)
+            if ps is not None:
+                moved, pvec, st, rs, pturn = ps
+                if len(set(pvec) | set(_AXES3)) <= MAX_FAMILIES3:
+                    move = float(np.linalg.norm(moved - u, axis=1).max())
+                    return cls(origin, s, pvec, move, pturn, derived,
+                               st if equal else (), rs if equal else (), moved)  # fmt: skip
         vectors = family_vectors(iu.astype(np.int64), faces, where)
         turned = _normal_change(pts, iu.astype(np.int64), faces) if snap and d == 3 else 0.0
-        return cls(origin, s, vectors, off if snap else 0.0, turned, derived)
+        steps: tuple[int, ...] = ()
+        residues: tuple[int, ...] = ()
+        if equal:
+            steps, residues = equal_steps(iu.astype(np.int64), faces, vectors)
+        return cls(origin, s, vectors, off if snap else 0.0, turned, derived, steps, residues)
 
     @classmethod
     def of(
@@ -437,6 +792,8 @@ class Lattice:
         spacing: float | None = None,
         *,
         snap: bool = False,
+        planes: str = "auto",
+        by_planes: bool = True,
     ) -> Lattice:
         """The lattice of a polygon or polyhedral model.
 
@@ -451,6 +808,10 @@ class Lattice:
             The spacing; default: derived, as in :meth:`of_points`.
         snap : bool, default False
             Round vertices that are off the lattice of ``spacing`` onto it.
+        planes : {"auto", "lattice", "equal"}, default "auto"
+            3D plane spacing per family (:data:`PLANES`).
+        by_planes : bool, default True
+            3D: snap by the faces' planes where they meet (:meth:`of_points`).
 
         Returns
         -------
@@ -464,7 +825,8 @@ class Lattice:
             ``snap``, an example too large or with too many families.
         """
         pts, faces = example.indexed_faces()
-        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source)
+        return cls.of_points(pts, faces, spacing, snap=snap, where=example.source, planes=planes,
+                             by_planes=by_planes)
 
     def to_lattice(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """World coordinates to lattice coordinates.

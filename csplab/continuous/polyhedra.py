@@ -592,17 +592,61 @@ def _triangulate(
         loc = np.asarray(_earcut().triangulate_float64(flat2, ring), dtype=np.int64)
         if len(loc) != 3 * (len(ids) - 2):
             raise InputError(f"{where}: face {j} cannot be triangulated (not a simple polygon)")
-        tris.append(ids[loc.reshape(-1, 3)])
+        tris.append(ids[_without_slivers(flat2, loc.reshape(-1, 3), scale)])
         owner.append(np.full(len(ids) - 2, j, dtype=np.int64))
     T = np.concatenate(tris)
     own = np.concatenate(owner)
     order = np.argsort(own, kind="stable")
     T, own = T[order], own[order]
-    # earcut's winding in the (e1, e2) plane may be either: match each face's normal
+    # earcut's winding in the (e1, e2) plane may be either, but is one per polygon: match
+    # each polygon's normal by the sum over its triangles (a sliver triangle of collinear
+    # points on a slanted face has a sign of rounding noise; alone it was flipped wrongly)
     ta, tb, tc = v[T[:, 0]], v[T[:, 1]], v[T[:, 2]]
-    flip = (np.cross(tb - ta, tc - ta) * normals[own]).sum(axis=1) < 0
+    dots = (np.cross(tb - ta, tc - ta) * normals[own]).sum(axis=1)
+    flip = (np.bincount(own, weights=dots, minlength=len(polys)) < 0)[own]
     T[flip] = T[flip][:, ::-1]
     return T, own
+
+
+def _without_slivers(
+    xy: NDArray[np.float64], tri: NDArray[np.int64], scale: float
+) -> NDArray[np.int64]:
+    """A polygon's triangulation ``tri`` (indices into its 2D points ``xy``) with every
+    zero-area triangle removed by an edge flip: earcut takes three nearly collinear
+    vertices of a slanted face (float coordinates) as an ear; its long side is a diagonal
+    shared with one other triangle, and the two become two proper triangles through the
+    middle vertex. Orientation follows the polygon's."""
+    t = tri.copy()
+
+    def area(a: int, b: int, c: int) -> float:
+        (ax, ay), (bx, by), (cx, cy) = xy[a], xy[b], xy[c]
+        return float((bx - ax) * (cy - ay) - (by - ay) * (cx - ax))
+
+    tol = 1e-9 * scale * scale
+    areas = np.array([area(*map(int, r)) for r in t])
+    sign = 1.0 if areas.sum() >= 0 else -1.0
+    for _ in range(4 * len(t)):
+        bad = [i for i in range(len(t)) if abs(area(*map(int, t[i]))) <= tol]
+        if not bad:
+            break
+        i = bad[0]
+        a, b, c = (int(x) for x in t[i])
+        # the middle vertex m of the three (on the segment between the other two, p and q)
+        pts = {v: xy[v] for v in (a, b, c)}
+        d = max(((u, w) for u in (a, b, c) for w in (a, b, c) if u < w),
+                key=lambda uw: float(np.hypot(*(pts[uw[0]] - pts[uw[1]]))))  # fmt: skip
+        p, q = d
+        m = ({a, b, c} - {p, q}).pop()
+        other = [k for k in range(len(t)) if k != i and p in t[k] and q in t[k]]
+        if not other:
+            break  # pragma: no cover - a degenerate triangle on the boundary: left as is
+        k = other[0]
+        r = ({int(x) for x in t[k]} - {p, q}).pop()
+        new = []
+        for tr in ((p, m, r), (m, q, r)):
+            new.append(tr if area(*tr) * sign > 0 else (tr[0], tr[2], tr[1]))
+        t[i], t[k] = new
+    return t
 
 
 def _check_edges(faces: NDArray[np.int64], owner: NDArray[np.int64], where: str) -> None:

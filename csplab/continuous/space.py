@@ -63,6 +63,7 @@ __all__ = [
     "check_budget3",
     "estimate3",
     "plane_counts",
+    "plane_ks",
     "primitive3",
 ]
 
@@ -177,16 +178,34 @@ def _gib(b: float) -> str:
     return f"{b / 2**30:.1f} GiB" if b >= 2**29 else f"{b / 2**20:.0f} MiB"
 
 
-def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
-    """Planes of each family (:meth:`Lattice.families` order) in the box ``size``: every
-    integer ``k`` with ``n . x = k`` meeting the box, two for a boundary-only family."""
+def plane_ks(
+    lattice: Lattice, size: Sequence[int], shift: Sequence[int] = (0, 0, 0)
+) -> list[NDArray[np.int64]]:
+    """The planes ``n . x = k`` of each family (:meth:`Lattice.families` order) meeting the
+    box ``size`` (lattice units, the lattice moved by ``shift``): the ``k`` of its step and
+    residue (:meth:`Lattice.plane_steps`), the two sides for a boundary-only family."""
     fams, bonly = lattice.families()
+    steps, residues = lattice.plane_steps()
     corners = np.array(list(itertools.product(*[(0, int(s)) for s in size])), dtype=np.int64)
+    t = np.array([int(x) for x in shift], dtype=np.int64)
     out = []
-    for n, b in zip(fams, bonly, strict=True):
-        kc = corners @ np.array(n, dtype=np.int64)
-        out.append(2 if b else int(kc.max() - kc.min()) + 1)
+    for n, b, st, r in zip(fams, bonly, steps, residues, strict=True):
+        nv = np.array(n, dtype=np.int64)
+        kc = corners @ nv
+        lo, hi = int(kc.min()), int(kc.max())
+        if b:
+            out.append(np.array([lo, hi], dtype=np.int64))
+            continue
+        r0 = (r + int(nv @ t)) % st
+        first = lo + (r0 - lo) % st
+        out.append(np.arange(first, hi + 1, st, dtype=np.int64))
     return out
+
+
+def plane_counts(lattice: Lattice, size: Sequence[int]) -> list[int]:
+    """Planes of each family (:meth:`Lattice.families` order) in the box ``size``
+    (:func:`plane_ks`)."""
+    return [len(k) for k in plane_ks(lattice, size)]
 
 
 def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
@@ -198,8 +217,9 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
     ``m`` families of ``n``). Most of those meeting points lie outside the box: the points
     of a triple form a lattice of ``|det(N_a, N_b, N_c)|`` points per unit volume, so a
     triple counts ``min(n_a n_b n_c, |det| (A + 1)(B + 1)(C + 1))`` (the full product when
-    one family is boundary-only). Each vertex starts at most three edges per triple through
-    it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
+    one family is boundary-only; with equal planes, :meth:`Lattice.plane_steps`, that
+    density divided by the product of the three steps). Each vertex starts at most three
+    edges per triple through it; bytes are :data:`BYTES_PER_VERTEX` per vertex.
 
     Examples
     --------
@@ -209,6 +229,7 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
     """
     n = plane_counts(lattice, size)
     fams, bonly = lattice.families()
+    steps, _ = lattice.plane_steps()
     N = np.array(fams, dtype=np.int64).reshape(-1, 3)
     vol = math.prod(int(x) + 1 for x in size)
     v = 0
@@ -217,7 +238,8 @@ def estimate3(lattice: Lattice, size: Sequence[int]) -> tuple[int, int, int]:
         if det == 0:
             continue
         full = n[t[0]] * n[t[1]] * n[t[2]]
-        v += full if any(bonly[k] for k in t) else min(full, det * vol)
+        dense = -(-det * vol // (steps[t[0]] * steps[t[1]] * steps[t[2]]))
+        v += full if any(bonly[k] for k in t) else min(full, dense)
     return v, 3 * v, BYTES_PER_VERTEX * v
 
 
@@ -277,6 +299,7 @@ class Arrangement3(ArrangementGraph):
         max_memory: int | None = None,
         where: str = "<model>",
         hint: str = " or a smaller --size",
+        shift: Sequence[int] = (0, 0, 0),
     ) -> None:
         if len(size) != 3 or any(int(s) < 1 for s in size):
             raise InputError(f"the region must be AxBxC with positive sides, not {tuple(size)}")
@@ -301,13 +324,9 @@ class Arrangement3(ArrangementGraph):
                 "--spacing (with --snap) gives simpler normals"
             )
         ext = np.array(self.size, dtype=np.int64) * D
-        corners = np.array(list(itertools.product(*[(0, s) for s in self.size])), dtype=np.int64)
-        self.k_range: list[NDArray[np.int64]] = []
-        for f in range(F):
-            kc = corners @ N[f]
-            lo, hi = int(kc.min()), int(kc.max())
-            ks = np.array([lo, hi]) if bonly[f] else np.arange(lo, hi + 1)
-            self.k_range.append(ks.astype(np.int64))
+        self.k_range: list[NDArray[np.int64]] = plane_ks(lattice, self.size, shift)
+        steps, _ = lattice.plane_steps()
+        self.steps = np.array(steps, dtype=np.int64)
         keys = []
         stride = (ext + 1).astype(np.int64)
         for t in triples:
@@ -316,9 +335,12 @@ class Arrangement3(ArrangementGraph):
             adj = _adj3(M)
             m = D // det
             gg, hh = np.meshgrid(self.k_range[t[1]], self.k_range[t[2]], indexing="ij")
-            kg, kh = gg.ravel(), hh.ravel()
-            for kf in self.k_range[t[0]].tolist():
-                P = (adj[:, 0:1] * kf + adj[:, 1:2] * kg + adj[:, 2:3] * kh) * m
+            base = adj[:, 1:2] * gg.ravel() + adj[:, 2:3] * hh.ravel()  # (3, G)
+            kfs = self.k_range[t[0]]
+            chunk = max(1, 1_000_000 // max(1, base.shape[1]))  # planes of f at once
+            for c0 in range(0, len(kfs), chunk):
+                kc = kfs[c0 : c0 + chunk]
+                P = ((adj[:, 0:1, None] * kc[None, None, :] + base[:, :, None]) * m).reshape(3, -1)
                 ok = ((P >= 0) & (P <= ext[:, None])).all(axis=0)
                 if ok.any():
                     q = P[:, ok]
@@ -331,7 +353,7 @@ class Arrangement3(ArrangementGraph):
         s = XYZ @ N.T  # (nv, F)
         on = s % D == 0
         for f in range(F):
-            if bonly[f]:
+            if bonly[f] or self.steps[f] > 1:
                 on[:, f] &= np.isin(s[:, f] // D, self.k_range[f])
         self.on = on
         # edges: consecutive vertices on the line of two planes
@@ -355,9 +377,12 @@ class Arrangement3(ArrangementGraph):
             dst.append(idx[1:][same])
             lid.append(np.full(int(same.sum()), li, dtype=np.int64))
         self.lines = np.array(sorted(lines, key=lines.__getitem__), dtype=np.int64).reshape(-1, 3)
-        e = np.stack([np.concatenate(src), np.concatenate(dst), np.concatenate(lid)], axis=1)
-        e = np.unique(e, axis=0)  # a line in three or more planes comes from several pairs
-        self.edge_src, self.edge_dst, self.edge_line = e[:, 0], e[:, 1], e[:, 2]
+        # a line in three or more planes comes from several pairs: one edge per (src, dst)
+        # (its line is the same), in (src, dst) order
+        a, b, c = (np.concatenate(x) if x else np.zeros(0, dtype=np.int64)
+                   for x in (src, dst, lid))  # fmt: skip
+        _, first = np.unique(a * max(1, self.n_vertices) + b, return_index=True)
+        self.edge_src, self.edge_dst, self.edge_line = a[first], b[first], c[first]
 
     @property
     def family_vectors(self) -> NDArray[np.int64]:
@@ -378,9 +403,17 @@ class Arrangement3(ArrangementGraph):
         return out
 
     def edge_families(self) -> NDArray[np.bool_]:
-        """``(n_edges, F)``: the families with a plane containing each edge."""
-        u = self.lines[self.edge_line]
-        out: NDArray[np.bool_] = (u @ self.normals.T == 0) & self.on[self.edge_src]
+        """``(n_edges, F)``: the families with a plane containing each edge (computed once,
+        read-only)."""
+        return self._edge_families
+
+    @cached_property
+    def _edge_families(self) -> NDArray[np.bool_]:
+        # a line lies in a family's planes when its direction is orthogonal to the normal
+        # (per line, not per edge) and its edge's first vertex is on one of them
+        along = self.lines @ self.normals.T == 0  # (lines, F)
+        out: NDArray[np.bool_] = along[self.edge_line] & self.on[self.edge_src]
+        out.setflags(write=False)
         return out
 
     @cached_property

@@ -133,7 +133,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
@@ -154,7 +154,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
@@ -174,7 +174,7 @@ def synthesize(
     spacing: float | None = None,
     snap: bool = False,
     boundary: int | Mapping[str, int] = 0,
-    lines: str = "lattice",
+    lines: str = "auto",
     restarts: int = 0,
     check: bool = True,
     constraints: UserConstraints3 | None = None,
@@ -199,7 +199,7 @@ def synthesize(
     rng : int or numpy Generator, optional
         Seed (recorded in the result).
     spacing, snap, boundary, lines, constraints, max_memory
-        See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: 2D; per-face
+        See :func:`~csplab.continuous.csp.continuous_csp` (``lines``: per family; per-face
         ``boundary`` and user ``constraints`` of thesis Sec. 4.6: 3D).
     ground : str or sequence of str or None, default "auto"
         3D: the faces past which the example and the output continue (an infinite

@@ -51,6 +51,7 @@ __all__ = [
     "SatOracle",
     "backends",
     "enumerate_solutions",
+    "free_at_exit",
     "preferred_labels",
 ]
 
@@ -87,6 +88,36 @@ _NOT_SUPPORTED = {
     "cryptosat": "cryptosat needs the pycryptosat package and has no phases or budgets in pysat",
 }
 _NO_LIMIT = ("lingeling",)  # no conflict budget and no interrupt in pysat
+
+# Freeing a native solver of millions of clauses takes about as long as loading them
+# (CaDiCaL frees each clause; 0.5 s at 40x40x10 castle). A command that exits right after
+# its one solve leaves large solvers to the operating system instead (free_at_exit).
+_EXIT_MIN_LITERALS = 1_000_000  # smaller solvers are freed as usual
+_EXIT_MAX_LITERALS = 20_000_000  # at most this many literals per process are left unfreed
+_EXIT = {"on": 0, "left": 0}
+
+
+def free_at_exit(on: bool = True) -> None:
+    """Leave large native solvers to the process exit instead of freeing them on ``close``.
+
+    For commands that end right after their solve (``csplab synthesize``): the operating
+    system reclaims the memory at once, where CaDiCaL's destructor frees clause by clause
+    (0.5 s at 40×40×10 castle). Only solvers of at least 10**6 literals are left, and at most
+    2·10**7 literals per process (then they are freed as usual), so a command that builds many
+    oracles cannot grow without bound. Off by default: library callers get every solver freed
+    by :meth:`SatOracle.close`. Results are unaffected: the solver is left only after its
+    answer has been read.
+
+    Parameters
+    ----------
+    on : bool
+        Switch the behaviour on (default) or off.
+
+    Examples
+    --------
+    >>> free_at_exit(False)      # the default: close() frees the native solver
+    """
+    _EXIT["on"] = int(bool(on))
 
 
 def backends() -> list[str]:
@@ -538,7 +569,26 @@ class SatOracle(Closing):
         return {k: int(v) for k, v in st.items()}
 
     def close(self) -> None:
+        """Free the native solver (or leave it to the process exit: :func:`free_at_exit`)."""
+        inner = getattr(self.solver, "solver", None)
+        size = int(self.enc.lits.size)
+        if (
+            _EXIT["on"]
+            and inner is not None
+            and size >= _EXIT_MIN_LITERALS
+            and _EXIT["left"] + size <= _EXIT_MAX_LITERALS
+        ):
+            # pysat's capsule has no destructor: with the backend's delete() a no-op the
+            # native object is never freed in-process, the operating system reclaims it
+            _EXIT["left"] += size
+            inner.delete = _keep
+            self.solver.solver = None
+            return
         self.solver.delete()
+
+
+def _keep() -> None:
+    """Stands in for a backend's ``delete`` when its solver is left to the process exit."""
 
 
 def preferred_labels(

@@ -15,6 +15,7 @@ Python entry point.
 ``sampling_bias``         label / 2×2-pattern frequencies vs exact uniform sampling
 ``table1_continuous``     continuous 3D: Table 1, Figs. 1, 10-13 of the 2008 paper
 ``baselines``             model synthesis against texture synthesis (Fig. 5.1/5.2)
+``infallibility``         proved / refuted / undecided per model, with certificates
 ========================  ============================================================
 
 Examples
@@ -63,6 +64,7 @@ EXPERIMENTS: dict[str, str] = {
     "table1_continuous": "csplab.experiments.table1_continuous:Table1Continuous",
     "baselines": "csplab.experiments.baselines:Baselines",
     "constraints": "csplab.experiments.constraints:ConstraintsExperiment",
+    "infallibility": "csplab.experiments.infallibility:Infallibility",
 }
 ALIASES: dict[str, str] = {"fig3_10": "blocksize", "table3.1": "table3_1", "fig3.8": "fig3_8"}
 
@@ -107,7 +109,8 @@ def run(
     store : path
         The SQLite results store (default ``results/csplab-experiments.sqlite``).
     out : path, optional
-        Report directory (default ``results/NAME``): ``NAME.md``, one CSV per table,
+        Report directory (default ``results/NAME``, or the experiment's ``default_out``):
+        ``NAME.md``, one CSV per table,
         ``NAME_trials.csv.gz`` (every trial), PNG and SVG.
     jobs, scheduler, progress
         See :func:`~csplab.experiments.runner.run_trials`.
@@ -130,7 +133,7 @@ def run(
     exp.draw_figures = figures
     config = exp.make_config(quick=quick, **overrides)
     trials, examples = exp.build(config)
-    outdir = Path(out) if out is not None else Path("results") / exp.name
+    outdir = Path(out) if out is not None else Path(exp.default_out or Path("results") / exp.name)
     with ResultsStore(store) as st:
         if rerun and not report_only:
             st.delete(exp.name, [t.key for t in trials])

@@ -373,6 +373,7 @@ class Experiment:
     quick: ClassVar[dict[str, Any]] = {}
     uses: ClassVar[frozenset[str]] = frozenset()
     tilesets: ClassVar[bool] = False  # whether examples may be tilesets (RuleSet files)
+    default_out: ClassVar[str] = ""  # report directory when none is given (results/NAME)
     draw_figures: bool = True  # draw figures in :meth:`report` (tests switch them off)
 
     def add_arguments(self, p: argparse.ArgumentParser) -> None:

@@ -121,7 +121,8 @@ class SatSolver(Solver):
                 if status == "unsat":
                     stats["proof"] = f"refutation by {o.backend}"
             t1 = time.perf_counter()
-        # freeing a solver with millions of clauses takes a while: it counts
+        # freeing a solver with millions of clauses takes a while: it counts (`csplab
+        # synthesize` leaves a large one to the process exit: engine.sat.free_at_exit)
         stats["free_s"] = time.perf_counter() - t1
         final: Status = "solved" if status == "sat" else "unsat" if status == "unsat" else "timeout"
         return self.result(final, grid, problem, stats, call)

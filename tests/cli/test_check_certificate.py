@@ -43,8 +43,8 @@ def test_refuted_certificate_and_undecided(tmp_path, capsys):
     code, out, _ = run(capsys, "check-certificate", str(cert), "--model", "fig3_5a")
     assert code == 0 and "wipes out a catalog" in out
     other = tmp_path / "u.json"
-    code, out, _ = run(capsys, "prove", "fig3_4a", "--order", "scan:yx", "--certificate",
-                       str(other))  # fmt: skip
+    code, out, _ = run(capsys, "prove", "fig3_4a", "--region", "2", "--order", "scan:yx",
+                       "--certificate", str(other))  # fmt: skip
     assert code == 3 and "no certificate written" in out and not other.exists()
 
 

@@ -20,10 +20,13 @@ def run(capsys, *argv):
 def test_prove_exit_codes(capsys):
     code, out, _ = run(capsys, "prove", "line", "--order", "scan:yx")
     assert code == 0 and out.startswith("infallible") and "re-check" in out
-    code, out, _ = run(capsys, "prove", "fig3_4a", "--order", "scan:yx")
+    code, out, _ = run(capsys, "prove", "fig3_4a", "--region", "2", "--order", "scan:yx")
     assert code == 3 and "Alg. 3.6" in out and "empty catalog" in out
     code, out, _ = run(capsys, "prove", "fig3_4a", "--region", "3x2", "--order", "scan:yx")
     assert code == 0
+    # the default decides: the smallest region that proves it (the thesis' 3x2)
+    code, out, _ = run(capsys, "prove", "fig3_4a", "--order", "scan:yx", "--time-limit", "60")
+    assert code == 0 and "method: region 3x2 (Alg. 3.6)" in out
     code, out, _ = run(capsys, "prove", "fig3_5a", "--order", "scan:yx")
     assert code == 1 and "fallible" in out and "inconsistent at choice" in out
 

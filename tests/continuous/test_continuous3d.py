@@ -190,7 +190,11 @@ def test_cli_synthesizes_a_mesh_example(tmp_path: pytest.TempPathFactory) -> Non
         assert main(["check", str(ex), str(out)]) == 0
     assert main(["show", str(out), "--out", str(png)]) == 0 and png.exists()
     assert main(["synthesize", str(ex), "--size", "8x8"]) == 2
-    assert main(["synthesize", str(ex), "--size", "8x8x5", "--lines", "equal"]) == 2
+    # equal plane spacing (the default for meshes in real coordinates) applies in 3D too
+    args = ["synthesize", str(ex), "--size", "8x8x5", "--lines", "equal", "--seed", "1",
+            "--out", str(out)]  # fmt: skip
+    assert main(args) == 0
+    assert main(["check", str(ex), str(out)]) == 0
 
 
 def test_ground_below_the_region() -> None:

@@ -109,3 +109,42 @@ def test_time_limit_on_a_large_problem():
     r = solve(P, "sat", rng=0, time_limit=0.2)
     assert r.status in ("timeout", "solved")
     assert r.time_s < 1.2
+
+
+def test_free_at_exit_leaves_large_solvers_and_changes_no_output(monkeypatch, tmp_path):
+    """With free_at_exit on, close() leaves the native solver unfreed (its delete() is a
+    no-op) and only while the per-process cap holds; the outputs are those of the freeing
+    path. The CLI switches it on for its one solve and off again after."""
+    from csplab import load_example
+    from csplab.cli import main
+    from csplab.engine import sat as engine_sat
+
+    P = from_example(load_example("castle"), (6, 6, 4))
+    freed = solve(P, "sat", rng=3).grid
+    monkeypatch.setattr(engine_sat, "_EXIT_MIN_LITERALS", 1)
+    monkeypatch.setattr(engine_sat, "_EXIT", {"on": 0, "left": 0})
+    engine_sat.free_at_exit()
+    try:
+        with SatOracle(P, seed=1) as o:
+            assert o.solve() == "sat"
+            inner = o.solver.solver
+        assert o.solver.solver is None and inner.delete is engine_sat._keep
+        left = engine_sat._EXIT["left"]
+        assert left == o.enc.lits.size > 0
+        assert np.array_equal(solve(P, "sat", rng=3).grid, freed)
+        monkeypatch.setattr(engine_sat, "_EXIT_MAX_LITERALS", engine_sat._EXIT["left"])
+        with SatOracle(P, seed=1) as o:  # over the cap: freed as usual
+            inner = o.solver.solver
+        assert inner.delete is not engine_sat._keep
+    finally:
+        engine_sat.free_at_exit(False)
+    # off (the default): close() frees, nothing is counted
+    monkeypatch.setattr(engine_sat, "_EXIT", {"on": 0, "left": 0})
+    with SatOracle(P, seed=1) as o:
+        inner = o.solver.solver
+    assert inner.delete is not engine_sat._keep and engine_sat._EXIT["left"] == 0
+    out = tmp_path / "o.npy"
+    assert main(["synthesize", "castle", "--size", "6x6x4", "--solver", "sat", "--seed", "1",
+                 "--out", str(out)]) == 0  # fmt: skip
+    assert engine_sat._EXIT["on"] == 0 and engine_sat._EXIT["left"] > 0
+    assert np.array_equal(np.load(out), solve(P, "sat", rng=1).grid)
