@@ -46,7 +46,8 @@ def auto_ground(
 ) -> str | tuple[str, ...] | None:
     """``ground="auto"``: the example's own ground (``example.meta["ground"]``, as the
     built-in polyhedral examples declare it) but the faces that ``boundary`` gives a label
-    (an explicit boundary wins); ``None`` for polygon models and examples without one.
+    (an explicit boundary wins; a polygon model's one boundary label other than 0 wins
+    over every side); ``None`` for examples without one.
 
     Examples
     --------
@@ -55,10 +56,13 @@ def auto_ground(
     >>> auto_ground(E), auto_ground(E, {"z-": 1}), auto_ground(E, 2)
     (('z-', 'x-', 'x+', 'y-', 'y+'), ('x-', 'x+', 'y-', 'y+'), None)
     """
+    from csplab.continuous.csp import ground_sides
     from csplab.continuous.csp3d import ground_faces
 
-    if not isinstance(example, PolyhedralModel) or not example.meta.get("ground"):
+    if not example.meta.get("ground"):
         return None
+    if isinstance(example, PolygonModel):
+        return None if boundary else ground_sides(example.meta["ground"])
     if not isinstance(boundary, Mapping):
         return None if boundary else ground_faces(example.meta["ground"])
     return tuple(f for f in ground_faces(example.meta["ground"]) if not boundary.get(f))
