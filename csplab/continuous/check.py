@@ -387,7 +387,9 @@ def violations2(
                 c = both.representative_point()
                 defects.append(Defect("label", (c.x, c.y), f"labels [{a}, {b}] overlap here"))
     segs, labs = _segments(model)
-    mv, me, extra = neighbourhoods(model, fams, scale, (segs, labs))
+    # only nodes in the region: a neighbourhood seen first outside it (on the frame or past
+    # an open side) would otherwise hide the same one inside
+    mv, me, extra = neighbourhoods(model, fams, scale, (segs, labs), within=region)
     for (ax, ay), (bx, by) in segs.tolist():
         r = fams.ray(bx - ax, by - ay)
         if r >= _FOREIGN:
