@@ -91,7 +91,7 @@ def ground_sides(ground: str | Sequence[str] | None) -> tuple[str, ...]:
     >>> ground_sides("z-")
     Traceback (most recent call last):
     ...
-    csplab.errors.InputError: ground: the sides of a polygon model are x-, x+, y-, y+ (or window, none), not z-
+    csplab.errors.InputError: ground: polygon model sides are x-, x+, y-, y+ (window, none), not z-
     """
     if ground is None or (isinstance(ground, str) and ground.strip() in ("", "none")):
         return ()
@@ -103,8 +103,8 @@ def ground_sides(ground: str | Sequence[str] | None) -> tuple[str, ...]:
         items = [str(g) for g in ground]
     bad = [g for g in items if g not in SIDES]
     if bad:
-        raise InputError(f"ground: the sides of a polygon model are {', '.join(SIDES)} (or "
-                         f"window, none), not {', '.join(bad)}")  # fmt: skip
+        raise InputError(f"ground: polygon model sides are {', '.join(SIDES)} (window, none), "
+                         f"not {', '.join(bad)}")  # fmt: skip
     return tuple(f for f in SIDES if f in items)
 
 
@@ -156,9 +156,9 @@ def _continued(
             if any(out[bit] and sides & bit and not open_bits & bit for bit in out):
                 what = ("fixed", 0)
             else:
-                if sides & 1 and c < 0 or sides & 2 and c > 0:
+                if (sides & 1 and c < 0) or (sides & 2 and c > 0):
                     c = (1e-6 if sides & 1 else -1e-6) * (abs(c) + abs(sn))
-                if sides & 4 and sn < 0 or sides & 8 and sn > 0:
+                if (sides & 4 and sn < 0) or (sides & 8 and sn > 0):
                     sn = (1.37e-6 if sides & 4 else -1.37e-6) * (abs(c) + abs(sn))
                 what = ("copy", sector_at(math.atan2(sn, c) % two))
             if k:
@@ -387,13 +387,13 @@ class ContinuousCSP:
             outside = A.outside_sectors(rays, sd) if sd else (False,) * len(rays)
             found: dict[tuple[int, ...], tuple[int, ...]] = {}
             if sd & opened:
-                full, after = _continued(angles, rays, outside, sd, opened)
+                full, past = _continued(angles, rays, outside, sd, opened)
                 at = [full.index(r) for r in rays]
                 for sig in self.signatures:
                     ex = _expand(sig, full)
                     if ex is None or any(
                         ex[k] != (b0 if kind == "fixed" else ex[at[i]])
-                        for k, (kind, i) in enumerate(after)
+                        for k, (kind, i) in enumerate(past)
                     ):
                         continue
                     found[tuple(ex[j] for j in at)] = ex
