@@ -231,8 +231,10 @@ def neighbourhoods(
     segs, labs = segments if segments is not None else _segments(model)
     t = 1e-9 * scale
     for n in _nodes(segs, labs, fams, scale):
-        if within is not None and not (within[0] - t <= n.point[0] <= within[2] + t
-                                       and within[1] - t <= n.point[1] <= within[3] + t):
+        if within is not None and not (
+            within[0] - t <= n.point[0] <= within[2] + t
+            and within[1] - t <= n.point[1] <= within[3] + t
+        ):
             continue  # fmt: skip
         rays = sorted(set(n.after) | set(n.before))
         m = len(rays)
@@ -348,7 +350,8 @@ def violations2(
         x0, y0, x1, y1 = region
         m = max(x1 - x0, y1 - y0)
         ring = shapely.box(x0 - m, y0 - m, x1 + m, y1 + m).difference(
-            _open_slabs(region, ground, m))
+            _open_slabs(region, ground, m)
+        )
         frame = [Polygon(outside, tuple(g.exterior.coords)[:-1],
                          tuple(tuple(h.coords)[:-1] for h in g.interiors))
                  for g in getattr(ring, "geoms", [ring]) if g.area > 0]  # fmt: skip
@@ -426,9 +429,7 @@ def violations2(
     return Violations(defects)
 
 
-def _open_slabs(
-    box: Sequence[float], ground: Sequence[str], far: float
-) -> shapely.Geometry:
+def _open_slabs(box: Sequence[float], ground: Sequence[str], far: float) -> shapely.Geometry:
     """The strips past the open sides of ``box`` (across each side, as wide as the box
     and the other open sides' strips)."""
     x0, y0, x1, y1 = box

@@ -442,8 +442,9 @@ class ContinuousCSP:
         pos_rel = np.full((len(ukeys), 2 * F), -1, dtype=np.int64)
         for t, (rays, states) in enumerate(zip(self.type_rays, self.type_states, strict=True)):
             full, seen = self.type_full[t]
-            S = np.array([seen[st] for st in states], dtype=np.int64).reshape(len(states),
-                                                                                len(full))
+            S = np.array([seen[st] for st in states], dtype=np.int64).reshape(
+                len(states), len(full)
+            )
             for r in rays:
                 i = full.index(r)
                 before, after = S[:, i - 1], S[:, i]
@@ -840,5 +841,6 @@ def continuous_csp(
         raise InputError("polygon models (2D) take no user constraints yet")
     if isinstance(boundary, Mapping):
         raise InputError("a polygon model has one label outside its region, not one per face")
-    return ContinuousCSP(example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines,
-                         ground=ground)
+    return ContinuousCSP(
+        example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines, ground=ground
+    )

@@ -59,10 +59,12 @@ def test_ground_removes_the_frame_edge_from_the_example() -> None:
 
 
 #: a hill cut by both sides of its frame, and outputs cut otherwise
-HILL = PolygonModel.from_json({"polygons": [
-    {"label": 1, "points": [[0, 0], [6, 0], [6, 2], [4, 2], [2, 4], [0, 4]]}]})
-STEEP = PolygonModel.from_json({"polygons": [
-    {"label": 1, "points": [[0, 0], [6, 0], [6, 2], [4, 2], [0, 6]]}]})
+HILL = PolygonModel.from_json(
+    {"polygons": [{"label": 1, "points": [[0, 0], [6, 0], [6, 2], [4, 2], [2, 4], [0, 4]]}]}
+)
+STEEP = PolygonModel.from_json(
+    {"polygons": [{"label": 1, "points": [[0, 0], [6, 0], [6, 2], [4, 2], [0, 6]]}]}
+)
 
 
 def test_checker_continues_polygons_past_open_sides() -> None:
