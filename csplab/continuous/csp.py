@@ -237,6 +237,7 @@ def _vertex_sectors(
 def example_signatures(
     example: PolygonModel, lattice: Lattice, label_index: dict[int, int],
     ground: Sequence[str] = (),
+    coverage: dict[Signature, int] | None = None,
 ) -> set[Signature]:  # fmt: skip
     """Every reduced neighbourhood of ``example`` (labels compacted by ``label_index``),
     from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b)).
@@ -244,7 +245,10 @@ def example_signatures(
     Past the sides of its bounding box named in ``ground`` (:func:`ground_sides`) the
     example continues: there the arrangement ends at the box, and the label past it is the
     one just inside (a polygon standing on the bottom goes on below it, so its bottom
-    edge is no boundary; see :func:`_continued`)."""
+    edge is no boundary; see :func:`_continued`). ``coverage``, if given, receives how much
+    of the example each neighbourhood covers: the number of the arrangement's vertices and
+    edges inside the example's box where it occurs (area, length or a count of corners, in
+    line spacings)."""
     lo = np.rint(lattice.to_lattice(np.array([example.bounds[:2]]))[0]).astype(np.int64)
     hi = np.rint(lattice.to_lattice(np.array([example.bounds[2:]]))[0]).astype(np.int64)
     bits = sum(SIDES[g] for g in ground)
@@ -269,8 +273,21 @@ def example_signatures(
         on_open = (common & bits) != 0
         left = np.where(on_open & (eout == 1), right, left)
         right = np.where(on_open & (eout == 2), left, right)
-    for f, L, R in zip(A.edge_family.tolist(), left.tolist(), right.tolist(), strict=True):
-        sigs.add(reduce_signature([f, F + f], [L, R]))
+    tol = 1e-9  # inside the example's box (closed), in lattice units
+    box_lo, box_hi = m0 - tol, m0 + (hi - lo) + tol
+    vpos, epos = A.vertex_positions(), A.edge_positions()
+    vin = ((vpos >= box_lo) & (vpos <= box_hi)).all(axis=1).tolist()
+    ein = ((epos >= box_lo) & (epos <= box_hi)).all(axis=1).tolist()
+
+    def seen(sig: Signature, inside: bool) -> None:
+        sigs.add(sig)
+        if coverage is not None and inside:
+            coverage[sig] = coverage.get(sig, 0) + 1
+
+    for e, (f, L, R) in enumerate(
+        zip(A.edge_family.tolist(), left.tolist(), right.tolist(), strict=True)
+    ):
+        seen(reduce_signature([f, F + f], [L, R]), ein[e])
     angles = A.ray_angles
     for v, (rays, labs) in enumerate(_vertex_sectors(A, left, right)):
         if not rays:
@@ -279,9 +296,9 @@ def example_signatures(
         if sd & bits:
             full, after = _continued(angles, rays, A.outside_sectors(rays, sd), sd, bits)
             flabs = [0 if k == "fixed" else labs[i] for k, i in after]
-            sigs.add(reduce_signature(full, flabs))
+            seen(reduce_signature(full, flabs), vin[v])
         else:
-            sigs.add(reduce_signature(rays, labs))
+            seen(reduce_signature(rays, labs), vin[v])
     return sigs
 
 
@@ -364,7 +381,11 @@ class ContinuousCSP:
         #: the open sides (:func:`ground_sides`): the example and the output continue past them
         self.ground = ground_sides(ground)
         opened = sum(SIDES[g] for g in self.ground)
-        self.signatures = example_signatures(example, self.lattice, index, self.ground)
+        #: how much of the example each neighbourhood covers (vertices and edges of its
+        #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
+        self.coverage: dict[Signature, int] = {}
+        self.signatures = example_signatures(example, self.lattice, index, self.ground,
+                                             self.coverage)  # fmt: skip
         A = self.arrangement = Arrangement(self.lattice, W, H, lines=lines)
         F, Kl = A.F, len(self.labels)
         self.Kl = Kl
@@ -381,11 +402,14 @@ class ContinuousCSP:
         #: each of them (:func:`_continued`; the type's own rays and states elsewhere)
         self.type_full: list[tuple[list[int], dict[tuple[int, ...], tuple[int, ...]]]] = []
         angles = A.ray_angles
+        #: per vertex type then edge family, the weight of each value (``choice="weighted"``)
+        self.state_weights: list[NDArray[np.float64]] = []
         for key in ukeys.tolist():
             mask, sd = key >> 4, key & 15
             rays = [r for r in range(2 * F) if (mask >> r) & 1]
             outside = A.outside_sectors(rays, sd) if sd else (False,) * len(rays)
             found: dict[tuple[int, ...], tuple[int, ...]] = {}
+            cover: dict[tuple[int, ...], int] = {}  # per state: the example it covers
             if sd & opened:
                 full, past = _continued(angles, rays, outside, sd, opened)
                 at = [full.index(r) for r in rays]
@@ -396,7 +420,9 @@ class ContinuousCSP:
                         for k, (kind, i) in enumerate(past)
                     ):
                         continue
-                    found[tuple(ex[j] for j in at)] = ex
+                    st = tuple(ex[j] for j in at)
+                    found[st] = ex
+                    cover[st] = cover.get(st, 0) + self.coverage.get(sig, 0)
             else:
                 full = rays
                 for sig in self.signatures:
@@ -404,6 +430,7 @@ class ContinuousCSP:
                     if st is not None and all(st[i] == b0 for i in range(len(rays))
                                               if outside[i]):  # fmt: skip
                         found[st] = st
+                        cover[st] = cover.get(st, 0) + self.coverage.get(sig, 0)
             ordered = sorted(found, key=lambda st: (any(st), st))
             if not ordered:
                 raise InputError(
@@ -414,6 +441,9 @@ class ContinuousCSP:
             self.type_states.append(ordered)
             self.type_outside.append(outside)
             self.type_full.append((full, found))
+            # Sec. 4.5.4's states, each weighted by the example it covers (+1: every state
+            # stays possible): the neighbourhoods that look like it here
+            self.state_weights.append(np.array([1.0 + cover[st] for st in ordered]))
         nst = max(len(s) for s in self.type_states)
         K = self.K = max(nst, Kl * Kl)
         # edge domains per family
@@ -436,6 +466,10 @@ class ContinuousCSP:
             dom[nv + sel, : Kl * Kl] &= (labs == b0)[None, :]
         # on an open side the world goes on: the same label on both sides of the edge
         dom[nv + np.flatnonzero((eout > 0) & eopen), : Kl * Kl] &= (Ls == Rs)[None, :]
+        for f in range(F):  # an edge value (left, right): the example's edges like it
+            self.state_weights.append(np.array(
+                [1.0 + self.coverage.get(reduce_signature([f, F + f], [L, R]), 0)
+                 for L in range(Kl) for R in range(Kl)]))  # fmt: skip
         # relations per (type, ray position), deduplicated
         rel_ids: dict[bytes, int] = {}
         rels: list[NDArray[np.bool_]] = []
@@ -470,6 +504,13 @@ class ContinuousCSP:
         ])  # fmt: skip
         if (arcs[:, 2] < 0).any():  # pragma: no cover - every incidence is a ray
             raise AssertionError("an edge end without its ray")
+        # the weighted choice: one weight class per vertex type and per edge family
+        table = np.zeros((len(self.state_weights), K), dtype=np.float64)
+        for t, w in enumerate(self.state_weights):
+            table[t, : len(w)] = w
+        cls = np.empty(nv + ne, dtype=np.int64)
+        cls[self.var_vertex] = self.vertex_type
+        cls[self.var_edge] = len(self.type_states) + A.edge_family
         self.problem = Problem(
             (nv + ne,),
             dom[order],
@@ -489,6 +530,7 @@ class ContinuousCSP:
                 "ground": list(self.ground),
             },
             positions=pos[order],
+            value_weights=(table, cls),
         )
 
     # ------------------------------------------------------------------ queries

@@ -71,11 +71,13 @@ def auto_ground(
 def default_choice(problem: Any, solver: str) -> str | None:
     """The label choice continuous synthesis gives ``solver`` when the caller names none:
     ``"weighted"`` when the problem weighs its values per cell (``value_weights``, the
-    3D CSP's coverage of the example) and the solver takes that choice, else ``None``
-    (the solver's own default)."""
+    CSP's coverage of the example) and is a 3D one, and the solver takes that choice, else
+    ``None`` (the solver's own default). Polygon models (2D) keep the thesis' uniform
+    choice by default (their built-in outputs stay as published); ``choice="weighted"``
+    gives them the coverage weights too."""
     from csplab.solvers import solver_class
 
-    if getattr(problem, "value_weights", None) is None:
+    if getattr(problem, "value_weights", None) is None or problem.meta.get("dim") != 3:
         return None
     o = solver_class(solver.partition(":")[0]).option("choice")
     return "weighted" if o is not None and (o.values is None or "weighted" in o.values) else None

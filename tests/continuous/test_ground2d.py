@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 import shapely
 
@@ -93,3 +94,30 @@ def test_ground_sides_refuses_other_names() -> None:
         ground_sides("z-")
     with pytest.raises(InputError, match="z-"):
         violations(HILL, HILL, region=HILL.bounds, ground=("z-",))
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_weighted_choice_moves_edge_frequencies_toward_coverage(seed: int) -> None:
+    # the share of edges that are a boundary (two labels): in the example's coverage, and
+    # in the outputs of the uniform and the weighted choice on the same seed
+    share = {}
+    for choice in ("uniform", "weighted"):
+        s = synthesize(TOWERS, (24, 16), rng=seed, choice=choice)
+        assert s.result.ok and len(s.violations) == 0
+        left, right = s.csp.edge_labels(s.result.grid)
+        share[choice] = float((left != right).mean())
+    C = s.csp
+    assert C.problem.value_weights is not None
+    Kl = C.Kl
+    cover = C.problem.value_weights[0][len(C.type_states) :, : Kl * Kl] - 1.0
+    L, R = divmod(np.arange(Kl * Kl), Kl)
+    example = float(cover[:, L != R].sum() / cover.sum())
+    assert abs(share["weighted"] - example) < abs(share["uniform"] - example)
+
+
+def test_uniform_stays_the_2d_default() -> None:
+    from csplab.continuous.synthesis import default_choice
+
+    C = ContinuousCSP(TOWERS, (6, 4))
+    assert C.problem.value_weights is not None  # the weights are there for --choice weighted
+    assert default_choice(C.problem, "catalog") is None
