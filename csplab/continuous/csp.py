@@ -426,11 +426,11 @@ class ContinuousCSP:
             else:
                 full = rays
                 for sig in self.signatures:
-                    st = _expand(sig, rays)
-                    if st is not None and all(st[i] == b0 for i in range(len(rays))
-                                              if outside[i]):  # fmt: skip
-                        found[st] = st
-                        cover[st] = cover.get(st, 0) + self.coverage.get(sig, 0)
+                    got = _expand(sig, rays)
+                    if got is not None and all(got[i] == b0 for i in range(len(rays))
+                                               if outside[i]):  # fmt: skip
+                        found[got] = got
+                        cover[got] = cover.get(got, 0) + self.coverage.get(sig, 0)
             ordered = sorted(found, key=lambda st: (any(st), st))
             if not ordered:
                 raise InputError(
