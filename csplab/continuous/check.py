@@ -373,6 +373,13 @@ def violations2(
     scale = float(max(1.0, np.abs(lo).max(), np.abs(hi).max(), (hi - lo).max()))
     fams = _Families(_edge_angles(example), angle_tol)
     ev, ee, _ = neighbourhoods(example, fams, scale, within=ebox)
+    # on an open side, the output has what the example has on that side of its box (or
+    # bare ground): its nodes there and the edges beside them
+    on_side: dict[str, set[Signature]] = {}
+    for g in ground:
+        assert ebox is not None
+        sv, se, _ = neighbourhoods(example, fams, scale, within=_side_of(ebox, g))
+        on_side[g] = {((-1, 0),)} | set(sv) | set(se)
     allowed = set(ev) | set(ee) | {((-1, 0),)} | {((-1, b),) for b in example.labels}
     defects: list[Defect] = []
     for b in model.labels:
@@ -402,6 +409,15 @@ def violations2(
                 f"an edge of direction {deg:.6g} degrees, which the example does not have",
             ))  # fmt: skip
     defects.extend(extra)
+    for g in ground:
+        assert region is not None
+        sv, se, _ = neighbourhoods(model, fams, scale, (segs, labs),
+                                   within=_side_of(region, g))  # fmt: skip
+        for sig, pt in {**se, **sv}.items():
+            if sig not in on_side[g]:
+                defects.append(Defect("ground", pt, f"a neighbourhood {_show(sig, fams)} on "
+                                      f"the open side {g} that the example does not have on "
+                                      "that side of its box"))  # fmt: skip
     F = fams.F
     for sig, pt in me.items():
         if sig not in allowed:
@@ -427,6 +443,14 @@ def violations2(
         defects = [d for d in defects if x0 - t <= d.point[0] <= x1 + t
                    and y0 - t <= d.point[1] <= y1 + t]  # fmt: skip
     return Violations(defects)
+
+
+def _side_of(box: Sequence[float], g: str) -> tuple[float, float, float, float]:
+    """The side ``g`` of ``box`` ``(x0, y0, x1, y1)``, as a box of zero width."""
+    x0, y0, x1, y1 = box
+    a, sgn = _SIDES[g]
+    at = box[a] if sgn < 0 else box[a + 2]
+    return (at, y0, at, y1) if a == 0 else (x0, at, x1, at)
 
 
 def _open_slabs(box: Sequence[float], ground: Sequence[str], far: float) -> shapely.Geometry:

@@ -238,6 +238,7 @@ def example_signatures(
     example: PolygonModel, lattice: Lattice, label_index: dict[int, int],
     ground: Sequence[str] = (),
     coverage: dict[Signature, int] | None = None,
+    on_ground: dict[str, set[Signature]] | None = None,
 ) -> set[Signature]:  # fmt: skip
     """Every reduced neighbourhood of ``example`` (labels compacted by ``label_index``),
     from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b)).
@@ -248,7 +249,10 @@ def example_signatures(
     edge is no boundary; see :func:`_continued`). ``coverage``, if given, receives how much
     of the example each neighbourhood covers: the number of the arrangement's vertices and
     edges inside the example's box where it occurs (area, length or a count of corners, in
-    line spacings)."""
+    line spacings). ``on_ground``, if given, receives per ``ground`` side the
+    neighbourhoods at the example's vertices and edges on that side of its box, and empty
+    space (what the output may have on the region's side: like the example's bottom, or
+    bare ground)."""
     lo = np.rint(lattice.to_lattice(np.array([example.bounds[:2]]))[0]).astype(np.int64)
     hi = np.rint(lattice.to_lattice(np.array([example.bounds[2:]]))[0]).astype(np.int64)
     bits = sum(SIDES[g] for g in ground)
@@ -279,15 +283,22 @@ def example_signatures(
     vin = ((vpos >= box_lo) & (vpos <= box_hi)).all(axis=1).tolist()
     ein = ((epos >= box_lo) & (epos <= box_hi)).all(axis=1).tolist()
 
-    def seen(sig: Signature, inside: bool) -> None:
+    on_sides: dict[str, set[Signature]] = on_ground if on_ground is not None else {}
+
+    def seen(sig: Signature, inside: bool, sides: int = 0) -> None:
         sigs.add(sig)
         if coverage is not None and inside:
             coverage[sig] = coverage.get(sig, 0) + 1
+        for g in ground if on_ground is not None else ():
+            if sides & SIDES[g]:  # on that side of the box: also bare ground
+                on_sides.setdefault(g, {((-1, 0),)}).add(sig)
+
+    eside = side[A.edge_src] & side[A.edge_dst]
 
     for e, (f, L, R) in enumerate(
         zip(A.edge_family.tolist(), left.tolist(), right.tolist(), strict=True)
     ):
-        seen(reduce_signature([f, F + f], [L, R]), ein[e])
+        seen(reduce_signature([f, F + f], [L, R]), ein[e], int(eside[e]))
     angles = A.ray_angles
     for v, (rays, labs) in enumerate(_vertex_sectors(A, left, right)):
         if not rays:
@@ -296,7 +307,7 @@ def example_signatures(
         if sd & bits:
             full, after = _continued(angles, rays, A.outside_sectors(rays, sd), sd, bits)
             flabs = [0 if k == "fixed" else labs[i] for k, i in after]
-            seen(reduce_signature(full, flabs), vin[v])
+            seen(reduce_signature(full, flabs), vin[v], sd)
         else:
             seen(reduce_signature(rays, labs), vin[v])
     return sigs
@@ -384,8 +395,11 @@ class ContinuousCSP:
         #: how much of the example each neighbourhood covers (vertices and edges of its
         #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
         self.coverage: dict[Signature, int] = {}
+        #: per open side, the example's neighbourhoods on that side of its box (and bare
+        #: ground): the only ones a vertex or edge on that side of the region may take
+        self.on_ground: dict[str, set[Signature]] = {g: {((-1, 0),)} for g in self.ground}
         self.signatures = example_signatures(example, self.lattice, index, self.ground,
-                                             self.coverage)  # fmt: skip
+                                             self.coverage, self.on_ground)  # fmt: skip
         A = self.arrangement = Arrangement(self.lattice, W, H, lines=lines)
         F, Kl = A.F, len(self.labels)
         self.Kl = Kl
@@ -419,6 +433,9 @@ class ContinuousCSP:
                         ex[k] != (b0 if kind == "fixed" else ex[at[i]])
                         for k, (kind, i) in enumerate(past)
                     ):
+                        continue
+                    here = reduce_signature(full, ex)  # on an open side: as the example's
+                    if any(sd & SIDES[g] and here not in self.on_ground[g] for g in self.ground):
                         continue
                     st = tuple(ex[j] for j in at)
                     found[st] = ex
@@ -466,6 +483,10 @@ class ContinuousCSP:
             dom[nv + sel, : Kl * Kl] &= (labs == b0)[None, :]
         # on an open side the world goes on: the same label on both sides of the edge
         dom[nv + np.flatnonzero((eout > 0) & eopen), : Kl * Kl] &= (Ls == Rs)[None, :]
+        for g in self.ground:  # and only what the example has on that side of its box
+            ok = np.array([((-1, int(L)),) in self.on_ground[g] for L in Ls.tolist()])
+            on_g = (side[A.edge_src] & side[A.edge_dst] & SIDES[g]) != 0
+            dom[nv + np.flatnonzero(on_g), : Kl * Kl] &= ok[None, :]
         for f in range(F):  # an edge value (left, right): the example's edges like it
             self.state_weights.append(np.array(
                 [1.0 + self.coverage.get(reduce_signature([f, F + f], [L, R]), 0)

@@ -70,12 +70,18 @@ STEEP = PolygonModel.from_json(
 
 def test_checker_continues_polygons_past_open_sides() -> None:
     region = (0.0, 0.0, 6.0, 7.0)
-    # the slope meets the region's left side: a corner the example has only seen through
-    # its window (its slope meets the flat top it continues from the left side)
+    # the slope meets the region's left side: without the ground an acute corner the
+    # example lacks; with it, the slope meets a flat top continued from the left, which
+    # the example has inside (at (2, 4)) but not on that side of its box
     v = violations(HILL, STEEP, region=region)
-    assert len(v) == 1 and v.counts() == {"vertex": 1} and v[0].point == (0.0, 6.0)
-    assert len(violations(HILL, STEEP, region=region, ground=("x-",))) == 0
-    assert len(violations(HILL, STEEP, region=region, ground=ground_sides("window"))) == 0
+    assert v.counts() == {"vertex": 1} and v[0].point == (0.0, 6.0)
+    for ground in (("x-",), ground_sides("window")):
+        v = violations(HILL, STEEP, region=region, ground=ground)
+        assert v.counts() == {"ground": 2} and {d.point for d in v} == {(0.0, 6.0)}
+    # the hill cut by the sides elsewhere, as the example is: valid with the window
+    cut = PolygonModel.from_json({"polygons": [
+        {"label": 1, "points": [[0, 0], [6, 0], [6, 3], [2, 3], [1, 4], [0, 4]]}]})  # fmt: skip
+    assert len(violations(HILL, cut, region=region, ground=ground_sides("window"))) == 0
 
 
 def test_checker_flags_a_floating_polygon_only_with_the_ground() -> None:
