@@ -146,8 +146,6 @@ def synthesize(
     if args.spacing is not None and not args.spacing > 0:
         raise InputError(f"--spacing must be positive, not {args.spacing}")
     ground = getattr(args, "ground", "auto")
-    if dim == 2 and ground not in ("auto", "none", None):
-        raise InputError(f"--ground {ground}: a ground applies to polyhedral models (3D)")
     lines = "lattice" if dim == 2 and args.lines == "auto" else args.lines
     size = region(args, dim)
     boundary = boundary_label(args, example)
@@ -187,7 +185,7 @@ def synthesize(
     _, seed = make_rng(args.seed)  # the seed the header prints: it reproduces every attempt
     common = dict(solver=args.solver, rng=seed, spacing=args.spacing, snap=args.snap,
                   boundary=boundary, restarts=restarts, fallback=fallback,
-                  ground=ground if dim == 3 else None)  # fmt: skip
+                  ground=ground)  # fmt: skip
     if dim == 3:  # the arrangement's estimate (Sec. 4.5.7) is refused over the budget
         common["max_memory"] = int(budget)
     cons = user_constraints(args, example)
@@ -210,8 +208,8 @@ def synthesize(
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
-    opened: tuple[str, ...] = getattr(csp, "ground", ())  # 3D only
-    if dim == 3:
+    opened: tuple[str, ...] = csp.ground
+    if dim == 3 or opened:
         open_faces = ",".join(opened) or "none"
         settings["ground"] = open_faces + (" (the example's)" if ground == "auto" else "")
     if dim == 3:
@@ -387,12 +385,11 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         raise InputError("--spacing, --snap and --lines of check apply to polyhedral models")
     ground = getattr(args, "ground", "auto")
     if ground == "auto":
-        ground = example.meta.get("ground") if isinstance(example, PolyhedralModel) else None
+        ground = example.meta.get("ground")
+    from csplab.continuous.csp import ground_sides
     from csplab.continuous.csp3d import ground_faces
 
-    faces = ground_faces(ground)
-    if faces and not isinstance(out, PolyhedralModel):
-        raise InputError(f"--ground {ground}: a ground applies to polyhedral models (3D)")
+    faces = ground_faces(ground) if isinstance(out, PolyhedralModel) else ground_sides(ground)
     if bounded is not None and isinstance(out, PolyhedralModel):
         from csplab.continuous.boundcheck import bounded_violations
 

@@ -38,9 +38,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--ground",
         default="auto",
-        help="polyhedral models: the faces past which example and output continue, as "
-        "synthesize --ground (the output's own box stands for its region); default auto: "
-        "the example's own",
+        help="the faces (polyhedral models) or sides (polygon models) past which example and "
+        "output continue, as synthesize --ground (the output's own box stands for its "
+        "region); default auto: the example's own",
     )
     p.add_argument(
         "--spacing",

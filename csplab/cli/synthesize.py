@@ -109,10 +109,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--ground",
         default="auto",
-        help="polyhedral models: faces past which the example (its bounding box) and the "
-        "output (the region) continue, an infinite ground: z- (solids standing on the "
-        "bottom go on below it, none floats), a list such as z-,x-,x+, window (every face "
-        "but z+), none; default auto: the example's own (the built-in ones declare theirs)",
+        help="faces (polyhedral models) or sides (polygon models: x-, x+, y-, y+) past which "
+        "the example (its bounding box) and the output (the region) continue, an infinite "
+        "ground: z- (y- in 2D; solids standing on the bottom go on below it, none floats), "
+        "a list such as z-,x-,x+, window (every face but the top), none; default auto: the "
+        "example's own (its meta's \"ground\"; the built-in polyhedral ones declare theirs)",
     )
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     add_memory_limit_arg(p)

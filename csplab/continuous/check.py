@@ -58,6 +58,8 @@ from csplab.errors import InputError
 __all__ = ["Defect", "Violations", "neighbourhoods", "reduced", "violations", "violations2"]
 
 _FACES = ("z-", "z+", "x-", "x+", "y-", "y+")
+#: a polygon model's sides, as ``(axis, sign)``
+_SIDES = {"x-": (0, -1), "x+": (0, 1), "y-": (1, -1), "y+": (1, 1)}
 
 #: a reduced neighbourhood: ``(ray, label after it)`` pairs, or ``((-1, label),)``
 Signature = tuple[tuple[int, int], ...]
@@ -215,17 +217,25 @@ def neighbourhoods(
     fams: _Families,
     scale: float,
     segments: tuple[np.ndarray[Any, Any], list[int]] | None = None,
+    within: tuple[float, float, float, float] | None = None,
 ) -> tuple[dict[Signature, tuple[float, float]], dict[Signature, tuple[float, float]],
            list[Defect]]:  # fmt: skip
     """Reduced neighbourhoods of ``model``'s nodes and of its edges (beside each node), each
     with one point where it occurs, and defects that are not about matching (foreign
-    directions, overlapping labels)."""
+    directions, overlapping labels); ``within`` ``(x0, y0, x1, y1)``: only nodes in that
+    closed box."""
     F = fams.F
     vsig: dict[Signature, tuple[float, float]] = {}
     esig: dict[Signature, tuple[float, float]] = {}
     defects: list[Defect] = []
     segs, labs = segments if segments is not None else _segments(model)
+    t = 1e-9 * scale
     for n in _nodes(segs, labs, fams, scale):
+        if within is not None and not (
+            within[0] - t <= n.point[0] <= within[2] + t
+            and within[1] - t <= n.point[1] <= within[3] + t
+        ):
+            continue  # fmt: skip
         rays = sorted(set(n.after) | set(n.before))
         m = len(rays)
         sect = []
@@ -271,9 +281,9 @@ def violations(
         The label around the region; in 3D also one per face (``{"z-": 1}``, faces not
         named being empty space, label 0).
     ground : sequence of str, default ()
-        3D: the faces (``"z-"`` ...) past which the example (its bounding box) and the
-        output (``region``) continue, as a synthesis with a ground
-        (:class:`~csplab.continuous.csp3d.ContinuousCSP3`) has them.
+        The sides (2D: ``"x-", "x+", "y-", "y+"``) or faces (3D: ``"z-"`` ...) past which
+        the example (its bounding box) and the output (``region``) continue, as a synthesis
+        with a ground has them.
 
     Returns
     -------
@@ -283,8 +293,8 @@ def violations(
     Raises
     ------
     InputError
-        When ``outside`` is a mapping for polygon models, or the two models differ in
-        dimension.
+        When ``outside`` is a mapping for polygon models, the two models differ in
+        dimension, or a 2D ``ground`` names another side or comes without a ``region``.
 
     Examples
     --------
@@ -298,9 +308,7 @@ def violations(
         if isinstance(outside, Mapping):
             raise InputError("a polygon model has one label outside its region, not one per face")
         r2 = None if region is None else (region[0], region[1], region[2], region[3])
-        if ground:
-            raise InputError("a ground applies to polyhedral models (3D)")
-        return violations2(example, model, region=r2, outside=outside)
+        return violations2(example, model, region=r2, outside=outside, ground=ground)
     if isinstance(example, PolyhedralModel) and isinstance(model, PolyhedralModel):
         faces = outside if isinstance(outside, Mapping) else dict.fromkeys(_FACES, outside)
         r3 = None if region is None else (region[0], region[1], region[2], region[3], region[4],
@@ -319,23 +327,43 @@ def violations2(
     angle_tol: float = ANGLE_TOL,
     region: tuple[float, float, float, float] | None = None,
     outside: int = 0,
+    ground: Sequence[str] = (),
 ) -> Violations:
     """Every place where the polygon model ``model`` breaks Eq. 4.1 w.r.t. ``example``
     (see the module docstring); ``len() == 0`` means the model is a valid output.
 
     ``region`` ``(x0, y0, x1, y1)`` and ``outside``: the model fills that rectangle and
     the plane around it has label ``outside`` (a synthesis with a boundary label other than
-    0); only points in the closed region are checked.
+    0); only points in the closed region are checked. ``ground``: the sides (``"x-"``,
+    ``"x+"``, ``"y-"``, ``"y+"``) past which the world goes on, for the example past its
+    bounding box and for the model past ``region``: each polygon touching such a side
+    along an edge is extended straight across it (the label just inside continues), and
+    only the example's neighbourhoods inside its box count.
     """
+    bad = [g for g in ground if g not in _SIDES]
+    if bad:
+        raise InputError(f"ground: a polygon model has the sides {', '.join(_SIDES)}, not "
+                         f"{', '.join(bad)}")  # fmt: skip
+    if ground and region is None:
+        raise InputError("a ground needs the output's region")
     if region is not None and outside != 0:
         x0, y0, x1, y1 = region
         m = max(x1 - x0, y1 - y0)
-        frame = Polygon(
-            outside,
-            ((x0 - m, y0 - m), (x1 + m, y0 - m), (x1 + m, y1 + m), (x0 - m, y1 + m)),
-            (((x0, y0), (x0, y1), (x1, y1), (x1, y0)),),
+        ring = shapely.box(x0 - m, y0 - m, x1 + m, y1 + m).difference(
+            _open_slabs(region, ground, m)
         )
-        model = PolygonModel._trusted([*model.polygons, frame], name=model.name)
+        frame = [Polygon(outside, tuple(g.exterior.coords)[:-1],
+                         tuple(tuple(h.coords)[:-1] for h in g.interiors))
+                 for g in getattr(ring, "geoms", [ring]) if g.area > 0]  # fmt: skip
+        model = PolygonModel._trusted([*model.polygons, *frame], name=model.name)
+    ebox = None
+    if ground:
+        assert region is not None
+        ebox = example.bounds
+        ext = max(ebox[2] - ebox[0], ebox[3] - ebox[1], region[2] - region[0],
+                  region[3] - region[1])  # fmt: skip
+        example = _continued(example, (ebox[0], ebox[1], ebox[2], ebox[3]), ground, ext)
+        model = _continued(model, region, ground, ext)
     lo = np.minimum(
         np.array(example.bounds[:2]), np.array(model.bounds[:2]) if len(model) else np.inf
     )
@@ -344,7 +372,14 @@ def violations2(
     )
     scale = float(max(1.0, np.abs(lo).max(), np.abs(hi).max(), (hi - lo).max()))
     fams = _Families(_edge_angles(example), angle_tol)
-    ev, ee, _ = neighbourhoods(example, fams, scale)
+    ev, ee, _ = neighbourhoods(example, fams, scale, within=ebox)
+    # on an open side, the output has what the example has on that side of its box (or
+    # bare ground): its nodes there and the edges beside them
+    on_side: dict[str, set[Signature]] = {}
+    for g in ground:
+        assert ebox is not None
+        sv, se, _ = neighbourhoods(example, fams, scale, within=_side_of(ebox, g))
+        on_side[g] = {((-1, 0),)} | set(sv) | set(se)
     allowed = set(ev) | set(ee) | {((-1, 0),)} | {((-1, b),) for b in example.labels}
     defects: list[Defect] = []
     for b in model.labels:
@@ -362,7 +397,9 @@ def violations2(
                 c = both.representative_point()
                 defects.append(Defect("label", (c.x, c.y), f"labels [{a}, {b}] overlap here"))
     segs, labs = _segments(model)
-    mv, me, extra = neighbourhoods(model, fams, scale, (segs, labs))
+    # only nodes in the region: a neighbourhood seen first outside it (on the frame or past
+    # an open side) would otherwise hide the same one inside
+    mv, me, extra = neighbourhoods(model, fams, scale, (segs, labs), within=region)
     for (ax, ay), (bx, by) in segs.tolist():
         r = fams.ray(bx - ax, by - ay)
         if r >= _FOREIGN:
@@ -372,6 +409,15 @@ def violations2(
                 f"an edge of direction {deg:.6g} degrees, which the example does not have",
             ))  # fmt: skip
     defects.extend(extra)
+    for g in ground:
+        assert region is not None
+        sv, se, _ = neighbourhoods(model, fams, scale, (segs, labs),
+                                   within=_side_of(region, g))  # fmt: skip
+        for sig, pt in {**se, **sv}.items():
+            if sig not in on_side[g]:
+                defects.append(Defect("ground", pt, f"a neighbourhood {_show(sig, fams)} on "
+                                      f"the open side {g} that the example does not have on "
+                                      "that side of its box"))  # fmt: skip
     F = fams.F
     for sig, pt in me.items():
         if sig not in allowed:
@@ -397,6 +443,69 @@ def violations2(
         defects = [d for d in defects if x0 - t <= d.point[0] <= x1 + t
                    and y0 - t <= d.point[1] <= y1 + t]  # fmt: skip
     return Violations(defects)
+
+
+def _side_of(box: Sequence[float], g: str) -> tuple[float, float, float, float]:
+    """The side ``g`` of ``box`` ``(x0, y0, x1, y1)``, as a box of zero width."""
+    x0, y0, x1, y1 = box
+    a, sgn = _SIDES[g]
+    at = box[a] if sgn < 0 else box[a + 2]
+    return (at, y0, at, y1) if a == 0 else (x0, at, x1, at)
+
+
+def _open_slabs(box: Sequence[float], ground: Sequence[str], far: float) -> shapely.Geometry:
+    """The strips past the open sides of ``box`` (across each side, as wide as the box
+    and the other open sides' strips)."""
+    x0, y0, x1, y1 = box
+    lo = [x0 - (far if "x-" in ground else 0), y0 - (far if "y-" in ground else 0)]
+    hi = [x1 + (far if "x+" in ground else 0), y1 + (far if "y+" in ground else 0)]
+    out = shapely.Polygon()
+    for g in ground:
+        a, sgn = _SIDES[g]
+        b0, b1 = list(lo), list(hi)
+        if sgn < 0:
+            b0[a], b1[a] = box[a] - far, box[a]
+        else:
+            b0[a], b1[a] = box[a + 2], box[a + 2] + far
+        out = out.union(shapely.box(b0[0], b0[1], b1[0], b1[1]))
+    return out
+
+
+def _continued(
+    model: PolygonModel, box: Sequence[float], ground: Sequence[str], far: float
+) -> PolygonModel:
+    """``model`` seen through the window ``box``: past each open side, every label
+    touching that side along a segment goes on straight across it for ``far`` (sides in
+    the order given, so a corner between two open sides takes the label at the box's
+    corner)."""
+    x0, y0, x1, y1 = box
+    shapes = {b: model.shape(b) for b in model.labels}
+    for g in ground:
+        a, sgn = _SIDES[g]
+        at = box[a] if sgn < 0 else box[a + 2]
+        span = (y0 - far, y1 + far) if a == 0 else (x0 - far, x1 + far)
+        line = (shapely.LineString([(at, span[0]), (at, span[1])]) if a == 0
+                else shapely.LineString([(span[0], at), (span[1], at)]))  # fmt: skip
+        for b, shp in shapes.items():
+            cut = shp.intersection(line)
+            rects = []
+            for part in getattr(cut, "geoms", [cut]):
+                if part.geom_type != "LineString" or part.length <= 0:
+                    continue  # touching at a point: nothing continues
+                c = np.asarray(part.coords)
+                u0, u1 = float(c[:, 1 - a].min()), float(c[:, 1 - a].max())
+                v0, v1 = (at - far, at) if sgn < 0 else (at, at + far)
+                rects.append(shapely.box(v0, u0, v1, u1) if a == 0
+                             else shapely.box(u0, v0, u1, v1))  # fmt: skip
+            if rects:
+                shapes[b] = shapely.union_all([shp, *rects])
+    polys = []
+    for b, shp in shapes.items():
+        for g in getattr(shp, "geoms", [shp]):
+            if g.geom_type == "Polygon" and g.area > 0:
+                polys.append(Polygon(b, tuple(g.exterior.coords)[:-1],
+                                     tuple(tuple(h.coords)[:-1] for h in g.interiors)))  # fmt: skip
+    return PolygonModel._trusted(polys, name=model.name)
 
 
 def _edge_sides(sig: Signature, F: int) -> tuple[int, int]:

@@ -42,6 +42,7 @@ True
 from __future__ import annotations
 
 import bisect
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any, TypedDict, Unpack, overload
 
@@ -50,7 +51,7 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
-from csplab.continuous.csp3d import ContinuousCSP3, ground_faces
+from csplab.continuous.csp3d import ContinuousCSP3
 from csplab.continuous.model import Polygon, PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -58,15 +59,112 @@ from csplab.errors import InputError
 from csplab.problem import Problem
 
 __all__ = [
+    "SIDES",
+    "WINDOW2",
     "ContinuousCSP",
     "Signature",
     "continuous_csp",
     "example_signatures",
+    "ground_sides",
     "reduce_signature",
 ]
 
 Signature = tuple[tuple[int, int], ...]
 _EPS = 1e-6  # offset (in lattice units / D) of the sample points beside an edge
+
+#: the region's sides in 2D, named as the 3D faces, with their bits of
+#: :meth:`~csplab.continuous.arrangement.Arrangement.on_side`
+SIDES = {"x-": 1, "x+": 2, "y-": 4, "y+": 8}
+#: ``ground="window"`` in 2D: every side but the sky
+WINDOW2 = ("y-", "x-", "x+")
+
+
+def ground_sides(ground: str | Sequence[str] | None) -> tuple[str, ...]:
+    """The open sides of a 2D ``ground`` declaration (see :class:`ContinuousCSP`):
+    ``None``, ``""`` or ``"none"``: none; ``"window"``: :data:`WINDOW2`; otherwise sides
+    of :data:`SIDES`, comma-separated or a sequence.
+
+    Examples
+    --------
+    >>> ground_sides("y-"), ground_sides("x+,y-"), ground_sides(None)
+    (('y-',), ('x+', 'y-'), ())
+    >>> ground_sides("z-")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: ground: polygon model sides are x-, x+, y-, y+ (window, none), not z-
+    """
+    if ground is None or (isinstance(ground, str) and ground.strip() in ("", "none")):
+        return ()
+    if isinstance(ground, str):
+        if ground.strip() == "window":
+            return WINDOW2
+        items = [g.strip() for g in ground.split(",") if g.strip()]
+    else:
+        items = [str(g) for g in ground]
+    bad = [g for g in items if g not in SIDES]
+    if bad:
+        raise InputError(f"ground: polygon model sides are {', '.join(SIDES)} (window, none), "
+                         f"not {', '.join(bad)}")  # fmt: skip
+    return tuple(f for f in SIDES if f in items)
+
+
+def _continued(
+    angles: NDArray[np.float64], rays: Sequence[int], outside: Sequence[bool], sides: int,
+    open_bits: int,
+) -> tuple[list[int], list[tuple[str, int]]]:  # fmt: skip
+    """How a vertex on the region's sides sees past them: the full rays (``rays`` plus
+    the axis rays that split its outside sector) and, per full ray, the label after it as
+    ``("in", i)`` (sector ``i`` of ``rays``), ``("fixed", 0)`` (the boundary label: past a
+    side that is not open) or ``("copy", i)`` (past open sides only: the continuation of
+    the world, the label just inside, in sector ``i``; the example as a window).
+
+    ``angles``: every ray's angle; ``sides``: the sides the vertex lies on
+    (:meth:`~csplab.continuous.arrangement.Arrangement.on_side` bits); ``open_bits``: the
+    open (ground) ones."""
+    m = len(rays)
+    full: list[int] = []
+    after: list[tuple[str, int]] = []
+    two = 2 * math.pi
+    axis = {k: int(np.argmin(np.abs((angles - k * math.pi / 2 + math.pi) % two - math.pi)))
+            for k in range(4)}  # fmt: skip
+
+    def sector_at(psi: float) -> int:
+        for j in range(m):
+            a = float(angles[rays[j]])
+            b = float(angles[rays[(j + 1) % m]]) if m > 1 else a + two
+            if b <= a:
+                b += two
+            if a < psi < b or a < psi + two < b:
+                return j
+        raise AssertionError("a direction on a ray")  # pragma: no cover
+
+    for i in range(m):
+        full.append(rays[i])
+        if not outside[i]:
+            after.append(("in", i))
+            continue
+        a = float(angles[rays[i]])
+        b = float(angles[rays[(i + 1) % m]]) if m > 1 else a + two
+        if b <= a:
+            b += two
+        cuts = [k * math.pi / 2 for k in range(1, 9) if a + 1e-9 < k * math.pi / 2 < b - 1e-9]
+        bounds = [a, *cuts, b]
+        for k in range(len(bounds) - 1):
+            phi = 0.5 * (bounds[k] + bounds[k + 1])
+            c, sn = math.cos(phi), math.sin(phi)
+            out = {1: c < 0, 2: c > 0, 4: sn < 0, 8: sn > 0}
+            if any(out[bit] and sides & bit and not open_bits & bit for bit in out):
+                what = ("fixed", 0)
+            else:
+                if (sides & 1 and c < 0) or (sides & 2 and c > 0):
+                    c = (1e-6 if sides & 1 else -1e-6) * (abs(c) + abs(sn))
+                if (sides & 4 and sn < 0) or (sides & 8 and sn > 0):
+                    sn = (1.37e-6 if sides & 4 else -1.37e-6) * (abs(c) + abs(sn))
+                what = ("copy", sector_at(math.atan2(sn, c) % two))
+            if k:
+                full.append(axis[round(bounds[k] / (math.pi / 2)) % 4])
+            after.append(what)
+    return full, after
 
 
 def reduce_signature(rays: Sequence[int], labels: Sequence[int]) -> Signature:
@@ -137,29 +235,81 @@ def _vertex_sectors(
 
 
 def example_signatures(
-    example: PolygonModel, lattice: Lattice, label_index: dict[int, int]
-) -> set[Signature]:
+    example: PolygonModel, lattice: Lattice, label_index: dict[int, int],
+    ground: Sequence[str] = (),
+    coverage: dict[Signature, int] | None = None,
+    on_ground: dict[str, set[Signature]] | None = None,
+) -> set[Signature]:  # fmt: skip
     """Every reduced neighbourhood of ``example`` (labels compacted by ``label_index``),
-    from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b))."""
+    from the arrangement of its own bounding box plus one spacing (paper Fig. 2(b)).
+
+    Past the sides of its bounding box named in ``ground`` (:func:`ground_sides`) the
+    example continues: there the arrangement ends at the box, and the label past it is the
+    one just inside (a polygon standing on the bottom goes on below it, so its bottom
+    edge is no boundary; see :func:`_continued`). ``coverage``, if given, receives how much
+    of the example each neighbourhood covers: the number of the arrangement's vertices and
+    edges inside the example's box where it occurs (area, length or a count of corners, in
+    line spacings). ``on_ground``, if given, receives per ``ground`` side the
+    neighbourhoods at the example's vertices and edges on that side of its box, and empty
+    space (what the output may have on the region's side: like the example's bottom, or
+    bare ground)."""
     lo = np.rint(lattice.to_lattice(np.array([example.bounds[:2]]))[0]).astype(np.int64)
     hi = np.rint(lattice.to_lattice(np.array([example.bounds[2:]]))[0]).astype(np.int64)
-    A = Arrangement(lattice, int(hi[0] - lo[0]) + 2, int(hi[1] - lo[1]) + 2)
+    bits = sum(SIDES[g] for g in ground)
+    m0 = np.array([0 if bits & 1 else 1, 0 if bits & 4 else 1])  # margins low
+    m1 = np.array([0 if bits & 2 else 1, 0 if bits & 8 else 1])  # and high
+    A = Arrangement(lattice, *(int(v) for v in hi - lo + m0 + m1))
     s = float(lattice.spacing)
     o = np.array([float(lattice.origin[0]), float(lattice.origin[1])])
     shapes = {}
     for b in example.labels:
         g = example.shape(b)
-        g = shapely.transform(g, lambda xy: (xy - o) / s - lo + 1.0)
+        g = shapely.transform(g, lambda xy: (xy - o) / s - lo + m0)
         shapely.prepare(g)
         shapes[label_index[b]] = g
     left, right = _edge_labels(A, shapes, (0.0, 0.0))
     sigs: set[Signature] = {((-1, 0),)} | {((-1, i),) for i in shapes}
     F = A.F
-    for f, L, R in zip(A.edge_family.tolist(), left.tolist(), right.tolist(), strict=True):
-        sigs.add(reduce_signature([f, F + f], [L, R]))
-    for rays, labs in _vertex_sectors(A, left, right):
-        if rays:
-            sigs.add(reduce_signature(rays, labs))
+    side = A.on_side()
+    if bits:  # an edge on an open side: the world continues past it (no boundary there)
+        common = side[A.edge_src] & side[A.edge_dst]
+        eout = A.edge_outside()
+        on_open = (common & bits) != 0
+        left = np.where(on_open & (eout == 1), right, left)
+        right = np.where(on_open & (eout == 2), left, right)
+    tol = 1e-9  # inside the example's box (closed), in lattice units
+    box_lo, box_hi = m0 - tol, m0 + (hi - lo) + tol
+    vpos, epos = A.vertex_positions(), A.edge_positions()
+    vin = ((vpos >= box_lo) & (vpos <= box_hi)).all(axis=1).tolist()
+    ein = ((epos >= box_lo) & (epos <= box_hi)).all(axis=1).tolist()
+
+    on_sides: dict[str, set[Signature]] = on_ground if on_ground is not None else {}
+
+    def seen(sig: Signature, inside: bool, sides: int = 0) -> None:
+        sigs.add(sig)
+        if coverage is not None and inside:
+            coverage[sig] = coverage.get(sig, 0) + 1
+        for g in ground if on_ground is not None else ():
+            if sides & SIDES[g]:  # on that side of the box: also bare ground
+                on_sides.setdefault(g, {((-1, 0),)}).add(sig)
+
+    eside = side[A.edge_src] & side[A.edge_dst]
+
+    for e, (f, L, R) in enumerate(
+        zip(A.edge_family.tolist(), left.tolist(), right.tolist(), strict=True)
+    ):
+        seen(reduce_signature([f, F + f], [L, R]), ein[e], int(eside[e]))
+    angles = A.ray_angles
+    for v, (rays, labs) in enumerate(_vertex_sectors(A, left, right)):
+        if not rays:
+            continue
+        sd = int(side[v])
+        if sd & bits:
+            full, after = _continued(angles, rays, A.outside_sectors(rays, sd), sd, bits)
+            flabs = [0 if k == "fixed" else labs[i] for k, i in after]
+            seen(reduce_signature(full, flabs), vin[v], sd)
+        else:
+            seen(reduce_signature(rays, labs), vin[v])
     return sigs
 
 
@@ -186,6 +336,12 @@ class ContinuousCSP:
     lattice : Lattice, optional
         The lattice to use (``spacing`` and ``snap`` are then ignored); default: the
         example's own, :meth:`Lattice.of_model`.
+    ground : str or sequence of str, optional
+        The open sides (:func:`ground_sides`, e.g. ``"y-"``): the example is a window onto
+        a world that continues past these sides of its bounding box, and so does the
+        output past these sides of the region (a state there has, outside the region, what
+        it has just inside: a polygon reaching the bottom stands on the ground). Default
+        none.
 
     Attributes
     ----------
@@ -216,6 +372,7 @@ class ContinuousCSP:
         boundary: int = 0,
         lines: str = "lattice",
         lattice: Lattice | None = None,
+        ground: str | Sequence[str] | None = None,
     ) -> None:
         if len(size) != 2:
             raise InputError(f"a continuous 2D region needs WxH, not {tuple(size)}")
@@ -232,7 +389,17 @@ class ContinuousCSP:
         if boundary not in index:
             raise InputError(f"boundary label {boundary} does not occur in the example")
         self.boundary = boundary
-        self.signatures = example_signatures(example, self.lattice, index)
+        #: the open sides (:func:`ground_sides`): the example and the output continue past them
+        self.ground = ground_sides(ground)
+        opened = sum(SIDES[g] for g in self.ground)
+        #: how much of the example each neighbourhood covers (vertices and edges of its
+        #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
+        self.coverage: dict[Signature, int] = {}
+        #: per open side, the example's neighbourhoods on that side of its box (and bare
+        #: ground): the only ones a vertex or edge on that side of the region may take
+        self.on_ground: dict[str, set[Signature]] = {g: {((-1, 0),)} for g in self.ground}
+        self.signatures = example_signatures(example, self.lattice, index, self.ground,
+                                             self.coverage, self.on_ground)  # fmt: skip
         A = self.arrangement = Arrangement(self.lattice, W, H, lines=lines)
         F, Kl = A.F, len(self.labels)
         self.Kl = Kl
@@ -245,15 +412,42 @@ class ContinuousCSP:
         self.type_rays: list[list[int]] = []
         self.type_states: list[list[tuple[int, ...]]] = []
         self.type_outside: list[tuple[bool, ...]] = []
+        #: per vertex type, its rays seen past open sides and each state's label after
+        #: each of them (:func:`_continued`; the type's own rays and states elsewhere)
+        self.type_full: list[tuple[list[int], dict[tuple[int, ...], tuple[int, ...]]]] = []
+        angles = A.ray_angles
+        #: per vertex type then edge family, the weight of each value (``choice="weighted"``)
+        self.state_weights: list[NDArray[np.float64]] = []
         for key in ukeys.tolist():
             mask, sd = key >> 4, key & 15
             rays = [r for r in range(2 * F) if (mask >> r) & 1]
             outside = A.outside_sectors(rays, sd) if sd else (False,) * len(rays)
-            found: set[tuple[int, ...]] = set()
-            for sig in self.signatures:
-                st = _expand(sig, rays)
-                if st is not None and all(st[i] == b0 for i in range(len(rays)) if outside[i]):
-                    found.add(st)
+            found: dict[tuple[int, ...], tuple[int, ...]] = {}
+            cover: dict[tuple[int, ...], int] = {}  # per state: the example it covers
+            if sd & opened:
+                full, past = _continued(angles, rays, outside, sd, opened)
+                at = [full.index(r) for r in rays]
+                for sig in self.signatures:
+                    ex = _expand(sig, full)
+                    if ex is None or any(
+                        ex[k] != (b0 if kind == "fixed" else ex[at[i]])
+                        for k, (kind, i) in enumerate(past)
+                    ):
+                        continue
+                    here = reduce_signature(full, ex)  # on an open side: as the example's
+                    if any(sd & SIDES[g] and here not in self.on_ground[g] for g in self.ground):
+                        continue
+                    st = tuple(ex[j] for j in at)
+                    found[st] = ex
+                    cover[st] = cover.get(st, 0) + self.coverage.get(sig, 0)
+            else:
+                full = rays
+                for sig in self.signatures:
+                    got = _expand(sig, rays)
+                    if got is not None and all(got[i] == b0 for i in range(len(rays))
+                                               if outside[i]):  # fmt: skip
+                        found[got] = got
+                        cover[got] = cover.get(got, 0) + self.coverage.get(sig, 0)
             ordered = sorted(found, key=lambda st: (any(st), st))
             if not ordered:
                 raise InputError(
@@ -263,6 +457,10 @@ class ContinuousCSP:
             self.type_rays.append(rays)
             self.type_states.append(ordered)
             self.type_outside.append(outside)
+            self.type_full.append((full, found))
+            # Sec. 4.5.4's states, each weighted by the example it covers (+1: every state
+            # stays possible): the neighbourhoods that look like it here
+            self.state_weights.append(np.array([1.0 + cover[st] for st in ordered]))
         nst = max(len(s) for s in self.type_states)
         K = self.K = max(nst, Kl * Kl)
         # edge domains per family
@@ -278,16 +476,32 @@ class ContinuousCSP:
         dom[:nv] = np.arange(K)[None, :] < nstates[vtype][:, None]
         dom[nv:, : Kl * Kl] = edge_ok[A.edge_family]
         Ls, Rs = np.divmod(np.arange(Kl * Kl), Kl)
+        side = A.on_side()
+        eopen = (side[A.edge_src] & side[A.edge_dst] & opened) != 0
         for code, labs in ((1, Ls), (2, Rs)):
-            sel = np.flatnonzero(eout == code)
+            sel = np.flatnonzero((eout == code) & ~eopen)
             dom[nv + sel, : Kl * Kl] &= (labs == b0)[None, :]
+        # on an open side the world goes on: the same label on both sides of the edge
+        dom[nv + np.flatnonzero((eout > 0) & eopen), : Kl * Kl] &= (Ls == Rs)[None, :]
+        for g in self.ground:  # and only what the example has on that side of its box
+            ok = np.array([((-1, int(L)),) in self.on_ground[g] for L in Ls.tolist()])
+            on_g = (side[A.edge_src] & side[A.edge_dst] & SIDES[g]) != 0
+            dom[nv + np.flatnonzero(on_g), : Kl * Kl] &= ok[None, :]
+        for f in range(F):  # an edge value (left, right): the example's edges like it
+            self.state_weights.append(np.array(
+                [1.0 + self.coverage.get(reduce_signature([f, F + f], [L, R]), 0)
+                 for L in range(Kl) for R in range(Kl)]))  # fmt: skip
         # relations per (type, ray position), deduplicated
         rel_ids: dict[bytes, int] = {}
         rels: list[NDArray[np.bool_]] = []
         pos_rel = np.full((len(ukeys), 2 * F), -1, dtype=np.int64)
         for t, (rays, states) in enumerate(zip(self.type_rays, self.type_states, strict=True)):
-            S = np.array(states, dtype=np.int64).reshape(len(states), len(rays))
-            for i, r in enumerate(rays):
+            full, seen = self.type_full[t]
+            S = np.array([seen[st] for st in states], dtype=np.int64).reshape(
+                len(states), len(full)
+            )
+            for r in rays:
+                i = full.index(r)
                 before, after = S[:, i - 1], S[:, i]
                 lab_l, lab_r = (after, before) if r < F else (before, after)
                 M = np.zeros((K, K), dtype=bool)
@@ -311,6 +525,13 @@ class ContinuousCSP:
         ])  # fmt: skip
         if (arcs[:, 2] < 0).any():  # pragma: no cover - every incidence is a ray
             raise AssertionError("an edge end without its ray")
+        # the weighted choice: one weight class per vertex type and per edge family
+        table = np.zeros((len(self.state_weights), K), dtype=np.float64)
+        for t, w in enumerate(self.state_weights):
+            table[t, : len(w)] = w
+        cls = np.empty(nv + ne, dtype=np.int64)
+        cls[self.var_vertex] = self.vertex_type
+        cls[self.var_edge] = len(self.type_states) + A.edge_family
         self.problem = Problem(
             (nv + ne,),
             dom[order],
@@ -327,8 +548,10 @@ class ContinuousCSP:
                 "edges": ne,
                 "boundary": boundary,
                 "lines": lines,
+                "ground": list(self.ground),
             },
             positions=pos[order],
+            value_weights=(table, cls),
         )
 
     # ------------------------------------------------------------------ queries
@@ -527,8 +750,11 @@ class ContinuousCSP:
         left, right = _edge_labels(A, shapes, (0.0, 0.0))
         eout = A.edge_outside()
         b0 = index[self.boundary]
-        left[eout == 1] = b0
-        right[eout == 2] = b0
+        side = A.on_side()
+        opened = sum(SIDES[g] for g in self.ground)
+        eopen = (side[A.edge_src] & side[A.edge_dst] & opened) != 0
+        left[eout == 1] = np.where(eopen, right, b0)[eout == 1]  # past an open side: as inside
+        right[eout == 2] = np.where(eopen, left, b0)[eout == 2]
         grid = np.full(self.problem.n, -1, dtype=np.int32)
         grid[self.var_edge] = left * self.Kl + right
         lookup = [{st: i for i, st in enumerate(sts)} for sts in self.type_states]
@@ -653,8 +879,9 @@ def continuous_csp(
         (:func:`~csplab.continuous.space.estimate3`); default a share of the memory
         available.
     ground : str or sequence of str, optional
-        3D: the faces past which the example and the output continue (an infinite ground,
-        :func:`~csplab.continuous.csp3d.ground_faces`); default none.
+        The sides (2D, :func:`ground_sides`: ``x-, x+, y-, y+``) or faces (3D,
+        :func:`~csplab.continuous.csp3d.ground_faces`) past which the example and the
+        output continue (an infinite ground); default none.
 
     Returns
     -------
@@ -671,12 +898,12 @@ def continuous_csp(
         return ContinuousCSP3(example, size, spacing=spacing, snap=snap, boundary=boundary,
                               constraints=constraints, max_memory=max_memory,
                               ground=ground, planes=lines)  # fmt: skip
-    if ground_faces(ground):
-        raise InputError("a ground applies to polyhedral models (3D) for now")
     if lines == "auto":
         lines = "lattice"
     if constraints:
         raise InputError("polygon models (2D) take no user constraints yet")
     if isinstance(boundary, Mapping):
         raise InputError("a polygon model has one label outside its region, not one per face")
-    return ContinuousCSP(example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines)
+    return ContinuousCSP(
+        example, size, spacing=spacing, snap=snap, boundary=boundary, lines=lines, ground=ground
+    )

@@ -47,7 +47,8 @@ def auto_ground(
 ) -> str | tuple[str, ...] | None:
     """``ground="auto"``: the example's own ground (``example.meta["ground"]``, as the
     built-in polyhedral examples declare it) but the faces that ``boundary`` gives a label
-    (an explicit boundary wins); ``None`` for polygon models and examples without one.
+    (an explicit boundary wins; a polygon model's one boundary label other than 0 wins
+    over every side); ``None`` for examples without one.
 
     Examples
     --------
@@ -56,10 +57,13 @@ def auto_ground(
     >>> auto_ground(E), auto_ground(E, {"z-": 1}), auto_ground(E, 2)
     (('z-', 'x-', 'x+', 'y-', 'y+'), ('x-', 'x+', 'y-', 'y+'), None)
     """
+    from csplab.continuous.csp import ground_sides
     from csplab.continuous.csp3d import ground_faces
 
-    if not isinstance(example, PolyhedralModel) or not example.meta.get("ground"):
+    if not example.meta.get("ground"):
         return None
+    if isinstance(example, PolygonModel):
+        return None if boundary else ground_sides(example.meta["ground"])
     if not isinstance(boundary, Mapping):
         return None if boundary else ground_faces(example.meta["ground"])
     return tuple(f for f in ground_faces(example.meta["ground"]) if not boundary.get(f))
@@ -68,11 +72,13 @@ def auto_ground(
 def default_choice(problem: Any, solver: str) -> str | None:
     """The label choice continuous synthesis gives ``solver`` when the caller names none:
     ``"weighted"`` when the problem weighs its values per cell (``value_weights``, the
-    3D CSP's coverage of the example) and the solver takes that choice, else ``None``
-    (the solver's own default)."""
+    CSP's coverage of the example) and is a 3D one, and the solver takes that choice, else
+    ``None`` (the solver's own default). Polygon models (2D) keep the thesis' uniform
+    choice by default (their built-in outputs stay as published); ``choice="weighted"``
+    gives them the coverage weights too."""
     from csplab.solvers import solver_class
 
-    if getattr(problem, "value_weights", None) is None:
+    if getattr(problem, "value_weights", None) is None or problem.meta.get("dim") != 3:
         return None
     o = solver_class(solver.partition(":")[0]).option("choice")
     return "weighted" if o is not None and (o.values is None or "weighted" in o.values) else None

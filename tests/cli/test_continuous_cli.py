@@ -130,3 +130,28 @@ def test_bad_polygon_file_names_file_and_polygon(
         {"label": 1, "points": [[5, 5], [6, 6], [6, 5], [5, 6]]}]}))  # fmt: skip
     code, _, err = run(capsys, "synthesize", str(f), "--size", "4x4")
     assert code == 2 and "bow.json" in err and "polygon 1" in err and "crosses itself" in err
+
+
+def test_ground_of_a_polygon_model(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    ex = tmp_path / "towers.json"
+    ex.write_text(json.dumps({"name": "towers", "ground": "y-", "polygons": [
+        {"label": 1, "points": [[0, 0], [2, 0], [2, 3], [1, 4], [0, 3]]},
+        {"label": 2, "points": [[4, 0], [7, 0], [7, 1], [4, 1]]}]}))  # fmt: skip
+    out = tmp_path / "o.json"
+    code, stdout, _ = run(capsys, "synthesize", str(ex), "--size", "24x16", "--seed", "1",
+                          "--out", str(out))  # fmt: skip
+    assert code == 0 and "ground=y- (the example's)" in stdout
+    M = read_polygons_json(out)
+    assert len(M) and all(min(y for _, y in p.points) == 0 for p in M.polygons)
+    code, stdout, _ = run(capsys, "check", str(ex), str(out))
+    assert code == 0 and stdout.startswith("0 violations")
+    free = tmp_path / "free.json"  # without the ground: polygons float, which it forbids
+    code, _, _ = run(capsys, "synthesize", str(ex), "--size", "24x16", "--seed", "1",
+                     "--ground", "none", "--out", str(free))  # fmt: skip
+    assert code == 0
+    code, stdout, _ = run(capsys, "check", str(ex), str(free), "--ground", "none")
+    assert code == 0 and stdout.startswith("0 violations")
+    code, stdout, _ = run(capsys, "check", str(ex), str(free))
+    assert code == 1 and not stdout.startswith("0 violations")
+    code, _, err = run(capsys, "synthesize", str(ex), "--size", "8x6", "--ground", "z-")
+    assert code == 2 and "z-" in err and len(err.strip().splitlines()) == 1
