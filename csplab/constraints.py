@@ -167,6 +167,22 @@ def grid_edges(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], 
     return out
 
 
+def _grid_csr(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`grid_edges` as a symmetric CSR adjacency ``(ptr, nbr)``, once per problem."""
+    cached = problem.__dict__.get("_grid_csr")
+    if cached is not None:
+        return cached  # type: ignore[no-any-return]
+    lo, hi, _ = grid_edges(problem)
+    src = np.concatenate([lo, hi])
+    dst = np.concatenate([hi, lo])
+    o = np.argsort(src, kind="stable")
+    ptr = np.zeros(problem.n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(src, minlength=problem.n), out=ptr[1:])
+    out = (ptr, np.ascontiguousarray(dst[o], dtype=np.int64))
+    problem.__dict__["_grid_csr"] = out
+    return out
+
+
 def arc_pairs(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
     """The pairs of cells the problem's arcs join, as ``(lo, hi, relation)`` with
     ``lo < hi``, each pair once (the neighbours of a problem whose cells sit at positions)."""
@@ -362,6 +378,33 @@ class Constraint(ABC):
     def cut(self, ctx: ClauseContext, lab: NDArray[np.int64]) -> None:  # noqa: B027
         """Add clauses excluding ``lab`` where the eager clauses let a breach through."""
 
+    def set_labels(self, problem: Problem) -> NDArray[np.bool_] | None:
+        """The label set ``S`` (bool ``(K,)``) when this constraint's propagator reads only
+        which cells may and which must take a label of ``S`` (:meth:`prune_sets`), so a
+        packed catalog needs no unpacking; ``None`` otherwise (then :meth:`propagate`)."""
+        return None
+
+    def prune_sets(
+        self, problem: Problem, can: NDArray[np.bool_], must: NDArray[np.bool_]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+        """:meth:`propagate` for a constraint with :meth:`set_labels`: from ``can`` and
+        ``must`` (bool ``(n,)``: may / must the cell take a label of ``S``; ``must`` may be
+        changed) the cells that leave ``S`` and the cells restricted to ``S``; ``None`` when
+        no completion exists."""
+        raise NotImplementedError(f"{self.kind} has no set propagator")
+
+    def prunes_nothing_new(
+        self,
+        problem: Problem,
+        can: NDArray[np.bool_],
+        must: NDArray[np.bool_],
+        last: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+    ) -> bool:
+        """Whether :meth:`prune_sets` needs no new run on ``can``/``must`` after one on
+        ``last`` found nothing to prune, judged from the cells that changed (a catalog
+        that only shrinks); ``False`` (run it) unless a kind knows better."""
+        return bool(np.array_equal(can, last[0]) and np.array_equal(must, last[1]))
+
     @abstractmethod
     def describe(self, problem: Problem) -> str:
         """One line for reports."""
@@ -431,6 +474,28 @@ class Count(Constraint):
         elif nc == self.min and open_.size:
             dom[open_] &= S
         return True
+
+    def set_labels(self, problem: Problem) -> NDArray[np.bool_] | None:
+        return label_mask(self.labels, problem.K)
+
+    def prune_sets(
+        self, problem: Problem, can: NDArray[np.bool_], must: NDArray[np.bool_]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+        cells = None if self.region is None else self.cells(problem)
+        c = can if cells is None else can[cells]
+        m = must if cells is None else must[cells]
+        nm, nc = int(np.count_nonzero(m)), int(np.count_nonzero(c))
+        if nc < self.min or (self.max is not None and nm > self.max):
+            return None
+        none = np.zeros(0, dtype=np.int64)
+        if nm == nc or not (nc == self.min or nm == self.max):
+            return none, none
+        open_ = np.flatnonzero(c & ~m)
+        if cells is not None:
+            open_ = cells[open_]
+        if self.max is not None and nm == self.max:
+            return open_.astype(np.int64), none
+        return none, open_.astype(np.int64)
 
     def clauses(self, ctx: ClauseContext) -> None:
         S = label_mask(self.labels, ctx.problem.K)
@@ -590,6 +655,51 @@ class Connected(Constraint):
         if force.any():
             dom[force] &= S if S.ndim == 1 else S[force]
         return True
+
+    def set_labels(self, problem: Problem) -> NDArray[np.bool_] | None:
+        if self.ports is not None or self.members is not None:
+            return None
+        return label_mask(self.labels, problem.K)
+
+    def prune_sets(
+        self, problem: Problem, can: NDArray[np.bool_], must: NDArray[np.bool_]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+        given = np.asarray(self.cells, dtype=np.int64)
+        if given.size:
+            if not can[given].all():
+                return None
+            given = given[~must[given]]
+            must[given] = True
+        if self.nonempty and not can.any():
+            return None
+        ptr, nbr = _grid_csr(problem)
+        ok, out, force = kern.connected_prune(ptr, nbr, can, must)
+        if not ok:
+            return None
+        if given.size:
+            force[given] = True
+        return np.flatnonzero(out).astype(np.int64), np.flatnonzero(force).astype(np.int64)
+
+    def prunes_nothing_new(
+        self,
+        problem: Problem,
+        can: NDArray[np.bool_],
+        must: NDArray[np.bool_],
+        last: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+    ) -> bool:
+        """No cell joined ``can``, the cells that left it were bypassed inside their box,
+        new must cells touch old ones (:func:`csplab._kernels.connected_unchanged`): no
+        cell became unreachable. Cells that now separate two must cells along a rerouted
+        path are found by the next full run (the caller bounds the steps in between)."""
+        ptr, nbr = _grid_csr(problem)
+        xyz = problem.__dict__.get("_grid_xyz")
+        if xyz is None:
+            xyz = np.ascontiguousarray(
+                np.stack(np.unravel_index(np.arange(problem.n), problem.shape), axis=1),
+                dtype=np.int64,
+            )
+            problem.__dict__["_grid_xyz"] = xyz
+        return bool(kern.connected_unchanged(ptr, nbr, xyz, can, must, last[0], last[1]))
 
     def in_set(self, ctx: ClauseContext, cell: int) -> Lit:
         """The literal "``cell`` is in the set"."""
