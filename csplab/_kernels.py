@@ -1362,43 +1362,72 @@ def connected_unchanged(
     seen = np.zeros(n, dtype=np.bool_)
     queue = np.empty(n, dtype=np.int64)
     for x in range(n):
-        if not (pcan[x] and not can[x]):
-            continue
-        # BFS from one may-neighbour of x through may-cells of x's box
-        start = -1
-        for e in range(ptr[x], ptr[x + 1]):
-            if can[nbr[e]]:
-                start = nbr[e]
-                break
-        if start < 0:
-            continue
-        qh = 0
-        qt = 1
-        queue[0] = start
-        seen[start] = True
-        while qh < qt:
-            u = queue[qh]
-            qh += 1
-            for e in range(ptr[u], ptr[u + 1]):
-                w = nbr[e]
-                if not can[w] or seen[w]:
-                    continue
-                near = True
-                for a in range(xyz.shape[1]):
-                    d = xyz[w, a] - xyz[x, a]
-                    if d > 1 or d < -1:
-                        near = False
-                if near:
-                    seen[w] = True
-                    queue[qt] = w
-                    qt += 1
-        ok = True
-        for e in range(ptr[x], ptr[x + 1]):
-            if can[nbr[e]] and not seen[nbr[e]]:
-                ok = False
-        for i in range(qt):
-            seen[queue[i]] = False
-        if not ok:
+        if pcan[x] and not can[x] and not _bypassed(ptr, nbr, xyz, can, x, seen, queue):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _bypassed(
+    ptr: np.ndarray,
+    nbr: np.ndarray,
+    xyz: np.ndarray,
+    can: np.ndarray,
+    x: int,
+    seen: np.ndarray,
+    queue: np.ndarray,
+) -> bool:
+    """Whether the ``can`` neighbours of cell ``x`` are joined through ``can`` cells of
+    x's box (one step along every axis, diagonals included; ``xyz``: the coordinates).
+    ``seen`` (all ``False``) and ``queue`` are work arrays of length ``n``."""
+    start = -1
+    for e in range(ptr[x], ptr[x + 1]):
+        if can[nbr[e]]:
+            start = nbr[e]
+            break
+    if start < 0:
+        return True
+    qh = 0
+    qt = 1
+    queue[0] = start
+    seen[start] = True
+    while qh < qt:
+        u = queue[qh]
+        qh += 1
+        for e in range(ptr[u], ptr[u + 1]):
+            w = nbr[e]
+            if not can[w] or seen[w] or w == x:
+                continue
+            near = True
+            for a in range(xyz.shape[1]):
+                d = xyz[w, a] - xyz[x, a]
+                if d > 1 or d < -1:
+                    near = False
+            if near:
+                seen[w] = True
+                queue[qt] = w
+                qt += 1
+    ok = True
+    for e in range(ptr[x], ptr[x + 1]):
+        if can[nbr[e]] and not seen[nbr[e]]:
+            ok = False
+    for i in range(qt):
+        seen[queue[i]] = False
+    return ok
+
+
+@njit(cache=True)
+def all_bypassed(
+    ptr: np.ndarray, nbr: np.ndarray, xyz: np.ndarray, can: np.ndarray, cells: np.ndarray
+) -> bool:
+    """Whether removing ``cells`` (not in ``can``) from the graph of ``can`` cells cut no
+    path between two of them: each one's ``can`` neighbours are joined around it inside
+    its box (:func:`_bypassed`)."""
+    n = can.shape[0]
+    seen = np.zeros(n, dtype=np.bool_)
+    queue = np.empty(n, dtype=np.int64)
+    for i in range(cells.shape[0]):
+        if not _bypassed(ptr, nbr, xyz, can, cells[i], seen, queue):
             return False
     return True
 

@@ -91,6 +91,7 @@ __all__ = [
     "parse_constraints",
     "propagate_all",
     "rotate",
+    "seqcounter",
 ]
 
 #: the kinds of the constraints file, in the order of the module docstring
@@ -181,6 +182,18 @@ def _grid_csr(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     out = (ptr, np.ascontiguousarray(dst[o], dtype=np.int64))
     problem.__dict__["_grid_csr"] = out
     return out
+
+
+def _grid_xyz(problem: Problem) -> NDArray[np.int64]:
+    """The coordinates of every cell, ``(n, ndim)``, once per problem."""
+    xyz = problem.__dict__.get("_grid_xyz")
+    if xyz is None:
+        xyz = np.ascontiguousarray(
+            np.stack(np.unravel_index(np.arange(problem.n), problem.shape), axis=1),
+            dtype=np.int64,
+        )
+        problem.__dict__["_grid_xyz"] = xyz
+    return xyz
 
 
 def arc_pairs(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
@@ -300,7 +313,13 @@ class ClauseContext:
             if bound is None or (atmost and bound >= len(free)) or (not atmost and bound <= 0):
                 continue
             small = min(bound, len(free) - bound) * len(free) <= 2_000_000
-            et = card.EncType.seqcounter if small else card.EncType.cardnetwrk
+            if small:  # at most `bound` of the lits, or at most n - lo of their negations
+                xs = np.array(free if atmost else [-x for x in free], dtype=np.int64)
+                k = bound if atmost else len(free) - bound
+                cl, self.top = seqcounter(xs, k, self.top)
+                self.clauses.extend(cl)
+                continue
+            et = card.EncType.cardnetwrk
             f = (card.CardEnc.atmost if atmost else card.CardEnc.atleast)(
                 lits=free, bound=bound, top_id=self.top, encoding=et
             )
@@ -316,6 +335,44 @@ class ClauseContext:
         for c in self.problem.constraints:
             c.cut(self, lab)
         return len(self.clauses) - before
+
+
+def seqcounter(xs: NDArray[np.int64], k: int, top: int) -> tuple[list[list[int]], int]:
+    """Sinz's sequential counter for "at most ``k`` of the literals ``xs`` are true"
+    (Sinz 2005, LT_SEQ; what ``pysat.card``'s seqcounter builds, there in time quadratic in
+    ``len(xs)``), built with array operations: the clauses and the new largest variable
+    (register ``s[i, j]``, "at least j + 1 of ``xs[:i + 1]``", is ``top + 1 + i * k + j``).
+
+    Examples
+    --------
+    >>> cl, top = seqcounter(np.array([1, 2, 3]), 1, 3)
+    >>> top, len(cl)
+    (5, 8)
+    """
+    n = len(xs)
+    if k <= 0:
+        return [[-int(x)] for x in xs], top
+    if k >= n:
+        return [], top
+    s = top + 1 + np.arange((n - 1) * k, dtype=np.int64).reshape(n - 1, k)
+    out: list[list[int]] = [[-int(xs[0]), int(s[0, 0])]]
+    out += [[-int(v)] for v in s[0, 1:]]
+    x = xs[1 : n - 1]
+    prev, cur = s[:-1], s[1:]
+    parts: list[NDArray[np.int64]] = [
+        np.stack([-x, cur[:, 0]], axis=1),
+        np.stack([-prev[:, 0], cur[:, 0]], axis=1),
+        np.stack([-prev[:, 1:], cur[:, 1:]], axis=2).reshape(-1, 2),
+        np.stack([-x, -prev[:, k - 1]], axis=1),
+    ]
+    for p in parts:
+        out += p.tolist()
+    if k > 1:
+        three = np.stack([np.repeat(-x, k - 1), -prev[:, :-1].reshape(-1), cur[:, 1:].reshape(-1)],
+                         axis=1)  # fmt: skip
+        out += three.tolist()
+    out.append([-int(xs[n - 1]), -int(s[n - 2, k - 1])])
+    return out, top + (n - 1) * k
 
 
 def constraint_clauses(problem: Problem, lit: Callable[[int, int], Lit], top: int) -> ClauseContext:
@@ -692,13 +749,7 @@ class Connected(Constraint):
         cell became unreachable. Cells that now separate two must cells along a rerouted
         path are found by the next full run (the caller bounds the steps in between)."""
         ptr, nbr = _grid_csr(problem)
-        xyz = problem.__dict__.get("_grid_xyz")
-        if xyz is None:
-            xyz = np.ascontiguousarray(
-                np.stack(np.unravel_index(np.arange(problem.n), problem.shape), axis=1),
-                dtype=np.int64,
-            )
-            problem.__dict__["_grid_xyz"] = xyz
+        xyz = _grid_xyz(problem)
         return bool(kern.connected_unchanged(ptr, nbr, xyz, can, must, last[0], last[1]))
 
     def in_set(self, ctx: ClauseContext, cell: int) -> Lit:

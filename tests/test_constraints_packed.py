@@ -123,3 +123,23 @@ def test_alg31_outputs_honour_connectivity_and_count():
             solved += 1
             assert not Q.violations(r.grid)
     assert solved >= 2
+
+
+def test_seqcounter_allows_exactly_the_assignments_within_the_bound():
+    pytest.importorskip("pysat")
+    import itertools
+
+    from pysat.solvers import Solver
+
+    from csplab.constraints import seqcounter
+
+    for n in range(1, 6):
+        for k in range(n + 1):
+            cl, top = seqcounter(np.arange(1, n + 1), k, n)
+            assert top >= n
+            with Solver("cadical195", bootstrap_with=cl) as S:
+                for bits in itertools.product([0, 1], repeat=n):
+                    got = S.solve(
+                        assumptions=[i + 1 if b else -(i + 1) for i, b in enumerate(bits)]
+                    )
+                    assert got == (sum(bits) <= k), (n, k, bits)
