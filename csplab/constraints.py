@@ -83,8 +83,11 @@ __all__ = [
     "MaxRun",
     "Separation",
     "Symmetric",
+    "adder_card",
     "arc_pairs",
     "constraints_json",
+    "grid_coords",
+    "grid_csr",
     "grid_edges",
     "label_mask",
     "mirror",
@@ -168,9 +171,18 @@ def grid_edges(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], 
     return out
 
 
-def _grid_csr(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
-    """:func:`grid_edges` as a symmetric CSR adjacency ``(ptr, nbr)``, once per problem."""
-    cached = problem.__dict__.get("_grid_csr")
+def grid_csr(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`grid_edges` as a symmetric CSR adjacency ``(ptr, nbr)``: the neighbours of
+    cell ``c`` are ``nbr[ptr[c]:ptr[c + 1]]``; computed once per problem.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, from_example
+    >>> ptr, nbr = grid_csr(from_example(ExampleModel([[0, 1], [1, 0]]), (2, 3)))
+    >>> sorted(nbr[ptr[0]:ptr[1]].tolist())
+    [1, 3]
+    """
+    cached = problem.__dict__.get("grid_csr")
     if cached is not None:
         return cached  # type: ignore[no-any-return]
     lo, hi, _ = grid_edges(problem)
@@ -180,19 +192,26 @@ def _grid_csr(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
     ptr = np.zeros(problem.n + 1, dtype=np.int64)
     np.cumsum(np.bincount(src, minlength=problem.n), out=ptr[1:])
     out = (ptr, np.ascontiguousarray(dst[o], dtype=np.int64))
-    problem.__dict__["_grid_csr"] = out
+    problem.__dict__["grid_csr"] = out
     return out
 
 
-def _grid_xyz(problem: Problem) -> NDArray[np.int64]:
-    """The coordinates of every cell, ``(n, ndim)``, once per problem."""
-    xyz = problem.__dict__.get("_grid_xyz")
+def grid_coords(problem: Problem) -> NDArray[np.int64]:
+    """The coordinates of every cell, ``(n, ndim)``, computed once per problem.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, from_example
+    >>> grid_coords(from_example(ExampleModel([[0, 1], [1, 0]]), (2, 3)))[4].tolist()
+    [1, 1]
+    """
+    xyz = problem.__dict__.get("grid_coords")
     if xyz is None:
         xyz = np.ascontiguousarray(
             np.stack(np.unravel_index(np.arange(problem.n), problem.shape), axis=1),
             dtype=np.int64,
         )
-        problem.__dict__["_grid_xyz"] = xyz
+        problem.__dict__["grid_coords"] = xyz
     return xyz
 
 
@@ -306,25 +325,23 @@ class ClauseContext:
         if (up is not None and up < 0) or lo > len(free):
             self.add([])
             return
-        from csplab.deps import require
-
-        card = require("pysat.card", "sat", "count constraints in CNF")
+        n = len(free)
+        big_lo = big_hi = None  # the bounds too large for a counter: one adder for both
         for bound, atmost in ((up, True), (lo, False)):
-            if bound is None or (atmost and bound >= len(free)) or (not atmost and bound <= 0):
+            if bound is None or (atmost and bound >= n) or (not atmost and bound <= 0):
                 continue
-            small = min(bound, len(free) - bound) * len(free) <= 2_000_000
-            if small:  # at most `bound` of the lits, or at most n - lo of their negations
+            if min(bound, n - bound) * n <= 2_000_000:
+                # at most `bound` of the lits, or at most n - lo of their negations
                 xs = np.array(free if atmost else [-x for x in free], dtype=np.int64)
-                k = bound if atmost else len(free) - bound
-                cl, self.top = seqcounter(xs, k, self.top)
+                cl, self.top = seqcounter(xs, bound if atmost else n - bound, self.top)
                 self.clauses.extend(cl)
-                continue
-            et = card.EncType.cardnetwrk
-            f = (card.CardEnc.atmost if atmost else card.CardEnc.atleast)(
-                lits=free, bound=bound, top_id=self.top, encoding=et
-            )
-            self.top = max(self.top, f.nv)
-            self.clauses.extend([list(c) for c in f.clauses])
+            elif atmost:
+                big_hi = bound
+            else:
+                big_lo = bound
+        if big_lo is not None or big_hi is not None:
+            cl, self.top = adder_card(free, big_lo or 0, big_hi, self.top)
+            self.clauses.extend(cl)
 
     def cuts(self, grid: NDArray[np.integer[Any]]) -> int:
         """Add clauses that exclude ``grid`` (a model of the clauses so far) where it breaks a
@@ -347,7 +364,7 @@ def seqcounter(xs: NDArray[np.int64], k: int, top: int) -> tuple[list[list[int]]
     --------
     >>> cl, top = seqcounter(np.array([1, 2, 3]), 1, 3)
     >>> top, len(cl)
-    (5, 8)
+    (5, 5)
     """
     n = len(xs)
     if k <= 0:
@@ -373,6 +390,82 @@ def seqcounter(xs: NDArray[np.int64], k: int, top: int) -> tuple[list[list[int]]
         out += three.tolist()
     out.append([-int(xs[n - 1]), -int(s[n - 2, k - 1])])
     return out, top + (n - 1) * k
+
+
+def adder_card(xs: Sequence[int], lo: int, hi: int | None, top: int) -> tuple[list[list[int]], int]:
+    """``lo <= (number of true xs) <= hi`` as a tree of binary adders (Warners 1998: the
+    count as a binary number, O(n) clauses and variables, where counters and sorting
+    networks need O(n k) or O(n log² k) for a bound k in the thousands) and a comparison of
+    the number with the bounds; the clauses and the new largest variable.
+
+    Examples
+    --------
+    >>> cl, top = adder_card([1, 2, 3], 1, 2, 3)
+    >>> top > 3 and len(cl) > 0
+    True
+    """
+    out: list[list[int]] = []
+    nxt = top
+
+    def new() -> int:
+        nonlocal nxt
+        nxt += 1
+        return nxt
+
+    def add(a: list[int], b: list[int]) -> list[int]:
+        res: list[int] = []
+        carry = 0
+        for i in range(max(len(a), len(b))):
+            ins = [v for v in (a[i] if i < len(a) else 0, b[i] if i < len(b) else 0, carry) if v]
+            if len(ins) == 1:
+                res.append(ins[0])
+                carry = 0
+                continue
+            sm, c = new(), new()
+            if len(ins) == 2:
+                x, y = ins
+                out.extend([[-x, -y, -sm], [x, y, -sm], [x, -y, sm], [-x, y, sm],
+                            [-c, x], [-c, y], [c, -x, -y]])  # fmt: skip
+            else:
+                x, y, z = ins
+                for sx in (1, -1):
+                    for sy in (1, -1):
+                        for sz in (1, -1):
+                            odd = (sx < 0) + (sy < 0) + (sz < 0)  # literals negated
+                            # the clause (sx·x ∨ sy·y ∨ sz·z ∨ ±sm) fixes sm's parity
+                            out.append([sx * x, sy * y, sz * z, sm if odd % 2 else -sm])
+                out.extend([[-x, -y, c], [-x, -z, c], [-y, -z, c],
+                            [x, y, -c], [x, z, -c], [y, z, -c]])  # fmt: skip
+            res.append(sm)
+            carry = c
+        if carry:
+            res.append(carry)
+        return res
+
+    nums: list[list[int]] = [[int(x)] for x in xs]
+    if not nums:
+        return ([[]] if lo > 0 else []), top
+    while len(nums) > 1:
+        nums = [add(nums[i], nums[i + 1]) if i + 1 < len(nums) else nums[i]
+                for i in range(0, len(nums), 2)]  # fmt: skip
+    bits = nums[0]
+    w = len(bits)
+    if hi is not None:
+        if hi < 0:
+            return [[]], nxt
+        B = [(hi >> i) & 1 for i in range(w)]
+        if hi < (1 << w):
+            for i in range(w):
+                if not B[i]:
+                    out.append([-bits[i]] + [-bits[j] for j in range(i + 1, w) if B[j]])
+    if lo > 0:
+        if lo >= (1 << w):
+            return [[]], nxt
+        L = [(lo >> i) & 1 for i in range(w)]
+        for i in range(w):
+            if L[i]:
+                out.append([bits[i]] + [bits[j] for j in range(i + 1, w) if not L[j]])
+    return out, nxt
 
 
 def constraint_clauses(problem: Problem, lit: Callable[[int, int], Lit], top: int) -> ClauseContext:
@@ -729,7 +822,7 @@ class Connected(Constraint):
             must[given] = True
         if self.nonempty and not can.any():
             return None
-        ptr, nbr = _grid_csr(problem)
+        ptr, nbr = grid_csr(problem)
         ok, out, force = kern.connected_prune(ptr, nbr, can, must)
         if not ok:
             return None
@@ -748,8 +841,8 @@ class Connected(Constraint):
         new must cells touch old ones (:func:`csplab._kernels.connected_unchanged`): no
         cell became unreachable. Cells that now separate two must cells along a rerouted
         path are found by the next full run (the caller bounds the steps in between)."""
-        ptr, nbr = _grid_csr(problem)
-        xyz = _grid_xyz(problem)
+        ptr, nbr = grid_csr(problem)
+        xyz = grid_coords(problem)
         return bool(kern.connected_unchanged(ptr, nbr, xyz, can, must, last[0], last[1]))
 
     def in_set(self, ctx: ClauseContext, cell: int) -> Lit:

@@ -143,3 +143,22 @@ def test_seqcounter_allows_exactly_the_assignments_within_the_bound():
                         assumptions=[i + 1 if b else -(i + 1) for i, b in enumerate(bits)]
                     )
                     assert got == (sum(bits) <= k), (n, k, bits)
+
+
+def test_adder_card_allows_exactly_the_counts_within_the_bounds():
+    pytest.importorskip("pysat")
+    import itertools
+
+    from pysat.solvers import Solver
+
+    from csplab.constraints import adder_card
+
+    for n in range(1, 6):
+        for lo in range(n + 2):
+            for hi in [None, *range(n + 1)]:
+                cl, _ = adder_card(list(range(1, n + 1)), lo, hi, n)
+                with Solver("cadical195", bootstrap_with=cl) as S:
+                    for bits in itertools.product([0, 1], repeat=n):
+                        lits = [i + 1 if b else -(i + 1) for i, b in enumerate(bits)]
+                        k = sum(bits)
+                        assert S.solve(assumptions=lits) == (lo <= k and (hi is None or k <= hi))

@@ -22,7 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab import _kernels as kern
-from csplab.constraints import ClauseContext, Connected, _grid_csr, _grid_xyz
+from csplab.constraints import ClauseContext, Connected, grid_coords, grid_csr
 from csplab.deps import require
 from csplab.problem import Problem
 
@@ -48,8 +48,8 @@ class _State:
         self.out: list[int] = []
         self.grid = con.members is None
         if self.grid:
-            self.ptr, self.nbr = _grid_csr(problem)
-            self.xyz = _grid_xyz(problem)
+            self.ptr, self.nbr = grid_csr(problem)
+            self.xyz = grid_coords(problem)
         self.y: list[Any] = [con.in_set(ctx, c) for c in range(problem.n)]
         self.val = np.zeros(problem.n, dtype=np.int8)  # 1 in, -1 out, 0 open; constants: 2/-2
         for c, y in enumerate(self.y):
