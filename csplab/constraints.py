@@ -4,7 +4,7 @@ A :class:`~csplab.problem.Problem` carries them in ``problem.constraints``;
 :meth:`Problem.violations <csplab.problem.Problem.violations>` checks them (it stays the one
 checker), and every solver says what it does with each kind (the ``constraints`` entry of
 its declaration, :mod:`csplab.solvers.base`): ``exact`` solvers encode them (CNF clauses and
-cardinality networks, a lazy cut loop for connectivity), ``propagated`` ones prune domains
+counters or adders for counts, a lazy cut loop for connectivity), ``propagated`` ones prune domains
 with :meth:`Constraint.propagate` during search, ``checked`` ones test the finished grid and
 report ``failed`` (so ``--restarts`` retries) instead of a broken ``solved``.
 
