@@ -1235,6 +1235,215 @@ def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: i
     return out
 
 
+@njit(cache=True)
+def set_status(bits: np.ndarray, sp: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per cell of the packed catalog ``bits``: may it take a label of the set ``sp``
+    (packed ``(W,)``), and must it (every label left is in the set)? Read from the bitsets,
+    without unpacking them."""
+    n, W = bits.shape
+    can = np.zeros(n, dtype=np.bool_)
+    must = np.zeros(n, dtype=np.bool_)
+    for v in range(n):
+        c = False
+        o = False
+        for w in range(W):
+            x = bits[v, w]
+            if x & sp[w]:
+                c = True
+            if x & ~sp[w]:
+                o = True
+        can[v] = c
+        must[v] = c and not o
+    return can, must
+
+
+@njit(cache=True)
+def connected_prune(
+    ptr: np.ndarray, nbr: np.ndarray, can: np.ndarray, must: np.ndarray
+) -> tuple[bool, np.ndarray, np.ndarray]:
+    """The connectivity propagator on the set's cells (:class:`csplab.constraints.Connected`):
+    ``can``/``must`` say which cells may / must be in the set, ``ptr``/``nbr`` (CSR) the
+    grid's neighbours. A search from the first must cell through may-cells reaches the
+    region every member has to lie in: ``(False, ...)`` when a must cell is outside it;
+    else ``(True, out, force)`` with ``out`` the may-cells outside it (they leave the
+    set) and ``force`` the may-not-must cells that separate two must cells (Tarjan's low
+    points, :func:`separating_cells`), which join it."""
+    n = can.shape[0]
+    out = np.zeros(n, dtype=np.bool_)
+    force = np.zeros(n, dtype=np.bool_)
+    root = -1
+    nm = 0
+    for v in range(n):
+        if must[v]:
+            if root < 0:
+                root = v
+            nm += 1
+    if root < 0:
+        return True, out, force
+    # iterative DFS through may-cells from the root, with low points
+    disc = np.full(n, -1, dtype=np.int64)
+    low = np.zeros(n, dtype=np.int64)
+    below = np.zeros(n, dtype=np.int64)
+    parent = np.full(n, -1, dtype=np.int64)
+    it = np.zeros(n, dtype=np.int64)
+    stack = np.empty(n, dtype=np.int64)
+    stack[0] = root
+    sp = 1
+    disc[root] = 0
+    it[root] = ptr[root]
+    below[root] = 1
+    t = 1
+    while sp > 0:
+        u = stack[sp - 1]
+        if it[u] < ptr[u + 1]:
+            w = nbr[it[u]]
+            it[u] += 1
+            if not can[w]:
+                continue
+            if disc[w] < 0:
+                disc[w] = t
+                low[w] = t
+                t += 1
+                parent[w] = u
+                it[w] = ptr[w]
+                below[w] = 1 if must[w] else 0
+                stack[sp] = w
+                sp += 1
+            elif w != parent[u] and disc[w] < low[u]:
+                low[u] = disc[w]
+        else:
+            sp -= 1
+            p = parent[u]
+            if p >= 0:
+                if low[u] < low[p]:
+                    low[p] = low[u]
+                below[p] += below[u]
+                if p != root and low[u] >= disc[p] and below[u] > 0 and below[u] < nm:
+                    force[p] = True
+    for v in range(n):
+        if can[v] and disc[v] < 0:
+            if must[v]:
+                return False, out, force
+            out[v] = True
+        elif must[v]:
+            force[v] = False
+    return True, out, force
+
+
+@njit(cache=True)
+def connected_unchanged(
+    ptr: np.ndarray,
+    nbr: np.ndarray,
+    xyz: np.ndarray,
+    can: np.ndarray,
+    must: np.ndarray,
+    pcan: np.ndarray,
+    pmust: np.ndarray,
+) -> bool:
+    """Whether :func:`connected_prune` on ``can``/``must`` can prune nothing more than it
+    did on ``pcan``/``pmust`` (the state it last ran on, its prunings applied), judged
+    from the cells that changed only, for a catalog that only shrinks.
+
+    ``True`` when no cell joined ``can``; every cell that left it had its may-neighbours
+    joined around it through may-cells of its box (the cells within one step along every
+    axis, diagonals included; ``xyz`` holds the cells' coordinates), so no path between
+    two cells was cut; and every new must cell touches an old one (a
+    vertex separating it from a must cell would separate its must neighbour too). A cut
+    path that is only rerouted can still create separating cells on the detour: the
+    caller runs the full propagator again after a bounded number of such steps.
+    """
+    n = can.shape[0]
+    had = False
+    for v in range(n):
+        if pmust[v]:
+            had = True
+            break
+    for v in range(n):
+        if can[v] and not pcan[v]:
+            return False
+        if must[v] and not pmust[v]:
+            if not had:
+                return False
+            ok = False
+            for e in range(ptr[v], ptr[v + 1]):
+                if pmust[nbr[e]]:
+                    ok = True
+                    break
+            if not ok:
+                return False
+    seen = np.zeros(n, dtype=np.bool_)
+    queue = np.empty(n, dtype=np.int64)
+    for x in range(n):
+        if pcan[x] and not can[x] and not _bypassed(ptr, nbr, xyz, can, x, seen, queue):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _bypassed(
+    ptr: np.ndarray,
+    nbr: np.ndarray,
+    xyz: np.ndarray,
+    can: np.ndarray,
+    x: int,
+    seen: np.ndarray,
+    queue: np.ndarray,
+) -> bool:
+    """Whether the ``can`` neighbours of cell ``x`` are joined through ``can`` cells of
+    x's box (one step along every axis, diagonals included; ``xyz``: the coordinates).
+    ``seen`` (all ``False``) and ``queue`` are work arrays of length ``n``."""
+    start = -1
+    for e in range(ptr[x], ptr[x + 1]):
+        if can[nbr[e]]:
+            start = nbr[e]
+            break
+    if start < 0:
+        return True
+    qh = 0
+    qt = 1
+    queue[0] = start
+    seen[start] = True
+    while qh < qt:
+        u = queue[qh]
+        qh += 1
+        for e in range(ptr[u], ptr[u + 1]):
+            w = nbr[e]
+            if not can[w] or seen[w] or w == x:
+                continue
+            near = True
+            for a in range(xyz.shape[1]):
+                d = xyz[w, a] - xyz[x, a]
+                if d > 1 or d < -1:
+                    near = False
+            if near:
+                seen[w] = True
+                queue[qt] = w
+                qt += 1
+    ok = True
+    for e in range(ptr[x], ptr[x + 1]):
+        if can[nbr[e]] and not seen[nbr[e]]:
+            ok = False
+    for i in range(qt):
+        seen[queue[i]] = False
+    return ok
+
+
+@njit(cache=True)
+def all_bypassed(
+    ptr: np.ndarray, nbr: np.ndarray, xyz: np.ndarray, can: np.ndarray, cells: np.ndarray
+) -> bool:
+    """Whether removing ``cells`` (not in ``can``) from the graph of ``can`` cells cut no
+    path between two of them: each one's ``can`` neighbours are joined around it inside
+    its box (:func:`_bypassed`)."""
+    n = can.shape[0]
+    seen = np.zeros(n, dtype=np.bool_)
+    queue = np.empty(n, dtype=np.int64)
+    for i in range(cells.shape[0]):
+        if not _bypassed(ptr, nbr, xyz, can, cells[i], seen, queue):
+            return False
+    return True
+
+
 # ----------------------------------------------------------------------------- modify in blocks
 
 

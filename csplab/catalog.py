@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike, NDArray
 from csplab import _interp
 from csplab import _kernels as kern
 from csplab._kernels import Code, Heap, Run, Search
-from csplab.constraints import propagate_all
+from csplab.constraints import Constraint, propagate_all
 from csplab.errors import InputError
 from csplab.problem import Problem, check_memory
 
@@ -195,6 +195,10 @@ class _Compiled:
         return self._doms
 
 
+#: the most calls in a row :meth:`Propagator.constrain` skips a constraint judged unchanged
+_FULL_EVERY = 16
+
+
 class Propagator:
     """Stateful bitset arc-consistency engine for one :class:`Problem`.
 
@@ -239,6 +243,9 @@ class Propagator:
         self._inq = np.zeros(max(n, 1), dtype=np.bool_)
         self.stats = np.zeros(2, dtype=np.int64)  # pops, removals
         self.refuted_by: str | None = None  # the global constraint :meth:`constrain` broke
+        # per constraint: its last fixpoint (can, must) and the calls skipped since
+        self._last: list[tuple[NDArray[np.bool_], NDArray[np.bool_]] | None] = []
+        self._skips: list[int] = []
         self.ok = bool(np.all(self.bits.any(axis=1))) if n else True
         self.wiped: int = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
         if propagate_initial and self.ok:
@@ -320,13 +327,94 @@ class Propagator:
             return False
         return self.propagate(changed)
 
-    def constrain(self, search: Search | None = None) -> int:
+    def constrain(self, search: Search | None = None, *, incremental: bool = False) -> int:
         """Prune the catalog with the problem's global constraints
         (:func:`csplab.constraints.propagate_all`) and arc consistency until neither removes
         more. Inside a MAC ``search`` the removals go on its trail (undone with the current
         decision). Returns -2 when a constraint propagator refutes the catalog (its
         description in ``refuted_by``), the wiped cell when arc consistency does, -1 when
-        the catalog survives."""
+        the catalog survives.
+
+        When every constraint has a set propagator
+        (:meth:`~csplab.constraints.Constraint.set_labels`: count, unported connectivity)
+        the catalog stays packed: each reads which cells may and must take its labels
+        straight from the bitsets (:func:`csplab._kernels.set_status`), and a constraint
+        runs again only when that changed. Its fixpoint is the unpacked loop's
+        (:meth:`constrain_unpacked`; the propagators are monotone, tests check equality).
+
+        ``incremental`` (Alg. 3.1, whose catalog only shrinks between calls): remember
+        each constraint's last fixpoint across calls and skip a constraint whose changes
+        since cannot prune (:meth:`~csplab.constraints.Constraint.prunes_nothing_new`),
+        at most ``_FULL_EVERY`` times in a row; the full run then catches up."""
+        sets = self._set_masks()
+        if sets is None:
+            return self.constrain_unpacked(search)
+        if not incremental or len(self._last) != len(sets):
+            self._last = [None] * len(sets)
+            self._skips = [0] * len(sets)
+        seen = self._last
+        for _ in range(100_000):
+            quiet = True
+            for i, (con, sp) in enumerate(sets):
+                can, must = kern.set_status(self.bits, sp)
+                last = seen[i]
+                if last is not None and (
+                    (np.array_equal(last[0], can) and np.array_equal(last[1], must))
+                    or (self._skips[i] < _FULL_EVERY
+                        and con.prunes_nothing_new(self.problem, can, must, last))
+                ):  # fmt: skip
+                    self._skips[i] += 1
+                    continue
+                self._skips[i] = 0
+                mine = must.copy()
+                got = con.prune_sets(self.problem, can, must)
+                if got is None:
+                    self.refuted_by = con.describe(self.problem)
+                    return -2
+                leave, join = got
+                if not leave.size and not join.size:
+                    seen[i] = (can, mine)  # a fixpoint of this constraint
+                    continue
+                cells = np.concatenate([leave, join])
+                rows = self.bits[cells].copy()
+                rows[: leave.size] &= ~sp
+                rows[leave.size :] &= sp
+                if np.array_equal(rows, self.bits[cells]):
+                    seen[i] = (can, mine)
+                    continue
+                seen[i] = None
+                quiet = False
+                if search is None:
+                    self.bits[cells] = rows
+                    if not self.propagate(cells):
+                        return self.wiped
+                else:
+                    wiped = kern.mac_restrict(self.c.arcs, self._ac(), search, cells, rows)
+                    if wiped >= 0:
+                        return int(wiped)
+            if quiet:
+                return -1
+        return -1
+
+    def _set_masks(self) -> list[tuple[Constraint, NDArray[np.uint64]]] | None:
+        """Each constraint with its packed label set, or ``None`` when one has no set
+        propagator."""
+        cached = self.__dict__.get("_sets")
+        if cached is not None:
+            return cached if cached else None
+        out: list[tuple[Constraint, NDArray[np.uint64]]] = []
+        for con in self.problem.constraints:
+            S = con.set_labels(self.problem)
+            if S is None:
+                out = []
+                break
+            out.append((con, pack(S.reshape(1, -1))[0]))
+        self.__dict__["_sets"] = out
+        return out if out else None
+
+    def constrain_unpacked(self, search: Search | None = None) -> int:
+        """:meth:`constrain` on the unpacked catalog with
+        :func:`csplab.constraints.propagate_all` (every kind of constraint)."""
         for _ in range(1000):
             cur = self.catalog()
             why: list[str] = []
@@ -419,6 +507,7 @@ class Propagator:
         self.bits[...] = state[0]
         self.prev[...] = state[1]
         self.ok, self.wiped = state[2], state[3]
+        self._last = []  # the catalog may have grown: no fixpoint to compare with
 
     def copy(self) -> Propagator:
         new = object.__new__(Propagator)
@@ -428,6 +517,7 @@ class Propagator:
         new._queue = self._queue.copy()
         new._inq = self._inq.copy()
         new.stats = self.stats.copy()
+        new._last, new._skips = list(self._last), list(self._skips)
         return new
 
     # --------------------------------------------------------------- views

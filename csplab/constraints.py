@@ -4,7 +4,7 @@ A :class:`~csplab.problem.Problem` carries them in ``problem.constraints``;
 :meth:`Problem.violations <csplab.problem.Problem.violations>` checks them (it stays the one
 checker), and every solver says what it does with each kind (the ``constraints`` entry of
 its declaration, :mod:`csplab.solvers.base`): ``exact`` solvers encode them (CNF clauses and
-cardinality networks, a lazy cut loop for connectivity), ``propagated`` ones prune domains
+counters or adders for counts, a lazy cut loop for connectivity), ``propagated`` ones prune domains
 with :meth:`Constraint.propagate` during search, ``checked`` ones test the finished grid and
 report ``failed`` (so ``--restarts`` retries) instead of a broken ``solved``.
 
@@ -83,14 +83,18 @@ __all__ = [
     "MaxRun",
     "Separation",
     "Symmetric",
+    "adder_card",
     "arc_pairs",
     "constraints_json",
+    "grid_coords",
+    "grid_csr",
     "grid_edges",
     "label_mask",
     "mirror",
     "parse_constraints",
     "propagate_all",
     "rotate",
+    "seqcounter",
 ]
 
 #: the kinds of the constraints file, in the order of the module docstring
@@ -165,6 +169,50 @@ def grid_edges(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], 
     )
     problem.__dict__["_grid_edges"] = out
     return out
+
+
+def grid_csr(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """:func:`grid_edges` as a symmetric CSR adjacency ``(ptr, nbr)``: the neighbours of
+    cell ``c`` are ``nbr[ptr[c]:ptr[c + 1]]``; computed once per problem.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, from_example
+    >>> ptr, nbr = grid_csr(from_example(ExampleModel([[0, 1], [1, 0]]), (2, 3)))
+    >>> sorted(nbr[ptr[0]:ptr[1]].tolist())
+    [1, 3]
+    """
+    cached = problem.__dict__.get("grid_csr")
+    if cached is not None:
+        return cached  # type: ignore[no-any-return]
+    lo, hi, _ = grid_edges(problem)
+    src = np.concatenate([lo, hi])
+    dst = np.concatenate([hi, lo])
+    o = np.argsort(src, kind="stable")
+    ptr = np.zeros(problem.n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(src, minlength=problem.n), out=ptr[1:])
+    out = (ptr, np.ascontiguousarray(dst[o], dtype=np.int64))
+    problem.__dict__["grid_csr"] = out
+    return out
+
+
+def grid_coords(problem: Problem) -> NDArray[np.int64]:
+    """The coordinates of every cell, ``(n, ndim)``, computed once per problem.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, from_example
+    >>> grid_coords(from_example(ExampleModel([[0, 1], [1, 0]]), (2, 3)))[4].tolist()
+    [1, 1]
+    """
+    xyz = problem.__dict__.get("grid_coords")
+    if xyz is None:
+        xyz = np.ascontiguousarray(
+            np.stack(np.unravel_index(np.arange(problem.n), problem.shape), axis=1),
+            dtype=np.int64,
+        )
+        problem.__dict__["grid_coords"] = xyz
+    return xyz
 
 
 def arc_pairs(problem: Problem) -> tuple[NDArray[np.int64], NDArray[np.int64], NDArray[np.int64]]:
@@ -277,19 +325,23 @@ class ClauseContext:
         if (up is not None and up < 0) or lo > len(free):
             self.add([])
             return
-        from csplab.deps import require
-
-        card = require("pysat.card", "sat", "count constraints in CNF")
+        n = len(free)
+        big_lo = big_hi = None  # the bounds too large for a counter: one adder for both
         for bound, atmost in ((up, True), (lo, False)):
-            if bound is None or (atmost and bound >= len(free)) or (not atmost and bound <= 0):
+            if bound is None or (atmost and bound >= n) or (not atmost and bound <= 0):
                 continue
-            small = min(bound, len(free) - bound) * len(free) <= 2_000_000
-            et = card.EncType.seqcounter if small else card.EncType.cardnetwrk
-            f = (card.CardEnc.atmost if atmost else card.CardEnc.atleast)(
-                lits=free, bound=bound, top_id=self.top, encoding=et
-            )
-            self.top = max(self.top, f.nv)
-            self.clauses.extend([list(c) for c in f.clauses])
+            if min(bound, n - bound) * n <= 2_000_000:
+                # at most `bound` of the lits, or at most n - lo of their negations
+                xs = np.array(free if atmost else [-x for x in free], dtype=np.int64)
+                cl, self.top = seqcounter(xs, bound if atmost else n - bound, self.top)
+                self.clauses.extend(cl)
+            elif atmost:
+                big_hi = bound
+            else:
+                big_lo = bound
+        if big_lo is not None or big_hi is not None:
+            cl, self.top = adder_card(free, big_lo or 0, big_hi, self.top)
+            self.clauses.extend(cl)
 
     def cuts(self, grid: NDArray[np.integer[Any]]) -> int:
         """Add clauses that exclude ``grid`` (a model of the clauses so far) where it breaks a
@@ -300,6 +352,120 @@ class ClauseContext:
         for c in self.problem.constraints:
             c.cut(self, lab)
         return len(self.clauses) - before
+
+
+def seqcounter(xs: NDArray[np.int64], k: int, top: int) -> tuple[list[list[int]], int]:
+    """Sinz's sequential counter for "at most ``k`` of the literals ``xs`` are true"
+    (Sinz 2005, LT_SEQ; what ``pysat.card``'s seqcounter builds, there in time quadratic in
+    ``len(xs)``), built with array operations: the clauses and the new largest variable
+    (register ``s[i, j]``, "at least j + 1 of ``xs[:i + 1]``", is ``top + 1 + i * k + j``).
+
+    Examples
+    --------
+    >>> cl, top = seqcounter(np.array([1, 2, 3]), 1, 3)
+    >>> top, len(cl)
+    (5, 5)
+    """
+    n = len(xs)
+    if k <= 0:
+        return [[-int(x)] for x in xs], top
+    if k >= n:
+        return [], top
+    s = top + 1 + np.arange((n - 1) * k, dtype=np.int64).reshape(n - 1, k)
+    out: list[list[int]] = [[-int(xs[0]), int(s[0, 0])]]
+    out += [[-int(v)] for v in s[0, 1:]]
+    x = xs[1 : n - 1]
+    prev, cur = s[:-1], s[1:]
+    parts: list[NDArray[np.int64]] = [
+        np.stack([-x, cur[:, 0]], axis=1),
+        np.stack([-prev[:, 0], cur[:, 0]], axis=1),
+        np.stack([-prev[:, 1:], cur[:, 1:]], axis=2).reshape(-1, 2),
+        np.stack([-x, -prev[:, k - 1]], axis=1),
+    ]
+    for p in parts:
+        out += p.tolist()
+    if k > 1:
+        three = np.stack([np.repeat(-x, k - 1), -prev[:, :-1].reshape(-1), cur[:, 1:].reshape(-1)],
+                         axis=1)  # fmt: skip
+        out += three.tolist()
+    out.append([-int(xs[n - 1]), -int(s[n - 2, k - 1])])
+    return out, top + (n - 1) * k
+
+
+def adder_card(xs: Sequence[int], lo: int, hi: int | None, top: int) -> tuple[list[list[int]], int]:
+    """``lo <= (number of true xs) <= hi`` as a tree of binary adders (Warners 1998: the
+    count as a binary number, O(n) clauses and variables, where counters and sorting
+    networks need O(n k) or O(n log² k) for a bound k in the thousands) and a comparison of
+    the number with the bounds; the clauses and the new largest variable.
+
+    Examples
+    --------
+    >>> cl, top = adder_card([1, 2, 3], 1, 2, 3)
+    >>> top > 3 and len(cl) > 0
+    True
+    """
+    out: list[list[int]] = []
+    nxt = top
+
+    def new() -> int:
+        nonlocal nxt
+        nxt += 1
+        return nxt
+
+    def add(a: list[int], b: list[int]) -> list[int]:
+        res: list[int] = []
+        carry = 0
+        for i in range(max(len(a), len(b))):
+            ins = [v for v in (a[i] if i < len(a) else 0, b[i] if i < len(b) else 0, carry) if v]
+            if len(ins) == 1:
+                res.append(ins[0])
+                carry = 0
+                continue
+            sm, c = new(), new()
+            if len(ins) == 2:
+                x, y = ins
+                out.extend([[-x, -y, -sm], [x, y, -sm], [x, -y, sm], [-x, y, sm],
+                            [-c, x], [-c, y], [c, -x, -y]])  # fmt: skip
+            else:
+                x, y, z = ins
+                for sx in (1, -1):
+                    for sy in (1, -1):
+                        for sz in (1, -1):
+                            odd = (sx < 0) + (sy < 0) + (sz < 0)  # literals negated
+                            # the clause (sx·x ∨ sy·y ∨ sz·z ∨ ±sm) fixes sm's parity
+                            out.append([sx * x, sy * y, sz * z, sm if odd % 2 else -sm])
+                out.extend([[-x, -y, c], [-x, -z, c], [-y, -z, c],
+                            [x, y, -c], [x, z, -c], [y, z, -c]])  # fmt: skip
+            res.append(sm)
+            carry = c
+        if carry:
+            res.append(carry)
+        return res
+
+    nums: list[list[int]] = [[int(x)] for x in xs]
+    if not nums:
+        return ([[]] if lo > 0 else []), top
+    while len(nums) > 1:
+        nums = [add(nums[i], nums[i + 1]) if i + 1 < len(nums) else nums[i]
+                for i in range(0, len(nums), 2)]  # fmt: skip
+    bits = nums[0]
+    w = len(bits)
+    if hi is not None:
+        if hi < 0:
+            return [[]], nxt
+        B = [(hi >> i) & 1 for i in range(w)]
+        if hi < (1 << w):
+            for i in range(w):
+                if not B[i]:
+                    out.append([-bits[i]] + [-bits[j] for j in range(i + 1, w) if B[j]])
+    if lo > 0:
+        if lo >= (1 << w):
+            return [[]], nxt
+        L = [(lo >> i) & 1 for i in range(w)]
+        for i in range(w):
+            if L[i]:
+                out.append([bits[i]] + [bits[j] for j in range(i + 1, w) if not L[j]])
+    return out, nxt
 
 
 def constraint_clauses(problem: Problem, lit: Callable[[int, int], Lit], top: int) -> ClauseContext:
@@ -361,6 +527,33 @@ class Constraint(ABC):
 
     def cut(self, ctx: ClauseContext, lab: NDArray[np.int64]) -> None:  # noqa: B027
         """Add clauses excluding ``lab`` where the eager clauses let a breach through."""
+
+    def set_labels(self, problem: Problem) -> NDArray[np.bool_] | None:
+        """The label set ``S`` (bool ``(K,)``) when this constraint's propagator reads only
+        which cells may and which must take a label of ``S`` (:meth:`prune_sets`), so a
+        packed catalog needs no unpacking; ``None`` otherwise (then :meth:`propagate`)."""
+        return None
+
+    def prune_sets(
+        self, problem: Problem, can: NDArray[np.bool_], must: NDArray[np.bool_]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+        """:meth:`propagate` for a constraint with :meth:`set_labels`: from ``can`` and
+        ``must`` (bool ``(n,)``: may / must the cell take a label of ``S``; ``must`` may be
+        changed) the cells that leave ``S`` and the cells restricted to ``S``; ``None`` when
+        no completion exists."""
+        raise NotImplementedError(f"{self.kind} has no set propagator")
+
+    def prunes_nothing_new(
+        self,
+        problem: Problem,
+        can: NDArray[np.bool_],
+        must: NDArray[np.bool_],
+        last: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+    ) -> bool:
+        """Whether :meth:`prune_sets` needs no new run on ``can``/``must`` after one on
+        ``last`` found nothing to prune, judged from the cells that changed (a catalog
+        that only shrinks); ``False`` (run it) unless a kind knows better."""
+        return bool(np.array_equal(can, last[0]) and np.array_equal(must, last[1]))
 
     @abstractmethod
     def describe(self, problem: Problem) -> str:
@@ -431,6 +624,28 @@ class Count(Constraint):
         elif nc == self.min and open_.size:
             dom[open_] &= S
         return True
+
+    def set_labels(self, problem: Problem) -> NDArray[np.bool_] | None:
+        return label_mask(self.labels, problem.K)
+
+    def prune_sets(
+        self, problem: Problem, can: NDArray[np.bool_], must: NDArray[np.bool_]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+        cells = None if self.region is None else self.cells(problem)
+        c = can if cells is None else can[cells]
+        m = must if cells is None else must[cells]
+        nm, nc = int(np.count_nonzero(m)), int(np.count_nonzero(c))
+        if nc < self.min or (self.max is not None and nm > self.max):
+            return None
+        none = np.zeros(0, dtype=np.int64)
+        if nm == nc or not (nc == self.min or nm == self.max):
+            return none, none
+        open_ = np.flatnonzero(c & ~m)
+        if cells is not None:
+            open_ = cells[open_]
+        if self.max is not None and nm == self.max:
+            return open_.astype(np.int64), none
+        return none, open_.astype(np.int64)
 
     def clauses(self, ctx: ClauseContext) -> None:
         S = label_mask(self.labels, ctx.problem.K)
@@ -590,6 +805,45 @@ class Connected(Constraint):
         if force.any():
             dom[force] &= S if S.ndim == 1 else S[force]
         return True
+
+    def set_labels(self, problem: Problem) -> NDArray[np.bool_] | None:
+        if self.ports is not None or self.members is not None:
+            return None
+        return label_mask(self.labels, problem.K)
+
+    def prune_sets(
+        self, problem: Problem, can: NDArray[np.bool_], must: NDArray[np.bool_]
+    ) -> tuple[NDArray[np.int64], NDArray[np.int64]] | None:
+        given = np.asarray(self.cells, dtype=np.int64)
+        if given.size:
+            if not can[given].all():
+                return None
+            given = given[~must[given]]
+            must[given] = True
+        if self.nonempty and not can.any():
+            return None
+        ptr, nbr = grid_csr(problem)
+        ok, out, force = kern.connected_prune(ptr, nbr, can, must)
+        if not ok:
+            return None
+        if given.size:
+            force[given] = True
+        return np.flatnonzero(out).astype(np.int64), np.flatnonzero(force).astype(np.int64)
+
+    def prunes_nothing_new(
+        self,
+        problem: Problem,
+        can: NDArray[np.bool_],
+        must: NDArray[np.bool_],
+        last: tuple[NDArray[np.bool_], NDArray[np.bool_]],
+    ) -> bool:
+        """No cell joined ``can``, the cells that left it were bypassed inside their box,
+        new must cells touch old ones (:func:`csplab._kernels.connected_unchanged`): no
+        cell became unreachable. Cells that now separate two must cells along a rerouted
+        path are found by the next full run (the caller bounds the steps in between)."""
+        ptr, nbr = grid_csr(problem)
+        xyz = grid_coords(problem)
+        return bool(kern.connected_unchanged(ptr, nbr, xyz, can, must, last[0], last[1]))
 
     def in_set(self, ctx: ClauseContext, cell: int) -> Lit:
         """The literal "``cell`` is in the set"."""

@@ -19,9 +19,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from csplab import _kernels as kern
-from csplab.constraints import ClauseContext, Connected
+from csplab.constraints import ClauseContext, Connected, grid_coords, grid_csr
 from csplab.deps import require
 from csplab.problem import Problem
 
@@ -33,10 +34,22 @@ def _base() -> type:
 
 
 class _State:
-    """One constraint's view: the literal "cell in the set" per cell and their values."""
+    """One constraint's view: the literal "cell in the set" per cell and their values.
+
+    ``R`` is the region of the last full run while only assignments have followed it
+    (``None``: run in full), ``out`` the cells of ``R`` excluded since. When each of
+    those has its open neighbours joined around it inside its box
+    (:func:`csplab._kernels.all_bypassed`), ``R`` minus them is the region a full run
+    would find, whose outside is already propagated: the run is skipped."""
 
     def __init__(self, problem: Problem, con: Connected, ctx: ClauseContext) -> None:
         self.lo, self.hi, _ = con.edges(problem)
+        self.R: NDArray[np.bool_] | None = None
+        self.out: list[int] = []
+        self.grid = con.members is None
+        if self.grid:
+            self.ptr, self.nbr = grid_csr(problem)
+            self.xyz = grid_coords(problem)
         self.y: list[Any] = [con.in_set(ctx, c) for c in range(problem.n)]
         self.val = np.zeros(problem.n, dtype=np.int8)  # 1 in, -1 out, 0 open; constants: 2/-2
         for c, y in enumerate(self.y):
@@ -69,6 +82,7 @@ class ConnectivityPropagator:
         self.dirty = True
         self.calls = 0
         self.propagated = 0
+        self.skipped = 0  # runs skipped: the region only lost bypassed cells
 
     def variables(self) -> list[int]:
         return sorted(self.watch)
@@ -78,9 +92,15 @@ class ConnectivityPropagator:
         for i, c, sgn in self.watch.get(abs(lit), ()):
             st = self.states[i]
             if st.val[c] == 0:
-                st.val[c] = 1 if (lit > 0) == (sgn > 0) else -1
+                inside = (lit > 0) == (sgn > 0)
+                st.val[c] = 1 if inside else -1
                 self.trail.append((i, c))
                 self.dirty = True
+                if st.R is not None:
+                    if not inside and st.R[c]:
+                        st.out.append(c)
+                    elif inside and not st.R[c]:
+                        st.R = None
 
     def on_new_level(self) -> None:
         self.levels.append(len(self.trail))
@@ -89,6 +109,9 @@ class ConnectivityPropagator:
         keep = self.levels[to + 1] if to + 1 < len(self.levels) else len(self.trail)
         for i, c in self.trail[keep:]:
             self.states[i].val[c] = 0
+        for st in self.states:  # open cells again: the region may grow
+            st.R = None
+            st.out = []
         del self.trail[keep:]
         del self.levels[to + 1 :]
         self.dirty = True
@@ -106,6 +129,17 @@ class ConnectivityPropagator:
         self.calls += 1
         out: list[int] = []
         for st in self.states:
+            if st.R is not None:
+                if not st.out:
+                    continue
+                cells = np.array(st.out, dtype=np.int64)
+                if kern.all_bypassed(st.ptr, st.nbr, st.xyz, st.val > -1, cells):
+                    st.R[cells] = False
+                    st.out = []
+                    self.skipped += 1
+                    continue
+            st.R = None
+            st.out = []
             act = st.val > 0
             if not act.any():
                 continue
@@ -114,6 +148,8 @@ class ConnectivityPropagator:
             s = int(np.flatnonzero(act)[0])
             R = comp == comp[s]
             bad = np.flatnonzero(act & ~R)
+            if not bad.size and st.grid:
+                st.R = R.copy()
             todo = bad[:1] if bad.size else np.flatnonzero((st.val == 0) & ~R)
             if not todo.size:
                 continue

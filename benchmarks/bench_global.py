@@ -1,0 +1,122 @@
+"""Benchmark: global constraints at scale (issue 29, item 4).
+
+Two problems, each with one connected structure and a count:
+
+- ``city`` 40x40x10 (``boundary="auto"``): every non-background label (not air, not
+  ground) one connected component, and 5-30 % of the cells non-background (the
+  ``constraints`` experiment's constraints);
+- the WFC pipes (knot) tileset of the test data at 128x128: every non-empty tile one
+  connected network, at most 2 crossings.
+
+Each is solved by ``catalog`` (with restarts), ``sat``, ``asp`` and ``cpsat`` with a time
+limit; the output is re-checked by :meth:`~csplab.problem.Problem.violations`. Beside each
+figure: the same solver on the same problem without the global constraints, in the same
+process (the reference: the machine's load inflates both alike), and the load average.
+
+Targets: ``catalog``, ``sat``, ``asp`` <= 10 s each, ``cpsat`` <= 30 s, every output valid.
+
+Usage::
+
+    python benchmarks/bench_global.py [--cases city pipes] [--solvers catalog sat asp cpsat]
+                                      [--time-limit 60] [--seed 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+TARGET = {"catalog": 10.0, "sat": 10.0, "asp": 10.0, "cpsat": 30.0}
+
+
+def city(size: tuple[int, ...] = (40, 40, 10)) -> tuple[Any, Any]:
+    import csplab
+    from csplab.constraints import parse_constraints
+    from csplab.experiments.base import background_labels
+
+    ex = csplab.load_example("city")
+    P = csplab.from_example(ex, size, boundary="auto")
+    bg = set(background_labels(ex))
+    fg = [b for b in range(ex.K) if b not in bg]
+    cons = [
+        {"type": "connected", "labels": fg},
+        {"type": "count", "labels": fg, "min": int(np.ceil(0.05 * P.n)), "max": int(0.3 * P.n)},
+    ]
+    return P, P.with_constraints(parse_constraints(cons, P))
+
+
+def pipes(size: tuple[int, ...] = (128, 128)) -> tuple[Any, Any]:
+    import csplab.examples
+    from csplab.constraints import parse_constraints
+
+    P = csplab.examples.load_model(ROOT / "tests" / "io" / "data" / "pipes.xml").problem(size)
+    cons = [
+        {"type": "connected", "labels": ["line", "corner", "tee", "cross"]},
+        {"type": "count", "labels": ["cross"], "min": 0, "max": 2},
+    ]
+    return P, P.with_constraints(parse_constraints(cons, P))
+
+
+CASES = {"city": (city, "city 40x40x10, connected + count"),
+         "pipes": (pipes, "pipes (knot) 128x128, one network + at most 2 crossings")}  # fmt: skip
+
+
+def run(problem: Any, solver: str, seed: int, limit: float) -> tuple[str, float, bool]:
+    import csplab
+
+    kw: dict[str, Any] = {"restarts": 50} if solver == "catalog" else {}
+    t = time.perf_counter()
+    r = csplab.solve(problem, solver, rng=seed, time_limit=limit, **kw)
+    dt = time.perf_counter() - t
+    ok = r.status == "solved" and r.grid is not None and not problem.violations(r.grid)
+    return r.status, dt, ok
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--cases", nargs="+", default=list(CASES), choices=list(CASES))
+    ap.add_argument("--solvers", nargs="+", default=list(TARGET), choices=list(TARGET))
+    ap.add_argument("--time-limit", type=float, default=60.0)
+    ap.add_argument("--seed", type=int, default=1)
+    args = ap.parse_args()
+
+    from csplab.solvers import available_solvers
+
+    have = {s["name"] for s in available_solvers() if s["installed"]}
+    small = {"city": (6, 6, 4), "pipes": (8, 8)}
+    for case in args.cases:
+        build, title = CASES[case]
+        print(f"== {title}", flush=True)
+        P, Q = build()
+        for solver in args.solvers:
+            if solver not in have:
+                print(f"  {solver:8s} not installed")
+                continue
+            run(build(small[case])[1], solver, args.seed, args.time_limit)  # warm: JIT, imports
+            ref = run(P, solver, args.seed, args.time_limit)
+            st, dt, ok = run(Q, solver, args.seed, args.time_limit)
+            target = TARGET[solver]
+            verdict = (
+                "meets" if ok and dt <= target
+                else f"shortfall: {dt / target:.1f}x the {target:.0f} s target"
+                if ok else f"shortfall: {st}, no valid output"
+            )  # fmt: skip
+            print(
+                f"  {solver:8s} constrained {st:8s} {dt:7.2f} s  valid={ok}  "
+                f"(reference without constraints: {ref[0]} {ref[1]:.2f} s; "
+                f"load {os.getloadavg()[0]:.1f})  target <= {target:.0f} s: {verdict}",
+                flush=True,
+            )
+
+
+if __name__ == "__main__":
+    main()
