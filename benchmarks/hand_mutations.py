@@ -14,8 +14,13 @@ Usage::
     python benchmarks/hand_mutations.py -k check3d # those whose id contains "check3d"
     python benchmarks/hand_mutations.py --list
 
-The exit status is 0 when every mutation selected was killed. It takes a few minutes
-(each test run loads the compiled kernels in a fresh directory).
+The exit status is 0 when every mutation selected was killed. Each run stops at its first
+failing test (``-x``) and has a time box (``--timeout``, default 300 s; a run that does not
+answer in time has hung and counts as killed, marked so). numba's on-disk cache of the copy
+is kept between runs: a mutated file gets a modification time of its own (so its kernels
+are compiled afresh, never taken from the cache of the unmutated file) and gets its original
+time back with its original text (so the unmutated kernels' cache stays valid). ``--out``
+also writes the report to a file.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-TIMEOUT_S = 900  # a test run that takes longer has hung: the mutation is killed
+TIMEOUT_S = 300.0  # a test run that takes longer has hung: the mutation is killed
 
 
 @dataclass(frozen=True)
@@ -175,16 +180,16 @@ def _copy_tree(dst: Path) -> None:
             shutil.copy2(f, t)
 
 
-def _pytest(cwd: Path, tests: tuple[str, ...]) -> tuple[bool, float, str]:
+def _pytest(cwd: Path, tests: tuple[str, ...], timeout: float) -> tuple[bool, float, str]:
     env = {**os.environ, "PYTHONPATH": str(cwd)}
     cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
            "-p", "no:randomly", *tests]  # fmt: skip
     t0 = time.perf_counter()
     try:
         r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True, check=False,
-                           timeout=TIMEOUT_S)  # fmt: skip
+                           timeout=timeout)  # fmt: skip
     except subprocess.TimeoutExpired:
-        return False, time.perf_counter() - t0, f"no answer in {TIMEOUT_S} s (a hang)"
+        return False, time.perf_counter() - t0, f"no answer in {timeout:.0f} s (a hang)"
     lines = r.stdout.strip().splitlines() or [""]
     failed = [ln.split()[1] for ln in lines if ln.startswith(("FAILED ", "ERROR "))]
     tail = lines[-1] if not failed else f"{lines[-1]}: {', '.join(failed)}"
@@ -199,6 +204,9 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("-k", default="", help="only mutations whose id contains this")
     ap.add_argument("--list", action="store_true", help="list the mutations and stop")
+    ap.add_argument("--timeout", type=float, default=TIMEOUT_S,
+                    help="seconds a test run may take before it counts as a hang")  # fmt: skip
+    ap.add_argument("--out", default=None, help="also write the report here")
     a = ap.parse_args(argv)
     chosen = [m for m in MUTATIONS if a.k in m.id]
     if a.list:
@@ -206,6 +214,13 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{m.id}: {m.what} ({m.path}) <- {', '.join(m.tests)}")
         return 0
     killed = 0
+    report: list[str] = []
+
+    def say(line: str) -> None:
+        print(line, flush=True)
+        report.append(line)
+
+    t_all = time.perf_counter()
     baseline: dict[tuple[str, ...], tuple[bool, float, str]] = {}
     with tempfile.TemporaryDirectory(prefix="csplab-mut-") as tmp:
         work = Path(tmp)
@@ -214,23 +229,30 @@ def main(argv: list[str] | None = None) -> int:
             src = work / m.path
             text = src.read_text()
             if text.count(m.old) != 1:
-                print(f"{m.id}: STALE (the text to mutate occurs {text.count(m.old)} times)")
+                say(f"{m.id}: STALE (the text to mutate occurs {text.count(m.old)} times)")
                 continue
             if m.tests not in baseline:  # each set of tests once, unmutated
-                baseline[m.tests] = _pytest(work, m.tests)
+                baseline[m.tests] = _pytest(work, m.tests, a.timeout)
             ok, dt, tail = baseline[m.tests]
             if not ok:
-                print(f"{m.id}: BROKEN (the tests fail unmutated: {tail})")
+                say(f"{m.id}: BROKEN (the tests fail unmutated: {tail})")
                 continue
+            stamp = src.stat().st_mtime_ns
             src.write_text(text.replace(m.old, m.new))
+            # a time of its own: numba must not take the mutant's kernels from the cache
+            os.utime(src, ns=(stamp + 7_000_000_000, stamp + 7_000_000_000))
             try:
-                ok, dt, tail = _pytest(work, m.tests)
+                ok, dt, tail = _pytest(work, m.tests, a.timeout)
             finally:
                 src.write_text(text)
+                os.utime(src, ns=(stamp, stamp))
             status = "survived" if ok else "killed"
             killed += not ok
-            print(f"{m.id}: {status} in {dt:.0f} s by {' '.join(m.tests)} [{tail}]", flush=True)
-    print(f"{killed} of {len(chosen)} hand mutations killed")
+            say(f"{m.id}: {status} in {dt:.0f} s by {' '.join(m.tests)} [{tail}]")
+    say(f"{killed} of {len(chosen)} hand mutations killed "
+        f"({time.perf_counter() - t_all:.0f} s in all)")  # fmt: skip
+    if a.out:
+        Path(a.out).write_text("\n".join(report) + "\n")
     return 0 if killed == len(chosen) else 1
 
 
