@@ -66,6 +66,26 @@ def test_alg31_same_as_kernels_on_random_examples(engine, order, choice):
     assert statuses & {"solved", "failed"}
 
 
+@pytest.mark.parametrize("order", ["min-entropy", "scanline"])
+def test_alg31_same_as_kernels_with_labels_of_weight_0(engine, order):
+    """Weights may be 0: a cell whose labels left all weigh 0 is keyed by its label count
+    and drawn uniformly (the weighted entropy's and choice's fallbacks), the same in both
+    twins, draw for draw."""
+    rng = np.random.default_rng(11)
+    for trial in range(8):
+        E = _random_example(rng, int(rng.integers(3, 7)), (5, 4))
+        w = rng.random(E.K) * (rng.random(E.K) < 0.5)
+        w[int(rng.integers(E.K))] = 0.0
+        shape = (int(rng.integers(4, 10)), int(rng.integers(4, 10)))
+
+        def build(E=E, w=w, shape=shape):
+            P = from_example(E, shape)
+            return Problem(P.shape, P.domains, P.relations, P.arcs, weights=w)
+
+        a, b = _both(engine, build, trial, order=order, choice="weighted")
+        _same(a, b)
+
+
 @pytest.mark.parametrize(
     "name,shape,kw",
     [
