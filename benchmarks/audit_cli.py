@@ -32,7 +32,8 @@ class Case:
     row: str
     argv: list[str]
     expect: int
-    files: dict[str, str] = field(default_factory=dict)  # name -> text (or "copy:PATH")
+    #: name -> text, or "copy:PATH", "npy", "stl:ico", "stl:cube", "gon:N"
+    files: dict[str, str] = field(default_factory=dict)
     after: str = ""  # a file that must NOT exist afterwards, or "same:NAME" unchanged
 
 
@@ -181,6 +182,10 @@ CASES = [
             "0",
             "--seed",
             "1",
+            "--fallback",
+            "none",
+            "--time-limit",
+            "0.001",
         ],
         1,
         {"conn.json": '{"constraints": [{"type": "connected", "labels": [1]}]}'},
@@ -266,7 +271,8 @@ def run(case: Case) -> dict[str, object]:
             ok = ok and (d / name).read_bytes() == before[name]
         elif case.after:
             ok = ok and not (d / case.after).exists()
-        text = (err.strip() or out.strip()).splitlines()
+        said = [ln for ln in err.strip().splitlines() if not ln.endswith(" ...")]  # notices
+        text = said or out.strip().splitlines()
         last = errors[-1] if errors else (text[-1] if text else "")
         return {"row": case.row, "command": "csplab " + " ".join(case.argv), "exit": code,
                 "expect": case.expect, "ok": ok, "time_s": round(dt, 1), "last": last}  # fmt: skip

@@ -121,17 +121,21 @@ TARGETS: tuple[Target, ...] = (
     Target(
         "engine.kernels",
         "csplab/_kernels.py",
-        ("alg31", "_propagate", "propagate", "choose_label", "entropy_of", "domain_size",
-         "nth_label", "heap_update", "heap_build", "heap_pop", "_heap_up", "_heap_down",
-         "_heap_swap", "ctz64", "popcount64"),  # fmt: skip
+        (
+            "alg31", "_propagate", "propagate", "choose_label", "entropy_of", "domain_size",
+            "nth_label", "heap_update", "heap_build", "heap_pop", "_heap_up", "_heap_down",
+            "_heap_swap", "ctz64", "popcount64",
+        ),
         (*_TWINS, "tests/test_kernels.py::test_alg31_in_chunks_equals_one_run"),
         _NOJIT,
     ),
     Target(
         "engine.interp",
         "csplab/_interp.py",
-        ("alg31", "_revise", "_choose", "_entropy", "propagate", "_write_back", "set_bits",
-         "_ints", "_store"),  # fmt: skip
+        (
+            "alg31", "_revise", "_choose", "_entropy", "propagate", "_write_back", "set_bits",
+            "_ints", "_store",
+        ),
         (*_TWINS, "tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm"),
         _NOJIT,
     ),

@@ -192,7 +192,8 @@ def synthesize(
     if dim == 2:
         settings["lines"] = args.lines
     try:
-        s = run(example, size, lines=args.lines, constraints=cons, **common, **opts)
+        s = run(example, size, lines=args.lines, constraints=cons, notices=True, **common,
+                **opts)  # fmt: skip
     except InputError as e:  # the library names its arguments; the user typed flags
         raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem

@@ -50,8 +50,8 @@ import shapely
 from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
-from csplab.continuous.lattice import check_snap
 from csplab.continuous.csp3d import ContinuousCSP3
+from csplab.continuous.lattice import check_snap
 from csplab.continuous.model import Polygon, PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3

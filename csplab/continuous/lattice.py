@@ -89,7 +89,8 @@ def check_snap(where: str, spacing: float, what: str, before: float, after: floa
     >>> check_snap("ball.stl", 1, "volume", 4.15, 8.0)
     Traceback (most recent call last):
     ...
-    csplab.errors.InputError: ball.stl: snapping onto spacing 1 distorts it (its volume 4.15 becomes 8; more than 50 % changed); pass a smaller --spacing
+    csplab.errors.InputError: ball.stl: snapping onto spacing 1 distorts it (its volume 4.15 \
+becomes 8; more than 50 % changed); pass a smaller --spacing
     """
     if after <= 0 or abs(after - before) > MAX_SNAP_CHANGE * abs(before):
         how = "collapses" if after <= 0 else "distorts"

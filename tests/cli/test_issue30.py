@@ -395,6 +395,23 @@ def test_row18_large_constraints_file_says_it_is_reading(capsys, monkeypatch, tm
     assert "csplab: reading the constraints of" in err or "csplab: parsing" in err, err
 
 
+@pytest.mark.parametrize("model,size", [("tetrahedron", "4x4x3"), ("triangle", "12x10")])
+def test_row18_continuous_phases_say_what_runs(capsys, monkeypatch, model, size):
+    """A long continuous run was silent between its phases (building the planes'
+    arrangement and the CSP, solving, the surface, the check): each now says itself on
+    stderr once it has run 2 s (here the delay is 0, so every phase that takes a moment
+    speaks)."""
+    import csplab.progress as progress
+
+    if model == "tetrahedron":
+        pytest.importorskip("trimesh")
+    monkeypatch.setattr(progress, "DELAY_S", 0.0)
+    code, _, err = run(capsys, "synthesize", model, "--size", size, "--seed", "1")
+    assert code == 0, err
+    assert f"csplab: {model} at {size}: building the arrangement and the CSP ..." in err, err
+    assert "Traceback" not in err
+
+
 # -------------------------------------------------- row 21: the README's Python calls
 def test_row21_subpackages_are_attributes_after_import_csplab():
     import subprocess
