@@ -30,7 +30,8 @@ def test_the_check_notices_a_paragraph_without_its_source() -> None:
 
 
 def test_the_counts_of_a_quoted_output_are_read() -> None:
-    quoted = ("prints `solved: triangle 40x30 spacings of 1 (3 edge directions, 14581 vertices,"
-              " 32640 edges, K=8) with catalog in 0.277 s, seed 1`, then `887 polygons`")  # fmt: skip
+    quoted = ("prints `solved: triangle 40x30 spacings of 1 (3 edge directions, 14581 "
+              "vertices, 32640 edges, K=8) with catalog in 0.277 s, seed 1`, then `887 "
+              "polygons`")  # fmt: skip
     assert rn._numbers(quoted) == {"vertices": "14581", "edges": "32640", "K": "8",
                                    "polygons": "887"}  # fmt: skip
