@@ -90,3 +90,24 @@ def test_heap_orders_visit_each_cell_once_and_solve_consistently():
                 if r.status == "solved":
                     assert sorted(cells.tolist()) == list(range(P.n))
                     assert len(P.violations(r.grid)) == 0
+
+
+def test_resemblance_windows_are_3_cells_wide_by_default():
+    """``run_alg31(choice="resemblance")`` uses windows of 3 cells (``window=1``, the 2007
+    paper's) unless told otherwise: the default run is the ``window=1`` run, draw for draw,
+    and a wider window changes some run."""
+    import numpy as np
+
+    from csplab.engine.alg31 import run_alg31
+    from csplab.examples import load_example
+    from csplab.grids import from_example
+
+    P = from_example(load_example("fig3_10"), (8, 8))
+    differs = False
+    for seed in range(4):
+        a = run_alg31(P, np.random.default_rng(seed), choice="resemblance")
+        b = run_alg31(P, np.random.default_rng(seed), choice="resemblance", window=1)
+        c = run_alg31(P, np.random.default_rng(seed), choice="resemblance", window=2)
+        assert a.status == b.status and np.array_equal(a.grid, b.grid)
+        differs |= not np.array_equal(a.grid, c.grid)
+    assert differs
