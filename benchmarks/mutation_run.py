@@ -139,7 +139,11 @@ TARGETS: tuple[Target, ...] = (
             "alg31", "_revise", "_choose", "_entropy", "propagate", "_write_back", "set_bits",
             "_ints", "_store",
         ),
-        (*_TWINS, "tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm"),
+        (
+            *_TWINS,
+            "tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",
+            "tests/test_interp.py::test_interpreted_work_is_counted",
+        ),
         _NOJIT,
     ),
     Target(
