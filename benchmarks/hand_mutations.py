@@ -3,7 +3,9 @@
 Every mutation below once passed the whole suite: a sampling of the 3D checker removed, a
 block that failed every retry handing back its partial labels, the Efros-Leung baseline
 matching loosely or not at all, the SAT oracle accepting models with several labels in a
-cell. The script copies the tracked files of the work tree to a temporary directory
+cell; or survived ``benchmarks/mutation_run.py`` until a test was written for it (the 3D
+checker's sampling of edges and of the example's triangles, a block's deadline, the
+interpreted engine's wipe-out at cell 0 and entropy of tiny weights). The script copies the tracked files of the work tree to a temporary directory
 (the work tree itself is never changed), checks that the killing tests pass there
 unmutated, then applies each mutation (an exact text replacement, which must match once)
 and runs its tests: a mutation is *killed* when they fail.
@@ -112,6 +114,54 @@ MUTATIONS: tuple[Mutation, ...] = (
         "    ustream = 1.0 - rng.random(n)\n    noise",
         ("tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",),
         "the compiled Alg. 3.1 draws its labels from the other end of the catalog",
+    ),
+    Mutation(
+        "check3d-example-sampled-as-output-at-dense-2",
+        "csplab/continuous/check3d.py",
+        "    if dense <= 1:\n",
+        "    if dense <= 2:\n",
+        ("tests/continuous/test_check3d_samples.py",),
+        "the example gets the output's sampling when dense=2 (the mutation_run survivor)",
+    ),
+    Mutation(
+        "check3d-first-edge-of-each-triangle-unsampled",
+        "csplab/continuous/check3d.py",
+        "ab = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]]",
+        "ab = np.concatenate([tri[:, [0, 2]], tri[:, [1, 2]]",
+        ("tests/continuous/test_check3d_samples.py",),
+        "an edge that is the first edge of both its triangles is not sampled",
+    ),
+    Mutation(
+        "check3d-example-grid-off-the-triangles",
+        "csplab/continuous/check3d.py",
+        "u, w = i / dense, j / dense",
+        "u, w = i * dense, j / dense",
+        ("tests/continuous/test_check3d_samples.py",),
+        "the example's grid of points lies off its triangles",
+    ),
+    Mutation(
+        "blocks-deadline-a-second-per-attempt",
+        "csplab/engine/waves.py",
+        "max(0.0, deadline - time.perf_counter())",
+        "max(1.0, deadline - time.perf_counter())",
+        ("tests/engine/test_waves.py",),
+        "a block's attempt gets a second of its own after the deadline (the deadline gap)",
+    ),
+    Mutation(
+        "interp-wipe-out-of-cell-0-goes-on",
+        "csplab/_interp.py",
+        "        if wiped >= 0:\n            break\n",
+        "        if wiped >= 1:\n            break\n",
+        ("tests/test_interp.py::test_propagate_stops_at_a_wipe_out_of_cell_0",),
+        "the interpreted propagation goes on after cell 0 is wiped out",
+    ),
+    Mutation(
+        "interp-tiny-weights-entropy",
+        "csplab/_interp.py",
+        "    return math.log(s) - sl / s\n",
+        "    return math.log(s) + sl / s\n",
+        ("tests/test_interp.py::test_alg31_same_as_kernels_with_labels_of_weight_0",),
+        "the interpreted entropy of a domain of tiny weights has the wrong sign",
     ),
     Mutation(
         "efros-leung-threshold-10",
