@@ -44,6 +44,7 @@ def test_run_alg31_is_the_literal_algorithm():
     the grid has, and a solved grid has no violation."""
     import numpy as np
 
+    from csplab.catalog import Propagator
     from csplab.engine.alg31 import alg31_reference, run_alg31, scan_order
 
     statuses = set()
@@ -61,6 +62,11 @@ def test_run_alg31_is_the_literal_algorithm():
                     flat = r.grid.reshape(-1)
                     if want == "unsat":
                         assert len(r.trace) == 0 and r.stats.get("proof"), key
+                        # nothing assigned; the work is the root propagation's
+                        root = Propagator(P)
+                        assert r.stats["assigned"] == 0, key
+                        assert r.stats["revisions"] == root.stats[0] > 0, key
+                        assert r.stats["removals"] == root.stats[1] > 0, key
                         continue
                     assert np.array_equal(r.grid, grid) or want == "failed", key
                     cells, labels = r.trace[:, 0], r.trace[:, 1]
