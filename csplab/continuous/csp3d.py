@@ -155,7 +155,7 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
             "--spacing"
         ) from None
     for b in example.labels:  # each label's volume, as snapping left it
-        check_snap(f"{example.source}: label {b}", lattice.spacing, "volume",
+        check_snap(f"{example.source}: label {b}", float(lattice.spacing), "volume",
                    example.volume(b), out.volume(b))  # fmt: skip
     return out
 
