@@ -5,8 +5,9 @@ block that failed every retry handing back its partial labels, the Efros-Leung b
 matching loosely or not at all, the SAT oracle accepting models with several labels in a
 cell; or survived ``benchmarks/mutation_run.py`` until a test was written for it (the 3D
 checker's sampling of edges and of the example's triangles, a block's deadline, the
-interpreted engine's wipe-out at cell 0 and entropy of tiny weights). The script copies the tracked files of the work tree to a temporary directory
-(the work tree itself is never changed), checks that the killing tests pass there
+interpreted engine's wipe-out at cell 0 and entropy of tiny weights). The script copies
+the tracked files of the work tree to a temporary directory (the work tree itself is never
+changed), checks that the killing tests pass there
 unmutated, then applies each mutation (an exact text replacement, which must match once)
 and runs its tests: a mutation is *killed* when they fail.
 
