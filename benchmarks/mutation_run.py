@@ -114,6 +114,7 @@ TARGETS: tuple[Target, ...] = (
         (
             "tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",
             "tests/engine/test_alg31.py::test_resemblance_windows_are_3_cells_wide_by_default",
+            "tests/engine/test_alg31.py::test_global_constraints_refuted_before_any_choice",
             "tests/test_kernels.py::test_alg31_in_chunks_equals_one_run",
             "tests/test_kernels.py::test_alg31_time_limit_chunks_do_not_change_the_grid",
             "tests/engine/test_waves.py",

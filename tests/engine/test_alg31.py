@@ -117,3 +117,27 @@ def test_resemblance_windows_are_3_cells_wide_by_default():
         assert a.status == b.status and np.array_equal(a.grid, b.grid)
         differs |= not np.array_equal(a.grid, c.grid)
     assert differs
+
+
+def test_global_constraints_refuted_before_any_choice():
+    """A fixed cell whose label a count constraint forbids: the constraint refutes the root
+    catalog, so Alg. 3.1 stops "unsat" before any choice, with the work of the root
+    propagation (revisions and removals told apart) and nothing assigned."""
+    import numpy as np
+
+    from csplab.catalog import Propagator
+    from csplab.constraints import Count
+    from csplab.engine.alg31 import run_alg31
+    from csplab.examples import load_example
+    from csplab.grids import from_example, with_fixed
+
+    P = with_fixed(from_example(load_example("fig3_10"), (6, 5)), {(2, 3): 1})
+    P = P.with_constraints([Count(labels=[1], max=0)])
+    r = run_alg31(P, np.random.default_rng(0))
+    assert r.status == "unsat" and len(r.trace) == 0
+    assert r.stats["proof"] == "global-constraint propagation before any choice"
+    assert r.stats["assigned"] == 0
+    root = Propagator(P)
+    assert root.constrain() == -2  # the same refutation, replayed: by the count, no cell
+    assert (r.stats["revisions"], r.stats["removals"]) == (root.stats[0], root.stats[1])
+    assert root.stats[0] != root.stats[1]  # the premise: the two counts differ here
