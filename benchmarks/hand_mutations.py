@@ -21,7 +21,8 @@ The exit status is 0 when every mutation selected was killed. Each run stops at 
 failing test (``-x``) and has a time box (``--timeout``, default 300 s; a run that does not
 answer in time has hung and counts as killed, marked so). numba's on-disk cache of the copy
 is kept between runs: a mutated file gets a modification time of its own (so its kernels
-are compiled afresh, never taken from the cache of the unmutated file) and gets its original
+and bytecode are compiled afresh, never taken from the cache of the unmutated file or of
+another mutant) and gets its original
 time back with its original text (so the unmutated kernels' cache stays valid). ``--out``
 also writes the report to a file.
 """
@@ -290,8 +291,10 @@ def main(argv: list[str] | None = None) -> int:
                 continue
             stamp = src.stat().st_mtime_ns
             src.write_text(text.replace(m.old, m.new))
-            # a time of its own: numba must not take the mutant's kernels from the cache
-            os.utime(src, ns=(stamp + 7_000_000_000, stamp + 7_000_000_000))
+            # a time of its own (one per mutation: two mutants of one file may have the same
+            # size), so neither Python's bytecode cache nor numba's takes another's code
+            own = stamp + (1 + MUTATIONS.index(m)) * 7_000_000_000
+            os.utime(src, ns=(own, own))
             try:
                 ok, dt, tail = _pytest(work, m.tests, a.timeout)
             finally:
