@@ -4,7 +4,7 @@
     python benchmarks/audit_cli.py            # print the table
     python benchmarks/audit_cli.py --write    # and put it in README.md (reliability section)
 
-Every case runs as a subprocess with a 120 s timeout and a 6 GB address-space limit (a
+Every case runs as a subprocess with a 180 s timeout and a 6 GB address-space limit (a
 memory blow-up is a failure, not a frozen machine). ``expect`` is the exit code the
 contract asks for: 2 for bad input (one line on stderr), 1 for a failed run, 0 for success.
 """
@@ -32,7 +32,8 @@ class Case:
     row: str
     argv: list[str]
     expect: int
-    files: dict[str, str] = field(default_factory=dict)  # name -> text (or "copy:PATH")
+    #: name -> text, or "copy:PATH", "npy", "stl:ico", "stl:cube", "gon:N"
+    files: dict[str, str] = field(default_factory=dict)
     after: str = ""  # a file that must NOT exist afterwards, or "same:NAME" unchanged
 
 
@@ -42,6 +43,28 @@ def _deep(n: int, key: str) -> str:
 
 def _poly(label: str) -> str:
     return '{"polygons": [{"label": ' + label + ', "points": [[0, 0], [4, 0], [4, 4]]}]}'
+
+
+def _stl(shape: str) -> str:
+    """An ASCII STL of float triangles, as a CAD package exports them: ``ico`` (an
+    icosphere of radius 1, 1,280 faces) or ``cube`` (a box with random float corners)."""
+    import numpy as np
+    import trimesh
+
+    if shape == "ico":
+        m = trimesh.creation.icosphere(subdivisions=3)
+    else:
+        lo = np.random.default_rng(30).random(3)
+        m = trimesh.creation.box(bounds=[lo, lo + 1 + np.random.default_rng(31).random(3)])
+    return str(m.export(file_type="stl_ascii"))
+
+
+def _gon(n: int, radius: float) -> str:
+    import math
+
+    pts = [[radius * math.cos(2 * math.pi * k / n), radius * math.sin(2 * math.pi * k / n)]
+           for k in range(n)]  # fmt: skip
+    return json.dumps({"polygons": [{"label": 1, "points": pts}]})
 
 
 CASES = [
@@ -87,6 +110,51 @@ CASES = [
         {"huge.json": _poly("1" + "0" * 30)},
         "r.png",
     ),
+    Case("4", ["synthesize", "triangle", "--size", "10x10", "--spacing", "1e-9"], 2),
+    Case("4", ["synthesize", "houses", "--size", "10x10x6", "--spacing", "1e-9"], 2),
+    Case(
+        "5",
+        ["synthesize", "ico.stl", "--size", "6x6x6", "--out", "r.obj"],
+        0,
+        {"ico.stl": "stl:ico"},
+    ),
+    Case(
+        "6",
+        ["synthesize", "gon.json", "--size", "300x300", "--spacing", "10", "--snap",
+         "--out", "r.svg"],
+        2,
+        {"gon.json": "gon:64"},
+        "r.svg",
+    ),
+    Case(
+        "7",
+        ["synthesize", "cube.stl", "--size", "3x3x3", "--spacing", "0.5", "--snap",
+         "--out", "r.obj"],
+        0,
+        {"cube.stl": "stl:cube"},
+    ),
+    Case(
+        "14",
+        ["synthesize", "houses", "--size", "10x10x4", "--spacing", "1000", "--snap", "--out",
+         "r.obj"],
+        2,
+        after="r.obj",
+    ),
+    Case(
+        "14",
+        ["synthesize", "ico.stl", "--size", "6x6x6", "--spacing", "1", "--snap", "--out",
+         "r.obj"],
+        2,
+        {"ico.stl": "stl:ico"},
+        "r.obj",
+    ),
+    Case(
+        "14",
+        ["synthesize", "triangle", "--size", "10x10", "--spacing", "1000", "--snap", "--out",
+         "r.svg"],
+        2,
+        after="r.svg",
+    ),
     Case(
         "8",
         ["synthesize", "fig3_5a", "--size", "6x6", "--constraints", "deep.json"],
@@ -114,6 +182,10 @@ CASES = [
             "0",
             "--seed",
             "1",
+            "--fallback",
+            "none",
+            "--time-limit",
+            "0.001",
         ],
         1,
         {"conn.json": '{"constraints": [{"type": "connected", "labels": [1]}]}'},
@@ -173,6 +245,10 @@ def run(case: Case) -> dict[str, object]:
                 np.save(p, np.array([[0, 0, 1], [0, 1, 1]], dtype=np.int32))
             elif text.startswith("copy:"):
                 shutil.copy(EX / text[5:], p)
+            elif text.startswith("stl:"):
+                p.write_text(_stl(text[4:]))
+            elif text.startswith("gon:"):
+                p.write_text(_gon(int(text[4:]), 1000.0))
             else:
                 p.write_text(text)
         before = {n: (d / n).read_bytes() for n in case.files if (d / n).is_file()}
@@ -180,11 +256,11 @@ def run(case: Case) -> dict[str, object]:
         t0 = time.perf_counter()
         try:
             p = subprocess.run([sys.executable, "-m", "csplab", *case.argv], cwd=d, env=env,
-                               capture_output=True, text=True, timeout=120,
+                               capture_output=True, text=True, timeout=180,
                                preexec_fn=_limit)  # fmt: skip
             code, out, err = p.returncode, p.stdout, p.stderr
         except subprocess.TimeoutExpired:
-            code, out, err = -9, "", "timeout after 120 s"
+            code, out, err = -9, "", "timeout after 180 s"
         dt = time.perf_counter() - t0
         ok = code == case.expect and "Traceback" not in err
         errors = [ln for ln in err.splitlines() if ln.startswith("csplab: error:")]
@@ -195,7 +271,8 @@ def run(case: Case) -> dict[str, object]:
             ok = ok and (d / name).read_bytes() == before[name]
         elif case.after:
             ok = ok and not (d / case.after).exists()
-        text = (err.strip() or out.strip()).splitlines()
+        said = [ln for ln in err.strip().splitlines() if not ln.endswith(" ...")]  # notices
+        text = said or out.strip().splitlines()
         last = errors[-1] if errors else (text[-1] if text else "")
         return {"row": case.row, "command": "csplab " + " ".join(case.argv), "exit": code,
                 "expect": case.expect, "ok": ok, "time_s": round(dt, 1), "last": last}  # fmt: skip

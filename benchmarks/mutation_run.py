@@ -45,6 +45,22 @@ class Target:
     path: str
     functions: tuple[str, ...]
     tests: tuple[str, ...]
+    #: environment of the test runs: ``NUMBA_DISABLE_JIT=1`` runs the ``@njit`` kernels as
+    #: the Python they are written in, so a mutant of a kernel is observed without compiling
+    #: every kernel of its file again (minutes per mutant); the compiled and interpreted
+    #: twins are then compared as Python, which is what mutmut mutates
+    env: tuple[tuple[str, str], ...] = ()
+
+
+_NOJIT = (("NUMBA_DISABLE_JIT", "1"),)
+#: the twins compared (kernels forced, then interpreted): statuses, grids, traces, stats
+_TWINS = (
+    "tests/test_interp.py::test_propagate_stops_at_a_wipe_out_of_cell_0",
+    "tests/test_interp.py::test_alg31_same_as_kernels_with_labels_of_weight_0",
+    "tests/test_interp.py::test_propagate_same_as_kernels_on_random_catalogs",
+    "tests/test_interp.py::test_alg31_same_as_kernels_on_random_examples",
+    "tests/test_interp.py::test_alg31_same_as_kernels_on_builtins",
+)
 
 
 TARGETS: tuple[Target, ...] = (
@@ -59,15 +75,16 @@ TARGETS: tuple[Target, ...] = (
         "csplab/continuous/check3d.py",
         ("_samples", "_edge_pieces", "_unique_rows", "_lex_less", "_families", "violations3"),
         (
+            "tests/continuous/test_check3d_samples.py",
             "tests/continuous/test_check3d_planted.py",
-            "tests/test_continuous3d.py::test_3d_checker_catches_planted_defects",
+            "tests/continuous/test_continuous3d.py::test_3d_checker_catches_planted_defects",
         ),
     ),
     Target(
         "check",
         "csplab/continuous/check.py",
         ("neighbourhoods", "violations", "_edge_angles"),
-        ("tests/continuous/test_check_planted.py", "tests/test_continuous.py"),
+        ("tests/continuous/test_check_planted.py", "tests/continuous/test_continuous.py"),
     ),
     Target(
         "constraints.check",
@@ -85,13 +102,60 @@ TARGETS: tuple[Target, ...] = (
         "blocks.arrays",
         "csplab/catalog.py",
         ("solve_block_arrays", "block_arrays"),
-        ("tests/solvers/test_blocks_failing.py",),
+        (
+            "tests/solvers/test_blocks_failing.py::test_failed_blocks_keep_their_labels_in_process",
+            "tests/solvers/test_blocks_parallel.py::test_compiled_blocks_same_as_python_blocks_in_waves",
+        ),
     ),
     Target(
         "alg31",
         "csplab/engine/alg31.py",
         ("run_alg31",),
-        ("tests/engine/test_alg31.py",),
+        (
+            "tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",
+            "tests/engine/test_alg31.py::test_resemblance_windows_are_3_cells_wide_by_default",
+            "tests/engine/test_alg31.py::test_global_constraints_refuted_before_any_choice",
+            "tests/test_kernels.py::test_alg31_in_chunks_equals_one_run",
+            "tests/test_kernels.py::test_alg31_time_limit_chunks_do_not_change_the_grid",
+            "tests/engine/test_waves.py",
+            *_TWINS,
+        ),
+        _NOJIT,
+    ),
+    Target(
+        "engine.kernels",
+        "csplab/_kernels.py",
+        (
+            "alg31", "_propagate", "propagate", "choose_label", "entropy_of", "domain_size",
+            "nth_label", "heap_update", "heap_build", "heap_pop", "_heap_up", "_heap_down",
+            "_heap_swap", "ctz64", "popcount64",
+        ),
+        (*_TWINS, "tests/test_kernels.py::test_alg31_in_chunks_equals_one_run"),
+        _NOJIT,
+    ),
+    Target(
+        "engine.interp",
+        "csplab/_interp.py",
+        (
+            "alg31", "_revise", "_choose", "_entropy", "propagate", "_write_back", "set_bits",
+            "_ints", "_store",
+        ),
+        (
+            *_TWINS,
+            "tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",
+            "tests/test_interp.py::test_interpreted_work_is_counted",
+        ),
+        _NOJIT,
+    ),
+    Target(
+        "blocks.kernels",
+        "csplab/_kernels.py",
+        ("block_catalog", "block_alg31"),
+        (
+            "tests/solvers/test_blocks_failing.py::test_failed_blocks_keep_their_labels_in_process",
+            "tests/solvers/test_blocks_parallel.py::test_compiled_blocks_same_as_python_blocks_in_waves",
+        ),
+        _NOJIT,
     ),
 )
 
@@ -119,6 +183,13 @@ def _spans(path: Path, names: tuple[str, ...]) -> list[tuple[str, int, int]]:
 class _NoStrings(ast.NodeTransformer):
     def visit_Constant(self, node: ast.Constant) -> ast.Constant:
         return ast.Constant("") if isinstance(node.value, str) else node
+
+    def visit_JoinedStr(self, node: ast.JoinedStr) -> ast.AST:
+        # an f-string's text parts go; its formatted values stay (a message with "XX"
+        # added at an end differs from the original only in a text part)
+        node.values = [v for v in node.values if not isinstance(v, ast.Constant)]
+        self.generic_visit(node)
+        return node
 
 
 def _code(src: str) -> str | None:
@@ -162,10 +233,12 @@ def _copy_tree(dst: Path) -> None:
             shutil.copy2(ROOT / f, dst / f)
 
 
-def _run(cwd: Path, tests: tuple[str, ...], timeout: float) -> tuple[str, float]:
-    env = {**os.environ, "PYTHONPATH": str(cwd), "HYPOTHESIS_PROFILE": "default"}
-    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
-           "--no-header", *tests]  # fmt: skip
+def _run(
+    cwd: Path, tests: tuple[str, ...], timeout: float, extra: tuple[tuple[str, str], ...] = ()
+) -> tuple[str, float]:
+    env = {**os.environ, "PYTHONPATH": str(cwd), "HYPOTHESIS_PROFILE": "default", **dict(extra)}
+    cmd = [sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-p",
+           "no:randomly", "-W", "ignore::RuntimeWarning", "--no-header", *tests]  # fmt: skip
     t0 = time.perf_counter()
     try:
         r = subprocess.run(cmd, cwd=cwd, env=env, capture_output=True, text=True,
@@ -190,6 +263,9 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--list", action="store_true", help="count the mutants and stop")
     ap.add_argument(
+        "--functions", default="", help="only these functions of the target (comma-separated)"
+    )
+    ap.add_argument(
         "--sample",
         type=int,
         default=None,
@@ -211,7 +287,8 @@ def main(argv: list[str] | None = None) -> int:
         for t in chosen:
             path = work / t.path
             src = path.read_text()
-            ms = mutants(path, t.functions)
+            only = tuple(f for f in a.functions.split(",") if f)
+            ms = mutants(path, tuple(f for f in t.functions if not only or f in only))
             n_all = len(ms)
             if a.sample is not None and a.sample < len(ms):
                 import random
@@ -221,7 +298,7 @@ def main(argv: list[str] | None = None) -> int:
             if a.list:
                 print(f"{t.name}: {len(ms)} mutants in {', '.join(t.functions)}")
                 continue
-            status, dt = _run(work, t.tests, RUN_TIMEOUT_S)
+            status, dt = _run(work, t.tests, RUN_TIMEOUT_S, t.env)
             if status != "survived":
                 print(f"{t.name}: its tests fail unmutated ({status}); skipped", flush=True)
                 continue
@@ -233,7 +310,7 @@ def main(argv: list[str] | None = None) -> int:
                     break
                 path.write_text(mutated)
                 try:
-                    status, dt = _run(work, t.tests, timeout)
+                    status, dt = _run(work, t.tests, timeout, t.env)
                 finally:
                     path.write_text(src)
                 counts[status] += 1

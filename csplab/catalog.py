@@ -43,7 +43,8 @@ from csplab import _kernels as kern
 from csplab._kernels import Code, Heap, Run, Search
 from csplab.constraints import Constraint, propagate_all
 from csplab.errors import InputError
-from csplab.problem import Problem, check_memory
+from csplab.limits import check_memory
+from csplab.problem import Problem, memory_estimate
 
 __all__ = [
     "HEAP_ORDERS",
@@ -153,7 +154,10 @@ class _Compiled:
     def __init__(self, problem: Problem) -> None:
         n, K = problem.n, problem.K
         # the problem exists already: only what the engine adds must still fit
-        check_memory(problem.shape, K, len(problem.arcs), problem=False)
+        size = "x".join(map(str, problem.shape))
+        check_memory(memory_estimate(n, K, len(problem.arcs), problem=False),
+                     f"{size} with K={K}", "a smaller --size, or fewer labels",
+                     available=True)  # fmt: skip
         W = words(K)
         a = problem.arcs
         keep = a[:, 0] != a[:, 1]  # self-arcs are folded into the domains

@@ -29,7 +29,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from csplab.errors import InputError
-from csplab.problem import AXIS_NAMES, Problem, Unary, check_memory
+from csplab.limits import check_memory
+from csplab.problem import AXIS_NAMES, Problem, Unary, memory_estimate
 
 if TYPE_CHECKING:
     from csplab.example import ExampleModel
@@ -156,7 +157,9 @@ def grid(
     if not topo.square and any(per):
         raise InputError(f"a {topo.name} grid cannot be periodic")
     n = math.prod(shp)
-    check_memory(shp, K)  # one line with the estimate before allocating
+    size = "x".join(map(str, shp))  # one line with the estimate before allocating
+    check_memory(memory_estimate(n, K, ndim * n), f"{size} with K={K}",
+                 "a smaller --size, or fewer labels", available=True)  # fmt: skip
     idx = np.arange(n, dtype=np.int64).reshape(shp)
     parts = [] if topo.square else [topo.arcs(shp)]
     for d in range(ndim if topo.square else 0):

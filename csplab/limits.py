@@ -35,6 +35,7 @@ __all__ = [
     "FALLBACK_MEMORY",
     "MAX_LABEL",
     "MEMORY_SHARE",
+    "SMALL_ESTIMATE",
     "available_memory",
     "check_label",
     "check_memory",
@@ -103,12 +104,40 @@ def fmt_bytes(n: float) -> str:
     return f"{n / 1e6:.0f} MB" if n >= 1e6 else f"{n / 1e3:.0f} kB"
 
 
-def check_memory(estimate: float, what: str, change: str, *, budget: float | None = None) -> None:
-    """Refuse (:class:`MemoryLimitError`, one line) when ``estimate`` bytes exceed
-    ``budget`` (default :func:`memory_budget`); ``change`` says what to change."""
-    limit = memory_budget() if budget is None else budget
+#: estimates up to this many bytes are always allowed against the memory available (not
+#: worth reading ``/proc/meminfo``: modify in blocks builds many small problems)
+SMALL_ESTIMATE = 256 * 2**20
+
+
+def check_memory(
+    estimate: float,
+    what: str,
+    change: str,
+    *,
+    budget: float | None = None,
+    available: bool = False,
+) -> None:
+    """Refuse (:class:`MemoryLimitError`, one line) a command or an allocation whose
+    ``estimate`` bytes exceed the bound: ``budget`` (default :func:`memory_budget`, which
+    ``--memory-limit`` raises), or with ``available=True`` the memory available now
+    (:func:`available_memory`: the library's own guard before it allocates a grid problem;
+    estimates up to :data:`SMALL_ESTIMATE` pass without looking). ``what`` names the work,
+    ``change`` says what to change. The one memory refusal of csplab.
+
+    Examples
+    --------
+    >>> check_memory(2e5, "a 10x10 problem", "a smaller --size", available=True)  # tiny
+    >>> check_memory(3e9, "x", "a smaller --size", budget=4e9)                      # fits
+    """
+    if available:
+        if estimate <= SMALL_ESTIMATE:
+            return
+        limit, bound = float(available_memory()), "the memory available"
+    else:
+        limit = memory_budget() if budget is None else budget
+        bound = "the memory budget"
     if estimate > limit:
         raise MemoryLimitError(
-            f"{what} would need about {fmt_bytes(estimate)}, over the memory budget of "
-            f"{fmt_bytes(limit)}: {change}, or raise --memory-limit"
+            f"{what} would need about {fmt_bytes(estimate)}, over {bound} of "
+            f"{fmt_bytes(limit)}: {change}" + ("" if available else ", or raise --memory-limit")
         )

@@ -40,8 +40,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from csplab.errors import InputError, MemoryLimitError
-from csplab.limits import available_memory
+from csplab.errors import InputError
 
 if TYPE_CHECKING:
     from csplab.constraints import Constraint
@@ -51,8 +50,6 @@ __all__ = [
     "Problem",
     "Unary",
     "Violations",
-    "available_memory",
-    "check_memory",
     "memory_estimate",
 ]
 
@@ -816,9 +813,6 @@ class Problem:
 
 # ----------------------------------------------------------------------------- memory
 
-_SMALL = 256 * 2**20
-
-
 def memory_estimate(
     n: int, K: int, arcs: int, *, problem: bool = True, propagator: bool = True
 ) -> int:
@@ -846,40 +840,3 @@ def memory_estimate(
         transient = max(64 * n * W + 16 * n * W, 64 * arcs)
         total += keeps + transient
     return total
-
-
-def _gib(b: float) -> str:
-    return f"{b / 2**30:.1f} GiB" if b >= 2**29 else f"{b / 2**20:.0f} MiB"
-
-
-def check_memory(
-    shape: Sequence[int],
-    K: int,
-    arcs: int | None = None,
-    *,
-    problem: bool = True,
-    propagator: bool = True,
-) -> int:
-    """Raise :class:`~csplab.errors.MemoryLimitError` (one line with the estimate) when a
-    problem on ``shape`` with ``K`` labels (and ``arcs`` arcs, default one per cell and
-    axis) would not fit in :func:`available_memory`; returns the estimate in bytes
-    (``problem`` and ``propagator`` as in :func:`memory_estimate`).
-
-    Examples
-    --------
-    >>> check_memory((10, 10), 3) < 2**20
-    True
-    """
-    n = math.prod(int(s) for s in shape)
-    a = len(shape) * n if arcs is None else int(arcs)
-    need = memory_estimate(n, K, a, problem=problem, propagator=propagator)
-    if need <= _SMALL:  # not worth reading /proc/meminfo (blocks build many small problems)
-        return need
-    have = available_memory()
-    if need > have:
-        size = "x".join(str(int(s)) for s in shape)
-        raise MemoryLimitError(
-            f"{size} with K={K} needs about {_gib(need)}; {_gib(have)} available "
-            "(a smaller --size, or fewer labels)"
-        )
-    return need

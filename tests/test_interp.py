@@ -66,6 +66,46 @@ def test_alg31_same_as_kernels_on_random_examples(engine, order, choice):
     assert statuses & {"solved", "failed"}
 
 
+def test_propagate_stops_at_a_wipe_out_of_cell_0(engine):
+    """A wipe-out ends the propagation at once, also when the wiped cell is cell 0 and more
+    cells wait in the queue: the twins pop the same cells (a chain 0 - 1 - 2 of equal
+    labels; cell 1 changed to label 1 empties cell 0, fixed to label 0, before cell 2 is
+    looked at)."""
+    EQ = np.eye(2, dtype=bool)[None]
+    dom = np.array([[True, False], [False, True], [True, True]])
+    P = Problem((3,), dom, EQ, [[0, 1, 0], [1, 2, 0]])
+    got = []
+    for name in ("kernels", "interp"):
+        engine(name)
+        eng = Propagator(P, domains=dom, propagate_initial=False)
+        ok = eng.propagate(np.array([1, 2]))
+        got.append((ok, eng.wiped, eng.stats.copy()))
+    (ok1, w1, s1), (ok2, w2, s2) = got
+    assert not ok1 and not ok2 and w1 == w2 == 0
+    assert np.array_equal(s1, s2)
+
+
+@pytest.mark.parametrize("order", ["min-entropy", "scanline"])
+def test_alg31_same_as_kernels_with_labels_of_weight_0(engine, order):
+    """Weights may be 0 or tiny: a cell whose labels left weigh (almost) nothing is keyed by
+    the entropy of its domain computed afresh, or by its label count when they weigh 0 (the
+    weighted entropy's fallbacks), the same in both twins, draw for draw."""
+    rng = np.random.default_rng(11)
+    for trial in range(16):
+        E = _random_example(rng, int(rng.integers(3, 7)), (5, 4))
+        w = rng.random(E.K) * (rng.random(E.K) < (0.5 if trial < 8 else 0.2))
+        w[int(rng.integers(E.K))] = 0.0
+        w[int(rng.integers(E.K))] = 1e-13  # below the memo's 1e-12: entropy from the domain
+        shape = (int(rng.integers(4, 10)), int(rng.integers(4, 10)))
+
+        def build(E=E, w=w, shape=shape):
+            P = from_example(E, shape)
+            return Problem(P.shape, P.domains, P.relations, P.arcs, weights=w)
+
+        a, b = _both(engine, build, trial, order=order, choice="weighted")
+        _same(a, b)
+
+
 @pytest.mark.parametrize(
     "name,shape,kw",
     [

@@ -9,12 +9,13 @@ from typing import Any
 import numpy as np
 import pytest
 
-from csplab import problem as problem_mod
+from csplab import limits
 from csplab.catalog import Propagator
 from csplab.errors import CsplabError, MemoryLimitError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
-from csplab.problem import check_memory, memory_estimate
+from csplab.limits import check_memory
+from csplab.problem import memory_estimate
 
 
 def test_estimate_grows_with_cells_and_labels() -> None:
@@ -26,16 +27,17 @@ def test_estimate_grows_with_cells_and_labels() -> None:
 
 
 def test_too_large_output_is_one_line_before_allocating(monkeypatch: Any) -> None:
-    monkeypatch.setattr(problem_mod, "available_memory", lambda: int(6.1 * 2**30))
+    monkeypatch.setattr(limits, "available_memory", lambda: int(6.1e9))
     E = ExampleModel(np.arange(119 * 2).reshape(119, 2, 1) % 119)
     t = time.perf_counter()
     with pytest.raises(MemoryLimitError) as exc:
         from_example(E, (2000, 2000, 10))
     assert time.perf_counter() - t < 2.0
     msg = str(exc.value)
-    assert msg == (
-        "2000x2000x10 with K=119 needs about 35.9 GiB; 6.1 GiB available "
-        "(a smaller --size, or fewer labels)"
+    assert msg == (  # the one memory refusal (csplab.limits.check_memory); no
+        # --memory-limit hint: the library's guard is the memory there is
+        "2000x2000x10 with K=119 would need about 38.6 GB, over the memory available of "
+        "6.1 GB: a smaller --size, or fewer labels"
     )
     assert isinstance(exc.value, MemoryError) and isinstance(exc.value, CsplabError)
 
@@ -44,21 +46,20 @@ def test_small_problems_do_not_read_meminfo(monkeypatch: Any) -> None:
     def boom() -> int:
         raise AssertionError("read /proc/meminfo for a tiny problem")
 
-    monkeypatch.setattr(problem_mod, "available_memory", boom)
-    assert check_memory((10, 10), 3) > 0
+    monkeypatch.setattr(limits, "available_memory", boom)
+    check_memory(memory_estimate(100, 3, 200), "10x10", "a smaller --size", available=True)
+    from_example(ExampleModel([[0, 1], [1, 0]]), (40, 40))
 
 
 def test_propagator_checks_what_it_adds(monkeypatch: Any) -> None:
     E = ExampleModel([[0, 1], [1, 0]])
     P = from_example(E, (3000, 3000))  # 9e6 cells: above the small threshold
-    monkeypatch.setattr(problem_mod, "available_memory", lambda: 2**20)
-    with pytest.raises(MemoryLimitError, match=r"^3000x3000 with K=2 needs about"):
+    monkeypatch.setattr(limits, "available_memory", lambda: 2**20)
+    with pytest.raises(MemoryLimitError, match=r"^3000x3000 with K=2 would need about"):
         Propagator(P)
 
 
 def test_available_memory_reads_meminfo_or_falls_back(monkeypatch: Any) -> None:
-    from csplab import limits
-
     assert limits.available_memory() > 0
     import builtins
 
@@ -74,7 +75,6 @@ def test_available_memory_reads_meminfo_or_falls_back(monkeypatch: Any) -> None:
 
 
 def test_cli_memory_estimate_exit_2(monkeypatch: Any, capsys: Any) -> None:
-    from csplab import limits
     from csplab.cli import main
 
     monkeypatch.setattr(limits, "available_memory", lambda: 2**30)

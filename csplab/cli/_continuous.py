@@ -198,7 +198,8 @@ def synthesize(
     if dim == 2:
         settings["lines"] = lines
     try:
-        s = run(example, size, lines=lines, constraints=cons, **common, **opts)
+        s = run(example, size, lines=lines, constraints=cons, notices=True, **common,
+                **opts)  # fmt: skip
     except InputError as e:  # the library names its arguments; the user typed flags
         raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem

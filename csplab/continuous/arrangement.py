@@ -100,7 +100,8 @@ class Arrangement(ArrangementGraph):
     Raises
     ------
     InputError
-        When ``W`` or ``H`` is below 1, or ``lines`` is not one of :data:`LINES`.
+        When ``W`` or ``H`` is below 1, ``lines`` is not one of :data:`LINES`, or the
+        meeting points' exact coordinates (denominator ``D``) exceed 64-bit integers.
     """
 
     def __init__(self, lattice: Lattice, W: int, H: int, *, lines: str = "lattice") -> None:
@@ -128,6 +129,14 @@ class Arrangement(ArrangementGraph):
                 D = _lcm(D, abs(self._det(f, g)))
         self.D = D
         WD, HD = self.W * D, self.H * D
+        big = max(int(np.abs(self.normals).max(initial=0)), 1)
+        if (WD + 1) * (HD + 1) >= 2**62 or 2 * (W + H) * big * big * D >= 2**62:
+            raise InputError(
+                f"the lines of {F} families meet at points of denominator "
+                f"{D if D < 10**9 else f'~10^{len(str(D)) - 1}'}: their exact coordinates in "
+                f"{W}x{H} spacings exceed 64-bit integers; a larger --spacing (with --snap) "
+                "gives simpler directions"
+            )
         corners = np.array([[0, 0], [W, 0], [0, H], [W, H]], dtype=np.int64)
         self.k_range: list[NDArray[np.int64]] = []
         for f in range(F):

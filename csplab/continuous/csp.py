@@ -52,6 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
 from csplab.continuous.csp3d import ContinuousCSP3
+from csplab.continuous.lattice import check_snap
 from csplab.continuous.model import Polygon, PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -795,7 +796,9 @@ def _assemble(label: int, rings: list[tuple[tuple[float, float], ...]]) -> list[
 
 
 def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
-    """The example with every vertex rounded onto ``lattice``."""
+    """The example with every vertex rounded onto ``lattice``; refused in one line
+    (:class:`~csplab.errors.InputError`) when that collapses a polygon or changes a label's
+    area by more than :data:`~csplab.continuous.lattice.MAX_SNAP_CHANGE` of itself."""
 
     def snap(r: Sequence[tuple[float, float]]) -> list[list[float]]:
         uv = np.rint(lattice.to_lattice(np.asarray(r, dtype=np.float64)))
@@ -806,7 +809,18 @@ def _snapped(example: PolygonModel, lattice: Lattice) -> PolygonModel:
          **dict(p.extra)}
         for p in example.polygons
     ]  # fmt: skip
-    return PolygonModel(polys, name=example.name, meta=example.meta, source=example.source)
+    s = float(lattice.spacing)
+    try:
+        out = PolygonModel(polys, name=example.name, meta=example.meta, source=example.source)
+    except InputError as e:
+        raise InputError(
+            f"{example.source}: snapping onto spacing {s:g} collapses it "
+            f"({str(e).splitlines()[0].removeprefix(f'{example.source}: ')}); pass a smaller "
+            "--spacing"
+        ) from None
+    for b in example.labels:  # each label's area, as snapping left it
+        check_snap(f"{example.source}: label {b}", s, "area", example.area(b), out.area(b))
+    return out
 
 
 class CSPOptions(TypedDict, total=False):

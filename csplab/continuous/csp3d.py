@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.constraints import Connected
 from csplab.continuous._geom import labels_at
-from csplab.continuous.lattice import Lattice, face_planes
+from csplab.continuous.lattice import Lattice, check_snap, face_planes
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.space import Arrangement3, check_budget3
 from csplab.continuous.surface import surface_of
@@ -245,7 +245,8 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
     """``example`` with every vertex rounded onto ``lattice`` (vertices that meet merged,
     faces flattened to a segment dropped); refused in one line
     (:class:`~csplab.errors.InputError`) when that breaks a solid (flattens it, turns it
-    inside out, makes two overlap)."""
+    inside out, makes two overlap) or changes a label's volume by more than
+    :data:`~csplab.continuous.lattice.MAX_SNAP_CHANGE` of itself."""
     solids = []
     base = 0
     for sol in example.solids:
@@ -270,13 +271,18 @@ def snapped3(example: PolyhedralModel, lattice: Lattice) -> PolyhedralModel:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error")
-            return PolyhedralModel(solids, name=example.name, meta=example.meta,
-                                   source=example.source)  # fmt: skip
+            out = PolyhedralModel(solids, name=example.name, meta=example.meta,
+                                  source=example.source)  # fmt: skip
     except (InputError, UserWarning) as e:
         raise InputError(
             f"{example.source}: snapping onto spacing {float(lattice.spacing):g} breaks it "
-            f"({str(e).splitlines()[0]}); pass a smaller --spacing"
+            f"({str(e).splitlines()[0].removeprefix(f'{example.source}: ')}); pass a smaller "
+            "--spacing"
         ) from None
+    for b in example.labels:  # each label's volume, as snapping left it
+        check_snap(f"{example.source}: label {b}", float(lattice.spacing), "volume",
+                   example.volume(b), out.volume(b))  # fmt: skip
+    return out
 
 
 def as_synthesized(

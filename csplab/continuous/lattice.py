@@ -48,10 +48,12 @@ __all__ = [
     "MAX_DENOMINATOR",
     "MAX_FAMILIES",
     "MAX_FAMILIES3",
+    "MAX_SNAP_CHANGE",
     "MERGE_DEG",
     "PLANES",
     "Lattice",
     "PlaneArrangement",
+    "check_snap",
     "denominator",
     "derived_spacing",
     "equal_steps",
@@ -96,6 +98,35 @@ MAX_DENOMINATOR = 1000
 #: ``auto`` (``equal`` for an example from real coordinates, whose spacing is derived;
 #: ``lattice`` for exact ones, the built-in examples)
 PLANES = ("auto", "lattice", "equal")
+
+
+#: the largest relative change of an example's area (2D) or of a solid's volume (3D) that
+#: snapping may make; beyond it the example is not the one given (an icosphere of radius 1
+#: snapped onto spacing 1 becomes a cube of twice its volume)
+MAX_SNAP_CHANGE = 0.5
+
+
+def check_snap(where: str, spacing: float, what: str, before: float, after: float) -> None:
+    """Refuse (:class:`~csplab.errors.InputError`, one line) a snapped example whose
+    ``what`` (an area or a volume) went from ``before`` to ``after``: collapsed to nothing,
+    or changed by more than :data:`MAX_SNAP_CHANGE` of itself.
+
+    Examples
+    --------
+    >>> check_snap("ball.stl", 0.5, "volume", 4.15, 4.0)      # a blocky ball: accepted
+    >>> check_snap("ball.stl", 1, "volume", 4.15, 8.0)
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: ball.stl: snapping onto spacing 1 distorts it (its volume 4.15 \
+becomes 8; more than 50 % changed); pass a smaller --spacing
+    """
+    if after <= 0 or abs(after - before) > MAX_SNAP_CHANGE * abs(before):
+        how = "collapses" if after <= 0 else "distorts"
+        raise InputError(
+            f"{where}: snapping onto spacing {float(spacing):g} {how} it (its {what} "
+            f"{before:.3g} becomes {max(after, 0.0):.3g}; more than "
+            f"{MAX_SNAP_CHANGE:.0%} changed); pass a smaller --spacing".replace("%", " %")
+        )
 
 
 def derived_spacing(points: NDArray[np.float64]) -> float:

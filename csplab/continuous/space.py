@@ -252,7 +252,7 @@ def check_budget3(
 ) -> int:
     """Refuse in one line (:class:`~csplab.errors.MemoryLimitError`) an arrangement whose
     :func:`estimate3` exceeds ``max_memory`` bytes (default :data:`csplab.limits.MEMORY_SHARE` of
-    :func:`~csplab.problem.available_memory`; ``hint`` follows "a larger --spacing" in the
+    :func:`~csplab.limits.available_memory`; ``hint`` follows "a larger --spacing" in the
     message); returns the estimated bytes."""
     from csplab.errors import MemoryLimitError
     from csplab.limits import MEMORY_SHARE, available_memory

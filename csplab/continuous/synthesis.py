@@ -35,6 +35,7 @@ from csplab.continuous.defects import Defect, Violations
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
+from csplab.progress import notice_after
 from csplab.result import Result
 from csplab.rng import RngLike
 from csplab.solvers import solve
@@ -146,6 +147,7 @@ def synthesize(
     max_memory: int | None = None,
     ground: str | Sequence[str] | None = "auto",
     bounding: bool = True,
+    notices: bool = False,
     **options: Any,
 ) -> Synthesis[ContinuousCSP, PolygonModel]: ...
 
@@ -167,6 +169,7 @@ def synthesize(
     max_memory: int | None = None,
     ground: str | Sequence[str] | None = "auto",
     bounding: bool = True,
+    notices: bool = False,
     **options: Any,
 ) -> Synthesis[ContinuousCSP3, PolyhedralModel]: ...
 
@@ -187,6 +190,7 @@ def synthesize(
     max_memory: int | None = None,
     ground: str | Sequence[str] | None = "auto",
     bounding: bool = True,
+    notices: bool = False,
     **options: Any,
 ) -> Synthesis[Any, M]:
     """Continuous model synthesis (Alg. 4.1) of a polygon or polyhedral example.
@@ -223,6 +227,10 @@ def synthesize(
         (:func:`csplab.solvers.solve`'s one restart loop; ``time_limit`` covers all).
     check : bool
         Run the checker on the output (default; it is the truth, not the CSP).
+    notices : bool
+        Say on stderr which phase is running when it takes over 2 s (building the
+        arrangement and the CSP, solving, building the surface, checking:
+        :func:`csplab.progress.notice_after`); the CLI turns it on.
     **options
         Solver options (``time_limit=``, ``order=``, ``block=`` ...), passed to
         :func:`csplab.solvers.solve`. ``choice`` defaults to ``"weighted"`` for a solver
@@ -274,28 +282,33 @@ def synthesize(
             example = bounded.proxy
     if ground == "auto":
         ground = auto_ground(example, boundary)
-    csp = continuous_csp(example, size, spacing=spacing, snap=snap, boundary=boundary,
-                         lines=lines, constraints=constraints, max_memory=max_memory,
-                         ground=ground)  # fmt: skip
+    what = f"{example.name or 'the example'} at {'x'.join(map(str, size))}"
+    with notice_after(f"{what}: building the arrangement and the CSP", enabled=notices):
+        csp = continuous_csp(example, size, spacing=spacing, snap=snap, boundary=boundary,
+                             lines=lines, constraints=constraints, max_memory=max_memory,
+                             ground=ground)  # fmt: skip
     t1 = time.perf_counter()
     options = {**options}
     choice = default_choice(csp.problem, solver)
     if choice is not None and "choice" not in options:
         options["choice"] = choice
-    result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
+    with notice_after(f"{what}: solving ({solver}, {csp.problem.n} cells)", enabled=notices):
+        result = solve(csp.problem, solver, rng=rng, restarts=restarts, **options)
     t2 = time.perf_counter()
-    model = csp.model(result.grid) if result.ok else None
+    with notice_after(f"{what}: building the output's surface", enabled=notices):
+        model = csp.model(result.grid) if result.ok else None
     t3 = time.perf_counter()
     region = csp.region()
     defects: list[Defect] = []
-    if check and model is not None:
-        defects = list(violations(csp.example, model, region=region, outside=csp.boundary,
-                                  ground=getattr(csp, "ground", ())))  # fmt: skip
     broken: list[Defect] = []
-    if constraints and isinstance(model, PolyhedralModel):
-        d = len(region) // 2
-        broken = user_violations3(model, constraints, origin=region[:d],
-                                  spacing=float(csp.lattice.spacing))  # fmt: skip
+    with notice_after(f"{what}: checking the output (Eq. 4.1)", enabled=notices):
+        if check and model is not None:
+            defects = list(violations(csp.example, model, region=region, outside=csp.boundary,
+                                      ground=getattr(csp, "ground", ())))  # fmt: skip
+        if constraints and isinstance(model, PolyhedralModel):
+            d = len(region) // 2
+            broken = user_violations3(model, constraints, origin=region[:d],
+                                      spacing=float(csp.lattice.spacing))  # fmt: skip
     t4 = time.perf_counter()
     if broken:
         result = replace(result, status="failed", stats={**result.stats, "broken": str(broken[0])})

@@ -611,7 +611,8 @@ def _from_tiled(d: dict[str, Any], mtype: str, f: Path, path: object) -> RuleSet
 def _from_sample(d: dict[str, Any], mtype: str, src: Any, path: object, strict: bool) -> RuleSet:
     if not isinstance(src, str) or not src.lower().endswith((".png", ".bmp", ".gif", ".tmx")):
         raise FormatError(
-            f"a {mtype} model without adjacencies needs a PNG or Tiled (.tmx) sample in "
+            f"{'an' if mtype[:1].lower() in 'aeiou' else 'a'} {mtype} model without "
+            "adjacencies needs a PNG or Tiled (.tmx) sample in "
             f"'src', got {src!r}",
             path=path,
         )

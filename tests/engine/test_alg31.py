@@ -44,6 +44,7 @@ def test_run_alg31_is_the_literal_algorithm():
     the grid has, and a solved grid has no violation."""
     import numpy as np
 
+    from csplab.catalog import Propagator
     from csplab.engine.alg31 import alg31_reference, run_alg31, scan_order
 
     statuses = set()
@@ -61,6 +62,11 @@ def test_run_alg31_is_the_literal_algorithm():
                     flat = r.grid.reshape(-1)
                     if want == "unsat":
                         assert len(r.trace) == 0 and r.stats.get("proof"), key
+                        # nothing assigned; the work is the root propagation's
+                        root = Propagator(P)
+                        assert r.stats["assigned"] == 0, key
+                        assert r.stats["revisions"] == root.stats[0] > 0, key
+                        assert r.stats["removals"] == root.stats[1] > 0, key
                         continue
                     assert np.array_equal(r.grid, grid) or want == "failed", key
                     cells, labels = r.trace[:, 0], r.trace[:, 1]
@@ -90,3 +96,48 @@ def test_heap_orders_visit_each_cell_once_and_solve_consistently():
                 if r.status == "solved":
                     assert sorted(cells.tolist()) == list(range(P.n))
                     assert len(P.violations(r.grid)) == 0
+
+
+def test_resemblance_windows_are_3_cells_wide_by_default():
+    """``run_alg31(choice="resemblance")`` uses windows of 3 cells (``window=1``, the 2007
+    paper's) unless told otherwise: the default run is the ``window=1`` run, draw for draw,
+    and a wider window changes some run."""
+    import numpy as np
+
+    from csplab.engine.alg31 import run_alg31
+    from csplab.examples import load_example
+    from csplab.grids import from_example
+
+    P = from_example(load_example("fig3_10"), (8, 8))
+    differs = False
+    for seed in range(4):
+        a = run_alg31(P, np.random.default_rng(seed), choice="resemblance")
+        b = run_alg31(P, np.random.default_rng(seed), choice="resemblance", window=1)
+        c = run_alg31(P, np.random.default_rng(seed), choice="resemblance", window=2)
+        assert a.status == b.status and np.array_equal(a.grid, b.grid)
+        differs |= not np.array_equal(a.grid, c.grid)
+    assert differs
+
+
+def test_global_constraints_refuted_before_any_choice():
+    """A fixed cell whose label a count constraint forbids: the constraint refutes the root
+    catalog, so Alg. 3.1 stops "unsat" before any choice, with the work of the root
+    propagation (revisions and removals told apart) and nothing assigned."""
+    import numpy as np
+
+    from csplab.catalog import Propagator
+    from csplab.constraints import Count
+    from csplab.engine.alg31 import run_alg31
+    from csplab.examples import load_example
+    from csplab.grids import from_example, with_fixed
+
+    P = with_fixed(from_example(load_example("fig3_10"), (6, 5)), {(2, 3): 1})
+    P = P.with_constraints([Count(labels=[1], max=0)])
+    r = run_alg31(P, np.random.default_rng(0))
+    assert r.status == "unsat" and len(r.trace) == 0
+    assert r.stats["proof"] == "global-constraint propagation before any choice"
+    assert r.stats["assigned"] == 0
+    root = Propagator(P)
+    assert root.constrain() == -2  # the same refutation, replayed: by the count, no cell
+    assert (r.stats["revisions"], r.stats["removals"]) == (root.stats[0], root.stats[1])
+    assert root.stats[0] != root.stats[1]  # the premise: the two counts differ here

@@ -28,3 +28,23 @@ def test_a_block_that_always_fails_counts_each_retry() -> None:
         assert o.labels is None and o.status == "failed"
         assert o.retries == k  # every retry spent, none more
         assert o.revisions == (k + 1) * one.revisions  # each attempt did the same work
+
+
+def test_a_block_started_after_its_deadline_times_out_without_labels() -> None:
+    """The time left for an attempt is the deadline minus now, never less than 0: a block
+    whose deadline has passed stops after its first chunk of steps ("timeout", no labels,
+    no retry), although the whole block would take milliseconds. (Mutants that give each
+    attempt a second of its own, or no limit, solve it.)"""
+    from csplab import ExampleModel, from_example
+    from csplab.engine.alg31 import _CHUNK
+
+    # a forced checkerboard, large enough to run compiled (milliseconds, once loaded)
+    sub = from_example(ExampleModel([[0, 1], [1, 0]]), (160, 160))
+    assert sub.n > _CHUNK  # more than one chunk: the deadline is looked at once at least
+    done = wv.solve_block(sub, np.random.default_rng(0), 3, retries=2, order="scanline",
+                          choice="uniform", deadline=None)  # fmt: skip
+    assert done.status == "solved" and done.labels is not None  # the block itself is easy
+    past = wv.time.perf_counter() - 1.0
+    o = wv.solve_block(sub, np.random.default_rng(0), 3, retries=2, order="scanline",
+                       choice="uniform", deadline=past)  # fmt: skip
+    assert (o.status, o.labels, o.retries) == ("timeout", None, 0)

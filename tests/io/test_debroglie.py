@@ -158,3 +158,13 @@ def test_a_tiled_tsx_tileset_gives_pictures_and_properties(tmp_path):
     assert tuple(rs.images[1, 0, 0]) == (0, 0, 255, 255)  # "water" = tile id 2
     assert rs.meta["tile_properties"]["water"] == {"name": "water", "cost": "3"}
     assert not any("no tile pictures" in w for w in rs.meta["warnings"])
+
+
+@pytest.mark.parametrize("mtype", ["adjacent", "overlapping"])
+def test_a_sample_model_without_a_sample_says_so_in_english(tmp_path, mtype):
+    """The message reads "an adjacent model without adjacencies ..." (it said "a adjacent")."""
+    p = tmp_path / "c.json"
+    p.write_text(json.dumps({"model": {"type": mtype}, "src": "x.txt"}))
+    with pytest.raises(FormatError) as e:
+        read_model(p)
+    assert f"an {mtype} model without adjacencies needs a PNG" in str(e.value)
