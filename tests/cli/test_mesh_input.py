@@ -126,3 +126,22 @@ def test_cad_exports_with_defects_are_repaired_with_one_note(tmp_path, capsys, n
     with pytest.warns(UserWarning):
         m = read_model(p)
     assert m.volume() == pytest.approx(float(cad.build(name).volume), rel=1e-6)
+
+
+@pytest.mark.parametrize("which", ["houses", "slanted"])
+def test_check_reads_glb_outputs_as_it_reads_obj(tmp_path, capsys, which):
+    if which == "houses":
+        ex, size = "csplab/examples/continuous3d/houses.obj", "8x8x3"
+    else:
+        ex, size = str(cad.export(cad.build(which), tmp_path / f"{which}.stl")), "10x10x4"
+    counts = {}
+    for ext in (".glb", ".obj"):
+        out = tmp_path / f"out{ext}"
+        code, _, err = run(capsys, "synthesize", ex, "--size", size, "--seed", "1",
+                           "--out", str(out))  # fmt: skip
+        assert code == 0, err
+        code, text, err = run(capsys, "check", ex, str(out), "--json")
+        assert "Traceback" not in err
+        counts[ext] = (code, text)
+    assert counts[".glb"] == counts[".obj"]
+    assert counts[".glb"][0] == 0  # the synthesized output violates nothing
