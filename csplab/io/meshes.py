@@ -31,9 +31,9 @@ Meshes as CAD tools write them are repaired first (:mod:`csplab.io.mesh_repair`)
 vertices merged, faces with repeated vertices dropped, zero-area sliver triangles removed by
 edge flips, inconsistent winding made consistent (and outward); one ``UserWarning`` line
 says what was repaired (the CLI prints it as ``csplab: warning: FILE: repaired ...``) and
-``meta["repaired"]`` has the counts. Files of more than
-:data:`~csplab.io.mesh_repair.MAX_FACES` faces are refused from their counts, before the
-faces are read.
+``meta["repaired"]`` has the counts. A file whose faces would need more memory than the
+budget (:data:`~csplab.io.mesh_repair.BYTES_PER_FACE` each) is refused from its counts,
+before the faces are read.
 
 Every problem is one line: a :class:`~csplab.errors.FormatError` naming the file and line
 for syntax, an :class:`~csplab.errors.InputError` naming the file and the line, triangle or

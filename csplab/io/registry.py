@@ -677,9 +677,9 @@ FORMATS: dict[str, Format] = {
             "group; a solid is one connected shell of one label and group; repaired as CAD "
             "exports need (duplicate vertices, zero-area slivers by edge flips, inconsistent "
             "winding; one warning line says what) and validated (watertight, manifold, no "
-            "self-crossing, no zero-area face, different labels do not overlap, at most "
-            "200,000 faces, coordinates up to 1e7), inside-out solids are reversed with a "
-            "warning; out: one "
+            "self-crossing, no zero-area face, different labels do not overlap, faces within "
+            "the memory budget at 4 kB each, coordinates up to 1e7), inside-out solids are "
+            "reversed with a warning; out: one "
             "`o solid_I` per solid, one material `label_N` per label with its colour in the "
             "`.mtl` (`.obj` results of label grids are the `obj` format)",
             example="csplab info  # in Python: "
