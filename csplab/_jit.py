@@ -12,8 +12,9 @@ dispatchers into the module's namespace, so kernels that call kernels of their o
 placeholder (:data:`prange`) is replaced by :func:`numba.prange` at the same moment.
 
 :func:`on_load` registers a callback run once per module just after its kernels became
-dispatchers (before any compiles): the CLI prints its one-line "compiling" notice there, only
-when numba's cache is cold and only for commands that do reach a kernel. :func:`loaded` says
+dispatchers (before any compiles): the CLI registers there a listener of numba's
+``numba:compile`` event (a cache miss) that prints its one-line "compiling" notice before
+the first kernel numba actually compiles. :func:`loaded` says
 whether numba has been imported by csplab in this process.
 
 Examples

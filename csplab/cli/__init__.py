@@ -20,6 +20,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 from types import ModuleType
+from typing import Any
 
 from csplab.cli.common import readable
 from csplab.errors import CsplabError
@@ -162,17 +163,46 @@ def _show_warning(message: Warning | str, category: type[Warning], *args: object
 _KERNEL_COMMANDS = frozenset(COMMANDS) - {"info", "show", "check", "check-certificate", "serve"}
 
 
-_ANNOUNCING = [False]
+_ANNOUNCING = [False, False]  # hook installed, listener registered
 
 
 def _compiling_notice(module: str) -> None:
-    """The :func:`csplab._jit.on_load` hook of the console script: one line on stderr when
-    the kernels of :mod:`csplab._kernels` become numba dispatchers with numba's cache cold
-    (small models, which the interpreted engine solves, never reach them)."""
-    from csplab.cli.common import COMPILING, kernels_cold
+    """The :func:`csplab._jit.on_load` hook of the console script: once csplab's kernels
+    are numba dispatchers, listen for numba compiling one of them (numba's
+    ``numba:compile`` event fires on a cache miss only, never for machine code loaded from
+    its cache) and print one line on stderr before the first such compilation. Small
+    models, which the interpreted engine solves, and paths that need no uncached kernel
+    (``--solver sat`` with its kernels cached, whatever Alg. 3.1's cache holds) print
+    nothing."""
+    if _ANNOUNCING[1] or not module.startswith("csplab"):
+        return
+    from numba.core import event
 
-    if module == "csplab._kernels" and kernels_cold():
-        print(f"csplab: {COMPILING}", file=sys.stderr, flush=True)
+    _ANNOUNCING[1] = True
+    event.register("numba:compile", _compile_listener())  # type: ignore[no-untyped-call]
+
+
+def _compile_listener() -> Any:
+    """A numba event listener printing :data:`~csplab.cli.common.COMPILING` on stderr when
+    numba starts compiling a function of csplab (once per listener)."""
+    from numba.core import event
+
+    from csplab.cli.common import COMPILING
+
+    class Notice(event.Listener):
+        printed = False
+
+        def on_start(self, ev: Any) -> None:
+            data = ev.data if isinstance(ev.data, dict) else {}
+            func = getattr(data.get("dispatcher"), "py_func", None)
+            if not self.printed and str(getattr(func, "__module__", "")).startswith("csplab"):
+                self.printed = True
+                print(f"csplab: {COMPILING}", file=sys.stderr, flush=True)
+
+        def on_end(self, ev: Any) -> None:
+            pass
+
+    return Notice()
 
 
 def _announce_compiling() -> None:
@@ -187,8 +217,8 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
     """Entry point of the ``csplab`` console script.
 
     ``announce`` (default: only for the console script itself, ``argv is None``) prints one
-    line on stderr before numba's one-time compilation of the kernels, when its cache is
-    cold.
+    line on stderr before numba's one-time compilation of a kernel (numba compiles one
+    only when its cache lacks it).
     """
     words = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     first = next((w for w in words if not w.startswith("-")), None)

@@ -39,7 +39,6 @@ __all__ = [
     "check_output_path",
     "check_time_limit",
     "input_files",
-    "kernels_cold",
     "load_grid",
     "load_model",
     "model_options",
@@ -290,22 +289,6 @@ def check_time_limit(value: float | None, what: str = "--time-limit") -> float |
     if not math.isfinite(value) or value < sys.float_info.min:  # subnormal: no usable time
         raise InputError(f"{what} must be a positive number of seconds, not {value:g}")
     return float(value)
-
-
-def kernels_cold() -> bool:
-    """Whether numba has no cached machine code for csplab's kernels yet (the next command
-    that runs Alg. 3.1 compiles them, about 5 s). Reads only numba's small index files of
-    ``csplab/_kernels.py``; ``False`` when that cannot be told."""
-    try:
-        from csplab import _kernels
-
-        for name in ("alg31", "propagate"):
-            cache = getattr(_kernels, name)._cache
-            if not cache._cache_file._load_index():
-                return True
-    except Exception:  # numba internals differ across versions: say nothing then
-        return False
-    return False
 
 
 def load_grid(path: str, ndim: int | None, model: Model | None = None) -> NDArray[np.int32]:

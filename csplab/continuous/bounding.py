@@ -53,8 +53,9 @@ its oriented one would be, and the ``axis`` kind needs a cylinder along a coordi
 (others scale uniformly). A part's content is the whole original inside its box, so
 flat geometry there travels with the curved faces. ``csplab check`` rebuilds the proxy with
 the derived spacing: an output made with another ``--spacing`` is checked against another
-proxy. A lathe output of 40x40x20 spacings has about 800,000 triangles, more than
-``csplab check`` reads back (:data:`csplab.io.mesh_repair.MAX_FACES`); in Python,
+proxy. A lathe output of 40x40x20 spacings has about 800,000 triangles: ``csplab check``
+reads it back when its memory budget allows
+(:data:`csplab.io.mesh_repair.BYTES_PER_FACE` each); in Python,
 :func:`~csplab.continuous.boundcheck.bounded_violations` checks it in memory.
 
 Examples

@@ -31,9 +31,9 @@ Meshes as CAD tools write them are repaired first (:mod:`csplab.io.mesh_repair`)
 vertices merged, faces with repeated vertices dropped, zero-area sliver triangles removed by
 edge flips, inconsistent winding made consistent (and outward); one ``UserWarning`` line
 says what was repaired (the CLI prints it as ``csplab: warning: FILE: repaired ...``) and
-``meta["repaired"]`` has the counts. Files of more than
-:data:`~csplab.io.mesh_repair.MAX_FACES` faces are refused from their counts, before the
-faces are read.
+``meta["repaired"]`` has the counts. A file whose faces would need more memory than the
+budget (:data:`~csplab.io.mesh_repair.BYTES_PER_FACE` each) is refused from its counts,
+before the faces are read.
 
 Every problem is one line: a :class:`~csplab.errors.FormatError` naming the file and line
 for syntax, an :class:`~csplab.errors.InputError` naming the file and the line, triangle or
@@ -92,12 +92,15 @@ from csplab.io.mesh_repair import (
 )
 
 __all__ = [
+    "read_glb",
     "read_obj_model",
     "read_off",
     "read_stl",
+    "sniff_glb",
     "sniff_obj",
     "sniff_off",
     "sniff_stl",
+    "write_glb",
     "write_obj_model",
     "write_png",
 ]
@@ -583,6 +586,146 @@ def read_stl(path: str | Path, labels: str = "one") -> PolyhedralModel:
     polys = np.arange(len(tri)).reshape(-1, 3).tolist()
     return _solids(tri, polys, [1] * len(polys), [""] * len(polys), {}, p, "stl", by,
                    lambda k: f"triangle {k // 3}")  # fmt: skip
+
+
+# ---------------------------------------------------------------------------- glTF in
+def sniff_glb(head: bytes) -> int:
+    """Binary glTF starts with the magic ``glTF``."""
+    return SURE if head[:4] == b"glTF" else NO
+
+
+def _glb_json(data: bytes, p: Path) -> dict[str, Any]:
+    """The JSON chunk of a ``.glb`` (header and chunk checked; one line naming the file)."""
+    import json
+
+    if len(data) < 20 or data[:4] != b"glTF":
+        raise FormatError("not a binary glTF file (no `glTF` header)", path=p)
+    version, total = struct.unpack_from("<II", data, 4)
+    n, kind = struct.unpack_from("<I4s", data, 12)
+    if version != 2 or kind != b"JSON" or 20 + n > len(data):
+        raise FormatError(
+            f"a glTF 2.0 binary starts with its JSON chunk (version {version}, "
+            f"{total} bytes announced, {len(data)} in the file)",
+            path=p,
+        )
+    try:
+        doc = json.loads(data[20 : 20 + n])
+    except (ValueError, UnicodeDecodeError) as e:
+        raise FormatError(f"the JSON chunk does not parse ({e})", path=p) from None
+    if not isinstance(doc, dict):
+        raise FormatError("the JSON chunk is not an object", path=p)
+    return doc
+
+
+def _glb_face_count(doc: dict[str, Any], p: Path) -> int:
+    """The triangles the file's meshes announce (index or position accessor counts / 3)."""
+    acc = doc.get("accessors", [])
+    total = 0
+    try:
+        for mesh in doc.get("meshes", []):
+            for prim in mesh.get("primitives", []):
+                k = prim.get("indices", prim.get("attributes", {}).get("POSITION"))
+                if k is not None:
+                    total += int(acc[k]["count"]) // 3
+    except (TypeError, KeyError, IndexError, ValueError, AttributeError):
+        raise FormatError("a mesh primitive refers to a missing accessor", path=p) from None
+    return total
+
+
+def read_glb(path: str | Path, labels: str = "auto") -> PolyhedralModel:
+    """A polyhedral model from a binary glTF file (``.glb``; trimesh).
+
+    What :func:`write_glb` writes reads back as the same solids and labels: a mesh whose
+    material (or, failing that, node or mesh) is named ``label_N`` has label ``N``; other
+    names get the free labels 1, 2, ... in order of appearance. Node transforms are applied
+    and glTF's ``y`` up is turned back into csplab's ``z`` up (``(x, y, z)`` ->
+    ``(x, -z, y)``). Every connected closed shell is a solid, repaired and validated as
+    for the other mesh readers (:mod:`csplab.io.mesh_repair`).
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.glb`` file.
+    labels : {"auto", "components", "one"}
+        Labels from the names, one per connected component, or one for the file.
+
+    Returns
+    -------
+    PolyhedralModel
+        The solids, named after the file.
+
+    Raises
+    ------
+    FormatError
+        Naming the file for a file that is not binary glTF or that trimesh cannot read.
+    InputError
+        Naming the file for a bad ``labels`` value, no triangles, and the solid or face
+        for geometry.
+    MemoryLimitError
+        When reading the faces the file announces would exceed the memory budget.
+    DependencyError
+        When trimesh (the ``mesh`` extra) is not installed.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from csplab.continuous.polyhedra import PolyhedralModel
+    >>> box = lambda x, b: {"label": b, "vertices": [[x, 0, 0], [x + 1, 0, 0], [x + 1, 1, 0],
+    ...     [x, 1, 0], [x, 0, 1], [x + 1, 0, 1], [x + 1, 1, 1], [x, 1, 1]],
+    ...     "faces": [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6],
+    ...               [3, 0, 4, 7]]}
+    >>> M = PolyhedralModel([box(0, 2), box(3, 5)])
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_glb(M, pathlib.Path(d) / "m.glb")
+    ...     B = read_glb(pathlib.Path(d) / "m.glb")
+    >>> B.labels, round(B.volume(5), 6), len(B), B.meta["format"]
+    ((2, 5), 1.0, 2, 'glb')
+    """
+    p = Path(path)
+    if labels not in ("auto", "components", "one"):
+        raise InputError(f"{p}: labels must be auto, components or one, not {labels!r}")
+    data = read_bytes(p)
+    doc = _glb_json(data, p)
+    check_face_count(_glb_face_count(doc, p), p)
+    nodes = doc.get("nodes", [])
+    rank = {n.get("name"): i for i, n in enumerate(nodes) if isinstance(n, dict)}
+    tm = require("trimesh", "mesh", "reading glTF")
+    try:
+        scene = tm.load(io.BytesIO(data), file_type="glb", force="scene", process=False)
+    except CsplabError:
+        raise
+    except Exception as e:  # trimesh raises many kinds on a damaged file
+        raise FormatError(f"trimesh cannot read it ({type(e).__name__}: {e})", path=p) from None
+    vs: list[NDArray[np.float64]] = []
+    polys: list[list[int]] = []
+    keys: list[str | None] = []
+    base = 0
+    for node in sorted(scene.graph.nodes_geometry, key=lambda n: rank.get(n, len(rank))):
+        transform, gname = scene.graph[node]
+        g = scene.geometry[gname]
+        faces = np.asarray(getattr(g, "faces", np.zeros((0, 3))), dtype=np.int64)
+        if not len(faces):
+            continue  # points and lines are no solids
+        v = np.asarray(g.vertices, dtype=np.float64)
+        v = v @ np.asarray(transform, dtype=np.float64)[:3, :3].T + transform[:3, 3]
+        vs.append(v[:, [0, 2, 1]] * np.array([1.0, -1.0, 1.0]))
+        mat = getattr(getattr(g, "visual", None), "material", None)
+        names = [getattr(mat, "name", None), node, gname]
+        key = next((n for n in names if n and _LABEL_NAME.fullmatch(n)), None)
+        key = key or next((n for n in names if n), None)
+        polys += (faces + base).tolist()
+        keys += [key] * len(faces)
+        base += len(v)
+    if not polys:
+        raise InputError(f"{p}: no triangles: a polyhedral example needs closed solids")
+    v = np.concatenate(vs)
+    names_: dict[int, str] = {}
+    if labels == "auto":
+        labs, names_ = _number_labels(keys, set(), p)
+    else:
+        labs = [1] * len(polys)
+    return _solids(v, polys, labs, [""] * len(polys), names_, p, "glb",
+                   labels == "components", lambda k: f"vertex {k}")  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OBJ out

@@ -677,9 +677,9 @@ FORMATS: dict[str, Format] = {
             "group; a solid is one connected shell of one label and group; repaired as CAD "
             "exports need (duplicate vertices, zero-area slivers by edge flips, inconsistent "
             "winding; one warning line says what) and validated (watertight, manifold, no "
-            "self-crossing, no zero-area face, different labels do not overlap, at most "
-            "200,000 faces, coordinates up to 1e7), inside-out solids are reversed with a "
-            "warning; out: one "
+            "self-crossing, no zero-area face, different labels do not overlap, faces within "
+            "the memory budget at 4 kB each, coordinates up to 1e7), inside-out solids are "
+            "reversed with a warning; out: one "
             "`o solid_I` per solid, one material `label_N` per label with its colour in the "
             "`.mtl` (`.obj` results of label grids are the `obj` format)",
             example="csplab info  # in Python: "
@@ -725,14 +725,30 @@ FORMATS: dict[str, Format] = {
         Format(
             name="glb",
             extensions=(".glb",),
-            gives=None,
+            gives="PolyhedralModel",
             writes="PolyhedralModel",
             description="binary glTF polyhedra (game engines, three.js)",
+            reader="csplab.io.meshes:read_glb",
             writer="csplab.io.meshes:write_glb",
-            details="out: one mesh and one PBR material `label_N` per label (the label "
-            "colours), the solids' triangles as for `stl` (no zero-area triangle, no "
-            "T-junction), `y` up (csplab `(x, y, z)` → `(x, z, -y)`); Godot, Unity, Unreal "
-            "and three.js load it directly",
+            sniffer="csplab.io.meshes:sniff_glb",
+            options=(
+                Option(
+                    "labels",
+                    str,
+                    "auto",
+                    "labels from the `label_N` material or node names (`auto`), one per "
+                    "connected `components`, or `one` for the file",
+                    choices=("auto", "components", "one"),
+                ),
+            ),
+            files="binary glTF 2.0 (`glTF` magic)",
+            details="in (trimesh): every mesh node with its transform, `y` up turned back "
+            "to csplab's `z` up; a material (or node) named `label_N` gives label N, other "
+            "names the free labels 1, 2, ...; every connected shell is a solid, repaired and "
+            "validated as for `mesh-obj`; out: one mesh and one PBR material `label_N` "
+            "per label (the label colours), the solids' triangles as for `stl` (no "
+            "zero-area triangle, no T-junction), `y` up (csplab `(x, y, z)` → `(x, z, -y)`); "
+            "Godot, Unity, Unreal and three.js load it directly",
             example="csplab synthesize csplab/examples/continuous3d/houses.obj "
             "--size 12x12x4 --seed 1 --out houses.glb",
         ),

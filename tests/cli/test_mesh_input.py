@@ -72,6 +72,12 @@ def _million(tmp_path):
     return p
 
 
+def _claims_billion(tmp_path):
+    p = tmp_path / "billion.stl"  # a header claiming 10^9 triangles, ten in the body
+    p.write_bytes(b"binary".ljust(80) + struct.pack("<I", 10**9) + bytes(50 * 10))
+    return p
+
+
 def _million_off(tmp_path):
     p = tmp_path / "million.off"
     p.write_text("OFF\n3 1000000 0\n0 0 0\n1 0 0\n0 1 0\n" + "3 0 1 2\n" * 10)
@@ -88,8 +94,14 @@ BAD = {
     "NaN": (_nan, r"nan\.off: line \d+: a vertex with a non-finite coordinate \(nan, 0\.0, 0\.0\)"),
     "infinite": (_inf, r"inf\.obj: line \d+: a vertex with a non-finite coordinate \(inf, "),
     "1e9": (_huge, r"huge\.stl: triangle \d+: coordinate [\d.]+e\+09 beyond the 1e\+07"),
-    "1e6 faces (stl)": (_million, r"million\.stl: 1000000 faces, more than the 200000 csplab"),
-    "1e6 faces (off)": (_million_off, r"million\.off: 1000000 faces, more than the 200000"),
+    "1e9 faces claimed (stl)": (
+        _claims_billion,
+        r"billion\.stl: 1000000000 triangles announced, the file holds 10",
+    ),
+    "1e6 faces claimed (off)": (
+        _million_off,
+        r"million\.off, line 2: 3 vertices and 1000000 faces announced, 13 lines follow",
+    ),
 }
 
 
@@ -110,6 +122,30 @@ def test_bad_meshes_are_one_line_exit_2_nothing_written(tmp_path, capsys, case):
     assert not out.exists() and not out.with_suffix(".mtl").exists()
 
 
+@pytest.mark.parametrize("make", [_million, _million_off])
+def test_a_million_faces_over_the_memory_budget_is_one_line_before_reading(
+    tmp_path, capsys, monkeypatch, make
+):
+    # the faces' memory (4 kB each) is estimated from the counts and refused in one line
+    # naming the number, before a face is read (a machine whose budget is 1 GB)
+    import csplab.io.mesh_repair as repair
+    import csplab.limits
+
+    monkeypatch.setattr(csplab.limits, "memory_budget", lambda limit_gb=None: 1e9)
+    read = []
+    monkeypatch.setattr(repair, "merge_duplicates", lambda *a: read.append(1))
+    p = make(tmp_path)
+    out = tmp_path / "out.obj"
+    code, _, err = run(capsys, "synthesize", str(p), "--size", "10x10x5", "--seed", "1",
+                       "--out", str(out))  # fmt: skip
+    assert code == 2 and not read and not out.exists()
+    lines = err.strip().splitlines()
+    assert lines == [
+        f"csplab: error: {p}: reading 1000000 faces would need about 4.1 GB, over the memory "
+        "budget of 1.0 GB: simplify the mesh first, or raise --memory-limit"
+    ]
+
+
 @pytest.mark.parametrize("name", ["engraved", "holes", "slanted", "tetra"])
 def test_cad_exports_with_defects_are_repaired_with_one_note(tmp_path, capsys, name):
     p = cad.export(cad.build(name), tmp_path / f"{name}.off", slivers=2, duplicate_vertices=True,
@@ -126,3 +162,22 @@ def test_cad_exports_with_defects_are_repaired_with_one_note(tmp_path, capsys, n
     with pytest.warns(UserWarning):
         m = read_model(p)
     assert m.volume() == pytest.approx(float(cad.build(name).volume), rel=1e-6)
+
+
+@pytest.mark.parametrize("which", ["houses", "slanted"])
+def test_check_reads_glb_outputs_as_it_reads_obj(tmp_path, capsys, which):
+    if which == "houses":
+        ex, size = "csplab/examples/continuous3d/houses.obj", "8x8x3"
+    else:
+        ex, size = str(cad.export(cad.build(which), tmp_path / f"{which}.stl")), "10x10x4"
+    counts = {}
+    for ext in (".glb", ".obj"):
+        out = tmp_path / f"out{ext}"
+        code, _, err = run(capsys, "synthesize", ex, "--size", size, "--seed", "1",
+                           "--out", str(out))  # fmt: skip
+        assert code == 0, err
+        code, text, err = run(capsys, "check", ex, str(out), "--json")
+        assert "Traceback" not in err
+        counts[ext] = (code, text)
+    assert counts[".glb"] == counts[".obj"]
+    assert counts[".glb"][0] == 0  # the synthesized output violates nothing

@@ -105,3 +105,56 @@ def test_zero_area_triangles_of_a_solid_are_ear_clipped_again():
     m = trimesh.Trimesh(vertices=s.vertices, faces=T, process=False)
     assert m.is_watertight and m.area_faces.min() > 1e-6 and float(m.volume) == pytest.approx(1)
     assert len(T) == len(fan)
+
+
+@pytest.mark.parametrize("which", ["synthesized", "engraved"])
+def test_glb_reads_back_as_the_same_solids_labels_and_volumes(tmp_path, request, which):
+    model = request.getfixturevalue(which)
+    p = tmp_path / "m.glb"
+    output_format(p, gives="PolyhedralModel").write(model, p)
+    back = read_model(p)
+    assert back.meta["format"] == "glb"
+    assert back.labels == model.labels
+    assert len(back.solids) == len(model.solids)
+    for b in model.labels:  # float32 coordinates in glTF
+        assert back.volume(b) == pytest.approx(model.volume(b), rel=1e-5)
+    # z up again (glTF's y up turned back): the same extent per axis
+    ext = lambda m: np.vstack([s.vertices for s in m.solids])  # noqa: E731
+    assert np.allclose(ext(back).min(0), ext(model).min(0), atol=1e-4)
+    assert np.allclose(ext(back).max(0), ext(model).max(0), atol=1e-4)
+
+
+def test_glb_of_another_tool_names_transforms_and_y_up(tmp_path):
+    # two CAD parts as a modelling tool exports them: named nodes without label_N, one
+    # moved by its node transform, glTF's y up
+    a, b = cad.build("tetra"), cad.build("holes")
+    scene = trimesh.Scene()
+    scene.add_geometry(a, node_name="roof", geom_name="roof")
+    t = np.eye(4)
+    t[:3, 3] = [100.0, 0.0, 0.0]
+    scene.add_geometry(b, node_name="wall", geom_name="wall", transform=t)
+    p = tmp_path / "tool.glb"
+    p.write_bytes(scene.export(file_type="glb"))
+    m = read_model(p)
+    assert m.labels == (1, 2)
+    assert m.meta["label_names"] == {"1": "roof", "2": "wall"}
+    assert m.volume(1) == pytest.approx(a.volume, rel=1e-5)
+    assert m.volume(2) == pytest.approx(b.volume, rel=1e-5)
+    # glTF (x, y, z) is csplab (x, -z, y): the moved part lies at x >= 100 - its extent
+    wall = [s for s in m.solids if s.label == 2]
+    assert min(float(s.vertices[:, 0].min()) for s in wall) == pytest.approx(
+        100.0 + float(b.vertices[:, 0].min()), abs=1e-4
+    )
+    assert float(m.solids[0].vertices[:, 2].max()) == pytest.approx(
+        float(a.vertices[:, 1].max()), abs=1e-4
+    )
+    assert len(read_model(p, labels="one").labels) == 1
+
+
+def test_bad_glb_is_one_line(tmp_path):
+    from csplab.errors import CsplabError
+
+    p = tmp_path / "bad.glb"
+    p.write_bytes(b"glTF" + bytes(30))
+    with pytest.raises(CsplabError, match=r"bad\.glb"):
+        read_model(p)
