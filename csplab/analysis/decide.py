@@ -29,8 +29,10 @@ Examples
 >>> v.holds, v.stats["method"]
 (True, 'region 3x2 (Alg. 3.6)')
 >>> v = decide_infallibility(load_example("fig3_5a"), order="scan:yx", time_limit=30)
->>> v.holds, v.stats["method"]
-(False, 'Alg. 3.6 run = Alg. 3.1 run')
+>>> v.holds, v.stats["method"] in ("Alg. 3.6 run = Alg. 3.1 run", "failure search")
+(False, True)
+
+(Which of the two finds the failing run first depends on the time slices, so on the load.)
 """
 
 from __future__ import annotations

@@ -26,7 +26,7 @@ Examples
 --------
 >>> from csplab.experiments import get_experiment
 >>> trials = get_experiment("infallibility").trials(quick=True)
->>> sorted({(t.example, t.boundary, t.params["order"]) for t in trials})[:2]
+>>> sorted({(t.example, t.params["boundary"], t.params["order"]) for t in trials})[:2]
 [('fig3_4a', 'auto', 'scan:yx'), ('fig3_4a', 'auto', 'scanline')]
 """
 
