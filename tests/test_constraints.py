@@ -341,3 +341,20 @@ def test_constraints_file_given_as_a_model_says_so(capsys):
     code, _, err = _run(capsys, "synthesize", DATA / "pipes.xml", "--size", "12x12",
                         "--solver", "sat", "--constraints", f, "--seed", "2")  # fmt: skip
     assert code == 0, err
+
+
+def test_alg31_counts_the_steps_where_a_constraint_pruned():
+    """``constraint_prunings`` counts the Alg. 3.1 steps after which a global constraint
+    removed labels: with at most 2 cells of label 1, once two are placed the others lose it
+    (a pruning, not a conflict), and the run still ends solved with exactly that count."""
+    from csplab.engine.alg31 import run_alg31
+
+    P = from_example(E2, (5, 5)).with_constraints([Count([1], max=2)])
+    seen = 0
+    for seed in range(6):
+        r = run_alg31(P, np.random.default_rng(seed))
+        assert r.stats["constraint_prunings"] <= r.stats["assigned"]
+        if r.status == "solved":
+            assert not P.violations(r.grid)
+            seen += r.stats["constraint_prunings"]
+    assert seen > 0

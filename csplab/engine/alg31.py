@@ -149,7 +149,10 @@ def run_alg31(
                          max_steps=steps)  # fmt: skip
         if cons and code in (kern.Code.PAUSED, kern.Code.SOLVED):
             # after each assignment the constraints prune (Alg. 3.1 never undoes a choice)
+            before = eng.bits.copy()
             got = eng.constrain(incremental=True)
+            if got == -1 and not np.array_equal(before, eng.bits):
+                stats["constraint_prunings"] += 1  # the propagators removed labels
             if got != -1:
                 stats["constraint_conflicts"] += 1
                 broken = (
