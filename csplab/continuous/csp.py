@@ -235,6 +235,17 @@ def _vertex_sectors(
     return out
 
 
+def _arrangement(
+    example: PolygonModel, lattice: Lattice, W: int, H: int, lines: str = "lattice"
+) -> Arrangement:
+    """:class:`~csplab.continuous.arrangement.Arrangement`, its refusal naming the
+    example's file."""
+    try:
+        return Arrangement(lattice, W, H, lines=lines)
+    except InputError as e:
+        raise InputError(f"{example.source}: {e}") from None
+
+
 def example_signatures(
     example: PolygonModel, lattice: Lattice, label_index: dict[int, int],
     ground: Sequence[str] = (),
@@ -259,7 +270,7 @@ def example_signatures(
     bits = sum(SIDES[g] for g in ground)
     m0 = np.array([0 if bits & 1 else 1, 0 if bits & 4 else 1])  # margins low
     m1 = np.array([0 if bits & 2 else 1, 0 if bits & 8 else 1])  # and high
-    A = Arrangement(lattice, *(int(v) for v in hi - lo + m0 + m1))
+    A = _arrangement(example, lattice, *(int(v) for v in hi - lo + m0 + m1))
     s = float(lattice.spacing)
     o = np.array([float(lattice.origin[0]), float(lattice.origin[1])])
     shapes = {}
@@ -401,7 +412,7 @@ class ContinuousCSP:
         self.on_ground: dict[str, set[Signature]] = {g: {((-1, 0),)} for g in self.ground}
         self.signatures = example_signatures(example, self.lattice, index, self.ground,
                                              self.coverage, self.on_ground)  # fmt: skip
-        A = self.arrangement = Arrangement(self.lattice, W, H, lines=lines)
+        A = self.arrangement = _arrangement(example, self.lattice, W, H, lines)
         F, Kl = A.F, len(self.labels)
         self.Kl = Kl
         b0 = index[boundary]

@@ -593,8 +593,10 @@ def test_row6_a_64_gon_of_radius_1000_is_one_line(capsys, tmp_path):
            for k in range(64)]  # fmt: skip
     path = tmp_path / "gon.json"
     path.write_text(json.dumps({"polygons": [{"label": 1, "points": pts}]}))
-    refused(capsys, "synthesize", path, "--size", "300x300", "--spacing", "10", "--snap",
-            "--out", tmp_path / "r.svg", words=("64-bit", "--spacing"))  # fmt: skip
+    line = refused(capsys, "synthesize", path, "--size", "300x300", "--spacing", "10",
+                   "--snap", "--out", tmp_path / "r.svg",
+                   words=("64-bit", "--spacing"))  # fmt: skip
+    assert str(path) in line  # the file is named
     assert not (tmp_path / "r.svg").exists()
 
 
