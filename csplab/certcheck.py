@@ -70,7 +70,7 @@ import itertools
 import json
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from csplab.errors import InputError
 
@@ -172,12 +172,12 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
         if rules_hash(rules) != cert.get("rules_sha256"):
             raise _Invalid("the rules do not match rules_sha256")
         fwd, bwd, used, ndim = _tables(rules)
-        face_rules = _face_rules(rules.get("faces") or [], ndim, rules)
+        model = _Rules(fwd, bwd, used, ndim, _face_rules(rules.get("faces") or [], ndim, rules))
         claim = cert.get("claim")
         if claim == "infallible":
-            msg = _check_closed(cert, fwd, bwd, used, ndim, face_rules)
+            msg = _check_closed(cert, model)
         elif claim == "fallible":
-            msg = _check_run(cert, fwd, bwd, used, ndim, face_rules)
+            msg = _check_run(cert, model)
         else:
             raise _Invalid(f"unknown claim {claim!r}")
     except _Invalid as e:
@@ -212,6 +212,17 @@ def _tables(rules: Mapping[str, Any]) -> tuple[list[list[int]], list[list[int]],
 
 
 FaceRule = tuple[str, str, int]
+
+
+class _Rules(NamedTuple):
+    """The certificate's rules as the checks use them: per axis the forward and backward
+    support bitsets of each label, the labels in use (a bitset), the axes and face rules."""
+
+    fwd: list[list[int]]
+    bwd: list[list[int]]
+    used: int
+    ndim: int
+    faces: list[FaceRule]
 
 
 def _face_rules(raw: Sequence[Any], ndim: int, rules: Mapping[str, Any]) -> list[FaceRule]:
@@ -263,14 +274,8 @@ def _axes_of(order: str, ndim: int) -> tuple[int, ...]:
 # ----------------------------------------------------------------------------- infallible
 
 
-def _check_closed(
-    cert: Mapping[str, Any],
-    fwd: list[list[int]],
-    bwd: list[list[int]],
-    used: int,
-    ndim: int,
-    face_rules: list[FaceRule],
-) -> str:
+def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
+    fwd, bwd, used, ndim, face_rules = rules
     region = [int(t) for t in cert["region"]]
     history = [int(t) for t in cert["history"]]
     axes = tuple(int(a) for a in cert["axes"])
@@ -558,14 +563,8 @@ def _small_ac(
 # ----------------------------------------------------------------------------- fallible
 
 
-def _check_run(
-    cert: Mapping[str, Any],
-    fwd: list[list[int]],
-    bwd: list[list[int]],
-    used: int,
-    ndim: int,
-    face_rules: list[FaceRule],
-) -> str:
+def _check_run(cert: Mapping[str, Any], rules: _Rules) -> str:
+    fwd, bwd, used, ndim, face_rules = rules
     run = cert["run"]
     shape = tuple(int(s) for s in run["shape"])
     if len(shape) != ndim or any(s < 1 for s in shape):

@@ -270,7 +270,8 @@ def example_signatures(
     bits = sum(SIDES[g] for g in ground)
     m0 = np.array([0 if bits & 1 else 1, 0 if bits & 4 else 1])  # margins low
     m1 = np.array([0 if bits & 2 else 1, 0 if bits & 8 else 1])  # and high
-    A = _arrangement(example, lattice, *(int(v) for v in hi - lo + m0 + m1))
+    ext = hi - lo + m0 + m1
+    A = _arrangement(example, lattice, int(ext[0]), int(ext[1]))
     s = float(lattice.spacing)
     o = np.array([float(lattice.origin[0]), float(lattice.origin[1])])
     shapes = {}
