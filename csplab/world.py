@@ -77,7 +77,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab import _interp
+from csplab.catalog import block_arrays, pack, solve_block_arrays, support_tables
 from csplab.engine import waves as wv
+from csplab.engine.alg31 import scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
@@ -98,7 +101,16 @@ def _zig(v: int) -> int:
 
 
 class _BlockSolver:
-    """Solve one block: a pure function of (settings, sub-pass, block, window)."""
+    """Solve one block: a pure function of (settings, sub-pass, block, window).
+
+    Built once per world: the template's CSR arcs and support tables serve every block. A
+    block runs in one kernel call (:func:`csplab.catalog.block_arrays`, then
+    :func:`csplab.catalog.solve_block_arrays`: Alg. 3.1 with its retries) when the compiled
+    kernels are the engine and the order and choice are ones they run; otherwise (and for
+    exact completion) through :meth:`Problem.subproblem` and
+    :func:`csplab.engine.waves.solve_block`, the twin that gives the same labels from the
+    same draws.
+    """
 
     def __init__(
         self,
@@ -115,6 +127,10 @@ class _BlockSolver:
         self.template, self.inner, self.arc_ids = template, inner, arc_ids
         self.block_shape, self.seed, self.retries = block_shape, seed, retries
         self.order, self.choice, self.exact = order, choice, exact
+        self.kernel = choice in ("uniform", "weighted") and order != "random"
+        scan = scan_order(block_shape, order) if self.kernel else None
+        self.scan = np.arange(inner.size, dtype=np.int64) if scan is None else scan.astype(np.int64)
+        self.tables = support_tables(template.relations, template.weights)
 
     def __call__(
         self,
@@ -125,24 +141,37 @@ class _BlockSolver:
     ) -> tuple[NDArray[np.int32], str]:
         """The block's labels (block shape) and how they came: ``alg31``, ``exact``,
         ``kept``."""
-        sub = self.template.subproblem(self.inner, window, shape=self.block_shape,
-                                       arc_ids=self.arc_ids)  # fmt: skip
-        if allowed is not None:
-            sub = sub.restrict(allowed)
         rng = np.random.default_rng(
             np.random.SeedSequence([self.seed, s, *(_zig(int(c)) for c in b)])
         )
-        o = wv.solve_block(sub, rng, 0, retries=self.retries, order=self.order,
-                           choice=self.choice, deadline=None)  # fmt: skip
+        flat = np.ascontiguousarray(window, dtype=np.int32).reshape(-1)
+        labels: NDArray[np.int32] | None
+        sub: Problem | None = None
+        if self.kernel and _interp.compiled_engine():
+            arrays = block_arrays(self.template, flat, self.inner)
+            if allowed is not None:
+                arrays = arrays._replace(dom0=arrays.dom0 & pack(allowed.reshape(self.inner.size, -1)))
+            labels, _, _ = solve_block_arrays(self.tables, arrays, self.scan, self.retries,
+                                              self.order, self.choice, rng)  # fmt: skip
+        else:
+            sub = self._sub(flat, allowed)
+            labels = wv.solve_block(sub, rng, 0, retries=self.retries, order=self.order,
+                                    choice=self.choice, deadline=None).labels  # fmt: skip
         how = "alg31"
-        labels = o.labels
-        if labels is None and self.exact != "none" and not (~sub.domains.any(axis=1)).any():
-            labels, _ = ExactCompletion(self.exact)(sub, rng, None)
-            how = "exact"
+        if labels is None and self.exact != "none":
+            sub = sub if sub is not None else self._sub(flat, allowed)
+            if not (~sub.domains.any(axis=1)).any():
+                labels, _ = ExactCompletion(self.exact)(sub, rng, None)
+                how = "exact"
         if labels is None:
-            old = window.reshape(-1)[self.inner]
+            old = flat[self.inner]
             return old.reshape(self.block_shape).astype(np.int32), "kept"
         return np.asarray(labels, dtype=np.int32).reshape(self.block_shape), how
+
+    def _sub(self, flat: NDArray[np.int32], allowed: NDArray[np.bool_] | None) -> Problem:
+        sub = self.template.subproblem(self.inner, flat, shape=self.block_shape,
+                                       arc_ids=self.arc_ids)  # fmt: skip
+        return sub if allowed is None else sub.restrict(allowed)
 
 
 _WORKER: _BlockSolver | None = None
@@ -304,6 +333,8 @@ class World:
         # the blocks one chunk needs from scratch: about (k + 1) ** 2 at k sub-passes below
         # the last; a smaller cache would solve blocks again and again within one chunk
         pyramid = sum((k + 2) ** 2 for k in range(self.S))
+        # a chunk from scratch is a job of ``pyramid`` blocks: large ones run compiled
+        _interp.kernels_for(pyramid * int(np.prod(self._bshape)), self.K)
         self.blocks: _LRU = _LRU(max(int(cache_blocks), pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
         self.stats: dict[str, int] = {"alg31": 0, "exact": 0, "kept": 0, "stored": 0}
