@@ -12,19 +12,23 @@ Construction: modify in blocks (Merrell 2009, Alg. 3.4/3.5, Sec. 3.3.6) on the w
   solution (:func:`csplab.solvers.blocks.trivial_solution`: one label, or uniform layers
   such as ground under empty space) of a small periodic problem, else a SAT solution of a
   small torus; a model with no periodic solution up to :data:`MAX_PERIOD` is refused.
-* **Sub-passes** ``s = 1 .. S`` (``S = passes * 4``). Pass ``q`` lays a lattice of blocks of
-  the chunk's size ``B`` over the plane, shifted by ``q * B // passes`` per axis (so a seam
-  of one pass lies inside the blocks of another); block ``(bx, by)`` has colour
-  ``(bx mod 2, by mod 2)`` and each colour is one sub-pass. Blocks of one colour are ``B``
-  cells apart, more than the arcs' reach ``r`` (checked), so neither sees the other's
-  cells: they are independent.
+* **Sub-pass 1** solves isolated blocks: block ``(bx, by)`` is the cells
+  ``[bx * B, (bx + 1) * B - r)`` (per axis; ``B`` the chunk's size, ``r`` the arcs' reach),
+  so a line of ``r`` cells of ``M0`` separates neighbours and every block sees only ``M0``:
+  no block of sub-pass 1 depends on another.
+* **Sub-passes** ``s = 2 .. S`` (``S = 1 + 4 * passes``). Pass ``q = 1 .. passes`` lays a
+  lattice of blocks of size ``B`` shifted by ``q * B // (passes + 1)`` per axis (so the
+  lines and block edges of the passes before lie inside its blocks); block ``(bx, by)``
+  has colour ``(bx mod 2, by mod 2)`` and each colour is one sub-pass. Blocks of one colour
+  are ``B`` cells apart, more than ``r`` (checked), so neither sees the other's cells:
+  they are independent.
 * **A block** of sub-pass ``s`` is the block's cells with the labels of state ``s - 1``
   around it fixed (a ring of width ``r``; :meth:`Problem.subproblem`). Alg. 3.1 completes
   it (:func:`csplab.engine.waves.solve_block`, with ``retries``) from the generator
   ``default_rng(SeedSequence([seed, s, zig(bx), zig(by)]))``; when every run fails, exact
   completion (SAT with the border fixed); when the border admits no completion, the block
   keeps its labels of state ``s - 1``. State ``s`` is state ``s - 1`` with the blocks of
-  colour ``s`` replaced.
+  sub-pass ``s`` replaced.
 
 Why the content does not depend on the visit order (proof sketch). By induction on ``s``:
 state 0 is a fixed function of the coordinates. A block of sub-pass ``s`` is a function of
@@ -40,8 +44,8 @@ consistent on the whole plane, and every stitched rectangle has 0 violations.
 
 Dependency neighbourhood. The final label of a cell depends on state ``s - 1`` within the
 block of sub-pass ``s`` that holds it widened by ``r``; unrolled over the ``S`` sub-passes,
-a chunk depends only on the cells within ``S * (B + r)`` of it (in practice on about
-``(2k + 1) ** 2 / 4`` blocks of the ``k``-th sub-pass below the last).
+a chunk depends only on the cells within ``S * (B + r)`` of it: with ``passes=1``, 49
+blocks (1, 2, 6 and 8 of the colour sub-passes, 32 isolated ones; :attr:`World.pyramid`).
 
 Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
@@ -91,6 +95,9 @@ __all__ = ["MAX_PERIOD", "World"]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
+#: the version of the blocks' lattice, part of the store's key (chunks stored under another
+#: lattice are not read back)
+LATTICE = 2
 
 Rect = tuple[tuple[int, int], ...]  # ((x0, x1), (y0, y1)) half-open
 
@@ -174,19 +181,19 @@ class _BlockSolver:
         return sub if allowed is None else sub.restrict(allowed)
 
 
-_WORKER: _BlockSolver | None = None
+_WORKER: tuple[_BlockSolver, _BlockSolver] | None = None
 
 
-def _init_worker(solver: _BlockSolver) -> None:
+def _init_worker(solvers: tuple[_BlockSolver, _BlockSolver]) -> None:
     global _WORKER
-    _WORKER = solver
+    _WORKER = solvers
 
 
 def _solve_task(
     tasks: list[tuple[int, tuple[int, ...], NDArray[np.int32], NDArray[np.bool_] | None]],
 ) -> list[tuple[NDArray[np.int32], str]]:
     assert _WORKER is not None
-    return [_WORKER(*t) for t in tasks]
+    return [_WORKER[t[0] > 1](*t) for t in tasks]
 
 
 class _LRU(OrderedDict[Any, Any]):
@@ -227,7 +234,8 @@ class World:
         :func:`csplab.grids.from_example`, ground below and sky above; only its ``z`` faces
         are kept). Faces on ``x``/``y`` do not exist in an infinite world: refused.
     passes : int
-        Passes of modify in blocks over the plane (each shifted by ``B // passes``).
+        Shifted colour passes of modify in blocks after the isolated blocks' sub-pass (pass
+        ``q`` shifted by ``q * B // (passes + 1)``).
     retries : int
         Alg. 3.1 runs per block after the first, before exact completion.
     exact : {"sat", "backtrack", "none"}
@@ -266,7 +274,7 @@ class World:
         seed: int = 0,
         chunk: Sequence[int] = (32, 32),
         boundary: Any = "auto",
-        passes: int = 2,
+        passes: int = 1,
         retries: int = 20,
         exact: str = "sat",
         order: str = "scanline",
@@ -303,17 +311,13 @@ class World:
         # the template: a block with its ring; the arcs' reach from it
         probe = self.problem(tuple(max(4, 2 * b) for b in self.B))
         self.reach = _reach(probe)
-        if self.reach > min(self.B):
+        if self.reach >= min(self.B):
             raise InputError(
-                f"the model's arcs reach {self.reach} cells, more than the chunk "
+                f"the model's arcs reach {self.reach} cells, as far as the chunk "
                 f"{self.B}: use a larger chunk"
             )
         r = self.reach
         self.template = self.problem(tuple(b + 2 * r for b in self.B))
-        idx = np.arange(self.template.n, dtype=np.int64).reshape(self.template.shape)
-        inner = idx[r : r + self.B[0], r : r + self.B[1]].reshape(-1)
-        a = self.template.arcs
-        touch = np.isin(a[:, 0], inner) | np.isin(a[:, 1], inner)
         self.K = self.template.K
         # blocks are cached in the smallest integer type that holds the labels
         self._small = np.int16 if self.K <= np.iinfo(np.int16).max else np.int32
@@ -325,17 +329,16 @@ class World:
                 raise InputError(f"fixed cell {k} is outside the world's height")
         self.mask = mask
         self.M0 = self._start()
-        self.solver = _BlockSolver(
-            self.template, inner, np.flatnonzero(touch).astype(np.int64), self._bshape,
-            self.seed, self.retries, order, choice, exact,
-        )  # fmt: skip
-        self.S = 4 * self.passes
-        # the blocks one chunk needs from scratch: about (k + 1) ** 2 at k sub-passes below
-        # the last; a smaller cache would solve blocks again and again within one chunk
-        pyramid = sum((k + 2) ** 2 for k in range(self.S))
+        # sub-pass 1 (the isolated blocks, a line of r cells of M0 between them) and the
+        # colour sub-passes: one template and one solver each
+        self.solvers = (self._solver(tuple(b - r for b in self.B)), self._solver(self.B))
+        self.S = 1 + 4 * self.passes
+        # the blocks one chunk needs from scratch; a smaller cache would solve blocks again
+        # and again within one chunk
+        self.pyramid = sum(len(n) for n in self._needed(self._chunk_rect(0, 0), set()))
         # a chunk from scratch is a job of ``pyramid`` blocks: large ones run compiled
-        _interp.kernels_for(pyramid * int(np.prod(self._bshape)), self.K)
-        self.blocks: _LRU = _LRU(max(int(cache_blocks), pyramid))
+        _interp.kernels_for(self.pyramid * int(np.prod(self._bshape)), self.K)
+        self.blocks: _LRU = _LRU(max(int(cache_blocks), self.pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
         self.stats: dict[str, int] = {"alg31": 0, "exact": 0, "kept": 0, "stored": 0}
         self.key = self._key()
@@ -352,7 +355,21 @@ class World:
     # -- problems -------------------------------------------------------------------------
     @property
     def _bshape(self) -> tuple[int, ...]:
-        return self.B if self.height is None else (*self.B, self.height)
+        return self._full(self.B)
+
+    def _full(self, xy: Sequence[int]) -> tuple[int, ...]:
+        """A block's shape from its ``x``/``y`` sizes (3D: the world's height)."""
+        return tuple(xy) if self.height is None else (*xy, self.height)
+
+    def _solver(self, xy: Sequence[int]) -> _BlockSolver:
+        """The solver of blocks ``xy`` wide: their template (the block and a ring of ``r``)."""
+        r = self.reach
+        t = self.template if tuple(xy) == self.B else self.problem(tuple(b + 2 * r for b in xy))
+        idx = np.arange(t.n, dtype=np.int64).reshape(t.shape)
+        inner = idx[r : r + xy[0], r : r + xy[1]].reshape(-1)
+        touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
+        return _BlockSolver(t, inner, np.flatnonzero(touch).astype(np.int64), self._full(xy),
+                            self.seed, self.retries, self.order, self.choice, self.exact)  # fmt: skip
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
         if boundary in (None, "none"):
@@ -465,17 +482,24 @@ class World:
 
     # -- lattice --------------------------------------------------------------------------
     def _pass_colour(self, s: int) -> tuple[int, tuple[int, int]]:
-        q, c = divmod(s - 1, 4)
-        return q, (c >> 1, c & 1)
+        """Sub-pass ``s >= 2``: its pass ``q >= 1`` and colour."""
+        q, c = divmod(s - 2, 4)
+        return q + 1, (c >> 1, c & 1)
 
     def _offset(self, q: int) -> tuple[int, int]:
-        return (q * self.B[0] // self.passes, q * self.B[1] // self.passes)
+        return (q * self.B[0] // (self.passes + 1), q * self.B[1] // (self.passes + 1))
 
     def _blocks_in(self, s: int, rect: Rect) -> list[tuple[int, int]]:
         """Blocks of sub-pass ``s`` (its colour only) that meet ``rect``."""
+        ranges = []
+        if s == 1:  # block b: [b * B, (b + 1) * B - r) per axis
+            for a in range(2):
+                lo, hi = rect[a]
+                B = self.B[a]
+                ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
+            return [(bx, by) for bx in ranges[0] for by in ranges[1]]
         q, col = self._pass_colour(s)
         off = self._offset(q)
-        ranges = []
         for a in range(2):
             lo, hi = rect[a]
             b0 = (lo - off[a]) // self.B[a]
@@ -485,9 +509,33 @@ class World:
         return [(bx, by) for bx in ranges[0] for by in ranges[1]]
 
     def _block_rect(self, s: int, b: tuple[int, int]) -> Rect:
+        if s == 1:
+            return tuple((b[a] * self.B[a], (b[a] + 1) * self.B[a] - self.reach)
+                         for a in range(2))  # fmt: skip
         q, _ = self._pass_colour(s)
         off = self._offset(q)
         return tuple((off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2))
+
+    def _chunk_rect(self, i: int, j: int) -> Rect:
+        return ((i * self.B[0], (i + 1) * self.B[0]), (j * self.B[1], (j + 1) * self.B[1]))
+
+    def _needed(self, rect: Rect, have: Any) -> list[set[tuple[int, int]]]:
+        """Per sub-pass ``s`` (index ``s - 1``), the blocks state ``S`` on ``rect`` depends
+        on that are not in ``have`` (a container of ``(s, b)``)."""
+        need: list[set[tuple[int, int]]] = [set() for _ in range(self.S)]
+        rects: list[Rect] = [rect]
+        for s in range(self.S, 0, -1):
+            new: list[Rect] = []
+            for rc in rects:
+                for b in self._blocks_in(s, rc):
+                    if b not in need[s - 1] and (s, b) not in have:
+                        need[s - 1].add(b)
+                        new.append(self._window(s, b))
+            rects = rects + new
+            if len(rects) > 64:  # merge into the bounding box (a superset: correct)
+                rects = [tuple((min(r[a][0] for r in rects), max(r[a][1] for r in rects))
+                               for a in range(2))]  # fmt: skip
+        return need
 
     # -- state ----------------------------------------------------------------------------
     def _state(self, s: int, rect: Rect) -> NDArray[np.int32]:
@@ -512,7 +560,7 @@ class World:
         if not self.fixed and self.mask is None:
             return None
         (x0, x1), (y0, y1) = self._block_rect(s, b)
-        al = np.ones((*self._bshape, self.K), dtype=bool)
+        al = np.ones((*self._full((x1 - x0, y1 - y0)), self.K), dtype=bool)
         if self.mask is not None:
             xs, ys = np.meshgrid(np.arange(x0, x1), np.arange(y0, y1), indexing="ij")
             al &= np.broadcast_to(np.asarray(self.mask(xs, ys), dtype=bool), al.shape)
@@ -530,7 +578,7 @@ class World:
         lab = self.blocks.get_(key)
         if lab is None:
             win = self._state(s - 1, self._window(s, b))
-            lab, how = self.solver(s, b, win, self._allowed(s, b))
+            lab, how = self.solvers[s > 1](s, b, win, self._allowed(s, b))
             self.stats[how] += 1
             self.blocks.put(key, lab.astype(self._small, copy=False))
         return lab  # type: ignore[no-any-return]
@@ -538,22 +586,10 @@ class World:
     def _prefetch(self, rect: Rect) -> None:
         """Solve the blocks ``rect`` needs, sub-pass by sub-pass, independent blocks of a
         sub-pass on the workers (``workers >= 2``)."""
-        need: list[set[tuple[int, int]]] = [set() for _ in range(self.S + 1)]
-        rects: list[Rect] = [rect]
-        for s in range(self.S, 0, -1):
-            new: list[Rect] = []
-            for rc in rects:
-                for b in self._blocks_in(s, rc):
-                    if b not in need[s] and (s, b) not in self.blocks:
-                        need[s].add(b)
-                        new.append(self._window(s, b))
-            rects = rects + new
-            if len(rects) > 64:  # merge into the bounding box (a superset: correct)
-                rects = [tuple((min(r[a][0] for r in rects), max(r[a][1] for r in rects))
-                               for a in range(2))]  # fmt: skip
+        need = self._needed(rect, self.blocks)
         pool = self._workers()
         for s in range(1, self.S + 1):
-            todo = sorted(b for b in need[s] if (s, b) not in self.blocks)
+            todo = sorted(b for b in need[s - 1] if (s, b) not in self.blocks)
             if not todo:
                 continue
             tasks = [(s, b, self._state(s - 1, self._window(s, b)), self._allowed(s, b))
@@ -571,7 +607,7 @@ class World:
             from csplab.engine.pool import Workers
 
             self._pool = Workers.local(self.workers, initializer=_init_worker,
-                                       initargs=(self.solver,))  # fmt: skip
+                                       initargs=(self.solvers,))  # fmt: skip
         return self._pool
 
     def close(self) -> None:
@@ -595,7 +631,7 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([self.seed, self.chunk_shape, self.passes, self.retries,
+        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.passes, self.retries,
                              self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              ]).encode())  # fmt: skip
@@ -636,8 +672,7 @@ class World:
                 self.chunks.put(key, arr)
                 self.stats["stored"] += 1
                 return arr.copy()
-        rect = ((key[0] * self.B[0], (key[0] + 1) * self.B[0]),
-                (key[1] * self.B[1], (key[1] + 1) * self.B[1]))  # fmt: skip
+        rect = self._chunk_rect(*key)
         if self.workers >= 2:
             self._prefetch(rect)
         arr = self._state(self.S, rect)

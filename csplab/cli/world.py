@@ -42,7 +42,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="3D worlds: z faces, 'auto' (ground and sky of the model), 'none' or "
         "'z-=1,z+=0' (x/y faces do not exist in an endless world)",
     )
-    p.add_argument("--passes", type=int, default=2, help="shifted passes of blocks (2)")
+    p.add_argument("--passes", type=int, default=1, help="shifted colour passes of blocks after the isolated one (1)")
     p.add_argument("--retries", type=int, default=20, help="Alg. 3.1 retries per block (20)")
     p.add_argument(
         "--exact",
