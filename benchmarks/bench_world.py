@@ -1,28 +1,41 @@
 """Benchmark: endless chunked worlds (:class:`csplab.World`, issue 27).
 
 Prints one line per target of issue 27 with the measured figure and ``meets`` or the
-shortfall:
+shortfall, and the load average of the machine:
 
+0. a reference run in this process: one Alg. 3.1 run (:func:`csplab.engine.alg31.run_alg31`,
+   compiled kernels) on a chunk-sized grid of each model, the median of 5 -- on a shared
+   machine every latency below is also printed as a multiple of it;
 1. memory (resident set) after walking N chunks in a straight line: <= 200 MB, with the
    growth over the second half of the walk (flat memory: the caches are bounded);
-2. 2D 32x32 chunk latency (p50/p99, one process) of each new chunk on a straight walk,
-   and the mean cost per chunk of filling a square, for a WFC-style tileset
-   (``tests/io/data/pipes.xml``) and an overlapping sample (``tests/io/data/sample.png``):
-   p99 <= 20 ms;
-3. 3D 16x16x10 city chunk latency, the same way: p99 <= 200 ms;
+2. latency of a new chunk, measured two ways, for a 2D 32x32 WFC-style tileset
+   (``tests/io/data/pipes.xml``), a 2D 32x32 overlapping sample (``tests/io/data/sample.png``),
+   and the 3D 16x16x10 city: targets p99 <= 20 / 20 / 200 ms.
+
+   * *walk*: a player walking in a line (chunks ``(i, 0)``, ``i = 1 .. n``, after chunk
+     ``(0, 0)``): each chunk's time includes every block it needs that the walk has not
+     solved yet (the cold cost of its neighbourhood, as the walker meets it), so the mean
+     is the amortised cost per chunk and p99 its worst steps;
+   * *jump*: chunks at random coordinates far from anything generated (``|i|, |j| <
+     10^6``): each solves its whole dependency pyramid (:attr:`World.pyramid` blocks).
+
+   The JIT is warmed up (one chunk far away) before anything is timed;
+3. throughput filling a square of chunks: one process, 2 local worker processes, and a Dask
+   ``LocalCluster`` of 2 processes, in chunks per second with the speed-up over one process
+   (a machine with fewer free cores than workers shows less);
 4. seam violations over N chunks: the chunks are stitched row by row, each row checked with
    the row before it (every seam counted once) by ``Problem.violations``: 0;
 5. identical bytes for R random visit orders (fresh worlds, a 3x3-chunk square).
 
 The issue's counts (10^5 chunks walked, 10^4 checked, 100 orders) take long on a shared
 2-core machine; ``--full`` runs them, the default runs smaller counts and says so on every
-line. The JIT is warmed up (one chunk) before anything is timed; timings are printed, never
-asserted.
+line. ``--only`` runs some parts (``memory,latency,throughput,seams,orders``). Timings are
+printed, never asserted.
 
 Usage::
 
-    python benchmarks/bench_world.py [--full] [--seed 1] [--walk 1500] [--seams 1000]
-        [--orders 20] [--chunks 64]
+    python benchmarks/bench_world.py [--full] [--seed 1] [--walk 1500] [--chunks 64]
+        [--jumps 24] [--square 8] [--seams 1024] [--orders 20] [--only PARTS]
 """
 
 from __future__ import annotations
@@ -34,10 +47,16 @@ from pathlib import Path
 
 import numpy as np
 
+from csplab.engine.alg31 import run_alg31
 from csplab.world import World
 
 ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "io" / "data"
+MODELS = (  # label, model, chunk, p99 target (ms)
+    ("2D 32x32 tileset pipes.xml", str(DATA / "pipes.xml"), (32, 32), 20.0),
+    ("2D 32x32 overlapping sample.png", str(DATA / "sample.png"), (32, 32), 20.0),
+    ("3D 16x16x10 city", "city", (16, 16, 10), 200.0),
+)
 
 
 def rss_mb() -> float:
@@ -52,106 +71,155 @@ def rss_mb() -> float:
         return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3
 
 
+def load() -> str:
+    return "load average " + " ".join(f"{v:.1f}" for v in os.getloadavg())
+
+
 def verdict(ok: bool, shortfall: str) -> str:
     return "meets" if ok else f"SHORT: {shortfall}"
 
 
-def latency(model: str, chunk: tuple[int, ...], n: int, seed: int) -> tuple[list[float], float]:
-    """Milliseconds per new chunk on a straight walk along ``x`` (a player moving: chunks
-    ``(i, 0)``, ``i = 0 .. n - 1``), after one warm-up chunk far away (JIT, start model);
-    and the mean cost per chunk of filling a square of ``n`` chunks (amortized)."""
-    w = World(model, seed=seed, chunk=chunk)
-    w.chunk(-1000, -1000)  # warm-up
+def reference_ms(w: World, seed: int) -> float:
+    """Median ms of one Alg. 3.1 run on a grid of the world's chunk shape (5 runs)."""
+    P = w.problem(w.chunk_shape[:2])
     times = []
-    for i in range(n):
+    for k in range(5):
+        t = time.perf_counter()
+        run_alg31(P, np.random.default_rng([seed, k]), order=w.order, choice=w.choice)
+        times.append((time.perf_counter() - t) * 1e3)
+    return float(np.median(times))
+
+
+def latency(model: str, chunk: tuple[int, ...], n: int, jumps: int, seed: int
+            ) -> tuple[list[float], list[float], float, World]:  # fmt: skip
+    """Milliseconds per new chunk on a straight walk (``n`` chunks) and per random far jump
+    (``jumps`` chunks), and the reference (ms); after one warm-up chunk far away."""
+    w = World(model, seed=seed, chunk=chunk)
+    w.chunk(-10**7, -10**7)  # warm-up: kernels, start model
+    ref = reference_ms(w, seed)
+    w.chunk(0, 0)
+    walk = []
+    for i in range(1, n + 1):
         t = time.perf_counter()
         w.chunk(i, 0)
-        times.append((time.perf_counter() - t) * 1e3)
-    side = max(2, round(n**0.5))
-    w = World(model, seed=seed, chunk=chunk)
-    w.chunk(-1000, -1000)
-    t = time.perf_counter()
-    w.region((0, side * chunk[0]), (0, side * chunk[1]))
-    return times, (time.perf_counter() - t) * 1e3 / side**2
+        walk.append((time.perf_counter() - t) * 1e3)
+    rng = np.random.default_rng(seed)
+    far = []
+    for _ in range(jumps):
+        i, j = (int(v) for v in rng.integers(-10**6, 10**6, size=2))
+        t = time.perf_counter()
+        w.chunk(i, j)
+        far.append((time.perf_counter() - t) * 1e3)
+    return walk, far, ref, w
+
+
+def throughput(side: int, seed: int) -> None:
+    """Chunks per second filling a ``side`` x ``side`` square of pipes chunks."""
+    model = str(DATA / "pipes.xml")
+    runs = (("1 process", {}), ("2 workers", {"workers": 2}),
+            ("Dask LocalCluster, 2 workers", {"workers": 2, "scheduler": "local"}))  # fmt: skip
+    base = None
+    ref_bytes = None
+    for label, kw in runs:
+        with World(model, seed=seed, chunk=(32, 32), **kw) as w:  # type: ignore[arg-type]
+            w.chunk(-10**7, -10**7)  # warm-up (and the workers' start)
+            t = time.perf_counter()
+            g = w.region((0, side * 32), (0, side * 32))
+            secs = time.perf_counter() - t
+        rate = side * side / secs
+        base = base or rate
+        same = ref_bytes is None or g.tobytes() == ref_bytes
+        ref_bytes = ref_bytes or g.tobytes()
+        print(f"throughput, {label}: {side * side} chunks of 32x32 pipes in {secs:.2f} s = "
+              f"{rate:.1f} chunks/s, speed-up {rate / base:.2f}x over 1 process; same bytes: "
+              f"{same}; {load()}")  # fmt: skip
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--full", action="store_true", help="the issue's counts (long)")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--chunks", type=int, default=64, help="chunks timed per latency line")
+    ap.add_argument("--chunks", type=int, default=64, help="chunks timed per walk")
+    ap.add_argument("--jumps", type=int, default=24, help="chunks timed per random jumps")
     ap.add_argument("--walk", type=int, default=1500, help="chunks walked for memory")
+    ap.add_argument("--square", type=int, default=8, help="side of the throughput square")
     ap.add_argument("--seams", type=int, default=1024, help="chunks checked for seams")
     ap.add_argument("--orders", type=int, default=20, help="random visit orders")
+    ap.add_argument("--only", default="memory,latency,throughput,seams,orders")
     a = ap.parse_args()
     if a.full:
         a.walk, a.seams, a.orders = 100_000, 10_000, 100
-    print(f"bench_world: seed {a.seed}, os.cpu_count() {os.cpu_count()}, load average "
-          f"{os.getloadavg()[0]:.1f} (a shared machine: timings indicative)")  # fmt: skip
+    parts = set(a.only.split(","))
+    print(f"bench_world: seed {a.seed}, os.cpu_count() {os.cpu_count()}, {load()} "
+          f"(a shared machine: timings indicative; compare with the reference)")  # fmt: skip
 
     # 1. memory (first: the latencies load more models) over a straight walk
-    w = World(str(DATA / "pipes.xml"), seed=a.seed, chunk=(32, 32))
-    w.chunk(0, 0)
-    t0 = time.perf_counter()
-    start = half = rss_mb()
-    for i in range(a.walk):
-        w.chunk(i, 0)
-        if i == a.walk // 2:
-            half = rss_mb()
-    end = rss_mb()
-    note = "" if a.walk >= 100_000 else " (issue: 10^5; --full)"
-    secs = time.perf_counter() - t0
-    print(f"memory after walking {a.walk} chunks{note}: {end:.0f} MB resident, {start:.0f} MB "
-          f"after the first chunk, {end - half:+.1f} MB over the second half, {secs:.0f} s, "
-          f"caches {len(w.blocks)}/{w.blocks.size} blocks {len(w.chunks)}/{w.chunks.size} "
-          f"chunks "
-          f"(target <= 200 MB): {verdict(end <= 200, f'{end - 200:.0f} MB over')}")  # fmt: skip
+    if "memory" in parts:
+        w = World(str(DATA / "pipes.xml"), seed=a.seed, chunk=(32, 32))
+        w.chunk(0, 0)
+        t0 = time.perf_counter()
+        start = half = rss_mb()
+        for i in range(a.walk):
+            w.chunk(i, 0)
+            if i == a.walk // 2:
+                half = rss_mb()
+        end = rss_mb()
+        note = "" if a.walk >= 100_000 else " (issue: 10^5; --full)"
+        secs = time.perf_counter() - t0
+        print(f"memory after walking {a.walk} chunks{note}: {end:.0f} MB resident, {start:.0f} "
+              f"MB after the first chunk, {end - half:+.1f} MB over the second half, {secs:.0f} "
+              f"s, caches {len(w.blocks)}/{w.blocks.size} blocks {len(w.chunks)}/{w.chunks.size} "
+              f"chunks (target <= 200 MB): {verdict(end <= 200, f'{end - 200:.0f} MB over')}; "
+              f"{load()}")  # fmt: skip
 
-    # 2. 2D latencies
-    for label, model in (("tileset pipes.xml", DATA / "pipes.xml"),
-                         ("overlapping sample.png", DATA / "sample.png")):  # fmt: skip
-        times, mean = latency(str(model), (32, 32), a.chunks, a.seed)
-        t = np.array(times)
-        p50, p99 = np.percentile(t, 50), np.percentile(t, 99)
-        ok = verdict(p99 <= 20, f"{p99 - 20:.1f} ms over")
-        print(f"2D 32x32 chunk, {label}: walk p50 {p50:.1f} ms, p99 {p99:.1f} ms over {t.size} "
-              f"chunks; square fill {mean:.1f} ms/chunk (target p99 <= 20 ms): {ok}")  # fmt: skip
+    # 2. latencies: walking in a line and random far jumps
+    if "latency" in parts:
+        for label, model, chunk, target in MODELS:
+            walk, far, ref, w = latency(model, chunk, a.chunks, a.jumps, a.seed)
+            for how, t in (("walk", np.array(walk)), ("jump", np.array(far))):
+                p50, p99, mean = (np.percentile(t, 50), np.percentile(t, 99), t.mean())
+                ok = verdict(p99 <= target, f"{p99 - target:.1f} ms over")
+                print(f"{label} chunk, {how} ({t.size} chunks): p50 {p50:.1f} ms, p99 "
+                      f"{p99:.1f} ms, mean {mean:.1f} ms = {p99 / ref:.1f}x the reference "
+                      f"{ref:.2f} ms (one Alg. 3.1 run on {'x'.join(map(str, chunk))}) "
+                      f"(target p99 <= {target:.0f} ms): {ok}; {load()}")  # fmt: skip
+            print(f"  {label}: {w.pyramid} blocks per far chunk, "
+                  f"{sum(w.stats.values()) - w.stats['stored']} solved in all "
+                  f"({w.stats['exact']} exact, {w.stats['kept']} kept)")  # fmt: skip
 
-    # 3. 3D city latency
-    times, mean = latency("city", (16, 16, 10), max(4, a.chunks // 2), a.seed)
-    t = np.array(times)
-    p50, p99 = np.percentile(t, 50), np.percentile(t, 99)
-    ok = verdict(p99 <= 200, f"{p99 - 200:.1f} ms over")
-    print(f"3D 16x16x10 city chunk: walk p50 {p50:.1f} ms, p99 {p99:.1f} ms over {t.size} "
-          f"chunks; square fill {mean:.1f} ms/chunk (target p99 <= 200 ms): {ok}")  # fmt: skip
+    # 3. throughput
+    if "throughput" in parts:
+        throughput(a.square, a.seed)
 
     # 4. seams: rows of chunks, each row checked with the previous one
-    w = World(str(DATA / "pipes.xml"), seed=a.seed + 1, chunk=(32, 32), cache_chunks=256)
-    cols = max(2, round(a.seams**0.5))
-    rows = max(2, -(-a.seams // cols))
-    P = w.problem((64, cols * 32))
-    bad = 0
-    for i in range(rows - 1):
-        g = w.region((i * 32, (i + 2) * 32), (0, cols * 32))
-        bad += len(P.violations(g))
-    n = rows * cols
-    note = "" if n >= 10_000 else " (issue: 10^4; --full)"
-    print(f"seam violations over {n} chunks{note}: {bad} (target 0): "
-          f"{verdict(bad == 0, f'{bad} violations')}")  # fmt: skip
+    if "seams" in parts:
+        w = World(str(DATA / "pipes.xml"), seed=a.seed + 1, chunk=(32, 32), cache_chunks=256)
+        cols = max(2, round(a.seams**0.5))
+        rows = max(2, -(-a.seams // cols))
+        P = w.problem((64, cols * 32))
+        bad = 0
+        for i in range(rows - 1):
+            g = w.region((i * 32, (i + 2) * 32), (0, cols * 32))
+            bad += len(P.violations(g))
+        n = rows * cols
+        note = "" if n >= 10_000 else " (issue: 10^4; --full)"
+        print(f"seam violations over {n} chunks{note}: {bad} (target 0): "
+              f"{verdict(bad == 0, f'{bad} violations')}")  # fmt: skip
 
     # 5. visit orders
-    coords = [(i, j) for i in range(3) for j in range(3)]
-    ref = World(str(DATA / "pipes.xml"), seed=a.seed, chunk=(32, 32))
-    want = {c: ref.chunk(*c).tobytes() for c in coords}
-    rng = np.random.default_rng(a.seed)
-    same = 0
-    for _ in range(a.orders):
-        wo = World(str(DATA / "pipes.xml"), seed=a.seed, chunk=(32, 32))
-        order = [coords[k] for k in rng.permutation(len(coords))]
-        same += all(wo.chunk(*c).tobytes() == want[c] for c in order)
-    note = "" if a.orders >= 100 else " (issue: 100; --full)"
-    print(f"identical bytes for random visit orders{note}: {same}/{a.orders} "
-          f"(target all): {verdict(same == a.orders, f'{a.orders - same} differ')}")  # fmt: skip
+    if "orders" in parts:
+        coords = [(i, j) for i in range(3) for j in range(3)]
+        ref = World(str(DATA / "pipes.xml"), seed=a.seed, chunk=(32, 32))
+        want = {c: ref.chunk(*c).tobytes() for c in coords}
+        rng = np.random.default_rng(a.seed)
+        same = 0
+        for _ in range(a.orders):
+            wo = World(str(DATA / "pipes.xml"), seed=a.seed, chunk=(32, 32))
+            order = [coords[k] for k in rng.permutation(len(coords))]
+            same += all(wo.chunk(*c).tobytes() == want[c] for c in order)
+        note = "" if a.orders >= 100 else " (issue: 100; --full)"
+        print(f"identical bytes for random visit orders{note}: {same}/{a.orders} "
+              f"(target all): {verdict(same == a.orders, f'{a.orders - same} differ')}")  # fmt: skip
 
 
 if __name__ == "__main__":
