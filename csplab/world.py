@@ -138,6 +138,7 @@ class _BlockSolver:
         scan = scan_order(block_shape, order) if self.kernel else None
         self.scan = np.arange(inner.size, dtype=np.int64) if scan is None else scan.astype(np.int64)
         self.tables = support_tables(template.relations, template.weights)
+        self.job = 0  #: cells of the job this solver is part of (whether to load kernels)
 
     def __call__(
         self,
@@ -191,9 +192,14 @@ def _init_worker(solvers: tuple[_BlockSolver, _BlockSolver]) -> None:
 
 def _solve_task(
     tasks: list[tuple[int, tuple[int, ...], NDArray[np.int32], NDArray[np.bool_] | None]],
+    solvers: tuple[_BlockSolver, _BlockSolver] | None = None,
 ) -> list[tuple[NDArray[np.int32], str]]:
-    assert _WORKER is not None
-    return [_WORKER[t[0] > 1](*t) for t in tasks]
+    """Blocks on a worker: the solvers are the pool's (``_WORKER``) or sent along (Dask)."""
+    sv = solvers or _WORKER
+    assert sv is not None
+    # a worker started without the kernels loads them (the parent's reason holds here)
+    _interp.kernels_for(sv[1].job, sv[1].template.K)
+    return [sv[t[0] > 1](*t) for t in tasks]
 
 
 class _LRU(OrderedDict[Any, Any]):
@@ -259,6 +265,10 @@ class World:
     workers : int
         Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
         the output is the same for any number.
+    scheduler : str, optional
+        Solve them on Dask instead: ``"local"`` (a ``LocalCluster`` of ``max(workers, 1)``
+        processes) or a scheduler address (as the ``blocks`` solver takes it); the same
+        output again.
 
     Raises
     ------
@@ -285,6 +295,7 @@ class World:
         cache_chunks: int = 1024,
         store: str | Path | None = None,
         workers: int = 0,
+        scheduler: str | None = None,
     ) -> None:
         from csplab.examples import load_model
 
@@ -304,6 +315,9 @@ class World:
         self.ndim = len(self.chunk_shape)
         self.passes, self.retries, self.exact = int(passes), int(retries), exact
         self.order, self.choice, self.workers = order, choice, int(workers)
+        self.scheduler = scheduler
+        #: blocks are solved a sub-pass at a time on workers (a local pool or Dask)
+        self.parallel = self.workers >= 2 or scheduler is not None
         self.B = self.chunk_shape[:2]
         self.height = self.chunk_shape[2] if self.ndim == 3 else None
         self.zfaces = self._zfaces(boundary)
@@ -337,7 +351,9 @@ class World:
         # and again within one chunk
         self.pyramid = sum(len(n) for n in self._needed(self._chunk_rect(0, 0), set()))
         # a chunk from scratch is a job of ``pyramid`` blocks: large ones run compiled
-        _interp.kernels_for(self.pyramid * int(np.prod(self._bshape)), self.K)
+        for sv in self.solvers:
+            sv.job = self.pyramid * int(np.prod(self._bshape))
+        _interp.kernels_for(self.solvers[1].job, self.K)
         self.blocks: _LRU = _LRU(max(int(cache_blocks), self.pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
         self.stats: dict[str, int] = {"alg31": 0, "exact": 0, "kept": 0, "stored": 0}
@@ -351,6 +367,7 @@ class World:
             )
             self._db.commit()
         self._pool: Any = None
+        self._shared: Any = None  # the solvers, sent to each Dask worker once
 
     # -- problems -------------------------------------------------------------------------
     @property
@@ -595,7 +612,7 @@ class World:
             tasks = [(s, b, self._state(s - 1, self._window(s, b)), self._allowed(s, b))
                      for b in todo]  # fmt: skip
             size = max(1, len(tasks) // (2 * pool.size))
-            futures = [pool.submit(_solve_task, tasks[i : i + size])
+            futures = [pool.submit(_solve_task, tasks[i : i + size], self._shared)
                        for i in range(0, len(tasks), size)]  # fmt: skip
             results = [x for f in futures for x in f.result()]
             for b, (lab, how) in zip(todo, results, strict=True):
@@ -606,8 +623,13 @@ class World:
         if self._pool is None:
             from csplab.engine.pool import Workers
 
-            self._pool = Workers.local(self.workers, initializer=_init_worker,
-                                       initargs=(self.solvers,))  # fmt: skip
+            if self.scheduler is None:
+                self._pool = Workers.local(self.workers, initializer=_init_worker,
+                                           initargs=(self.solvers,))  # fmt: skip
+            else:
+                self._pool = Workers.dask(self.scheduler, purpose="csplab.World with scheduler=",
+                                          local_workers=max(1, self.workers))  # fmt: skip
+                self._shared = self._pool.share(self.solvers)
         return self._pool
 
     def close(self) -> None:
@@ -662,21 +684,21 @@ class World:
         key = (int(i), int(j))
         got = self.chunks.get_(key)
         if got is not None:
-            return got.copy()  # type: ignore[no-any-return]
+            return got.astype(np.int32)  # type: ignore[no-any-return]
         if self._db is not None:
             row = self._db.execute(
                 "SELECT data FROM chunks WHERE world=? AND i=? AND j=?", (self.key, *key)
             ).fetchone()
             if row is not None:
                 arr = np.frombuffer(row[0], dtype=np.int32).reshape(self._bshape).copy()
-                self.chunks.put(key, arr)
+                self.chunks.put(key, arr.astype(self._small))
                 self.stats["stored"] += 1
                 return arr.copy()
         rect = self._chunk_rect(*key)
-        if self.workers >= 2:
+        if self.parallel:
             self._prefetch(rect)
         arr = self._state(self.S, rect)
-        self.chunks.put(key, arr)
+        self.chunks.put(key, arr.astype(self._small))
         if self._db is not None:
             self._db.execute("INSERT OR REPLACE INTO chunks VALUES (?, ?, ?, ?)",
                              (self.key, *key, arr.tobytes()))  # fmt: skip
@@ -717,7 +739,7 @@ class World:
 
         def chunks() -> Iterable[tuple[int, int]]:
             for i in rows:
-                if self.workers >= 2:  # a row of chunks at a time on the workers
+                if self.parallel:  # a row of chunks at a time on the workers
                     self._prefetch(((i * X, (i + 1) * X), (cols[0] * Y, (cols[-1] + 1) * Y)))
                 for j in cols:
                     yield i, j

@@ -254,3 +254,11 @@ def test_cli_world_bad_input_exits_2(
     assert main(["world", "fig3_4a", *args]) == 2
     err = capsys.readouterr().err
     assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_dask_scheduler_gives_the_same_bytes() -> None:
+    pytest.importorskip("distributed")
+    a = World("fig3_4a", seed=9, chunk=(8, 8)).region((-8, 16), (0, 16))
+    with World("fig3_4a", seed=9, chunk=(8, 8), workers=1, scheduler="local") as w:
+        b = w.region((-8, 16), (0, 16))
+    assert a.tobytes() == b.tobytes()

@@ -42,7 +42,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="3D worlds: z faces, 'auto' (ground and sky of the model), 'none' or "
         "'z-=1,z+=0' (x/y faces do not exist in an endless world)",
     )
-    p.add_argument("--passes", type=int, default=1, help="shifted colour passes of blocks after the isolated one (1)")
+    p.add_argument(
+        "--passes", type=int, default=1,
+        help="shifted colour passes of blocks after the isolated blocks (1)",
+    )  # fmt: skip
     p.add_argument("--retries", type=int, default=20, help="Alg. 3.1 retries per block (20)")
     p.add_argument(
         "--exact",
@@ -58,6 +61,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--choice", help="Alg. 3.1's label choice (default: the model format's, else uniform)"
     )
     p.add_argument("--jobs", type=int, default=1, help="worker processes (same output)")
+    p.add_argument(
+        "--scheduler", metavar="ADDRESS", help="solve blocks on Dask: 'local' (a LocalCluster "
+        "of --jobs processes) or a scheduler address such as tcp://host:8786 (same output)"
+    )  # fmt: skip
     p.add_argument("--store", help="SQLite file keeping generated chunks across runs")
     add_model_option(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
@@ -103,6 +110,7 @@ def run(args: argparse.Namespace) -> int:
         model, seed=args.seed, chunk=chunk, boundary=parse_boundary(args.boundary) or "none",
         passes=args.passes, retries=args.retries, exact=args.exact, order=order,
         choice=choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
+        scheduler=args.scheduler,
     )  # fmt: skip
     try:
         grid = world.region(xs, ys, progress=True)
