@@ -1264,6 +1264,14 @@ def block_catalog(
     ptr, nbr, sidx, sup = arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup
     W = doms.shape[1]
     nb = cells.shape[0]
+    # a block that is most of the problem (a world's template) looks its cells up in a
+    # table of the problem's cells; a small block of a large grid bisects ``cells``
+    n = grid.shape[0]
+    dense = n <= 4 * nb
+    pos = np.full(n if dense else 0, -1, dtype=np.int64)
+    if dense:
+        for i in range(nb):
+            pos[cells[i]] = i
     k = 0
     for i in range(nb):
         v = cells[i]
@@ -1272,7 +1280,7 @@ def block_catalog(
             dom0[i, w] = doms[v, w]
         for e in range(ptr[v], ptr[v + 1]):
             u = nbr[e]
-            j = _find(cells, nb, u)
+            j = pos[u] if dense else _find(cells, nb, u)
             if j >= 0:
                 lnbr[k] = j
                 lsidx[k] = sidx[e]
