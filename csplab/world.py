@@ -51,11 +51,10 @@ Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=call
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
 completion keeps its previous labels, so a fixed cell may stay unmet where every pass puts
 a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help). Not
-honoured in an infinite world: the global constraints of a model file (counts over the
-whole grid, connectivity, paths: dropped with a warning, :attr:`World.dropped`), boundary
-faces on the infinite ``x``/``y`` axes (there is no outside: refused), and counts per chunk
-(the chunk grid is not the blocks' lattice in every pass: a later pass' block straddles
-chunks, so a count met in one pass is not kept by the next).
+honoured in an infinite world: global constraints (counts, connectivity, symmetry; the
+reasons are :data:`UNHONOURED`): given as ``constraints=`` they are refused in one line, in
+a model file they are dropped with a warning (:attr:`World.dropped`); boundary faces on the
+infinite ``x``/``y`` axes (there is no outside: refused).
 
 Examples
 --------
@@ -85,16 +84,33 @@ from csplab import _interp
 from csplab.catalog import block_arrays, pack, solve_block_arrays, support_tables
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import scan_order
+from csplab.constraints import Constraint
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["MAX_PERIOD", "World"]
+__all__ = ["LATTICE", "MAX_PERIOD", "UNHONOURED", "World"]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
+#: why each global-constraint kind (:data:`csplab.constraints.KINDS`; ``symmetric`` is
+#: mirror and rotate) is not honoured by a world: ``World(constraints=...)`` refuses it
+#: with this line
+UNHONOURED = {
+    "count": "an endless plane has no total to count, and a count per chunk is not kept: "
+    "the shifted pass' blocks straddle chunks and change what the blocks before counted",
+    "connected": "connectivity is not local (whether two cells are joined can depend on "
+    "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only; "
+    "'each chunk's roads reach its four sides' is local but straddles the blocks as counts do",
+    "symmetric": "a mirror or rotation maps cells to cells arbitrarily far away (an endless "
+    "plane has no centre)",
+    "separation": "local, so it could hold as arcs of the blocks, but a block's subproblem "
+    "carries no global constraints: not supported yet",
+    "max-run": "local, so it could hold as arcs of the blocks, but a block's subproblem "
+    "carries no global constraints: not supported yet",
+}
 #: the version of the blocks' lattice, part of the store's key (chunks stored under another
 #: lattice are not read back)
 LATTICE = 2
@@ -265,6 +281,10 @@ class World:
     workers : int
         Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
         the output is the same for any number.
+    constraints : sequence of Constraint
+        Global constraints (:mod:`csplab.constraints`): every kind is refused, with the
+        reason of :data:`UNHONOURED` (fixed cells and masks are the constraints a world
+        honours).
     scheduler : str, optional
         Solve them on Dask instead: ``"local"`` (a ``LocalCluster`` of ``max(workers, 1)``
         processes) or a scheduler address (as the ``blocks`` solver takes it); the same
@@ -273,8 +293,8 @@ class World:
     Raises
     ------
     InputError
-        For bad settings (a chunk shape, faces on ``x``/``y``, unknown options) or a model
-        with no periodic solution to start from.
+        For bad settings (a chunk shape, faces on ``x``/``y``, unknown options, a global
+        constraint) or a model with no periodic solution to start from.
     """
 
     def __init__(
@@ -296,9 +316,14 @@ class World:
         store: str | Path | None = None,
         workers: int = 0,
         scheduler: str | None = None,
+        constraints: Sequence[Constraint] = (),
     ) -> None:
         from csplab.examples import load_model
 
+        for c in constraints:  # refused, one line each (module doc, UNHONOURED)
+            kind = getattr(c, "kind", type(c).__name__)
+            why = UNHONOURED.get(kind, "not a grid constraint of csplab.constraints")
+            raise InputError(f"a world cannot honour a {kind} constraint: {why}")
         if isinstance(model, str | Path):
             model = load_model(model)
         self.model = model

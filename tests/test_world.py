@@ -262,3 +262,32 @@ def test_dask_scheduler_gives_the_same_bytes() -> None:
     with World("fig3_4a", seed=9, chunk=(8, 8), workers=1, scheduler="local") as w:
         b = w.region((-8, 16), (0, 16))
     assert a.tobytes() == b.tobytes()
+
+
+def test_global_constraints_are_refused_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from csplab.cli import main
+    from csplab.constraints import KINDS, parse_constraints
+    from csplab.world import UNHONOURED
+
+    P = World("fig3_4a", chunk=(8, 8)).problem((8, 8))
+    specs = {
+        "count": {"type": "count", "labels": [1], "min": 1},
+        "connected": {"type": "connected", "labels": [1]},
+        "mirror": {"type": "mirror", "axis": "x"},
+        "separation": {"type": "separation", "labels": [1], "distance": 2},
+        "max-run": {"type": "max-run", "labels": [1], "n": 2},
+    }
+    assert set(KINDS) - {"rotate"} == set(specs)  # rotate needs a square: mirror's kind
+    for name, spec in specs.items():
+        (c,) = parse_constraints({"constraints": [spec]}, P)
+        with pytest.raises(InputError, match=f"cannot honour a {c.kind} constraint") as e:
+            World("fig3_4a", chunk=(8, 8), constraints=[c])
+        assert UNHONOURED[c.kind] in str(e.value), name
+    f = tmp_path / "c.json"
+    f.write_text('{"constraints": [{"type": "connected", "labels": [1]}]}')
+    argv = ["world", "fig3_4a", "--chunk", "8x8", "--region", "0:16,0:16", "--constraints", str(f)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "cannot honour a connected constraint" in err and len(err.strip().splitlines()) == 1

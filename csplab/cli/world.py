@@ -7,7 +7,13 @@ import json
 import re
 import time
 
-from csplab.cli.common import add_model_option, check_output_path, load_model, model_options
+from csplab.cli.common import (
+    add_constraints_arg,
+    add_model_option,
+    check_output_path,
+    load_model,
+    model_options,
+)
 from csplab.errors import InputError
 from csplab.grids import parse_boundary, parse_shape
 
@@ -66,6 +72,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "of --jobs processes) or a scheduler address such as tcp://host:8786 (same output)"
     )  # fmt: skip
     p.add_argument("--store", help="SQLite file keeping generated chunks across runs")
+    add_constraints_arg(p)
     add_model_option(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
@@ -105,12 +112,19 @@ def run(args: argparse.Namespace) -> int:
     suggested, _ = synthesis_defaults(model)
     order = args.order or suggested.get("order", "scanline")
     choice = args.choice or suggested.get("choice", "uniform")
+    constraints = []
+    if args.constraints:  # read against a grid of the model; the world refuses them
+        from csplab.io.constraints import read_constraints
+
+        grid = World(model, chunk=chunk, boundary=parse_boundary(args.boundary) or "none")
+        for path in args.constraints:
+            constraints += read_constraints(path, grid.problem(chunk[:2]))
     t0 = time.perf_counter()
     world = World(
         model, seed=args.seed, chunk=chunk, boundary=parse_boundary(args.boundary) or "none",
         passes=args.passes, retries=args.retries, exact=args.exact, order=order,
         choice=choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
-        scheduler=args.scheduler,
+        scheduler=args.scheduler, constraints=constraints,
     )  # fmt: skip
     try:
         grid = world.region(xs, ys, progress=True)
