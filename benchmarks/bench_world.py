@@ -166,6 +166,9 @@ def main() -> None:
             w.chunk(i, 0)
             if i == a.walk // 2:
                 half = rss_mb()
+            if a.walk >= 10_000 and (i + 1) % (a.walk // 10) == 0:  # a long walk: progress
+                print(f"  walked {i + 1} chunks: {rss_mb():.0f} MB resident, "
+                      f"{time.perf_counter() - t0:.0f} s; {load()}", flush=True)  # fmt: skip
         end = rss_mb()
         note = "" if a.walk >= 100_000 else " (issue: 10^5; --full)"
         secs = time.perf_counter() - t0
