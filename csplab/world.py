@@ -13,7 +13,8 @@ Construction: modify in blocks (Merrell 2009, Alg. 3.4/3.5, Sec. 3.3.6) on the w
   such as ground under empty space) of a small periodic problem, else a SAT solution of a
   small torus; a model with no periodic solution up to :data:`MAX_PERIOD` is refused.
 * **Sub-pass 1** solves isolated blocks: block ``(bx, by)`` is the cells
-  ``[bx * B, (bx + 1) * B - r)`` (per axis; ``B`` the chunk's size, ``r`` the arcs' reach),
+  ``[bx * B, (bx + 1) * B - r)`` (per axis; ``B`` the blocks' size, by default
+  ``min(chunk, BLOCK)``, chunks being only windows; ``r`` the arcs' reach),
   so a line of ``r`` cells of ``M0`` separates neighbours and every block sees only ``M0``:
   no block of sub-pass 1 depends on another.
 * **Sub-passes** ``s = 2 .. S`` (``S = 1 + 4 * passes``). Pass ``q = 1 .. passes`` lays a
@@ -44,8 +45,10 @@ consistent on the whole plane, and every stitched rectangle has 0 violations.
 
 Dependency neighbourhood. The final label of a cell depends on state ``s - 1`` within the
 block of sub-pass ``s`` that holds it widened by ``r``; unrolled over the ``S`` sub-passes,
-a chunk depends only on the cells within ``S * (B + r)`` of it: with ``passes=1``, 49
-blocks (1, 2, 6 and 8 of the colour sub-passes, 32 isolated ones; :attr:`World.pyramid`).
+a chunk depends only on the cells within ``S * (B + r)`` of it: with ``passes=1`` and
+blocks of the chunk's size, 49 blocks (1, 2, 6 and 8 of the colour sub-passes, 32 isolated
+ones); a 32x32 chunk of 16x16 blocks (the default), 97 of a quarter of the cells
+(:attr:`World.pyramid`).
 
 Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
@@ -91,7 +94,7 @@ from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["LATTICE", "MAX_PERIOD", "UNHONOURED", "World"]
+__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "UNHONOURED", "World"]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
@@ -111,6 +114,8 @@ UNHONOURED = {
     "max-run": "local, so it could hold as arcs of the blocks, but a block's subproblem "
     "carries no global constraints: not supported yet",
 }
+#: the largest default block side: blocks are ``min(chunk, BLOCK)`` cells wide unless given
+BLOCK = 16
 #: the version of the blocks' lattice, part of the store's key (chunks stored under another
 #: lattice are not read back)
 LATTICE = 2
@@ -250,7 +255,7 @@ class World:
         The world's seed (any non-negative integer).
     chunk : tuple of int
         ``(X, Y)`` for a 2D world, ``(X, Y, Z)`` for a 3D one (``Z``: its fixed height).
-        The blocks of modify in blocks have the chunk's size in ``x`` and ``y``.
+        Chunks are windows on the world: the blocks of modify in blocks have their own size.
     boundary : "auto", "none" or mapping
         Labels of the ``z`` faces of a 3D world (``"auto"``: the rule of
         :func:`csplab.grids.from_example`, ground below and sky above; only its ``z`` faces
@@ -281,6 +286,11 @@ class World:
     workers : int
         Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
         the output is the same for any number.
+    block : tuple of int, optional
+        ``(bx, by)``, the blocks' size in ``x`` and ``y`` (default ``min(chunk, BLOCK)``
+        per axis; more than the arcs' reach). Smaller blocks make a chunk depend on fewer
+        cells (a 32x32 chunk: 24 32x32-equivalents from scratch with 16x16 blocks, 49 with
+        32x32 ones), larger ones leave room for larger structures.
     constraints : sequence of Constraint
         Global constraints (:mod:`csplab.constraints`): every kind is refused, with the
         reason of :data:`UNHONOURED` (fixed cells and masks are the constraints a world
@@ -317,6 +327,7 @@ class World:
         workers: int = 0,
         scheduler: str | None = None,
         constraints: Sequence[Constraint] = (),
+        block: Sequence[int] | None = None,
     ) -> None:
         from csplab.examples import load_model
 
@@ -343,7 +354,12 @@ class World:
         self.scheduler = scheduler
         #: blocks are solved a sub-pass at a time on workers (a local pool or Dask)
         self.parallel = self.workers >= 2 or scheduler is not None
-        self.B = self.chunk_shape[:2]
+        self.C = self.chunk_shape[:2]
+        if block is None:  # small blocks: a chunk depends on fewer cells (module doc)
+            block = tuple(min(c, BLOCK) for c in self.C)
+        self.B = tuple(int(b) for b in block)
+        if len(self.B) != 2 or min(self.B) < 2:
+            raise InputError(f"block must be 2 sizes >= 2 (x and y), not {block!r}")
         self.height = self.chunk_shape[2] if self.ndim == 3 else None
         self.zfaces = self._zfaces(boundary)
         self.dropped: list[str] = []  # the model's global constraints (cannot hold)
@@ -352,8 +368,8 @@ class World:
         self.reach = _reach(probe)
         if self.reach >= min(self.B):
             raise InputError(
-                f"the model's arcs reach {self.reach} cells, as far as the chunk "
-                f"{self.B}: use a larger chunk"
+                f"the model's arcs reach {self.reach} cells, as far as the blocks "
+                f"{self.B}: use larger blocks"
             )
         r = self.reach
         self.template = self.problem(tuple(b + 2 * r for b in self.B))
@@ -377,7 +393,7 @@ class World:
         self.pyramid = sum(len(n) for n in self._needed(self._chunk_rect(0, 0), set()))
         # a chunk from scratch is a job of ``pyramid`` blocks: large ones run compiled
         for sv in self.solvers:
-            sv.job = self.pyramid * int(np.prod(self._bshape))
+            sv.job = self.pyramid * int(np.prod(self._full(self.B)))
         _interp.kernels_for(self.solvers[1].job, self.K)
         self.blocks: _LRU = _LRU(max(int(cache_blocks), self.pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
@@ -397,7 +413,8 @@ class World:
     # -- problems -------------------------------------------------------------------------
     @property
     def _bshape(self) -> tuple[int, ...]:
-        return self._full(self.B)
+        """A chunk's shape."""
+        return self._full(self.C)
 
     def _full(self, xy: Sequence[int]) -> tuple[int, ...]:
         """A block's shape from its ``x``/``y`` sizes (3D: the world's height)."""
@@ -559,7 +576,7 @@ class World:
         return tuple((off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2))
 
     def _chunk_rect(self, i: int, j: int) -> Rect:
-        return ((i * self.B[0], (i + 1) * self.B[0]), (j * self.B[1], (j + 1) * self.B[1]))
+        return ((i * self.C[0], (i + 1) * self.C[0]), (j * self.C[1], (j + 1) * self.C[1]))
 
     def _needed(self, rect: Rect, have: Any) -> list[set[tuple[int, int]]]:
         """Per sub-pass ``s`` (index ``s - 1``), the blocks state ``S`` on ``rect`` depends
@@ -678,7 +695,7 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.passes, self.retries,
+        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.B, self.passes, self.retries,
                              self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              ]).encode())  # fmt: skip
@@ -757,7 +774,7 @@ class World:
         (x0, x1), (y0, y1) = (int(xs[0]), int(xs[1])), (int(ys[0]), int(ys[1]))
         if x1 <= x0 or y1 <= y0:
             raise InputError(f"empty region {xs}, {ys}")
-        X, Y = self.B
+        X, Y = self.C
         out = np.empty((x1 - x0, y1 - y0, *self._bshape[2:]), dtype=np.int32)
         rows = range(x0 // X, (x1 - 1) // X + 1)
         cols = range(y0 // Y, (y1 - 1) // Y + 1)
@@ -792,7 +809,7 @@ class World:
         tuple of int
             ``(i, j)`` of each chunk, row by row.
         """
-        X, Y = self.B
+        X, Y = self.C
         for i in range(xs[0] // X, (xs[1] - 1) // X + 1):
             for j in range(ys[0] // Y, (ys[1] - 1) // Y + 1):
                 yield i, j

@@ -49,6 +49,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "'z-=1,z+=0' (x/y faces do not exist in an endless world)",
     )
     p.add_argument(
+        "--block", help="the blocks' size BXxBY (default: the chunk's, at most 16x16)"
+    )
+    p.add_argument(
         "--passes", type=int, default=1,
         help="shifted colour passes of blocks after the isolated blocks (1)",
     )  # fmt: skip
@@ -125,6 +128,7 @@ def run(args: argparse.Namespace) -> int:
         passes=args.passes, retries=args.retries, exact=args.exact, order=order,
         choice=choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
         scheduler=args.scheduler, constraints=constraints,
+        block=parse_shape(args.block, what="--block") if args.block else None,
     )  # fmt: skip
     try:
         grid = world.region(xs, ys, progress=True)
