@@ -100,8 +100,11 @@ def reference_ms(w: World, seed: int) -> tuple[float, float]:
     return float(np.median([t[0] for t in times])), float(np.median([t[1] for t in times]))
 
 
+Times = NDArray[np.float64]
+
+
 def latency(model: str, chunk: tuple[int, ...], n: int, jumps: int, seed: int
-            ) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[float, float], World]:  # fmt: skip
+            ) -> tuple[Times, Times, tuple[float, float], World]:  # fmt: skip
     """Wall and CPU milliseconds (columns) per new chunk on a straight walk (``n`` chunks)
     and per random far jump (``jumps`` chunks), and the reference; after one warm-up chunk
     far away."""
@@ -229,8 +232,9 @@ def main() -> None:
             order = [coords[k] for k in rng.permutation(len(coords))]
             same += all(wo.chunk(*c).tobytes() == want[c] for c in order)
         note = "" if a.orders >= 100 else " (issue: 100; --full)"
+        ok = verdict(same == a.orders, f"{a.orders - same} differ")
         print(f"identical bytes for random visit orders{note}: {same}/{a.orders} "
-              f"(target all): {verdict(same == a.orders, f'{a.orders - same} differ')}")  # fmt: skip
+              f"(target all): {ok}")  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -85,9 +85,9 @@ from numpy.typing import NDArray
 
 from csplab import _interp
 from csplab.catalog import block_arrays, pack, solve_block_arrays, support_tables
+from csplab.constraints import Constraint
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import scan_order
-from csplab.constraints import Constraint
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
@@ -179,7 +179,8 @@ class _BlockSolver:
         if self.kernel and _interp.compiled_engine():
             arrays = block_arrays(self.template, flat, self.inner)
             if allowed is not None:
-                arrays = arrays._replace(dom0=arrays.dom0 & pack(allowed.reshape(self.inner.size, -1)))
+                cut = pack(allowed.reshape(self.inner.size, -1))
+                arrays = arrays._replace(dom0=arrays.dom0 & cut)
             labels, _, _ = solve_block_arrays(self.tables, arrays, self.scan, self.retries,
                                               self.order, self.choice, rng)  # fmt: skip
         else:
@@ -427,8 +428,9 @@ class World:
         idx = np.arange(t.n, dtype=np.int64).reshape(t.shape)
         inner = idx[r : r + xy[0], r : r + xy[1]].reshape(-1)
         touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
-        return _BlockSolver(t, inner, np.flatnonzero(touch).astype(np.int64), self._full(xy),
-                            self.seed, self.retries, self.order, self.choice, self.exact)  # fmt: skip
+        arc_ids = np.flatnonzero(touch).astype(np.int64)
+        return _BlockSolver(t, inner, arc_ids, self._full(xy), self.seed, self.retries,
+                            self.order, self.choice, self.exact)  # fmt: skip
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
         if boundary in (None, "none"):
@@ -695,8 +697,8 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.B, self.passes, self.retries,
-                             self.exact, self.order, self.choice, self.zfaces,
+        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.B, self.passes,
+                             self.retries, self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              ]).encode())  # fmt: skip
         return h.hexdigest()[:32]

@@ -119,9 +119,9 @@ def run(args: argparse.Namespace) -> int:
     if args.constraints:  # read against a grid of the model; the world refuses them
         from csplab.io.constraints import read_constraints
 
-        grid = World(model, chunk=chunk, boundary=parse_boundary(args.boundary) or "none")
+        probe = World(model, chunk=chunk, boundary=parse_boundary(args.boundary) or "none")
         for path in args.constraints:
-            constraints += read_constraints(path, grid.problem(chunk[:2]))
+            constraints += read_constraints(path, probe.problem(chunk[:2]))
     t0 = time.perf_counter()
     world = World(
         model, seed=args.seed, chunk=chunk, boundary=parse_boundary(args.boundary) or "none",
