@@ -291,3 +291,21 @@ def test_global_constraints_are_refused_in_one_line(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "cannot honour a connected constraint" in err and len(err.strip().splitlines()) == 1
+
+
+def test_blocks_of_another_size_than_the_chunk() -> None:
+    kw = {"seed": 3, "chunk": (8, 8), "block": (6, 6)}
+    w = World("fig3_4a", **kw)  # type: ignore[arg-type]
+    assert w.B == (6, 6) and World("fig3_4a", chunk=(32, 32)).B == (12, 12)  # BLOCK
+    a = {c: w.chunk(*c) for c in CHUNKS}
+    w2 = World("fig3_4a", **kw)  # type: ignore[arg-type]
+    assert all(w2.chunk(*c).tobytes() == a[c].tobytes() for c in reversed(CHUNKS))
+    g = w.region((-8, 16), (-8, 16))
+    assert len(w.problem(g.shape).violations(g)) == 0 and len(np.unique(g)) > 2
+    # the cache floor is the most blocks a chunk needs from scratch, over its positions
+    solved = []
+    for i in range(3):  # 6 // gcd(6, 8) phases per axis
+        f = World("fig3_4a", **kw)  # type: ignore[arg-type]
+        f.chunk(i, 2 * i)
+        solved.append(sum(f.stats.values()))
+    assert max(solved) <= w.pyramid and w.pyramid in solved

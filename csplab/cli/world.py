@@ -49,7 +49,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "'z-=1,z+=0' (x/y faces do not exist in an endless world)",
     )
     p.add_argument(
-        "--block", help="the blocks' size BXxBY (default: the chunk's, at most 16x16)"
+        "--block", help="the blocks' size BXxBY (default: the chunk's, at most 12x12)"
     )
     p.add_argument(
         "--passes", type=int, default=1,
