@@ -24,7 +24,9 @@ shortfall, and the load average of the machine:
    up (one chunk far away) before anything is timed;
 3. throughput filling a square of chunks: one process, 2 local worker processes, and a Dask
    ``LocalCluster`` of 2 processes, in chunks per second with the speed-up over one process
-   (a machine with fewer free cores than workers shows less);
+   (a machine with fewer free cores than workers shows less; on one loaded by other
+   processes, more processes also take a larger share of the cores, so a speed-up can
+   exceed the worker count);
 4. seam violations over N chunks: the chunks are stitched row by row, each row checked with
    the row before it (every seam counted once) by ``Problem.violations``: 0;
 5. identical bytes for R random visit orders (fresh worlds, a 3x3-chunk square).
@@ -120,7 +122,9 @@ def latency(model: str, chunk: tuple[int, ...], n: int, jumps: int, seed: int
 
 
 def throughput(side: int, seed: int) -> None:
-    """Chunks per second filling a ``side`` x ``side`` square of pipes chunks."""
+    """Chunks per second filling a ``side`` x ``side`` square of pipes chunks (wall clock:
+    on a machine loaded by other processes, more processes also take a larger share of the
+    cores, so a speed-up can exceed the worker count)."""
     model = str(DATA / "pipes.xml")
     runs = (("1 process", {}), ("2 workers", {"workers": 2}),
             ("Dask LocalCluster, 2 workers", {"workers": 2, "scheduler": "local"}))  # fmt: skip

@@ -787,12 +787,23 @@ class World:
         rows = range(x0 // X, (x1 - 1) // X + 1)
         cols = range(y0 // Y, (y1 - 1) // Y + 1)
 
+        def band(i: int, k: int) -> Rect:
+            return ((i * X, (i + k) * X), (cols[0] * Y, (cols[-1] + 1) * Y))
+
         def chunks() -> Iterable[tuple[int, int]]:
-            for i in rows:
-                if self.parallel:  # a row of chunks at a time on the workers
-                    self._prefetch(((i * X, (i + 1) * X), (cols[0] * Y, (cols[-1] + 1) * Y)))
-                for j in cols:
-                    yield i, j
+            i = rows[0]
+            while i <= rows[-1]:
+                k = rows[-1] + 1 - i
+                if self.parallel:  # bands of rows on the workers: as many as half the cache
+                    while k > 1 and sum(map(len, self._needed(band(i, k), self.blocks))) > (
+                        self.blocks.size // 2
+                    ):
+                        k = (k + 1) // 2
+                    self._prefetch(band(i, k))
+                for r in range(i, i + k):
+                    for j in cols:
+                        yield r, j
+                i += k
 
         for i, j in progress_bar(chunks(), total=len(rows) * len(cols), desc="chunks",
                                  enabled=progress, unit="chunk"):  # fmt: skip
