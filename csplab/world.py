@@ -356,25 +356,25 @@ class World:
         self.scheduler = scheduler
         #: blocks are solved a sub-pass at a time on workers (a local pool or Dask)
         self.parallel = self.workers >= 2 or scheduler is not None
-        self.C = self.chunk_shape[:2]
+        self.B = self.chunk_shape[:2]
         if block is None:  # small blocks: a chunk depends on fewer cells (module doc)
-            block = tuple(min(c, BLOCK) for c in self.C)
-        self.B = tuple(int(b) for b in block)
-        if len(self.B) != 2 or min(self.B) < 2:
+            block = tuple(min(c, BLOCK) for c in self.B)
+        self.block = tuple(int(b) for b in block)
+        if len(self.block) != 2 or min(self.block) < 2:
             raise InputError(f"block must be 2 sizes >= 2 (x and y), not {block!r}")
         self.height = self.chunk_shape[2] if self.ndim == 3 else None
         self.zfaces = self._zfaces(boundary)
         self.dropped: list[str] = []  # the model's global constraints (cannot hold)
         # the template: a block with its ring; the arcs' reach from it
-        probe = self.problem(tuple(max(4, 2 * b) for b in self.B))
+        probe = self.problem(tuple(max(4, 2 * b) for b in self.block))
         self.reach = _reach(probe)
-        if self.reach >= min(self.B):
+        if self.reach >= min(self.block):
             raise InputError(
                 f"the model's arcs reach {self.reach} cells, as far as the blocks "
-                f"{self.B}: use larger blocks"
+                f"{self.block}: use larger blocks"
             )
         r = self.reach
-        self.template = self.problem(tuple(b + 2 * r for b in self.B))
+        self.template = self.problem(tuple(b + 2 * r for b in self.block))
         self.K = self.template.K
         # blocks are cached in the smallest integer type that holds the labels
         self._small = np.int16 if self.K <= np.iinfo(np.int16).max else np.int32
@@ -388,19 +388,20 @@ class World:
         self.M0 = self._start()
         # sub-pass 1 (the isolated blocks, a line of r cells of M0 between them) and the
         # colour sub-passes: one template and one solver each
-        self.solvers = (self._solver(tuple(b - r for b in self.B)), self._solver(self.B))
+        iso = tuple(b - r for b in self.block)
+        self.solvers = (self._solver(iso), self._solver(self.block))
         self.S = 1 + 4 * self.passes
         # the blocks one chunk needs from scratch; a smaller cache would solve blocks again
         # and again within one chunk
         # (the most over the chunk's positions relative to the blocks' lattice)
-        phases = [b // math.gcd(b, c) for b, c in zip(self.B, self.C, strict=True)]
+        phases = [b // math.gcd(b, c) for b, c in zip(self.block, self.B, strict=True)]
         self.pyramid = max(
             sum(len(n) for n in self._needed(self._chunk_rect(i, j), set()))
             for i in range(phases[0]) for j in range(phases[1])
         )  # fmt: skip
         # a chunk from scratch is a job of ``pyramid`` blocks: large ones run compiled
         for sv in self.solvers:
-            sv.job = self.pyramid * int(np.prod(self._full(self.B)))
+            sv.job = self.pyramid * int(np.prod(self._full(self.block)))
         _interp.kernels_for(self.solvers[1].job, self.K)
         self.blocks: _LRU = _LRU(max(int(cache_blocks), self.pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
@@ -421,7 +422,7 @@ class World:
     @property
     def _bshape(self) -> tuple[int, ...]:
         """A chunk's shape."""
-        return self._full(self.C)
+        return self._full(self.B)
 
     def _full(self, xy: Sequence[int]) -> tuple[int, ...]:
         """A block's shape from its ``x``/``y`` sizes (3D: the world's height)."""
@@ -430,7 +431,8 @@ class World:
     def _solver(self, xy: Sequence[int]) -> _BlockSolver:
         """The solver of blocks ``xy`` wide: their template (the block and a ring of ``r``)."""
         r = self.reach
-        t = self.template if tuple(xy) == self.B else self.problem(tuple(b + 2 * r for b in xy))
+        same = tuple(xy) == self.block
+        t = self.template if same else self.problem(tuple(b + 2 * r for b in xy))
         idx = np.arange(t.n, dtype=np.int64).reshape(t.shape)
         inner = idx[r : r + xy[0], r : r + xy[1]].reshape(-1)
         touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
@@ -554,7 +556,8 @@ class World:
         return q + 1, (c >> 1, c & 1)
 
     def _offset(self, q: int) -> tuple[int, int]:
-        return (q * self.B[0] // (self.passes + 1), q * self.B[1] // (self.passes + 1))
+        return (q * self.block[0] // (self.passes + 1),
+                q * self.block[1] // (self.passes + 1))  # fmt: skip
 
     def _blocks_in(self, s: int, rect: Rect) -> list[tuple[int, int]]:
         """Blocks of sub-pass ``s`` (its colour only) that meet ``rect``."""
@@ -562,29 +565,30 @@ class World:
         if s == 1:  # block b: [b * B, (b + 1) * B - r) per axis
             for a in range(2):
                 lo, hi = rect[a]
-                B = self.B[a]
+                B = self.block[a]
                 ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
             return [(bx, by) for bx in ranges[0] for by in ranges[1]]
         q, col = self._pass_colour(s)
         off = self._offset(q)
         for a in range(2):
             lo, hi = rect[a]
-            b0 = (lo - off[a]) // self.B[a]
-            b1 = (hi - 1 - off[a]) // self.B[a]
+            b0 = (lo - off[a]) // self.block[a]
+            b1 = (hi - 1 - off[a]) // self.block[a]
             first = b0 + ((col[a] - b0) % 2)
             ranges.append(range(first, b1 + 1, 2))
         return [(bx, by) for bx in ranges[0] for by in ranges[1]]
 
     def _block_rect(self, s: int, b: tuple[int, int]) -> Rect:
         if s == 1:
-            return tuple((b[a] * self.B[a], (b[a] + 1) * self.B[a] - self.reach)
+            return tuple((b[a] * self.block[a], (b[a] + 1) * self.block[a] - self.reach)
                          for a in range(2))  # fmt: skip
         q, _ = self._pass_colour(s)
         off = self._offset(q)
-        return tuple((off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2))
+        B = self.block
+        return tuple((off[a] + b[a] * B[a], off[a] + (b[a] + 1) * B[a]) for a in range(2))
 
     def _chunk_rect(self, i: int, j: int) -> Rect:
-        return ((i * self.C[0], (i + 1) * self.C[0]), (j * self.C[1], (j + 1) * self.C[1]))
+        return ((i * self.B[0], (i + 1) * self.B[0]), (j * self.B[1], (j + 1) * self.B[1]))
 
     def _needed(self, rect: Rect, have: Any) -> list[set[tuple[int, int]]]:
         """Per sub-pass ``s`` (index ``s - 1``), the blocks state ``S`` on ``rect`` depends
@@ -703,7 +707,7 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.B, self.passes,
+        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.block, self.passes,
                              self.retries, self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              ]).encode())  # fmt: skip
@@ -782,7 +786,7 @@ class World:
         (x0, x1), (y0, y1) = (int(xs[0]), int(xs[1])), (int(ys[0]), int(ys[1]))
         if x1 <= x0 or y1 <= y0:
             raise InputError(f"empty region {xs}, {ys}")
-        X, Y = self.C
+        X, Y = self.B
         out = np.empty((x1 - x0, y1 - y0, *self._bshape[2:]), dtype=np.int32)
         rows = range(x0 // X, (x1 - 1) // X + 1)
         cols = range(y0 // Y, (y1 - 1) // Y + 1)
@@ -828,7 +832,7 @@ class World:
         tuple of int
             ``(i, j)`` of each chunk, row by row.
         """
-        X, Y = self.C
+        X, Y = self.B
         for i in range(xs[0] // X, (xs[1] - 1) // X + 1):
             for j in range(ys[0] // Y, (ys[1] - 1) // Y + 1):
                 yield i, j

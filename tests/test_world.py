@@ -296,7 +296,8 @@ def test_global_constraints_are_refused_in_one_line(
 def test_blocks_of_another_size_than_the_chunk() -> None:
     kw = {"seed": 3, "chunk": (8, 8), "block": (6, 6)}
     w = World("fig3_4a", **kw)  # type: ignore[arg-type]
-    assert w.B == (6, 6) and World("fig3_4a", chunk=(32, 32)).B == (12, 12)  # BLOCK
+    assert w.block == (6, 6) and w.B == (8, 8)  # B: the chunk's x/y size, as before
+    assert World("fig3_4a", chunk=(32, 32)).block == (12, 12)  # BLOCK
     a = {c: w.chunk(*c) for c in CHUNKS}
     w2 = World("fig3_4a", **kw)  # type: ignore[arg-type]
     assert all(w2.chunk(*c).tobytes() == a[c].tobytes() for c in reversed(CHUNKS))
