@@ -85,7 +85,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab import _interp
-from csplab.catalog import block_arrays, pack, solve_block_arrays, support_tables
+from csplab.catalog import (
+    block_arrays,
+    pack,
+    solve_block_arrays,
+    support_tables,
+    sweep_blocks,
+)
 from csplab.constraints import Constraint
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import scan_order
@@ -132,13 +138,13 @@ def _zig(v: int) -> int:
 class _BlockSolver:
     """Solve one block: a pure function of (settings, sub-pass, block, window).
 
-    Built once per world: the template's CSR arcs and support tables serve every block. A
-    block runs in one kernel call (:func:`csplab.catalog.block_arrays`, then
-    :func:`csplab.catalog.solve_block_arrays`: Alg. 3.1 with its retries) when the compiled
-    kernels are the engine and the order and choice are ones they run; otherwise (and for
-    exact completion) through :meth:`Problem.subproblem` and
-    :func:`csplab.engine.waves.solve_block`, the twin that gives the same labels from the
-    same draws.
+    Built once per world: the template's CSR arcs and support tables serve every block.
+    When the compiled kernels are the engine and run the order and choice, a block is one
+    kernel call on its window (:func:`csplab.catalog.sweep_blocks`: its catalog, then Alg.
+    3.1 with its retries), or, with fixed cells or a mask, :func:`csplab.catalog.block_arrays`
+    cut by them then :func:`csplab.catalog.solve_block_arrays`; otherwise (and for exact
+    completion) :meth:`Problem.subproblem` and :func:`csplab.engine.waves.solve_block`, the
+    twins that give the same labels from the same draws.
     """
 
     def __init__(
@@ -160,6 +166,7 @@ class _BlockSolver:
         scan = scan_order(block_shape, order) if self.kernel else None
         self.scan = np.arange(inner.size, dtype=np.int64) if scan is None else scan.astype(np.int64)
         self.tables = support_tables(template.relations, template.weights)
+        self.bptr = np.array([0, inner.size], dtype=np.int64)
         self.job = 0  #: cells of the job this solver is part of (whether to load kernels)
 
     def __call__(
@@ -177,7 +184,14 @@ class _BlockSolver:
         flat = np.ascontiguousarray(window, dtype=np.int32).reshape(-1)
         labels: NDArray[np.int32] | None
         sub: Problem | None = None
-        if self.kernel and _interp.compiled_engine():
+        if self.kernel and _interp.compiled_engine() and allowed is None:
+            # one kernel call: the block's catalog, then Alg. 3.1 with its retries
+            counters = np.zeros(4, dtype=np.int64)
+            grid = flat.copy()
+            sweep_blocks(self.template, grid, self.bptr, self.inner, (0, 1), self.scan,
+                         self.retries, self.order, self.choice, rng, counters)  # fmt: skip
+            labels = grid[self.inner] if counters[1] else None
+        elif self.kernel and _interp.compiled_engine():
             arrays = block_arrays(self.template, flat, self.inner)
             if allowed is not None:
                 cut = pack(allowed.reshape(self.inner.size, -1))

@@ -310,3 +310,21 @@ def test_blocks_of_another_size_than_the_chunk() -> None:
         f.chunk(i, 2 * i)
         solved.append(sum(f.stats.values()))
     assert max(solved) <= w.pyramid and w.pyramid in solved
+
+
+@pytest.mark.parametrize("fixed", [None, {(3, 4): 1}])
+def test_kernel_blocks_equal_the_interpreted_twin(
+    monkeypatch: pytest.MonkeyPatch, fixed: dict[tuple[int, int], int] | None
+) -> None:
+    """A block in one kernel call (or block_arrays + solve_block_arrays with fixed cells)
+    gives the bytes of Problem.subproblem + solve_block run interpreted."""
+    from csplab import _interp
+
+    kw = {"seed": 7, "chunk": (8, 8), "fixed": fixed}
+    monkeypatch.setattr(_interp, "ENGINE", "kernels")
+    assert _interp.compiled_engine()
+    a = World("fig3_4a", **kw).region((-8, 16), (0, 16))  # type: ignore[arg-type]
+    monkeypatch.setattr(_interp, "ENGINE", "interp")
+    w = World("fig3_4a", **kw)  # type: ignore[arg-type]
+    assert not _interp.compiled_engine()
+    assert w.region((-8, 16), (0, 16)).tobytes() == a.tobytes()
