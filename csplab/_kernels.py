@@ -1448,6 +1448,21 @@ def all_bypassed(
 
 
 @njit(cache=True)
+def _find(cells: np.ndarray, nb: int, u: int) -> int:
+    """The index of ``u`` in the sorted ``cells[:nb]``, else -1 (a bisection: numba's
+    ``np.searchsorted`` on a scalar costs ten times more per call)."""
+    lo = 0
+    hi = nb
+    while lo < hi:
+        mid = (lo + hi) >> 1
+        if cells[mid] < u:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo if lo < nb and cells[lo] == u else -1
+
+
+@njit(cache=True)
 def block_catalog(
     arcs: Arcs,
     doms: np.ndarray,
@@ -1470,6 +1485,14 @@ def block_catalog(
     ptr, nbr, sidx, sup = arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup
     W = doms.shape[1]
     nb = cells.shape[0]
+    # a block that is most of the problem (a world's template) looks its cells up in a
+    # table of the problem's cells; a small block of a large grid bisects ``cells``
+    n = grid.shape[0]
+    dense = n <= 4 * nb
+    pos = np.full(n if dense else 0, -1, dtype=np.int64)
+    if dense:
+        for i in range(nb):
+            pos[cells[i]] = i
     k = 0
     for i in range(nb):
         v = cells[i]
@@ -1478,8 +1501,8 @@ def block_catalog(
             dom0[i, w] = doms[v, w]
         for e in range(ptr[v], ptr[v + 1]):
             u = nbr[e]
-            j = np.searchsorted(cells, u)
-            if j < nb and cells[j] == u:
+            j = pos[u] if dense else _find(cells, nb, u)
+            if j >= 0:
                 lnbr[k] = j
                 lsidx[k] = sidx[e]
                 k += 1

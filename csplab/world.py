@@ -12,19 +12,24 @@ Construction: modify in blocks (Merrell 2009, Alg. 3.4/3.5, Sec. 3.3.6) on the w
   solution (:func:`csplab.solvers.blocks.trivial_solution`: one label, or uniform layers
   such as ground under empty space) of a small periodic problem, else a SAT solution of a
   small torus; a model with no periodic solution up to :data:`MAX_PERIOD` is refused.
-* **Sub-passes** ``s = 1 .. S`` (``S = passes * 4``). Pass ``q`` lays a lattice of blocks of
-  the chunk's size ``B`` over the plane, shifted by ``q * B // passes`` per axis (so a seam
-  of one pass lies inside the blocks of another); block ``(bx, by)`` has colour
-  ``(bx mod 2, by mod 2)`` and each colour is one sub-pass. Blocks of one colour are ``B``
-  cells apart, more than the arcs' reach ``r`` (checked), so neither sees the other's
-  cells: they are independent.
+* **Sub-pass 1** solves isolated blocks: block ``(bx, by)`` is the cells
+  ``[bx * B, (bx + 1) * B - r)`` (per axis; ``B`` the blocks' size, by default
+  ``min(chunk, BLOCK)``, chunks being only windows; ``r`` the arcs' reach),
+  so a line of ``r`` cells of ``M0`` separates neighbours and every block sees only ``M0``:
+  no block of sub-pass 1 depends on another.
+* **Sub-passes** ``s = 2 .. S`` (``S = 1 + 4 * passes``). Pass ``q = 1 .. passes`` lays a
+  lattice of blocks of size ``B`` shifted by ``q * B // (passes + 1)`` per axis (so the
+  lines and block edges of the passes before lie inside its blocks); block ``(bx, by)``
+  has colour ``(bx mod 2, by mod 2)`` and each colour is one sub-pass. Blocks of one colour
+  are ``B`` cells apart, more than ``r`` (checked), so neither sees the other's cells:
+  they are independent.
 * **A block** of sub-pass ``s`` is the block's cells with the labels of state ``s - 1``
   around it fixed (a ring of width ``r``; :meth:`Problem.subproblem`). Alg. 3.1 completes
   it (:func:`csplab.engine.waves.solve_block`, with ``retries``) from the generator
   ``default_rng(SeedSequence([seed, s, zig(bx), zig(by)]))``; when every run fails, exact
   completion (SAT with the border fixed); when the border admits no completion, the block
   keeps its labels of state ``s - 1``. State ``s`` is state ``s - 1`` with the blocks of
-  colour ``s`` replaced.
+  sub-pass ``s`` replaced.
 
 Why the content does not depend on the visit order (proof sketch). By induction on ``s``:
 state 0 is a fixed function of the coordinates. A block of sub-pass ``s`` is a function of
@@ -40,18 +45,19 @@ consistent on the whole plane, and every stitched rectangle has 0 violations.
 
 Dependency neighbourhood. The final label of a cell depends on state ``s - 1`` within the
 block of sub-pass ``s`` that holds it widened by ``r``; unrolled over the ``S`` sub-passes,
-a chunk depends only on the cells within ``S * (B + r)`` of it (in practice on about
-``(2k + 1) ** 2 / 4`` blocks of the ``k``-th sub-pass below the last).
+a chunk depends only on the cells within ``S * (B + r)`` of it: with ``passes=1`` and
+blocks of the chunk's size, 49 blocks (1, 2, 6 and 8 of the colour sub-passes, 32 isolated
+ones); a 32x32 chunk of 12x12 blocks (the default), 97 blocks of 144 cells
+(:attr:`World.pyramid`, the most over the chunk's positions on the lattice).
 
 Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
 completion keeps its previous labels, so a fixed cell may stay unmet where every pass puts
 a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help). Not
-honoured in an infinite world: the global constraints of a model file (counts over the
-whole grid, connectivity, paths: dropped with a warning, :attr:`World.dropped`), boundary
-faces on the infinite ``x``/``y`` axes (there is no outside: refused), and counts per chunk
-(the chunk grid is not the blocks' lattice in every pass: a later pass' block straddles
-chunks, so a count met in one pass is not kept by the next).
+honoured in an infinite world: global constraints (counts, connectivity, symmetry; the
+reasons are :data:`UNHONOURED`): given as ``constraints=`` they are refused in one line, in
+a model file they are dropped with a warning (:attr:`World.dropped`); boundary faces on the
+infinite ``x``/``y`` axes (there is no outside: refused).
 
 Examples
 --------
@@ -67,6 +73,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import sqlite3
 import warnings
 from collections import OrderedDict
@@ -77,17 +84,48 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab import _interp
+from csplab.catalog import (
+    block_arrays,
+    pack,
+    solve_block_arrays,
+    support_tables,
+    sweep_blocks,
+)
+from csplab.constraints import Constraint
 from csplab.engine import waves as wv
+from csplab.engine.alg31 import scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.example import ExampleModel
 from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["MAX_PERIOD", "World"]
+__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "UNHONOURED", "World"]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
+#: why each global-constraint kind (:data:`csplab.constraints.KINDS`; ``symmetric`` is
+#: mirror and rotate) is not honoured by a world: ``World(constraints=...)`` refuses it
+#: with this line
+UNHONOURED = {
+    "count": "an endless plane has no total to count, and a count per chunk is not kept: "
+    "the shifted pass' blocks straddle chunks and change what the blocks before counted",
+    "connected": "connectivity is not local (whether two cells are joined can depend on "
+    "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only; "
+    "'each chunk's roads reach its four sides' is local but straddles the blocks as counts do",
+    "symmetric": "a mirror or rotation maps cells to cells arbitrarily far away (an endless "
+    "plane has no centre)",
+    "separation": "local, so it could hold as arcs of the blocks, but a block's subproblem "
+    "carries no global constraints: not supported yet",
+    "max-run": "local, so it could hold as arcs of the blocks, but a block's subproblem "
+    "carries no global constraints: not supported yet",
+}
+#: the largest default block side: blocks are ``min(chunk, BLOCK)`` cells wide unless given
+BLOCK = 12
+#: the version of the blocks' lattice, part of the store's key (chunks stored under another
+#: lattice are not read back)
+LATTICE = 2
 
 Rect = tuple[tuple[int, int], ...]  # ((x0, x1), (y0, y1)) half-open
 
@@ -98,7 +136,16 @@ def _zig(v: int) -> int:
 
 
 class _BlockSolver:
-    """Solve one block: a pure function of (settings, sub-pass, block, window)."""
+    """Solve one block: a pure function of (settings, sub-pass, block, window).
+
+    Built once per world: the template's CSR arcs and support tables serve every block.
+    When the compiled kernels are the engine and run the order and choice, a block is one
+    kernel call on its window (:func:`csplab.catalog.sweep_blocks`: its catalog, then Alg.
+    3.1 with its retries), or, with fixed cells or a mask, :func:`csplab.catalog.block_arrays`
+    cut by them then :func:`csplab.catalog.solve_block_arrays`; otherwise (and for exact
+    completion) :meth:`Problem.subproblem` and :func:`csplab.engine.waves.solve_block`, the
+    twins that give the same labels from the same draws.
+    """
 
     def __init__(
         self,
@@ -115,6 +162,12 @@ class _BlockSolver:
         self.template, self.inner, self.arc_ids = template, inner, arc_ids
         self.block_shape, self.seed, self.retries = block_shape, seed, retries
         self.order, self.choice, self.exact = order, choice, exact
+        self.kernel = choice in ("uniform", "weighted") and order != "random"
+        scan = scan_order(block_shape, order) if self.kernel else None
+        self.scan = np.arange(inner.size, dtype=np.int64) if scan is None else scan.astype(np.int64)
+        self.tables = support_tables(template.relations, template.weights)
+        self.bptr = np.array([0, inner.size], dtype=np.int64)
+        self.job = 0  #: cells of the job this solver is part of (whether to load kernels)
 
     def __call__(
         self,
@@ -125,39 +178,65 @@ class _BlockSolver:
     ) -> tuple[NDArray[np.int32], str]:
         """The block's labels (block shape) and how they came: ``alg31``, ``exact``,
         ``kept``."""
-        sub = self.template.subproblem(self.inner, window, shape=self.block_shape,
-                                       arc_ids=self.arc_ids)  # fmt: skip
-        if allowed is not None:
-            sub = sub.restrict(allowed)
         rng = np.random.default_rng(
             np.random.SeedSequence([self.seed, s, *(_zig(int(c)) for c in b)])
         )
-        o = wv.solve_block(sub, rng, 0, retries=self.retries, order=self.order,
-                           choice=self.choice, deadline=None)  # fmt: skip
+        flat = np.ascontiguousarray(window, dtype=np.int32).reshape(-1)
+        labels: NDArray[np.int32] | None
+        sub: Problem | None = None
+        if self.kernel and _interp.compiled_engine() and allowed is None:
+            # one kernel call: the block's catalog, then Alg. 3.1 with its retries
+            counters = np.zeros(4, dtype=np.int64)
+            grid = flat.copy()
+            sweep_blocks(self.template, grid, self.bptr, self.inner, (0, 1), self.scan,
+                         self.retries, self.order, self.choice, rng, counters)  # fmt: skip
+            labels = grid[self.inner] if counters[1] else None
+        elif self.kernel and _interp.compiled_engine():
+            arrays = block_arrays(self.template, flat, self.inner)
+            if allowed is not None:
+                cut = pack(allowed.reshape(self.inner.size, -1))
+                arrays = arrays._replace(dom0=arrays.dom0 & cut)
+            labels, _, _ = solve_block_arrays(self.tables, arrays, self.scan, self.retries,
+                                              self.order, self.choice, rng)  # fmt: skip
+        else:
+            sub = self._sub(flat, allowed)
+            labels = wv.solve_block(sub, rng, 0, retries=self.retries, order=self.order,
+                                    choice=self.choice, deadline=None).labels  # fmt: skip
         how = "alg31"
-        labels = o.labels
-        if labels is None and self.exact != "none" and not (~sub.domains.any(axis=1)).any():
-            labels, _ = ExactCompletion(self.exact)(sub, rng, None)
-            how = "exact"
+        if labels is None and self.exact != "none":
+            sub = sub if sub is not None else self._sub(flat, allowed)
+            if not (~sub.domains.any(axis=1)).any():
+                labels, _ = ExactCompletion(self.exact)(sub, rng, None)
+                how = "exact"
         if labels is None:
-            old = window.reshape(-1)[self.inner]
+            old = flat[self.inner]
             return old.reshape(self.block_shape).astype(np.int32), "kept"
         return np.asarray(labels, dtype=np.int32).reshape(self.block_shape), how
 
+    def _sub(self, flat: NDArray[np.int32], allowed: NDArray[np.bool_] | None) -> Problem:
+        sub = self.template.subproblem(self.inner, flat, shape=self.block_shape,
+                                       arc_ids=self.arc_ids)  # fmt: skip
+        return sub if allowed is None else sub.restrict(allowed)
 
-_WORKER: _BlockSolver | None = None
+
+_WORKER: tuple[_BlockSolver, _BlockSolver] | None = None
 
 
-def _init_worker(solver: _BlockSolver) -> None:
+def _init_worker(solvers: tuple[_BlockSolver, _BlockSolver]) -> None:
     global _WORKER
-    _WORKER = solver
+    _WORKER = solvers
 
 
 def _solve_task(
     tasks: list[tuple[int, tuple[int, ...], NDArray[np.int32], NDArray[np.bool_] | None]],
+    solvers: tuple[_BlockSolver, _BlockSolver] | None = None,
 ) -> list[tuple[NDArray[np.int32], str]]:
-    assert _WORKER is not None
-    return [_WORKER(*t) for t in tasks]
+    """Blocks on a worker: the solvers are the pool's (``_WORKER``) or sent along (Dask)."""
+    sv = solvers or _WORKER
+    assert sv is not None
+    # a worker started without the kernels loads them (the parent's reason holds here)
+    _interp.kernels_for(sv[1].job, sv[1].template.K)
+    return [sv[t[0] > 1](*t) for t in tasks]
 
 
 class _LRU(OrderedDict[Any, Any]):
@@ -192,13 +271,14 @@ class World:
         The world's seed (any non-negative integer).
     chunk : tuple of int
         ``(X, Y)`` for a 2D world, ``(X, Y, Z)`` for a 3D one (``Z``: its fixed height).
-        The blocks of modify in blocks have the chunk's size in ``x`` and ``y``.
+        Chunks are windows on the world: the blocks of modify in blocks have their own size.
     boundary : "auto", "none" or mapping
         Labels of the ``z`` faces of a 3D world (``"auto"``: the rule of
         :func:`csplab.grids.from_example`, ground below and sky above; only its ``z`` faces
         are kept). Faces on ``x``/``y`` do not exist in an infinite world: refused.
     passes : int
-        Passes of modify in blocks over the plane (each shifted by ``B // passes``).
+        Shifted colour passes of modify in blocks after the isolated blocks' sub-pass (pass
+        ``q`` shifted by ``q * B // (passes + 1)``).
     retries : int
         Alg. 3.1 runs per block after the first, before exact completion.
     exact : {"sat", "backtrack", "none"}
@@ -222,12 +302,25 @@ class World:
     workers : int
         Processes solving independent blocks of a sub-pass at once (0 or 1: this process);
         the output is the same for any number.
+    block : tuple of int, optional
+        ``(bx, by)``, the blocks' size in ``x`` and ``y`` (default ``min(chunk, BLOCK)``
+        per axis; more than the arcs' reach). Smaller blocks make a chunk depend on fewer
+        cells (a 32x32 chunk from scratch: 13.6 times its cells with 12x12 blocks, 49 times
+        with 32x32 ones), larger ones leave room for larger structures.
+    constraints : sequence of Constraint
+        Global constraints (:mod:`csplab.constraints`): every kind is refused, with the
+        reason of :data:`UNHONOURED` (fixed cells and masks are the constraints a world
+        honours).
+    scheduler : str, optional
+        Solve them on Dask instead: ``"local"`` (a ``LocalCluster`` of ``max(workers, 1)``
+        processes) or a scheduler address (as the ``blocks`` solver takes it); the same
+        output again.
 
     Raises
     ------
     InputError
-        For bad settings (a chunk shape, faces on ``x``/``y``, unknown options) or a model
-        with no periodic solution to start from.
+        For bad settings (a chunk shape, faces on ``x``/``y``, unknown options, a global
+        constraint) or a model with no periodic solution to start from.
     """
 
     def __init__(
@@ -237,7 +330,7 @@ class World:
         seed: int = 0,
         chunk: Sequence[int] = (32, 32),
         boundary: Any = "auto",
-        passes: int = 2,
+        passes: int = 1,
         retries: int = 20,
         exact: str = "sat",
         order: str = "scanline",
@@ -248,9 +341,16 @@ class World:
         cache_chunks: int = 1024,
         store: str | Path | None = None,
         workers: int = 0,
+        scheduler: str | None = None,
+        constraints: Sequence[Constraint] = (),
+        block: Sequence[int] | None = None,
     ) -> None:
         from csplab.examples import load_model
 
+        for c in constraints:  # refused, one line each (module doc, UNHONOURED)
+            kind = getattr(c, "kind", type(c).__name__)
+            why = UNHONOURED.get(kind, "not a grid constraint of csplab.constraints")
+            raise InputError(f"a world cannot honour a {kind} constraint: {why}")
         if isinstance(model, str | Path):
             model = load_model(model)
         self.model = model
@@ -267,24 +367,28 @@ class World:
         self.ndim = len(self.chunk_shape)
         self.passes, self.retries, self.exact = int(passes), int(retries), exact
         self.order, self.choice, self.workers = order, choice, int(workers)
+        self.scheduler = scheduler
+        #: blocks are solved a sub-pass at a time on workers (a local pool or Dask)
+        self.parallel = self.workers >= 2 or scheduler is not None
         self.B = self.chunk_shape[:2]
+        if block is None:  # small blocks: a chunk depends on fewer cells (module doc)
+            block = tuple(min(c, BLOCK) for c in self.B)
+        self.block = tuple(int(b) for b in block)
+        if len(self.block) != 2 or min(self.block) < 2:
+            raise InputError(f"block must be 2 sizes >= 2 (x and y), not {block!r}")
         self.height = self.chunk_shape[2] if self.ndim == 3 else None
         self.zfaces = self._zfaces(boundary)
         self.dropped: list[str] = []  # the model's global constraints (cannot hold)
         # the template: a block with its ring; the arcs' reach from it
-        probe = self.problem(tuple(max(4, 2 * b) for b in self.B))
+        probe = self.problem(tuple(max(4, 2 * b) for b in self.block))
         self.reach = _reach(probe)
-        if self.reach > min(self.B):
+        if self.reach >= min(self.block):
             raise InputError(
-                f"the model's arcs reach {self.reach} cells, more than the chunk "
-                f"{self.B}: use a larger chunk"
+                f"the model's arcs reach {self.reach} cells, as far as the blocks "
+                f"{self.block}: use larger blocks"
             )
         r = self.reach
-        self.template = self.problem(tuple(b + 2 * r for b in self.B))
-        idx = np.arange(self.template.n, dtype=np.int64).reshape(self.template.shape)
-        inner = idx[r : r + self.B[0], r : r + self.B[1]].reshape(-1)
-        a = self.template.arcs
-        touch = np.isin(a[:, 0], inner) | np.isin(a[:, 1], inner)
+        self.template = self.problem(tuple(b + 2 * r for b in self.block))
         self.K = self.template.K
         # blocks are cached in the smallest integer type that holds the labels
         self._small = np.int16 if self.K <= np.iinfo(np.int16).max else np.int32
@@ -296,15 +400,24 @@ class World:
                 raise InputError(f"fixed cell {k} is outside the world's height")
         self.mask = mask
         self.M0 = self._start()
-        self.solver = _BlockSolver(
-            self.template, inner, np.flatnonzero(touch).astype(np.int64), self._bshape,
-            self.seed, self.retries, order, choice, exact,
+        # sub-pass 1 (the isolated blocks, a line of r cells of M0 between them) and the
+        # colour sub-passes: one template and one solver each
+        iso = tuple(b - r for b in self.block)
+        self.solvers = (self._solver(iso), self._solver(self.block))
+        self.S = 1 + 4 * self.passes
+        # the blocks one chunk needs from scratch; a smaller cache would solve blocks again
+        # and again within one chunk
+        # (the most over the chunk's positions relative to the blocks' lattice)
+        phases = [b // math.gcd(b, c) for b, c in zip(self.block, self.B, strict=True)]
+        self.pyramid = max(
+            sum(len(n) for n in self._needed(self._chunk_rect(i, j), set()))
+            for i in range(phases[0]) for j in range(phases[1])
         )  # fmt: skip
-        self.S = 4 * self.passes
-        # the blocks one chunk needs from scratch: about (k + 1) ** 2 at k sub-passes below
-        # the last; a smaller cache would solve blocks again and again within one chunk
-        pyramid = sum((k + 2) ** 2 for k in range(self.S))
-        self.blocks: _LRU = _LRU(max(int(cache_blocks), pyramid))
+        # a chunk from scratch is a job of ``pyramid`` blocks: large ones run compiled
+        for sv in self.solvers:
+            sv.job = self.pyramid * int(np.prod(self._full(self.block)))
+        _interp.kernels_for(self.solvers[1].job, self.K)
+        self.blocks: _LRU = _LRU(max(int(cache_blocks), self.pyramid))
         self.chunks: _LRU = _LRU(int(cache_chunks))
         self.stats: dict[str, int] = {"alg31": 0, "exact": 0, "kept": 0, "stored": 0}
         self.key = self._key()
@@ -317,11 +430,29 @@ class World:
             )
             self._db.commit()
         self._pool: Any = None
+        self._shared: Any = None  # the solvers, sent to each Dask worker once
 
     # -- problems -------------------------------------------------------------------------
     @property
     def _bshape(self) -> tuple[int, ...]:
-        return self.B if self.height is None else (*self.B, self.height)
+        """A chunk's shape."""
+        return self._full(self.B)
+
+    def _full(self, xy: Sequence[int]) -> tuple[int, ...]:
+        """A block's shape from its ``x``/``y`` sizes (3D: the world's height)."""
+        return tuple(xy) if self.height is None else (*xy, self.height)
+
+    def _solver(self, xy: Sequence[int]) -> _BlockSolver:
+        """The solver of blocks ``xy`` wide: their template (the block and a ring of ``r``)."""
+        r = self.reach
+        same = tuple(xy) == self.block
+        t = self.template if same else self.problem(tuple(b + 2 * r for b in xy))
+        idx = np.arange(t.n, dtype=np.int64).reshape(t.shape)
+        inner = idx[r : r + xy[0], r : r + xy[1]].reshape(-1)
+        touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
+        arc_ids = np.flatnonzero(touch).astype(np.int64)
+        return _BlockSolver(t, inner, arc_ids, self._full(xy), self.seed, self.retries,
+                            self.order, self.choice, self.exact)  # fmt: skip
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
         if boundary in (None, "none"):
@@ -434,29 +565,62 @@ class World:
 
     # -- lattice --------------------------------------------------------------------------
     def _pass_colour(self, s: int) -> tuple[int, tuple[int, int]]:
-        q, c = divmod(s - 1, 4)
-        return q, (c >> 1, c & 1)
+        """Sub-pass ``s >= 2``: its pass ``q >= 1`` and colour."""
+        q, c = divmod(s - 2, 4)
+        return q + 1, (c >> 1, c & 1)
 
     def _offset(self, q: int) -> tuple[int, int]:
-        return (q * self.B[0] // self.passes, q * self.B[1] // self.passes)
+        return (q * self.block[0] // (self.passes + 1),
+                q * self.block[1] // (self.passes + 1))  # fmt: skip
 
     def _blocks_in(self, s: int, rect: Rect) -> list[tuple[int, int]]:
         """Blocks of sub-pass ``s`` (its colour only) that meet ``rect``."""
+        ranges = []
+        if s == 1:  # block b: [b * B, (b + 1) * B - r) per axis
+            for a in range(2):
+                lo, hi = rect[a]
+                B = self.block[a]
+                ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
+            return [(bx, by) for bx in ranges[0] for by in ranges[1]]
         q, col = self._pass_colour(s)
         off = self._offset(q)
-        ranges = []
         for a in range(2):
             lo, hi = rect[a]
-            b0 = (lo - off[a]) // self.B[a]
-            b1 = (hi - 1 - off[a]) // self.B[a]
+            b0 = (lo - off[a]) // self.block[a]
+            b1 = (hi - 1 - off[a]) // self.block[a]
             first = b0 + ((col[a] - b0) % 2)
             ranges.append(range(first, b1 + 1, 2))
         return [(bx, by) for bx in ranges[0] for by in ranges[1]]
 
     def _block_rect(self, s: int, b: tuple[int, int]) -> Rect:
+        if s == 1:
+            return tuple((b[a] * self.block[a], (b[a] + 1) * self.block[a] - self.reach)
+                         for a in range(2))  # fmt: skip
         q, _ = self._pass_colour(s)
         off = self._offset(q)
-        return tuple((off[a] + b[a] * self.B[a], off[a] + (b[a] + 1) * self.B[a]) for a in range(2))
+        B = self.block
+        return tuple((off[a] + b[a] * B[a], off[a] + (b[a] + 1) * B[a]) for a in range(2))
+
+    def _chunk_rect(self, i: int, j: int) -> Rect:
+        return ((i * self.B[0], (i + 1) * self.B[0]), (j * self.B[1], (j + 1) * self.B[1]))
+
+    def _needed(self, rect: Rect, have: Any) -> list[set[tuple[int, int]]]:
+        """Per sub-pass ``s`` (index ``s - 1``), the blocks state ``S`` on ``rect`` depends
+        on that are not in ``have`` (a container of ``(s, b)``)."""
+        need: list[set[tuple[int, int]]] = [set() for _ in range(self.S)]
+        rects: list[Rect] = [rect]
+        for s in range(self.S, 0, -1):
+            new: list[Rect] = []
+            for rc in rects:
+                for b in self._blocks_in(s, rc):
+                    if b not in need[s - 1] and (s, b) not in have:
+                        need[s - 1].add(b)
+                        new.append(self._window(s, b))
+            rects = rects + new
+            if len(rects) > 64:  # merge into the bounding box (a superset: correct)
+                rects = [tuple((min(r[a][0] for r in rects), max(r[a][1] for r in rects))
+                               for a in range(2))]  # fmt: skip
+        return need
 
     # -- state ----------------------------------------------------------------------------
     def _state(self, s: int, rect: Rect) -> NDArray[np.int32]:
@@ -481,7 +645,7 @@ class World:
         if not self.fixed and self.mask is None:
             return None
         (x0, x1), (y0, y1) = self._block_rect(s, b)
-        al = np.ones((*self._bshape, self.K), dtype=bool)
+        al = np.ones((*self._full((x1 - x0, y1 - y0)), self.K), dtype=bool)
         if self.mask is not None:
             xs, ys = np.meshgrid(np.arange(x0, x1), np.arange(y0, y1), indexing="ij")
             al &= np.broadcast_to(np.asarray(self.mask(xs, ys), dtype=bool), al.shape)
@@ -499,7 +663,7 @@ class World:
         lab = self.blocks.get_(key)
         if lab is None:
             win = self._state(s - 1, self._window(s, b))
-            lab, how = self.solver(s, b, win, self._allowed(s, b))
+            lab, how = self.solvers[s > 1](s, b, win, self._allowed(s, b))
             self.stats[how] += 1
             self.blocks.put(key, lab.astype(self._small, copy=False))
         return lab  # type: ignore[no-any-return]
@@ -507,28 +671,16 @@ class World:
     def _prefetch(self, rect: Rect) -> None:
         """Solve the blocks ``rect`` needs, sub-pass by sub-pass, independent blocks of a
         sub-pass on the workers (``workers >= 2``)."""
-        need: list[set[tuple[int, int]]] = [set() for _ in range(self.S + 1)]
-        rects: list[Rect] = [rect]
-        for s in range(self.S, 0, -1):
-            new: list[Rect] = []
-            for rc in rects:
-                for b in self._blocks_in(s, rc):
-                    if b not in need[s] and (s, b) not in self.blocks:
-                        need[s].add(b)
-                        new.append(self._window(s, b))
-            rects = rects + new
-            if len(rects) > 64:  # merge into the bounding box (a superset: correct)
-                rects = [tuple((min(r[a][0] for r in rects), max(r[a][1] for r in rects))
-                               for a in range(2))]  # fmt: skip
+        need = self._needed(rect, self.blocks)
         pool = self._workers()
         for s in range(1, self.S + 1):
-            todo = sorted(b for b in need[s] if (s, b) not in self.blocks)
+            todo = sorted(b for b in need[s - 1] if (s, b) not in self.blocks)
             if not todo:
                 continue
             tasks = [(s, b, self._state(s - 1, self._window(s, b)), self._allowed(s, b))
                      for b in todo]  # fmt: skip
             size = max(1, len(tasks) // (2 * pool.size))
-            futures = [pool.submit(_solve_task, tasks[i : i + size])
+            futures = [pool.submit(_solve_task, tasks[i : i + size], self._shared)
                        for i in range(0, len(tasks), size)]  # fmt: skip
             results = [x for f in futures for x in f.result()]
             for b, (lab, how) in zip(todo, results, strict=True):
@@ -539,8 +691,13 @@ class World:
         if self._pool is None:
             from csplab.engine.pool import Workers
 
-            self._pool = Workers.local(self.workers, initializer=_init_worker,
-                                       initargs=(self.solver,))  # fmt: skip
+            if self.scheduler is None:
+                self._pool = Workers.local(self.workers, initializer=_init_worker,
+                                           initargs=(self.solvers,))  # fmt: skip
+            else:
+                self._pool = Workers.dask(self.scheduler, purpose="csplab.World with scheduler=",
+                                          local_workers=max(1, self.workers))  # fmt: skip
+                self._shared = self._pool.share(self.solvers)
         return self._pool
 
     def close(self) -> None:
@@ -564,8 +721,8 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([self.seed, self.chunk_shape, self.passes, self.retries,
-                             self.exact, self.order, self.choice, self.zfaces,
+        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.block, self.passes,
+                             self.retries, self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              ]).encode())  # fmt: skip
         return h.hexdigest()[:32]
@@ -595,22 +752,21 @@ class World:
         key = (int(i), int(j))
         got = self.chunks.get_(key)
         if got is not None:
-            return got.copy()  # type: ignore[no-any-return]
+            return got.astype(np.int32)  # type: ignore[no-any-return]
         if self._db is not None:
             row = self._db.execute(
                 "SELECT data FROM chunks WHERE world=? AND i=? AND j=?", (self.key, *key)
             ).fetchone()
             if row is not None:
                 arr = np.frombuffer(row[0], dtype=np.int32).reshape(self._bshape).copy()
-                self.chunks.put(key, arr)
+                self.chunks.put(key, arr.astype(self._small))
                 self.stats["stored"] += 1
                 return arr.copy()
-        rect = ((key[0] * self.B[0], (key[0] + 1) * self.B[0]),
-                (key[1] * self.B[1], (key[1] + 1) * self.B[1]))  # fmt: skip
-        if self.workers >= 2:
+        rect = self._chunk_rect(*key)
+        if self.parallel:
             self._prefetch(rect)
         arr = self._state(self.S, rect)
-        self.chunks.put(key, arr)
+        self.chunks.put(key, arr.astype(self._small))
         if self._db is not None:
             self._db.execute("INSERT OR REPLACE INTO chunks VALUES (?, ?, ?, ?)",
                              (self.key, *key, arr.tobytes()))  # fmt: skip
@@ -649,12 +805,23 @@ class World:
         rows = range(x0 // X, (x1 - 1) // X + 1)
         cols = range(y0 // Y, (y1 - 1) // Y + 1)
 
+        def band(i: int, k: int) -> Rect:
+            return ((i * X, (i + k) * X), (cols[0] * Y, (cols[-1] + 1) * Y))
+
         def chunks() -> Iterable[tuple[int, int]]:
-            for i in rows:
-                if self.workers >= 2:  # a row of chunks at a time on the workers
-                    self._prefetch(((i * X, (i + 1) * X), (cols[0] * Y, (cols[-1] + 1) * Y)))
-                for j in cols:
-                    yield i, j
+            i = rows[0]
+            while i <= rows[-1]:
+                k = rows[-1] + 1 - i
+                if self.parallel:  # bands of rows on the workers: as many as half the cache
+                    while k > 1 and sum(map(len, self._needed(band(i, k), self.blocks))) > (
+                        self.blocks.size // 2
+                    ):
+                        k = (k + 1) // 2
+                    self._prefetch(band(i, k))
+                for r in range(i, i + k):
+                    for j in cols:
+                        yield r, j
+                i += k
 
         for i, j in progress_bar(chunks(), total=len(rows) * len(cols), desc="chunks",
                                  enabled=progress, unit="chunk"):  # fmt: skip

@@ -17,7 +17,12 @@ import json
 import re
 import time
 
-from csplab.cli.common import add_model_option, check_output_path, model_from_args
+from csplab.cli.common import (
+    add_constraints_arg,
+    add_model_option,
+    check_output_path,
+    model_from_args,
+)
 from csplab.errors import InputError
 from csplab.grids import parse_boundary, parse_shape
 
@@ -41,7 +46,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="3D worlds: z faces, 'auto' (ground and sky of the model), 'none' or "
         "'z-=1,z+=0' (x/y faces do not exist in an endless world)",
     )
-    p.add_argument("--passes", type=int, default=2, help="shifted passes of blocks (2)")
+    p.add_argument(
+        "--block", help="the blocks' size BXxBY (default: the chunk's, at most 12x12)"
+    )
+    p.add_argument(
+        "--passes", type=int, default=1,
+        help="shifted colour passes of blocks after the isolated blocks (1)",
+    )  # fmt: skip
     p.add_argument("--retries", type=int, default=20, help="Alg. 3.1 retries per block (20)")
     p.add_argument(
         "--exact",
@@ -57,7 +68,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--choice", help="Alg. 3.1's label choice (default: the model format's, else uniform)"
     )
     p.add_argument("--jobs", type=int, default=1, help="worker processes (same output)")
+    p.add_argument(
+        "--scheduler", metavar="ADDRESS", help="solve blocks on Dask: 'local' (a LocalCluster "
+        "of --jobs processes) or a scheduler address such as tcp://host:8786 (same output)"
+    )  # fmt: skip
     p.add_argument("--store", help="SQLite file keeping generated chunks across runs")
+    add_constraints_arg(p)
     add_model_option(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
@@ -97,11 +113,20 @@ def run(args: argparse.Namespace) -> int:
     suggested, _ = synthesis_defaults(model)
     order = args.order or suggested.get("order", "scanline")
     choice = args.choice or suggested.get("choice", "uniform")
+    constraints = []
+    if args.constraints:  # read against a grid of the model; the world refuses them
+        from csplab.io.constraints import read_constraints
+
+        probe = World(model, chunk=chunk, boundary=parse_boundary(args.boundary) or "none")
+        for path in args.constraints:
+            constraints += read_constraints(path, probe.problem(chunk[:2]))
     t0 = time.perf_counter()
     world = World(
         model, seed=args.seed, chunk=chunk, boundary=parse_boundary(args.boundary) or "none",
         passes=args.passes, retries=args.retries, exact=args.exact, order=order,
         choice=choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
+        scheduler=args.scheduler, constraints=constraints,
+        block=parse_shape(args.block, what="--block") if args.block else None,
     )  # fmt: skip
     try:
         grid = world.region(xs, ys, progress=True)
