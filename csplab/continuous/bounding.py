@@ -442,14 +442,7 @@ class Bounded:
             blo, bhi = c.bounding_box()[:3], c.bounding_box()[3:]
             items.append((label, c, np.asarray(blo, dtype=np.float64),
                           np.asarray(bhi, dtype=np.float64)))  # fmt: skip
-        parent = list(range(len(items)))
-
-        def root(i: int) -> int:
-            while parent[i] != i:
-                parent[i] = parent[parent[i]]
-                i = parent[i]
-            return i
-
+        pairs: list[tuple[int, int]] = []
         if placed:
             lab = np.array([it[0] for it in items])
             los = np.array([it[2] for it in items]).reshape(-1, 3)
@@ -458,17 +451,14 @@ class Bounded:
             for i in range(len(kept), len(items)):
                 meet = (lab == lab[i]) & np.all(los <= his[i] + tol, axis=1) & np.all(
                     los[i] <= his + tol, axis=1)  # fmt: skip
-                for j in np.flatnonzero(meet).tolist():
-                    parent[root(j)] = root(i)
-        groups: dict[int, list[int]] = {}
-        for i in range(len(items)):
-            groups.setdefault(root(i), []).append(i)
+                pairs += [(i, j) for j in np.flatnonzero(meet).tolist()]
+        groups = _components(len(items), pairs)
         # as thin as the mesh readers' slivers (a height of 1e-6 of the model's extent):
         # collapsed, so that the written output reads back without a repair
         ext = np.ptp(np.concatenate([los, his]), axis=0).max() if placed else 0.0
         flat = _FLAT * float(ext)
         solids: list[Solid] = []
-        for members in groups.values():
+        for members in groups:
             if len(members) == 1 and members[0] < len(kept):
                 solids.append(kept[members[0]])
                 continue
@@ -501,21 +491,23 @@ def _overlap(alo: Any, ahi: Any, blo: Any, bhi: Any, tol: float) -> bool:
 
 def _groups(boxes: list[tuple[Any, Any]], tol: float) -> list[list[int]]:
     """Indices of boxes grouped by touching or overlapping (transitively)."""
-    parent = list(range(len(boxes)))
+    n = len(boxes)
+    return _components(n, [(i, j) for i in range(n) for j in range(i)
+                           if _overlap(*boxes[i], *boxes[j], tol)])  # fmt: skip
 
-    def root(i: int) -> int:
-        while parent[i] != i:
-            parent[i] = parent[parent[i]]
-            i = parent[i]
-        return i
 
-    for i in range(len(boxes)):
-        for j in range(i):
-            if _overlap(*boxes[i], *boxes[j], tol):
-                parent[root(i)] = root(j)
+def _components(n: int, pairs: list[tuple[int, int]]) -> list[list[int]]:
+    """``0..n-1`` grouped by the connected components of the graph of ``pairs`` (scipy's
+    ``connected_components``): each group ascending, the groups by their first member."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    e = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+    graph = coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
+    comp = connected_components(graph, directed=False)[1]
     out: dict[int, list[int]] = {}
-    for i in range(len(boxes)):
-        out.setdefault(root(i), []).append(i)
+    for i, c in enumerate(comp.tolist()):
+        out.setdefault(int(c), []).append(i)
     return list(out.values())
 
 
