@@ -141,3 +141,47 @@ def test_global_constraints_refuted_before_any_choice():
     assert root.constrain() == -2  # the same refutation, replayed: by the count, no cell
     assert (r.stats["revisions"], r.stats["removals"]) == (root.stats[0], root.stats[1])
     assert root.stats[0] != root.stats[1]  # the premise: the two counts differ here
+
+
+def test_a_global_constraint_pruning_left_to_arc_consistency_names_the_wiped_cell(monkeypatch):
+    """The root pruning by a global constraint may leave the wipe-out to arc consistency:
+    the constraint removes labels without seeing a contradiction, and the arcs then empty a
+    cell. Alg. 3.1 stops "unsat" with the global-constraint proof and names that cell.
+
+    A chain 0 - 1 - 2 of labels A, C, X, Y: cells 0 and 2 may be A or C, cell 1 X or Y;
+    after C only X may follow, before C only Y may come, A goes with both. The catalog is
+    arc consistent and no cell must be A, so "no A" (a count with max 0) prunes A from
+    cells 0 and 2 without refuting; cell 1 must then be X (after C) and Y (before C): arc
+    consistency empties cell 1 while it revises it against the two changed cells, before
+    cell 1 itself is looked at."""
+    import itertools
+
+    import numpy as np
+
+    from csplab import Problem, _interp
+    from csplab.catalog import Propagator
+    from csplab.constraints import Count
+    from csplab.engine.alg31 import run_alg31
+
+    A, C, X, Y = range(4)
+    dom = np.zeros((3, 4), dtype=bool)
+    dom[0, [A, C]] = dom[1, [X, Y]] = dom[2, [A, C]] = True
+    rel = np.zeros((1, 4, 4), dtype=bool)
+    for a, b in [(A, X), (A, Y), (C, X), (X, A), (Y, A), (Y, C)]:
+        rel[0, a, b] = True
+    free = Problem((3,), dom, rel, [[0, 1, 0], [1, 2, 0]], names="ACXY")
+    P = free.with_constraints([Count([A], max=0)])
+    grids = [np.array(g) for g in itertools.product([A, C], [X, Y], [A, C])]
+    assert any(free.is_solution(g) for g in grids)  # the arcs alone are satisfiable
+    assert not any(P.is_solution(g) for g in grids)  # with "no A" nothing is
+    root = Propagator(P)
+    assert root.ok and root.catalog().sum() == 6  # arc consistent, nothing removed
+    assert root.constrain() == 1 and root.refuted_by is None  # the count did not refute
+    assert Propagator(P).constrain_unpacked() == 1  # the unpacked path agrees
+    for name in ("kernels", "interp"):
+        monkeypatch.setattr(_interp, "ENGINE", name)
+        r = run_alg31(P, np.random.default_rng(0))
+        assert r.status == "unsat" and len(r.trace) == 0, name
+        assert r.stats["proof"] == "global-constraint propagation before any choice", name
+        assert r.stats["fail_cell"] == [1], name
+        assert r.stats["assigned"] == 0, name
