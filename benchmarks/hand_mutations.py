@@ -5,7 +5,8 @@ block that failed every retry handing back its partial labels, the Efros-Leung b
 matching loosely or not at all, the SAT oracle accepting models with several labels in a
 cell; or survived ``benchmarks/mutation_run.py`` until a test was written for it (the 3D
 checker's sampling of edges and of the example's triangles, a block's deadline, the
-interpreted engine's wipe-out at cell 0 and entropy of tiny weights). The script copies
+interpreted engine's wipe-out at cell 0 and entropy of tiny weights, the cell
+Alg. 3.1 names when a global constraint's root pruning ends in a wipe-out). The script copies
 the tracked files of the work tree to a temporary directory (the work tree itself is never
 changed), checks that the killing tests pass there
 unmutated, then applies each mutation (an exact text replacement, which must match once)
@@ -116,6 +117,17 @@ MUTATIONS: tuple[Mutation, ...] = (
         "    ustream = 1.0 - rng.random(n)\n    noise",
         ("tests/engine/test_alg31.py::test_run_alg31_is_the_literal_algorithm",),
         "the compiled Alg. 3.1 draws its labels from the other end of the catalog",
+    ),
+    Mutation(
+        "alg31-root-constraint-wipe-out-unnamed",
+        "csplab/engine/alg31.py",
+        'stats["fail_cell"] = list(problem.coords(got)) if got >= 0 else None',
+        'stats["fail_cell"] = None',
+        (
+            "tests/engine/test_alg31.py"
+            "::test_a_global_constraint_pruning_left_to_arc_consistency_names_the_wiped_cell",
+        ),
+        "a root pruned by a global constraint then wiped by arc consistency names no cell",
     ),
     Mutation(
         "check3d-example-sampled-as-output-at-dense-2",
