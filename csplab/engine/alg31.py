@@ -293,8 +293,11 @@ def alg31_reference(
 
     Draws random numbers exactly as :func:`run_alg31` does for the
     scan orders and ``random``, so both return the same grid for the same seed.
-    Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``.
+    Returns ``(status, grid)`` with status ``solved``, ``failed`` or ``unsat``. Arcs only:
+    a problem with global constraints is refused (:class:`~csplab.errors.InputError`)
+    rather than "solved" by a grid that may break them.
     """
+    problem.require_no_constraints("the reference Alg. 3.1")
     if order in HEAP_ORDERS:
         raise InputError("the reference Alg. 3.1 supports the scan and random orders")
     n, K = problem.n, problem.K

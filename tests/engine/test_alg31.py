@@ -153,15 +153,18 @@ def test_a_global_constraint_pruning_left_to_arc_consistency_names_the_wiped_cel
     arc consistent and no cell must be A, so "no A" (a count with max 0) prunes A from
     cells 0 and 2 without refuting; cell 1 must then be X (after C) and Y (before C): arc
     consistency empties cell 1 while it revises it against the two changed cells, before
-    cell 1 itself is looked at."""
+    cell 1 itself is looked at. The literal reference (arcs only) refuses the problem
+    rather than "solve" it."""
     import itertools
 
     import numpy as np
+    import pytest
 
     from csplab import Problem, _interp
     from csplab.catalog import Propagator
     from csplab.constraints import Count
-    from csplab.engine.alg31 import run_alg31
+    from csplab.engine.alg31 import alg31_reference, run_alg31
+    from csplab.errors import InputError
 
     A, C, X, Y = range(4)
     dom = np.zeros((3, 4), dtype=bool)
@@ -185,3 +188,6 @@ def test_a_global_constraint_pruning_left_to_arc_consistency_names_the_wiped_cel
         assert r.stats["proof"] == "global-constraint propagation before any choice", name
         assert r.stats["fail_cell"] == [1], name
         assert r.stats["assigned"] == 0, name
+    with pytest.raises(InputError, match="global constraints"):  # it would "solve" P
+        alg31_reference(P, np.random.default_rng(0))
+    assert alg31_reference(free, np.random.default_rng(0))[0] == "solved"
