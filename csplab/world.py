@@ -53,11 +53,22 @@ ones); a 32x32 chunk of 12x12 blocks (the default), 97 blocks of 144 cells
 Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
 completion keeps its previous labels, so a fixed cell may stay unmet where every pass puts
-a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help). Not
-honoured in an infinite world: global constraints (counts, connectivity, symmetry; the
-reasons are :data:`UNHONOURED`): given as ``constraints=`` they are refused in one line, in
-a model file they are dropped with a warning (:attr:`World.dropped`); boundary faces on the
-infinite ``x``/``y`` axes (there is no outside: refused).
+a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help).
+
+Per-chunk constraints (``chunk_constraints=``, :data:`PER_CHUNK`: a count, and a set that
+is one component reaching the chunk's four sides) add a last pass: sub-passes ``S + 1 ..
+S + 4`` whose blocks are the chunks (colour ``(i mod 2, j mod 2)``), each solved with the
+constraints on its cells and its ring fixed (Alg. 3.1 checked by
+:meth:`Problem.is_solution`, else SAT, else it keeps its labels). No later block writes a
+chunk's cells, so every chunk meets them unless its ring admits no labels that do
+(:meth:`World.unmet_chunks` lists those); the pass is four more sub-passes of independent
+blocks keyed by their coordinates, so the induction above still holds.
+
+Not honoured in an infinite world: global constraints over the whole world (counts,
+connectivity, symmetry; the reasons are :data:`UNHONOURED`): given as ``constraints=``
+they are refused in one line, in a model file they are dropped with a warning
+(:attr:`World.dropped`); boundary faces on the infinite ``x``/``y`` axes (there is no
+outside: refused).
 
 Examples
 --------
@@ -110,11 +121,11 @@ MAX_PERIOD = 8
 #: with this line
 UNHONOURED = {
     "count": "an endless plane has no total to count (a count per chunk is honoured: "
-    "chunk_constraints=, or \"per\": \"chunk\" in a constraints file)",
+    'chunk_constraints=, or "per": "chunk" in a constraints file)',
     "connected": "one network is not local (whether two cells are joined can depend on "
     "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only "
     "(per chunk, one component reaching the chunk's four sides, it is honoured: "
-    "chunk_constraints=, or \"per\": \"chunk\" in a constraints file)",
+    'chunk_constraints=, or "per": "chunk" in a constraints file)',
     "symmetric": "a mirror or rotation maps cells to cells arbitrarily far away (an endless "
     "plane has no centre)",
     "separation": "local, so it could hold as arcs of the blocks, but a block's subproblem "
@@ -664,11 +675,11 @@ class World:
                 ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
             return [(bx, by) for bx in ranges[0] for by in ranges[1]]
         _, col = self._pass_colour(s)
-        off, B = self._lattice(s)
+        off, size = self._lattice(s)
         for a in range(2):
             lo, hi = rect[a]
-            b0 = (lo - off[a]) // B[a]
-            b1 = (hi - 1 - off[a]) // B[a]
+            b0 = (lo - off[a]) // size[a]
+            b1 = (hi - 1 - off[a]) // size[a]
             first = b0 + ((col[a] - b0) % 2)
             ranges.append(range(first, b1 + 1, 2))
         return [(bx, by) for bx in ranges[0] for by in ranges[1]]

@@ -86,10 +86,8 @@ def read_world_constraints(
         if v is not None and v != "chunk":
             raise FormatError(f'constraints[{i}]: "per" must be "chunk", not {v!r}', path=p)
         per.append(v == "chunk")
-    plain = [
-        {k: v for k, v in c.items() if k != "per"} if isinstance(c, Mapping) else c
-        for c in items
-    ]
+    plain = [{k: v for k, v in c.items() if k != "per"} if isinstance(c, Mapping) else c
+             for c in items]  # fmt: skip
     parsed = parse_constraints(plain, problem, p)
     return (
         [c for c, f in zip(parsed, per, strict=True) if not f],
