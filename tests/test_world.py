@@ -413,3 +413,13 @@ def test_cli_per_chunk_constraints(tmp_path: Path, capsys: pytest.CaptureFixture
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert '"per" must be "chunk"' in err and len(err.strip().splitlines()) == 1
+
+
+def test_per_chunk_constraints_on_workers_give_the_same_bytes() -> None:
+    from csplab.constraints import Count
+
+    a = pipes_world([Count([11], 2, 2)]).region((0, 32), (-16, 16))
+    with World(str(DATA / "pipes.xml"), seed=1, chunk=(16, 16), workers=2,
+               chunk_constraints=[Count([11], 2, 2)]) as w:  # fmt: skip
+        assert w.region((0, 32), (-16, 16)).tobytes() == a.tobytes()
+    assert (a == 11).reshape(2, 16, 2, 16).sum(axis=(1, 3)).tolist() == [[2, 2], [2, 2]]
