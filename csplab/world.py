@@ -53,11 +53,22 @@ ones); a 32x32 chunk of 12x12 blocks (the default), 97 blocks of 144 cells
 Constraints in world coordinates. ``fixed={(x, y[, z]): label}`` and ``mask=callable``
 restrict the domains of the blocks that hold those cells; a block whose border leaves no
 completion keeps its previous labels, so a fixed cell may stay unmet where every pass puts
-a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help). Not
-honoured in an infinite world: global constraints (counts, connectivity, symmetry; the
-reasons are :data:`UNHONOURED`): given as ``constraints=`` they are refused in one line, in
-a model file they are dropped with a warning (:attr:`World.dropped`); boundary faces on the
-infinite ``x``/``y`` axes (there is no outside: refused).
+a seam too close to it (:meth:`World.unmet` lists them; more ``passes`` help).
+
+Per-chunk constraints (``chunk_constraints=``, :data:`PER_CHUNK`: a count, and a set that
+is one component reaching the chunk's four sides) add a last pass: sub-passes ``S + 1 ..
+S + 4`` whose blocks are the chunks (colour ``(i mod 2, j mod 2)``), each solved with the
+constraints on its cells and its ring fixed (Alg. 3.1 checked by
+:meth:`Problem.is_solution`, else SAT, else it keeps its labels). No later block writes a
+chunk's cells, so every chunk meets them unless its ring admits no labels that do
+(:meth:`World.unmet_chunks` lists those); the pass is four more sub-passes of independent
+blocks keyed by their coordinates, so the induction above still holds.
+
+Not honoured in an infinite world: global constraints over the whole world (counts,
+connectivity, symmetry; the reasons are :data:`UNHONOURED`): given as ``constraints=``
+they are refused in one line, in a model file they are dropped with a warning
+(:attr:`World.dropped`); boundary faces on the infinite ``x``/``y`` axes (there is no
+outside: refused).
 
 Examples
 --------
@@ -92,7 +103,7 @@ from csplab.catalog import (
     support_tables,
     sweep_blocks,
 )
-from csplab.constraints import Constraint
+from csplab.constraints import Connected, Constraint, Count
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
@@ -101,7 +112,7 @@ from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "UNHONOURED", "World"]
+__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "PER_CHUNK", "UNHONOURED", "World"]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
@@ -109,17 +120,26 @@ MAX_PERIOD = 8
 #: mirror and rotate) is not honoured by a world: ``World(constraints=...)`` refuses it
 #: with this line
 UNHONOURED = {
-    "count": "an endless plane has no total to count, and a count per chunk is not kept: "
-    "the shifted pass' blocks straddle chunks and change what the blocks before counted",
-    "connected": "connectivity is not local (whether two cells are joined can depend on "
-    "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only; "
-    "'each chunk's roads reach its four sides' is local but straddles the blocks as counts do",
+    "count": "an endless plane has no total to count (a count per chunk is honoured: "
+    'chunk_constraints=, or "per": "chunk" in a constraints file)',
+    "connected": "one network is not local (whether two cells are joined can depend on "
+    "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only "
+    "(per chunk, one component reaching the chunk's four sides, it is honoured: "
+    'chunk_constraints=, or "per": "chunk" in a constraints file)',
     "symmetric": "a mirror or rotation maps cells to cells arbitrarily far away (an endless "
     "plane has no centre)",
     "separation": "local, so it could hold as arcs of the blocks, but a block's subproblem "
     "carries no global constraints: not supported yet",
     "max-run": "local, so it could hold as arcs of the blocks, but a block's subproblem "
     "carries no global constraints: not supported yet",
+}
+#: the kinds a world honours per chunk (``World(chunk_constraints=...)``), and what each
+#: means in every chunk
+PER_CHUNK = {
+    "count": "the count of the chunk's cells (of its region, in chunk coordinates) with a "
+    "label of the set lies in [min, max]",
+    "connected": "the chunk's cells with a label of the set form one component (inside the "
+    "chunk) that holds the given cells and touches each of the chunk's four x/y sides",
 }
 #: the largest default block side: blocks are ``min(chunk, BLOCK)`` cells wide unless given
 BLOCK = 12
@@ -158,11 +178,15 @@ class _BlockSolver:
         order: str,
         choice: str,
         exact: str,
+        constraints: Sequence[Constraint] = (),
     ) -> None:
         self.template, self.inner, self.arc_ids = template, inner, arc_ids
         self.block_shape, self.seed, self.retries = block_shape, seed, retries
         self.order, self.choice, self.exact = order, choice, exact
+        #: global constraints on the block's cells (a chunk's, in the chunk pass)
+        self.constraints = tuple(constraints)
         self.kernel = choice in ("uniform", "weighted") and order != "random"
+        self.kernel = self.kernel and not self.constraints
         scan = scan_order(block_shape, order) if self.kernel else None
         self.scan = np.arange(inner.size, dtype=np.int64) if scan is None else scan.astype(np.int64)
         self.tables = support_tables(template.relations, template.weights)
@@ -202,6 +226,8 @@ class _BlockSolver:
             sub = self._sub(flat, allowed)
             labels = wv.solve_block(sub, rng, 0, retries=self.retries, order=self.order,
                                     choice=self.choice, deadline=None).labels  # fmt: skip
+            if labels is not None and self.constraints and not sub.is_solution(labels):
+                labels = None  # Alg. 3.1 keeps the arcs only: exact completion next
         how = "alg31"
         if labels is None and self.exact != "none":
             sub = sub if sub is not None else self._sub(flat, allowed)
@@ -216,27 +242,32 @@ class _BlockSolver:
     def _sub(self, flat: NDArray[np.int32], allowed: NDArray[np.bool_] | None) -> Problem:
         sub = self.template.subproblem(self.inner, flat, shape=self.block_shape,
                                        arc_ids=self.arc_ids)  # fmt: skip
+        if self.constraints:
+            sub = sub.with_constraints(self.constraints)
         return sub if allowed is None else sub.restrict(allowed)
 
 
-_WORKER: tuple[_BlockSolver, _BlockSolver] | None = None
+_WORKER: tuple[_BlockSolver, ...] | None = None
+
+#: a block task: the solver's index (isolated, shifted, chunk pass), the sub-pass, the
+#: block, its window of the state before and the labels allowed in it
+_Task = tuple[int, int, tuple[int, ...], NDArray[np.int32], NDArray[np.bool_] | None]
 
 
-def _init_worker(solvers: tuple[_BlockSolver, _BlockSolver]) -> None:
+def _init_worker(solvers: tuple[_BlockSolver, ...]) -> None:
     global _WORKER
     _WORKER = solvers
 
 
 def _solve_task(
-    tasks: list[tuple[int, tuple[int, ...], NDArray[np.int32], NDArray[np.bool_] | None]],
-    solvers: tuple[_BlockSolver, _BlockSolver] | None = None,
+    tasks: list[_Task], solvers: tuple[_BlockSolver, ...] | None = None
 ) -> list[tuple[NDArray[np.int32], str]]:
     """Blocks on a worker: the solvers are the pool's (``_WORKER``) or sent along (Dask)."""
     sv = solvers or _WORKER
     assert sv is not None
     # a worker started without the kernels loads them (the parent's reason holds here)
     _interp.kernels_for(sv[1].job, sv[1].template.K)
-    return [sv[t[0] > 1](*t) for t in tasks]
+    return [sv[t[0]](*t[1:]) for t in tasks]
 
 
 class _LRU(OrderedDict[Any, Any]):
@@ -308,9 +339,15 @@ class World:
         cells (a 32x32 chunk from scratch: 13.6 times its cells with 12x12 blocks, 49 times
         with 32x32 ones), larger ones leave room for larger structures.
     constraints : sequence of Constraint
-        Global constraints (:mod:`csplab.constraints`): every kind is refused, with the
-        reason of :data:`UNHONOURED` (fixed cells and masks are the constraints a world
-        honours).
+        Global constraints (:mod:`csplab.constraints`) on the whole world: every kind is
+        refused, with the reason of :data:`UNHONOURED` (fixed cells, masks and
+        ``chunk_constraints`` are the constraints a world honours).
+    chunk_constraints : sequence of Count or Connected
+        Constraints that hold in every chunk (:data:`PER_CHUNK`), built on the chunk's
+        grid (:meth:`problem` of the chunk's shape: regions and cells in chunk
+        coordinates). A last pass solves each chunk as one block with them, its ring
+        fixed (module doc); a chunk whose ring admits no such labels keeps its labels
+        and is listed by :meth:`unmet_chunks`.
     scheduler : str, optional
         Solve them on Dask instead: ``"local"`` (a ``LocalCluster`` of ``max(workers, 1)``
         processes) or a scheduler address (as the ``blocks`` solver takes it); the same
@@ -344,6 +381,7 @@ class World:
         scheduler: str | None = None,
         constraints: Sequence[Constraint] = (),
         block: Sequence[int] | None = None,
+        chunk_constraints: Sequence[Constraint] = (),
     ) -> None:
         from csplab.examples import load_model
 
@@ -403,8 +441,25 @@ class World:
         # sub-pass 1 (the isolated blocks, a line of r cells of M0 between them) and the
         # colour sub-passes: one template and one solver each
         iso = tuple(b - r for b in self.block)
-        self.solvers = (self._solver(iso), self._solver(self.block))
-        self.S = 1 + 4 * self.passes
+        self.chunk_constraints = tuple(chunk_constraints)
+        #: the chunk's grid with the per-chunk constraints (their checker:
+        #: :meth:`unmet_chunks`)
+        self.chunk_problem = self.problem(self.B).with_constraints(
+            self._per_chunk(self.chunk_constraints)
+        )
+        solvers = [self._solver(iso), self._solver(self.block)]
+        #: the sub-passes of the blocks' lattice; a last pass of chunks (4 colours) after
+        #: them when there are per-chunk constraints
+        self.S_blocks = 1 + 4 * self.passes
+        self.S = self.S_blocks
+        if self.chunk_constraints:
+            if min(self.B) <= r:
+                raise InputError(
+                    f"per-chunk constraints need chunks wider than the arcs' reach {r}"
+                )
+            solvers.append(self._solver(self.B, self.chunk_problem.constraints))
+            self.S += 4
+        self.solvers = tuple(solvers)
         # the blocks one chunk needs from scratch; a smaller cache would solve blocks again
         # and again within one chunk
         # (the most over the chunk's positions relative to the blocks' lattice)
@@ -442,7 +497,34 @@ class World:
         """A block's shape from its ``x``/``y`` sizes (3D: the world's height)."""
         return tuple(xy) if self.height is None else (*xy, self.height)
 
-    def _solver(self, xy: Sequence[int]) -> _BlockSolver:
+    def _per_chunk(self, cons: Sequence[Constraint]) -> list[Constraint]:
+        """The chunk grid's constraints of the per-chunk ones (:data:`PER_CHUNK`): a count
+        as given; a connectivity as one non-empty component with a cell on each side."""
+        P = self.problem(self.B)
+        out: list[Constraint] = []
+        for c in cons:
+            kind = getattr(c, "kind", type(c).__name__)
+            if not isinstance(c, Count | Connected) or (
+                isinstance(c, Connected) and c.members is not None
+            ):
+                raise InputError(
+                    f"a world cannot honour a {kind} constraint per chunk: only "
+                    f"{' and '.join(PER_CHUNK)} hold per chunk"
+                )
+            c.validate(P)
+            if isinstance(c, Count):
+                out.append(c)
+                continue
+            out.append(Connected(c.labels, c.cells, c.ports, nonempty=True))
+            full = [(0, n - 1) for n in P.shape]
+            for a in range(2):
+                for end in (0, P.shape[a] - 1):
+                    side = list(full)
+                    side[a] = (end, end)
+                    out.append(Count(c.labels, 1, None, tuple(side)))
+        return out
+
+    def _solver(self, xy: Sequence[int], constraints: Sequence[Constraint] = ()) -> _BlockSolver:
         """The solver of blocks ``xy`` wide: their template (the block and a ring of ``r``)."""
         r = self.reach
         same = tuple(xy) == self.block
@@ -452,7 +534,7 @@ class World:
         touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
         arc_ids = np.flatnonzero(touch).astype(np.int64)
         return _BlockSolver(t, inner, arc_ids, self._full(xy), self.seed, self.retries,
-                            self.order, self.choice, self.exact)  # fmt: skip
+                            self.order, self.choice, self.exact, constraints)  # fmt: skip
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
         if boundary in (None, "none"):
@@ -564,10 +646,20 @@ class World:
         return np.ascontiguousarray(tile[xs[:, None], ys[None, :]], dtype=np.int32)
 
     # -- lattice --------------------------------------------------------------------------
+    def _kind(self, s: int) -> int:
+        """The solver of sub-pass ``s``: 0 isolated blocks, 1 shifted blocks, 2 chunks."""
+        return 0 if s == 1 else 1 if s <= self.S_blocks else 2
+
     def _pass_colour(self, s: int) -> tuple[int, tuple[int, int]]:
-        """Sub-pass ``s >= 2``: its pass ``q >= 1`` and colour."""
+        """Sub-pass ``s >= 2``: its pass ``q >= 1`` (``passes + 1``: the chunks) and colour."""
         q, c = divmod(s - 2, 4)
         return q + 1, (c >> 1, c & 1)
+
+    def _lattice(self, s: int) -> tuple[tuple[int, int], Sequence[int]]:
+        """Offset and size of the blocks of sub-pass ``s >= 2`` (chunks in the last pass)."""
+        if self._kind(s) == 2:
+            return (0, 0), self.B
+        return self._offset(self._pass_colour(s)[0]), self.block
 
     def _offset(self, q: int) -> tuple[int, int]:
         return (q * self.block[0] // (self.passes + 1),
@@ -582,12 +674,12 @@ class World:
                 B = self.block[a]
                 ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
             return [(bx, by) for bx in ranges[0] for by in ranges[1]]
-        q, col = self._pass_colour(s)
-        off = self._offset(q)
+        _, col = self._pass_colour(s)
+        off, size = self._lattice(s)
         for a in range(2):
             lo, hi = rect[a]
-            b0 = (lo - off[a]) // self.block[a]
-            b1 = (hi - 1 - off[a]) // self.block[a]
+            b0 = (lo - off[a]) // size[a]
+            b1 = (hi - 1 - off[a]) // size[a]
             first = b0 + ((col[a] - b0) % 2)
             ranges.append(range(first, b1 + 1, 2))
         return [(bx, by) for bx in ranges[0] for by in ranges[1]]
@@ -596,9 +688,7 @@ class World:
         if s == 1:
             return tuple((b[a] * self.block[a], (b[a] + 1) * self.block[a] - self.reach)
                          for a in range(2))  # fmt: skip
-        q, _ = self._pass_colour(s)
-        off = self._offset(q)
-        B = self.block
+        off, B = self._lattice(s)
         return tuple((off[a] + b[a] * B[a], off[a] + (b[a] + 1) * B[a]) for a in range(2))
 
     def _chunk_rect(self, i: int, j: int) -> Rect:
@@ -663,7 +753,7 @@ class World:
         lab = self.blocks.get_(key)
         if lab is None:
             win = self._state(s - 1, self._window(s, b))
-            lab, how = self.solvers[s > 1](s, b, win, self._allowed(s, b))
+            lab, how = self.solvers[self._kind(s)](s, b, win, self._allowed(s, b))
             self.stats[how] += 1
             self.blocks.put(key, lab.astype(self._small, copy=False))
         return lab  # type: ignore[no-any-return]
@@ -677,8 +767,10 @@ class World:
             todo = sorted(b for b in need[s - 1] if (s, b) not in self.blocks)
             if not todo:
                 continue
-            tasks = [(s, b, self._state(s - 1, self._window(s, b)), self._allowed(s, b))
-                     for b in todo]  # fmt: skip
+            tasks: list[_Task] = [
+                (self._kind(s), s, b, self._state(s - 1, self._window(s, b)),
+                 self._allowed(s, b)) for b in todo
+            ]  # fmt: skip
             size = max(1, len(tasks) // (2 * pool.size))
             futures = [pool.submit(_solve_task, tasks[i : i + size], self._shared)
                        for i in range(0, len(tasks), size)]  # fmt: skip
@@ -724,6 +816,7 @@ class World:
         h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.block, self.passes,
                              self.retries, self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
+                             [c.to_json(self.chunk_problem) for c in self.chunk_constraints],
                              ]).encode())  # fmt: skip
         return h.hexdigest()[:32]
 
@@ -871,6 +964,27 @@ class World:
                 if int(g[(k[0] - xs[0], k[1] - ys[0], *k[2:])]) != v:
                     out.append(k)
         return out
+
+
+    def unmet_chunks(self, xs: tuple[int, int], ys: tuple[int, int]) -> list[tuple[int, int]]:
+        """The chunks of a region whose labels break a per-chunk constraint.
+
+        The check is the chunk grid's :meth:`Problem.violations` (:attr:`chunk_problem`).
+
+        Parameters
+        ----------
+        xs, ys : tuple of int
+            ``(x0, x1)`` and ``(y0, y1)``, half-open.
+
+        Returns
+        -------
+        list of tuple of int
+            ``(i, j)`` of those chunks, row by row (none without per-chunk constraints).
+        """
+        if not self.chunk_constraints:
+            return []
+        return [(i, j) for i, j in self.chunks_in(xs, ys)
+                if len(self.chunk_problem.violations(self.chunk(i, j)))]  # fmt: skip
 
 
 def _name_of(f: Callable[..., Any] | None) -> str | None:

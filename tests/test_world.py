@@ -328,3 +328,98 @@ def test_kernel_blocks_equal_the_interpreted_twin(
     w = World("fig3_4a", **kw)  # type: ignore[arg-type]
     assert not _interp.compiled_engine()
     assert w.region((-8, 16), (0, 16)).tobytes() == a.tobytes()
+
+
+ROADS = list(range(1, 12))  # every pipes tile but the empty one
+
+
+def pipes_world(cons: list[object], seed: int = 1) -> World:
+    return World(str(DATA / "pipes.xml"), seed=seed, chunk=(16, 16),
+                 chunk_constraints=cons)  # type: ignore[arg-type]  # fmt: skip
+
+
+def test_per_chunk_count_and_connectivity_hold_in_every_chunk() -> None:
+    """Checked here with numpy and scipy's labelling, not with the constraints' code."""
+    from scipy import ndimage
+
+    from csplab.constraints import Connected, Count
+
+    region = ((-16, 32), (-16, 16))
+    w = pipes_world([Count([11], 4, 4), Connected(ROADS)])
+    g = w.region(*region)
+    assert len(w.problem(g.shape).violations(g)) == 0 and w.unmet_chunks(*region) == []
+    free = World(str(DATA / "pipes.xml"), seed=1, chunk=(16, 16)).region(*region)
+    crosses = (free == 11).reshape(3, 16, 2, 16).sum(axis=(1, 3))
+    assert (crosses != 4).any()  # without the constraint the counts differ: not by chance
+    for i in range(3):
+        for j in range(2):
+            c = g[16 * i : 16 * (i + 1), 16 * j : 16 * (j + 1)]
+            assert int((c == 11).sum()) == 4
+            lab, n = ndimage.label(np.isin(c, ROADS))  # 4-neighbourhood
+            assert n == 1
+            on = lab > 0
+            assert on[0].any() and on[-1].any() and on[:, 0].any() and on[:, -1].any()
+
+
+@settings(max_examples=2, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(order=st.permutations([(i, j) for i in range(-1, 1) for j in range(-1, 1)]))
+def test_per_chunk_constraints_keep_any_visit_order(order: list[tuple[int, int]]) -> None:
+    from csplab.constraints import Count
+
+    cons = [Count([0], 60, 80)]  # twice the empty tiles of the free world: SAT completes
+    if "pipes-cons" not in _REF:
+        w = pipes_world(cons, seed=4)
+        _REF["pipes-cons"] = {c: w.chunk(*c) for c in sorted(order)}
+        assert w.stats["exact"] > 0  # the exact completion's path is part of the world
+    ref = _REF["pipes-cons"]
+    w = pipes_world(cons, seed=4)
+    assert all(w.chunk(*c).tobytes() == ref[c].tobytes() for c in order)
+    assert all(60 <= int((ref[c] == 0).sum()) <= 80 for c in ref)
+
+
+def test_per_chunk_constraints_that_cannot_hold_are_reported_or_refused() -> None:
+    from csplab.constraints import Count, MaxRun, Separation
+
+    # more crosses than cells: no chunk can hold it; each keeps its labels (consistent)
+    # and is listed
+    w = pipes_world([Count([11], 257)])
+    g = w.region((0, 32), (0, 16))
+    assert len(w.problem(g.shape).violations(g)) == 0
+    assert w.unmet_chunks((0, 32), (0, 16)) == [(0, 0), (1, 0)]
+    assert pipes_world([]).unmet_chunks((0, 32), (0, 16)) == []
+    for c in (Separation([11], 3), MaxRun([11], 2)):
+        with pytest.raises(InputError, match=f"cannot honour a {c.kind} constraint per chunk"):
+            pipes_world([c])
+
+
+def test_cli_per_chunk_constraints(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    import json
+
+    from csplab.cli import main
+
+    f = tmp_path / "c.json"
+    f.write_text(json.dumps({"constraints": [
+        {"type": "count", "labels": ["cross"], "min": 2, "max": 2, "per": "chunk"},
+        {"type": "connected", "labels": ["line", "corner", "tee", "cross"], "per": "chunk"},
+    ]}))  # fmt: skip
+    argv = ["world", str(DATA / "pipes.xml"), "--chunk", "16x16", "--region", "0:32,0:32",
+            "--constraints", str(f), "--json", "--out", str(tmp_path / "w.npy")]  # fmt: skip
+    assert main(argv) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["violations"] == 0 and out["chunks_breaking_constraints"] == []
+    g = np.load(tmp_path / "w.npy")
+    assert (g == 11).reshape(2, 16, 2, 16).sum(axis=(1, 3)).tolist() == [[2, 2], [2, 2]]
+    f.write_text('{"constraints": [{"type": "count", "labels": [1], "per": "world"}]}')
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert '"per" must be "chunk"' in err and len(err.strip().splitlines()) == 1
+
+
+def test_per_chunk_constraints_on_workers_give_the_same_bytes() -> None:
+    from csplab.constraints import Count
+
+    a = pipes_world([Count([11], 2, 2)]).region((0, 32), (-16, 16))
+    with World(str(DATA / "pipes.xml"), seed=1, chunk=(16, 16), workers=2,
+               chunk_constraints=[Count([11], 2, 2)]) as w:  # fmt: skip
+        assert w.region((0, 32), (-16, 16)).tobytes() == a.tobytes()
+    assert (a == 11).reshape(2, 16, 2, 16).sum(axis=(1, 3)).tolist() == [[2, 2], [2, 2]]
