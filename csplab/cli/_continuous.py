@@ -7,6 +7,8 @@ import json
 import sys
 from typing import Any
 
+import numpy as np
+
 from csplab.cli.common import EXPLAINED_STATS, explain, fallback_setting, not_written, outcome
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
@@ -349,6 +351,35 @@ def as_flags(message: str) -> str:
     return message
 
 
+#: output formats that store float32 coordinates (binary STL, glTF positions)
+FLOAT32_SUFFIXES = (".stl", ".glb")
+
+
+def onto_planes(model: PolyhedralModel, lat: Any) -> tuple[PolyhedralModel, int]:
+    """``model`` (read from a float32 format) with every vertex that lies within float32's
+    rounding of a point where three of ``lat``'s planes meet put exactly there (a
+    synthesis output's vertices are such points: rationals of denominator
+    :func:`~csplab.continuous.lattice.denominator` in lattice units); other vertices (the
+    curved geometry of bounding volumes) stay as read. Returns the model and how many
+    vertices moved."""
+    from csplab.continuous.lattice import denominator
+
+    D = denominator(lat.normals)
+    solids, moved = [], 0
+    for sol in model.solids:
+        v = np.asarray(sol.vertices, dtype=np.float64)
+        u = lat.to_lattice(v) * D
+        r = np.rint(u)
+        near = (np.abs(u - r) <= 1e-4 * D).all(axis=1) & (np.abs(u - r) > 0).any(axis=1)
+        v[near] = lat.to_world(r[near] / D)
+        moved += int(near.sum())
+        solids.append({"label": int(sol.label), "vertices": v.tolist(),
+                       "faces": [list(f) for f in sol.faces]})  # fmt: skip
+    if not moved:
+        return model, 0
+    return PolyhedralModel(solids, name=model.name, meta=model.meta, source=model.source), moved
+
+
 def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> int:
     """``csplab check EXAMPLE.json OUT.json`` (or ``EXAMPLE.obj OUT.obj``): violations of
     Eq. 4.1 (and of the user constraints of thesis Sec. 4.6 on solids)."""
@@ -384,6 +415,12 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         args.spacing is not None or args.snap or args.lines != "auto"
     ):
         raise InputError("--spacing, --snap and --lines of check apply to polyhedral models")
+    if isinstance(out, PolyhedralModel) and args.grid.lower().endswith(FLOAT32_SUFFIXES):
+        # float32 coordinates: the output's plane vertices put back where synthesis made them
+        plat = Lattice.of_model(bounded.proxy, bounded.spacing) if bounded is not None else lat
+        out, moved = onto_planes(out, plat)
+        if moved:
+            snapped += f" ({moved} float32 vertices of the output put back on its planes)"
     ground = getattr(args, "ground", "auto")
     if ground == "auto":
         ground = example.meta.get("ground")

@@ -165,6 +165,14 @@ def bounded_violations(
                         f"the mapped original by volume {diff:.3g}")  # fmt: skip
         return ""
 
+    def near_lattice(q: NDArray[np.float64]) -> NDArray[np.float64]:
+        """A box corner found from a file's curved vertices, put on the lattice where it
+        is within a file's rounding of it (float32 STL/glTF: the corner is then the
+        lattice point synthesis placed, not one ~1e-6 beside it)."""
+        u = (q - bounded.origin) / bounded.spacing
+        r = np.rint(u)
+        return np.where(np.abs(u - r) <= 1e-4, bounded.origin + r * bounded.spacing, q)
+
     def on_lattice(qlo: NDArray[np.float64], qhi: NDArray[np.float64]) -> bool:
         u = (np.concatenate([qlo, qhi]).reshape(2, 3) - bounded.origin) / bounded.spacing
         return bool(np.abs(u - np.rint(u)).max() <= 1e-6)
@@ -189,7 +197,7 @@ def bounded_violations(
                     continue
                 d, near = tree.query(gp)  # one to one: as many points, each its own
                 if float(d.max()) <= tol and len(np.unique(near)) == len(rp):
-                    qlo, qhi = move(f.box_lo), move(f.box_hi)
+                    qlo, qhi = near_lattice(move(f.box_lo)), near_lattice(move(f.box_hi))
                     key = (k, tuple(np.round(np.concatenate([qlo, qhi]) / tol).tolist()))
                     hits.append((key, f, qlo, qhi, j))
         if not hits:
