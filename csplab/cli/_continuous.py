@@ -432,7 +432,8 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         from csplab.continuous.boundcheck import bounded_violations
 
         region = out.bounds if faces and len(out) else None
-        v = bounded_violations(bounded, out, region=region, ground=faces)
+        v = bounded_violations(bounded, out, region=region, ground=faces,
+                               float32=args.grid.lower().endswith(FLOAT32_SUFFIXES))  # fmt: skip
     elif faces and len(out):  # the output's box stands for its region (solids reach its faces)
         v = violations(example, out, region=out.bounds, ground=faces)
     else:

@@ -97,6 +97,7 @@ def bounded_violations(
     region: tuple[float, float, float, float, float, float] | None = None,
     outside: Mapping[str, int] | None = None,
     ground: Sequence[str] = (),
+    float32: bool = False,
 ) -> Violations:
     """The defects of an output synthesized through bounding volumes (see the module
     docstring): labels the example lacks (``"label"``: a box left unfilled), curved parts
@@ -112,6 +113,10 @@ def bounded_violations(
         The output, with the curved geometry substituted back.
     region, outside, ground
         As for :func:`~csplab.continuous.check3d.violations3` (Eq. 4.1 on the proxy).
+    float32 : bool, default False
+        The output was read from a format that stores float32 coordinates (binary STL,
+        glTF): a box corner found from its curved vertices within ``1e-4`` spacings of a
+        lattice point is that point (the one synthesis placed), not the rounding beside it.
 
     Returns
     -------
@@ -171,6 +176,8 @@ def bounded_violations(
         lattice point synthesis placed, not one ~1e-6 beside it)."""
         u = (q - bounded.origin) / bounded.spacing
         r = np.rint(u)
+        if not float32:
+            return q
         return np.where(np.abs(u - r) <= 1e-4, bounded.origin + r * bounded.spacing, q)
 
     def on_lattice(qlo: NDArray[np.float64], qhi: NDArray[np.float64]) -> bool:
