@@ -1178,16 +1178,14 @@ def components(n: int, eu: np.ndarray, ev: np.ndarray, active: np.ndarray) -> np
 
 
 @njit(cache=True)
-def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: int) -> np.ndarray:
-    """The vertices whose removal separates two ``must`` vertices (the graph ``ptr``/``nbr``,
-    CSR, holds only the vertices that may take part; ``root`` is a must vertex).
-
-    Tarjan's low points over an iterative depth-first search from ``root``: a vertex ``u``
-    other than the root separates when a child ``c`` has ``low[c] >= disc[u]`` and the
-    subtree of ``c`` holds a must vertex (the root, a must vertex, is on the other side).
-    Vertices not reached from the root get -1 in slot 1 of the result: ``out[:, 0]`` is
-    "separating", ``out[:, 1]`` is "reached".
-    """
+def _cut_search(
+    ptr: np.ndarray, nbr: np.ndarray, can: np.ndarray, must: np.ndarray, root: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Tarjan's low points over an iterative depth-first search from the must vertex
+    ``root`` through the vertices ``can`` allows (the graph ``ptr``/``nbr``, CSR): the
+    discovery times (-1: not reached) and the vertices whose removal cuts a must vertex off
+    the root (a vertex ``u`` other than the root with a child ``c``, ``low[c] >= disc[u]``,
+    whose subtree holds a must vertex)."""
     n = ptr.shape[0] - 1
     disc = np.full(n, -1, dtype=np.int64)
     low = np.zeros(n, dtype=np.int64)
@@ -1195,21 +1193,20 @@ def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: i
     parent = np.full(n, -1, dtype=np.int64)
     it = np.zeros(n, dtype=np.int64)
     stack = np.empty(n, dtype=np.int64)
-    out = np.zeros((n, 2), dtype=np.bool_)
-    t = 0
-    sp = 0
+    sep = np.zeros(n, dtype=np.bool_)
     stack[0] = root
     sp = 1
     disc[root] = 0
-    low[root] = 0
     it[root] = ptr[root]
-    below[root] = 1 if must[root] else 0
+    below[root] = 1
     t = 1
     while sp > 0:
         u = stack[sp - 1]
         if it[u] < ptr[u + 1]:
             w = nbr[it[u]]
             it[u] += 1
+            if not can[w]:
+                continue
             if disc[w] < 0:
                 disc[w] = t
                 low[w] = t
@@ -1229,8 +1226,22 @@ def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: i
                     low[p] = low[u]
                 below[p] += below[u]
                 if p != root and low[u] >= disc[p] and below[u] > 0:
-                    out[p, 0] = True
+                    sep[p] = True
+    return disc, sep
+
+
+@njit(cache=True)
+def separating_cells(ptr: np.ndarray, nbr: np.ndarray, must: np.ndarray, root: int) -> np.ndarray:
+    """The vertices whose removal separates two ``must`` vertices (the graph ``ptr``/``nbr``,
+    CSR, holds only the vertices that may take part; ``root`` is a must vertex), by
+    :func:`_cut_search`: ``out[:, 0]`` is "separating", ``out[:, 1]`` is "reached" from the
+    root.
+    """
+    n = ptr.shape[0] - 1
+    disc, sep = _cut_search(ptr, nbr, np.ones(n, dtype=np.bool_), must, root)
+    out = np.zeros((n, 2), dtype=np.bool_)
     for v in range(n):
+        out[v, 0] = sep[v]
         out[v, 1] = disc[v] >= 0
     return out
 
@@ -1270,56 +1281,15 @@ def connected_prune(
     points, :func:`separating_cells`), which join it."""
     n = can.shape[0]
     out = np.zeros(n, dtype=np.bool_)
-    force = np.zeros(n, dtype=np.bool_)
     root = -1
-    nm = 0
     for v in range(n):
         if must[v]:
-            if root < 0:
-                root = v
-            nm += 1
+            root = v
+            break
     if root < 0:
-        return True, out, force
-    # iterative DFS through may-cells from the root, with low points
-    disc = np.full(n, -1, dtype=np.int64)
-    low = np.zeros(n, dtype=np.int64)
-    below = np.zeros(n, dtype=np.int64)
-    parent = np.full(n, -1, dtype=np.int64)
-    it = np.zeros(n, dtype=np.int64)
-    stack = np.empty(n, dtype=np.int64)
-    stack[0] = root
-    sp = 1
-    disc[root] = 0
-    it[root] = ptr[root]
-    below[root] = 1
-    t = 1
-    while sp > 0:
-        u = stack[sp - 1]
-        if it[u] < ptr[u + 1]:
-            w = nbr[it[u]]
-            it[u] += 1
-            if not can[w]:
-                continue
-            if disc[w] < 0:
-                disc[w] = t
-                low[w] = t
-                t += 1
-                parent[w] = u
-                it[w] = ptr[w]
-                below[w] = 1 if must[w] else 0
-                stack[sp] = w
-                sp += 1
-            elif w != parent[u] and disc[w] < low[u]:
-                low[u] = disc[w]
-        else:
-            sp -= 1
-            p = parent[u]
-            if p >= 0:
-                if low[u] < low[p]:
-                    low[p] = low[u]
-                below[p] += below[u]
-                if p != root and low[u] >= disc[p] and below[u] > 0 and below[u] < nm:
-                    force[p] = True
+        return True, out, np.zeros(n, dtype=np.bool_)
+    # the region reachable through may-cells, and its cut cells (Tarjan's low points)
+    disc, force = _cut_search(ptr, nbr, can, must, root)
     for v in range(n):
         if can[v] and disc[v] < 0:
             if must[v]:
