@@ -34,8 +34,6 @@ def load_analysis_model(spec: str, options: list[str] | None = None) -> ExampleM
 def save_certificate(cert: dict[str, Any], path: str) -> None:
     """Write a certificate as JSON, atomically (a temporary file, then renamed): a reader
     never sees half a certificate."""
-    from csplab.io.common import write_atomic
-
     write_atomic(path, json.dumps(cert, default=_plain))
 
 
@@ -70,6 +68,30 @@ def check_witness_out(path: str | None) -> None:
         if Path(path).suffix not in (".png", ".json"):
             raise InputError(f"--out {path}: use a .png picture or a .json file")
         check_output_path(path, "--out")
+
+
+def open_analysis(args: argparse.Namespace) -> ExampleModel | RuleSet:
+    """What ``prove`` and ``witness`` do before their work: refuse a bad ``--out``, then
+    load ``MODEL`` with its ``--model-option`` values (:func:`load_analysis_model`)."""
+    check_witness_out(args.out)
+    return load_analysis_model(args.model, args.model_option)
+
+
+def report_run(
+    run: dict[str, Any],
+    example: ExampleModel | RuleSet,
+    args: argparse.Namespace,
+    heading: str | None = None,
+    describe: bool = True,
+) -> None:
+    """Show a failing run (``heading``, then :func:`describe_run`; nothing with ``--json``
+    or ``describe=False``) and save it to ``--out`` when given (:func:`save_witness`)."""
+    if describe and not args.json:
+        if heading:
+            print(heading)
+        print(describe_run(run, example))
+    if args.out:
+        save_witness(run, args.out, example)
 
 
 def save_witness(w: dict[str, Any], path: str, example: ExampleModel | RuleSet) -> None:

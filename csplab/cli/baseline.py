@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from csplab.cli.common import (
-    add_model_option,
+    add_model_args,
     check_output_path,
     input_files,
     model_from_args,
@@ -29,11 +29,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     from csplab.baselines import BASELINES
 
     p.add_argument("name", choices=list(BASELINES), help="the baseline")
-    p.add_argument("model", metavar="MODEL", help="built-in example name or example grid file")
+    add_model_args(p, help="built-in example name or example grid file")
     p.add_argument("--size", required=True, help="output size such as 20x20 or 20x20x10")
     p.add_argument("--seed", type=int, help="random seed (default: fresh, printed)")
     p.add_argument("--out", help="output grid (.npy, .grid, .txt, .png, ...)")
-    add_model_option(p)
     seen: set[str] = set()
     for b in BASELINES.values():
         for o in b.options:

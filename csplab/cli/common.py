@@ -33,6 +33,7 @@ __all__ = [
     "Model",
     "add_constraints_arg",
     "add_memory_limit_arg",
+    "add_model_args",
     "add_model_option",
     "add_problem_args",
     "check_output_dir",
@@ -375,12 +376,19 @@ def add_constraints_arg(p: argparse.ArgumentParser) -> None:
     )
 
 
-def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) -> None:
+def add_model_args(p: argparse.ArgumentParser, help: str | None = None) -> None:
+    """The positional ``MODEL`` (described by ``help``, by default every input format) and
+    ``--model-option`` (:func:`add_model_option`)."""
     p.add_argument(
         "model",
         metavar="MODEL",
-        help=f"built-in example name or model file ({input_help()}; see `csplab info`)",
+        help=help or f"built-in example name or model file ({input_help()}; see `csplab info`)",
     )
+    add_model_option(p)
+
+
+def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) -> None:
+    add_model_args(p)
     p.add_argument(
         "--size",
         help="output size such as 40x40x10 (trailing axes of extent 1 may be omitted)"
@@ -408,7 +416,6 @@ def add_problem_args(p: argparse.ArgumentParser, *, size_required: bool = True) 
         "hex:even-r, hex:odd-q, hex:even-q, tri, cylinder (theta = y, periodic) or "
         "affine:A,B,C,D (default: the example's own, else square)",
     )
-    add_model_option(p)
     p.set_defaults(_size_required=size_required)
 
 

@@ -23,19 +23,17 @@ from csplab.analysis.decide import decide_infallibility
 from csplab.cli._analysis import (
     ORDER_HELP,
     add_witness_out,
-    check_witness_out,
-    describe_run,
-    load_analysis_model,
+    open_analysis,
     print_verdict,
+    report_run,
     save_certificate,
-    save_witness,
 )
-from csplab.cli.common import add_model_option, check_output_path, check_time_limit
+from csplab.cli.common import add_model_args, check_output_path, check_time_limit
 from csplab.errors import InputError
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("model", metavar="MODEL", help="built-in example, example or tileset file")
+    add_model_args(p)
     p.add_argument(
         "--region", default="auto",
         help="region size per axis, e.g. 3x2, or auto (default): growing regions and a "
@@ -68,14 +66,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="write a certificate (JSON) of a proved or refuted verdict",
     )
     p.add_argument("--json", action="store_true", help="print the verdict as JSON")
-    add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:
-    check_witness_out(args.out)
     if args.certificate:
         check_output_path(args.certificate, "--certificate")
-    E = load_analysis_model(args.model, args.model_option)
+    E = open_analysis(args)
     if args.corner:
         v = corner_condition(E, args.order)
         print_verdict(v, args.json)
@@ -124,15 +120,12 @@ def run(args: argparse.Namespace) -> int:
             return 3
         return 0
     w = (v.witness or {}).get("alg31") if v.holds is False else (v.witness or {}).get("alg36")
-    if w is not None and not args.json:
-        if v.holds is False:
-            print("failing run of Alg. 3.1:")
-            print(describe_run(w, E))
-        elif w.get("realized"):
-            print("failing run of Alg. 3.6 (Alg. 3.1 does not fail on it):")
-            print(describe_run(w["run"], E))
-    if args.out and w is not None:
-        save_witness(w if v.holds is False else w.get("run", w), args.out, E)
+    if w is not None and v.holds is False:
+        report_run(w, E, args, "failing run of Alg. 3.1:")
+    elif w is not None:
+        report_run(w.get("run", w), E, args,
+                   "failing run of Alg. 3.6 (Alg. 3.1 does not fail on it):",
+                   describe=bool(w.get("realized")))  # fmt: skip
     if v.holds is None and not args.json and "method" not in v.stats:
         print(f"  states enumerated: {v.stats.get('states', 0)}")
     elif v.holds is None and not args.json:

@@ -14,11 +14,11 @@ import argparse
 
 from csplab.analysis import to_infallible
 from csplab.cli._analysis import ORDER_HELP, load_example_model, print_verdict
-from csplab.cli.common import add_model_option, check_output_path
+from csplab.cli.common import add_model_args, check_output_path
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
+    add_model_args(p, help="built-in example name or example file")
     p.add_argument("--order", default="scanline", help=ORDER_HELP)
     p.add_argument("--regions", default="2x2,3x2,4x2",
                    help="region sizes the prover tries, comma separated")  # fmt: skip
@@ -26,7 +26,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--beam", type=int, default=20, help="search width (default 20)")
     p.add_argument("--out", help="write E_I to this .grid (or any example format) file")
     p.add_argument("--json", action="store_true")
-    add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:

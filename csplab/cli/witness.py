@@ -13,25 +13,21 @@ found (printed; ``--out`` saves it), 3 nothing found but the search was not exha
 from __future__ import annotations
 
 import argparse
-import math
 
 from csplab.analysis import find_failure
 from csplab.analysis.witness import searched
 from csplab.cli._analysis import (
     ORDER_HELP,
     add_witness_out,
-    check_witness_out,
-    describe_run,
-    load_analysis_model,
+    open_analysis,
     print_verdict,
-    save_witness,
+    report_run,
 )
-from csplab.cli.common import add_model_option
-from csplab.errors import InputError
+from csplab.cli.common import add_model_args, check_time_limit
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("model", metavar="MODEL", help="built-in example name or example file")
+    add_model_args(p)
     p.add_argument("--max-size", default=None,
                    help="largest output searched (default: 4x4 for 2D examples; 3D: growing "
                    "sizes until the time limit)")  # fmt: skip
@@ -52,14 +48,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of the random runs")
     add_witness_out(p)
     p.add_argument("--json", action="store_true")
-    add_model_option(p)
 
 
 def run(args: argparse.Namespace) -> int:
-    if not (math.isfinite(args.time_limit) and args.time_limit > 0):
-        raise InputError(f"--time-limit {args.time_limit}: give a positive number of seconds")
-    check_witness_out(args.out)
-    E = load_analysis_model(args.model, args.model_option)
+    check_time_limit(args.time_limit)
+    E = open_analysis(args)
     v = find_failure(
         E,
         order=args.order,
@@ -75,9 +68,6 @@ def run(args: argparse.Namespace) -> int:
     if not args.json:
         print(f"  searched: {searched(v.stats)}")
     if v.holds is False:
-        if not args.json:
-            print(describe_run(v.witness, E))
-        if args.out:
-            save_witness(v.witness, args.out, E)
+        report_run(v.witness, E, args)
         return 1
     return 0 if v.holds else 3

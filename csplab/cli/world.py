@@ -22,7 +22,7 @@ import time
 
 from csplab.cli.common import (
     add_constraints_arg,
-    add_model_option,
+    add_model_args,
     check_output_path,
     model_from_args,
 )
@@ -33,7 +33,7 @@ from csplab.grids import parse_boundary, parse_shape
 def add_arguments(p: argparse.ArgumentParser) -> None:
     from csplab.io.registry import formats
 
-    p.add_argument("model", metavar="MODEL", help="built-in example name or model file")
+    add_model_args(p)
     p.add_argument("--chunk", default="32x32", help="chunk size XxY or XxYxZ (default 32x32)")
     p.add_argument("--seed", type=int, default=0, help="the world's seed (default 0)")
     p.add_argument(
@@ -77,7 +77,6 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )  # fmt: skip
     p.add_argument("--store", help="SQLite file keeping generated chunks across runs")
     add_constraints_arg(p)
-    add_model_option(p)
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
 
 
