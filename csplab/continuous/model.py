@@ -36,6 +36,7 @@ import shapely
 from numpy.typing import NDArray
 from shapely.geometry import Polygon as ShapelyPolygon
 
+from csplab.continuous._parts import PartsModel
 from csplab.errors import InputError
 
 __all__ = ["Point", "Polygon", "PolygonModel", "Ring"]
@@ -131,7 +132,7 @@ class Polygon:
         return d
 
 
-class PolygonModel:
+class PolygonModel(PartsModel):
     """A labelled polygon set (see the module docstring); immutable.
 
     Parameters
@@ -278,11 +279,6 @@ class PolygonModel:
     parts = "polygons"
     kind = "polygon"
 
-    @property
-    def labels(self) -> tuple[int, ...]:
-        """The object labels used (sorted; 0 is implicit everywhere else)."""
-        return tuple(sorted({p.label for p in self.polygons}))
-
     def shape(self, label: int) -> Any:
         """The union of the polygons of one label.
 
@@ -354,13 +350,6 @@ class PolygonModel:
     def n_polygons(self) -> int:
         """The number of polygons (as :attr:`PolyhedralModel.n_polygons` counts faces)."""
         return len(self.polygons)
-
-    def __len__(self) -> int:
-        return len(self.polygons)
-
-    def __repr__(self) -> str:
-        nm = f"{self.name!r}, " if self.name else ""
-        return f"PolygonModel({nm}{len(self.polygons)} polygons, labels={list(self.labels)})"
 
     # ------------------------------------------------------------------ validation
     def _validate(self) -> None:

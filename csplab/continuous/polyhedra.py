@@ -61,6 +61,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab.continuous._parts import PartsModel
 from csplab.deps import require
 from csplab.errors import InputError
 
@@ -135,7 +136,7 @@ class Solid:
         return d
 
 
-class PolyhedralModel:
+class PolyhedralModel(PartsModel):
     """A labelled set of closed polyhedra (see the module docstring); immutable.
 
     Parameters
@@ -250,11 +251,6 @@ class PolyhedralModel:
         return self
 
     # ------------------------------------------------------------------ queries
-    @property
-    def labels(self) -> tuple[int, ...]:
-        """The object labels used (sorted; 0 is implicit everywhere else)."""
-        return tuple(sorted({s.label for s in self.solids}))
-
     def indexed_faces(self) -> tuple[NDArray[np.float64], list[list[int]]]:
         """Every solid's vertices and every polygon as a list of indices into them.
 
@@ -410,13 +406,6 @@ class PolyhedralModel:
             h.update(str((s.label, s.vertices.shape, s.polygons)).encode())
             h.update(np.ascontiguousarray(s.vertices, dtype=np.float64).tobytes())
         return h.hexdigest()[:16]
-
-    def __len__(self) -> int:
-        return len(self.solids)
-
-    def __repr__(self) -> str:
-        nm = f"{self.name!r}, " if self.name else ""
-        return f"PolyhedralModel({nm}{len(self.solids)} solids, labels={list(self.labels)})"
 
     # ------------------------------------------------------------------ validation
     def _check_overlaps(self) -> None:
