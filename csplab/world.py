@@ -112,7 +112,7 @@ from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "PER_CHUNK", "UNHONOURED", "World"]
+__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "PER_CHUNK", "THIN_MARGIN", "UNHONOURED", "World"]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
@@ -143,6 +143,9 @@ PER_CHUNK = {
 }
 #: the largest default block side: blocks are ``min(chunk, BLOCK)`` cells wide unless given
 BLOCK = 12
+#: thin seams (:attr:`World.seams` ``"proved-infallible"``): a seam block reaches this many
+#: times the arcs' reach into the isolated blocks on each side of a line
+THIN_MARGIN = 2
 #: the version of the blocks' lattice, part of the store's key (chunks stored under another
 #: lattice are not read back)
 LATTICE = 2
@@ -179,10 +182,15 @@ class _BlockSolver:
         choice: str,
         exact: str,
         constraints: Sequence[Constraint] = (),
+        proved: bool = False,
     ) -> None:
         self.template, self.inner, self.arc_ids = template, inner, arc_ids
         self.block_shape, self.seed, self.retries = block_shape, seed, retries
         self.order, self.choice, self.exact = order, choice, exact
+        #: the blocks cannot fail (:attr:`World.seams`): one run, no exact completion
+        self.proved = proved
+        if proved:
+            self.retries, self.exact = 0, "none"
         #: global constraints on the block's cells (a chunk's, in the chunk pass)
         self.constraints = tuple(constraints)
         self.kernel = choice in ("uniform", "weighted") and order != "random"
@@ -235,6 +243,11 @@ class _BlockSolver:
                 labels, _ = ExactCompletion(self.exact)(sub, rng, None)
                 how = "exact"
         if labels is None:
+            if self.proved:
+                raise AssertionError(
+                    f"block {b} of sub-pass {s} failed although its ring cannot make it fail "
+                    "(World.seams): the ring-completion check is wrong"
+                )
             old = flat[self.inner]
             return old.reshape(self.block_shape).astype(np.int32), "kept"
         return np.asarray(labels, dtype=np.int32).reshape(self.block_shape), how
@@ -248,6 +261,9 @@ class _BlockSolver:
 
 
 _WORKER: tuple[_BlockSolver, ...] | None = None
+#: the ring-completion verdicts (:mod:`csplab.analysis.rings`) per block template (its
+#: relations, domains and arcs): a model's is computed once per process
+_RING_VERDICTS: dict[str, Any] = {}
 
 #: a block task: the solver's index (isolated, shifted, chunk pass), the sub-pass, the
 #: block, its window of the state before and the labels allowed in it
@@ -348,6 +364,13 @@ class World:
         coordinates). A last pass solves each chunk as one block with them, its ring
         fixed (module doc); a chunk whose ring admits no such labels keeps its labels
         and is listed by :meth:`unmet_chunks`.
+    seams : {"auto", "general"}
+        ``"auto"``: when every cell has a label whatever its neighbours hold
+        (:func:`csplab.analysis.rings.ring_completion` of the blocks' template, cached per
+        rule set), no block with any ring can fail, and the seams between the isolated
+        blocks are redrawn by thin strips (:data:`THIN_MARGIN`) instead of a shifted pass
+        of whole blocks: :attr:`seams` is ``"proved-infallible"`` (other bytes, another
+        store key). Otherwise, or with ``"general"``, the lattice above.
     scheduler : str, optional
         Solve them on Dask instead: ``"local"`` (a ``LocalCluster`` of ``max(workers, 1)``
         processes) or a scheduler address (as the ``blocks`` solver takes it); the same
@@ -382,6 +405,7 @@ class World:
         constraints: Sequence[Constraint] = (),
         block: Sequence[int] | None = None,
         chunk_constraints: Sequence[Constraint] = (),
+        seams: str = "auto",
     ) -> None:
         from csplab.examples import load_model
 
@@ -402,6 +426,8 @@ class World:
             raise InputError("passes must be >= 1, retries >= 0 and workers >= 0")
         if exact not in ("sat", "backtrack", "none"):
             raise InputError(f"exact must be sat, backtrack or none, not {exact!r}")
+        if seams not in ("auto", "general"):
+            raise InputError(f"seams must be auto or general, not {seams!r}")
         self.ndim = len(self.chunk_shape)
         self.passes, self.retries, self.exact = int(passes), int(retries), exact
         self.order, self.choice, self.workers = order, choice, int(workers)
@@ -447,10 +473,25 @@ class World:
         self.chunk_problem = self.problem(self.B).with_constraints(
             self._per_chunk(self.chunk_constraints)
         )
-        solvers = [self._solver(iso), self._solver(self.block)]
-        #: the sub-passes of the blocks' lattice; a last pass of chunks (4 colours) after
-        #: them when there are per-chunk constraints
-        self.S_blocks = 1 + 4 * self.passes
+        #: how blocks and seams are solved: ``"proved-infallible"`` (every cell has a label
+        #: whatever its neighbours hold, so no block with any ring can fail: one Alg. 3.1
+        #: run per block, no retry, no exact completion, same bytes) or ``"general"``;
+        #: :attr:`seams_why` says why (module doc, "Seams and infallibility")
+        self.seams, self.seams_why = self._seams(seams)
+        #: thin seams (proved-infallible only): how far a seam block reaches into the
+        #: isolated blocks on each side of a line (0: the general lattice)
+        self.margin = THIN_MARGIN * r if self.seams == "proved-infallible" else 0
+        if self.margin:
+            w = r + 2 * self.margin  # a seam's width; a strip's length below
+            strip = [b - w for b in self.block]
+            solvers = [self._solver(iso), self._solver((w, strip[1])),
+                       self._solver((strip[0], w)), self._solver((w, w))]  # fmt: skip
+            self.S_blocks = 4
+        else:
+            solvers = [self._solver(iso), self._solver(self.block)]
+            #: the sub-passes of the blocks' lattice; a last pass of chunks (4 colours)
+            #: after them when there are per-chunk constraints
+            self.S_blocks = 1 + 4 * self.passes
         self.S = self.S_blocks
         if self.chunk_constraints:
             if min(self.B) <= r:
@@ -533,8 +574,45 @@ class World:
         inner = idx[r : r + xy[0], r : r + xy[1]].reshape(-1)
         touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
         arc_ids = np.flatnonzero(touch).astype(np.int64)
+        proved = self.seams == "proved-infallible" and not constraints
         return _BlockSolver(t, inner, arc_ids, self._full(xy), self.seed, self.retries,
-                            self.order, self.choice, self.exact, constraints)  # fmt: skip
+                            self.order, self.choice, self.exact, constraints,
+                            proved=proved)  # fmt: skip
+
+    def _seams(self, mode: str) -> tuple[str, str]:
+        """The seams' path and why (:attr:`seams`): the ring-completion check of the
+        template's centre column (cached per rule set, :data:`_RING_VERDICTS`)."""
+        if mode == "general":
+            return "general", "asked for (seams='general')"
+        if self.fixed or self.mask is not None or self.chunk_constraints:
+            return "general", (
+                "fixed cells, a mask or per-chunk constraints restrict blocks beyond the "
+                "model's rules: those blocks may fail"
+            )
+        t = self.template
+        h = hashlib.sha256()
+        for arr in (t.relations, t.domains, t.arcs):
+            h.update(np.ascontiguousarray(arr).tobytes())
+        key = h.hexdigest()
+        v = _RING_VERDICTS.get(key)
+        if v is None:
+            from csplab.analysis.rings import ring_completion
+
+            idx = np.arange(t.n).reshape(t.shape)
+            centre = idx[t.shape[0] // 2, t.shape[1] // 2].reshape(-1)
+            v = _RING_VERDICTS[key] = ring_completion(t, centre.tolist())
+        if v.holds:
+            r = self.reach
+            w = r + 2 * THIN_MARGIN * r
+            if min(self.block) < w + r:
+                return "general", (
+                    f"{v.message}, but blocks {self.block} are too small for thin seams "
+                    f"(at least {w + r} per axis)"
+                )
+            return "proved-infallible", v.message
+        return "general", "ring completion " + (
+            f"fails: {v.message}" if v.holds is False else v.message
+        )
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
         if boundary in (None, "none"):
@@ -647,8 +725,16 @@ class World:
 
     # -- lattice --------------------------------------------------------------------------
     def _kind(self, s: int) -> int:
-        """The solver of sub-pass ``s``: 0 isolated blocks, 1 shifted blocks, 2 chunks."""
+        """The solver of sub-pass ``s``: 0 isolated blocks, 1 shifted blocks, 2 chunks;
+        thin seams: 0 isolated blocks, 1 strips across ``x``, 2 along ``x``, 3 crossings."""
+        if self.margin:
+            return s - 1
         return 0 if s == 1 else 1 if s <= self.S_blocks else 2
+
+    def _thin_axes(self, s: int) -> tuple[bool, bool]:
+        """Thin seams, sub-pass ``s >= 2``: per axis, whether its blocks are seams across
+        that axis (``[k * B - r - m, k * B + m)``) or spans between them."""
+        return (s in (2, 4), s in (3, 4))
 
     def _pass_colour(self, s: int) -> tuple[int, tuple[int, int]]:
         """Sub-pass ``s >= 2``: its pass ``q >= 1`` (``passes + 1``: the chunks) and colour."""
@@ -674,6 +760,16 @@ class World:
                 B = self.block[a]
                 ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
             return [(bx, by) for bx in ranges[0] for by in ranges[1]]
+        if self.margin:  # a seam [k B - r - m, k B + m), a span [b B + m, (b + 1) B - r - m)
+            r, m = self.reach, self.margin
+            for a, seam in enumerate(self._thin_axes(s)):
+                lo, hi = rect[a]
+                B = self.block[a]
+                if seam:
+                    ranges.append(range((lo - m) // B + 1, (hi + r + m - 1) // B + 1))
+                else:
+                    ranges.append(range((lo + r + m) // B, (hi - m - 1) // B + 1))
+            return [(bx, by) for bx in ranges[0] for by in ranges[1]]
         _, col = self._pass_colour(s)
         off, size = self._lattice(s)
         for a in range(2):
@@ -688,6 +784,13 @@ class World:
         if s == 1:
             return tuple((b[a] * self.block[a], (b[a] + 1) * self.block[a] - self.reach)
                          for a in range(2))  # fmt: skip
+        if self.margin:
+            r, m = self.reach, self.margin
+            return tuple(
+                (b[a] * self.block[a] - r - m, b[a] * self.block[a] + m) if seam
+                else (b[a] * self.block[a] + m, (b[a] + 1) * self.block[a] - r - m)
+                for a, seam in enumerate(self._thin_axes(s))
+            )  # fmt: skip
         off, B = self._lattice(s)
         return tuple((off[a] + b[a] * B[a], off[a] + (b[a] + 1) * B[a]) for a in range(2))
 
@@ -813,7 +916,8 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.block, self.passes,
+        thin = ["thin seams", self.margin] if self.margin else []  # another lattice
+        h.update(json.dumps([LATTICE, *thin, self.seed, self.chunk_shape, self.block, self.passes,
                              self.retries, self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              [c.to_json(self.chunk_problem) for c in self.chunk_constraints],
