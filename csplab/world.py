@@ -112,7 +112,16 @@ from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "PER_CHUNK", "THIN_MARGIN", "UNHONOURED", "World"]
+__all__ = [
+    "BLOCK",
+    "LATTICE",
+    "MAX_PERIOD",
+    "PER_CHUNK",
+    "THIN_MARGIN",
+    "UNHONOURED",
+    "World",
+    "network_per_chunk",
+]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
@@ -122,10 +131,13 @@ MAX_PERIOD = 8
 UNHONOURED = {
     "count": "an endless plane has no total to count (a count per chunk is honoured: "
     'chunk_constraints=, or "per": "chunk" in a constraints file)',
-    "connected": "one network is not local (whether two cells are joined can depend on "
-    "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only "
-    "(per chunk, one component reaching the chunk's four sides, it is honoured: "
-    'chunk_constraints=, or "per": "chunk" in a constraints file)',
+    "connected": "whether two cells are joined is not local: it can depend on cells "
+    "arbitrarily far away (one road made to join two far cities must pass somewhere between "
+    "them), while a chunk may depend only on a bounded neighbourhood, or it would not be a "
+    "function of its coordinates in any visit order; per chunk it is honoured "
+    '(chunk_constraints=, or "per": "chunk" in a constraints file: one component reaching '
+    "the chunk's four sides), and network_per_chunk() matches the sides so that any "
+    "4-connected set of chunks holds one network",
     "symmetric": "a mirror or rotation maps cells to cells arbitrarily far away (an endless "
     "plane has no centre)",
     "separation": "local, so it could hold as arcs of the blocks, but a block's subproblem "
@@ -1089,6 +1101,82 @@ class World:
             return []
         return [(i, j) for i, j in self.chunks_in(xs, ys)
                 if len(self.chunk_problem.violations(self.chunk(i, j)))]  # fmt: skip
+
+
+def network_per_chunk(
+    chunk: Sequence[int], labels: Sequence[int], ports: NDArray[np.bool_] | None = None
+) -> tuple[list[Constraint], Callable[..., Any] | None]:
+    """Per-chunk constraints (and a mask) under which every 4-connected set of chunks is
+    one network.
+
+    ``Connected(labels)`` per chunk (:data:`PER_CHUNK`) makes each chunk's set one
+    component touching its four sides, but two neighbouring chunks may touch their shared
+    side at different cells: their components need not meet. Matched sides: each chunk's
+    component holds the middle cell of each side (``(0, Y // 2)``, ``(X - 1, Y // 2)``,
+    ``(X // 2, 0)``, ``(X // 2, Y - 1)``), so across a shared side two cells of the set
+    face each other and join the two components. With ``ports`` (connections through open
+    tile edges) the mask also opens each middle cell's edge across its side, in world
+    coordinates (every pass sees it, so the chunk solved first does not fix a closed edge
+    its neighbour cannot open); the model's rules must join an open edge to an open edge
+    only (pipes, roads).
+
+    Parameters
+    ----------
+    chunk : sequence of int
+        The world's chunk ``(X, Y)`` (2D).
+    labels : sequence of int
+        The set (the roads).
+    ports : bool array ``(K, 4)``, optional
+        Open edges per label (``x-, x+, y-, y+``), as :class:`csplab.constraints.Connected`.
+
+    Returns
+    -------
+    list of Constraint
+        For ``World(chunk_constraints=...)``.
+    callable or None
+        For ``World(mask=...)`` (with ``ports``).
+
+    Raises
+    ------
+    InputError
+        For a 3D chunk, or one too small to have four middle cells.
+
+    Examples
+    --------
+    >>> cons, mask = network_per_chunk((8, 8), [1])
+    >>> [c.kind for c in cons], mask
+    (['connected'], None)
+    """
+    if len(chunk) != 2 or min(chunk) < 2:
+        raise InputError(f"a matched network needs a 2D chunk of at least 2x2, not {chunk!r}")
+    X, Y = (int(c) for c in chunk)
+    mids = [(0, Y // 2), (X - 1, Y // 2), (X // 2, 0), (X // 2, Y - 1)]
+    cons: list[Constraint] = [Connected(list(labels), [x * Y + y for x, y in mids], ports)]
+    if ports is None:
+        return cons, None
+    P = np.asarray(ports, dtype=bool)
+    inset = np.zeros(P.shape[0], dtype=bool)
+    inset[list(labels)] = True
+    return cons, _SideMask(X, Y, mids, P & inset[:, None])
+
+
+class _SideMask:
+    """The labels allowed at world cells: at each chunk's side middles, those of the set
+    whose edge across that side is open (:func:`network_per_chunk`); a plain object, so
+    workers can take it, named by its settings in the store's key."""
+
+    def __init__(
+        self, X: int, Y: int, mids: Sequence[tuple[int, int]], open_: NDArray[np.bool_]
+    ) -> None:
+        self.X, self.Y, self.mids, self.open = X, Y, list(mids), open_
+        digest = hashlib.sha256(np.ascontiguousarray(open_).tobytes()).hexdigest()[:12]
+        self.__qualname__ = f"_SideMask({X}x{Y}, {digest})"
+
+    def __call__(self, xs: NDArray[np.int64], ys: NDArray[np.int64]) -> NDArray[np.bool_]:
+        al = np.ones((*np.shape(xs), self.open.shape[0]), dtype=bool)
+        for face, (x, y) in enumerate(self.mids):
+            al[(xs % self.X == x) & (ys % self.Y == y)] = self.open[:, face]
+        return al
 
 
 def _name_of(f: Callable[..., Any] | None) -> str | None:

@@ -509,3 +509,45 @@ def reference_thin() -> dict[tuple[int, int], np.ndarray]:
         w = World(complete_pipes(), seed=4, chunk=(16, 16))
         _REF["thin"] = {c: w.chunk(*c) for c in CHUNKS}
     return _REF["thin"]
+
+
+def pipe_networks(g: np.ndarray, ports: np.ndarray) -> int:
+    """Components of the pipes of ``g`` joined through open edges facing each other
+    (a plain flood fill: not the constraints' code)."""
+    seen = np.zeros(g.shape, dtype=bool)
+    n = 0
+    steps = ((1, 0, 1, 0), (-1, 0, 0, 1), (0, 1, 3, 2), (0, -1, 2, 3))
+    for start in zip(*np.nonzero(ports[g].any(axis=-1)), strict=True):
+        if seen[start]:
+            continue
+        n += 1
+        seen[start] = True
+        stack = [start]
+        while stack:
+            x, y = stack.pop()
+            for dx, dy, out, back in steps:
+                u, v = x + dx, y + dy
+                if (0 <= u < g.shape[0] and 0 <= v < g.shape[1] and not seen[u, v]
+                        and ports[g[x, y], out] and ports[g[u, v], back]):  # fmt: skip
+                    seen[u, v] = True
+                    stack.append((u, v))
+    return n
+
+
+def test_matched_sides_make_one_network_over_a_stitched_region() -> None:
+    from csplab.world import network_per_chunk
+
+    pipes = World(str(DATA / "pipes.xml"), seed=1, chunk=(8, 8))
+    rel = pipes.model.transitions()
+    # an edge is open where the empty tile (0) cannot face it
+    ports = np.stack([~rel[0, 0, :], ~rel[0, :, 0], ~rel[1, 0, :], ~rel[1, :, 0]], axis=1)
+    free = pipes.region((0, 32), (0, 32))
+    assert pipe_networks(free, ports) > 1  # without the constraints: many networks
+    cons, mask = network_per_chunk((8, 8), ROADS, ports)
+    w = World(str(DATA / "pipes.xml"), seed=1, chunk=(8, 8), chunk_constraints=cons, mask=mask)
+    g = w.region((0, 32), (0, 32))  # 4x4 chunks
+    assert len(w.problem(g.shape).violations(g)) == 0 and w.unmet_chunks((0, 32), (0, 32)) == []
+    assert pipe_networks(g, ports) == 1
+    assert pipe_networks(g[8:24, 0:16], ports) == 1  # any 4-connected set of chunks
+    with pytest.raises(InputError, match="2D chunk"):
+        network_per_chunk((8, 8, 4), ROADS)
