@@ -64,8 +64,24 @@ chunk's cells, so every chunk meets them unless its ring admits no labels that d
 (:meth:`World.unmet_chunks` lists those); the pass is four more sub-passes of independent
 blocks keyed by their coordinates, so the induction above still holds.
 
+Seams and infallibility (:attr:`World.seams`). ``csplab prove`` proves that Alg. 3.1
+cannot fail on an *open* grid filled from nothing; a block here has its ring fixed, on its
+forward sides too, which no open-grid run has (a block of the last sub-pass always does),
+and open-grid infallibility does not reach it (pipes is proved, yet a ring with one pipe
+end pointing at a cell leaves it no label). What does: every cell has a label whatever its
+neighbours hold (:func:`csplab.analysis.rings.ring_completion`, checked on the template's
+centre column, cached per rule set); then no block of any shape with any consistent ring
+fails in any order. When it holds and no fixed cell, mask or per-chunk constraint restricts
+the blocks, ``seams`` is ``"proved-infallible"``: sub-passes 2, 3, 4 redraw only the lines
+between isolated blocks, as thin strips across ``x`` (``[k B - r - m, k B + m)`` by ``[b B
++ m, (b + 1) B - r - m)``), across ``y``, then their crossings (``m`` = :data:`THIN_MARGIN`
+times ``r``), with one Alg. 3.1 run each: no retry, no exact completion. Blocks of one
+sub-pass are at least ``r`` apart, so the induction above holds; the store key names this
+lattice. Otherwise ``seams`` is ``"general"`` (:attr:`World.seams_why` says why).
+
 Not honoured in an infinite world: global constraints over the whole world (counts,
-connectivity, symmetry; the reasons are :data:`UNHONOURED`): given as ``constraints=``
+connectivity, symmetry; the reasons are :data:`UNHONOURED`; for one network,
+:func:`network_per_chunk` matches the chunks' sides instead): given as ``constraints=``
 they are refused in one line, in a model file they are dropped with a warning
 (:attr:`World.dropped`); boundary faces on the infinite ``x``/``y`` axes (there is no
 outside: refused).
