@@ -84,8 +84,9 @@ def ring_completion(P: Problem, cells: Sequence[int], *, max_sets: int = 200_000
     --------
     >>> import numpy as np
     >>> from csplab.grids import grid
-    >>> ring_completion(grid((3, 3), np.ones((2, 2, 2), dtype=bool)), [4]).message
-    'every cell has a label whatever its neighbours hold (1 cells, 4 neighbours each at most)'
+    >>> v = ring_completion(grid((3, 3), np.ones((2, 2, 2), dtype=bool)), [4])
+    >>> v.holds, v.stats
+    (True, {'cells': 1, 'neighbours': 4})
     """
     rel, dom = P.relations, P.domains
     s, d, r = P.arcs[:, 0], P.arcs[:, 1], P.arcs[:, 2]
@@ -122,8 +123,8 @@ def ring_completion(P: Problem, cells: Sequence[int], *, max_sets: int = 200_000
             return Verdict(False, {"cell": p, "neighbours": {}}, {},
                            f"cell {_at(P, p)} has no label")  # fmt: skip
     return Verdict(True, None, {"cells": len(cells), "neighbours": most},
-                   f"every cell has a label whatever its neighbours hold ({len(cells)} cells, "
-                   f"{most} neighbours each at most)")  # fmt: skip
+                   f"every cell has a label whatever its neighbours hold (checked at "
+                   f"{len(cells)} cell(s), at most {most} neighbours each)")  # fmt: skip
 
 
 def _at(P: Problem, c: int) -> tuple[int, ...]:
