@@ -7,13 +7,15 @@ situation: an *open* grid that Alg. 3.1 fills from nothing in scan order, with c
 labels forced on whole faces at most. What it covers for a block:
 
 * a block whose ring is one label ``e`` on every side (the isolated blocks of a world
-  whose start model is that label): the block and its ring form an open grid with its
-  faces forced to ``e``, so a proof with that boundary covers it, for every block size;
-* with a proof of 2x2 regions (the corner condition), a ring with any consistent labels on
-  the *backward* sides (``x-``, ``y-``, a down-set in the scan) and a constant label on the
-  forward ones: every consistent labelling of a down-set extends cell by cell;
-* not a ring with arbitrary labels on a *forward* side. Alg. 3.1 reaches those cells last,
-  with their labels fixed from the start: an open-grid proof says nothing about them.
+  whose start model is that label), arcs reaching one cell: the block and its ring form an
+  open grid with its faces forced to ``e``, so a proof with that boundary covers it, for
+  every block size;
+* with a proof of 2x2 regions (the corner condition) and the forward faces forced to
+  ``e``, a ring with any consistent labels on the *backward* sides (``x-``, ``y-``: with
+  every scan prefix they form a down-set, and the corner condition extends a consistent
+  down-set cell by cell) and ``e`` on the forward ones;
+* not a ring with arbitrary labels on a *forward* side: an open-grid run never has cells
+  after the one it assigns fixed beforehand, so its proof says nothing about them.
   Every modify in blocks that leaves none of the start model behind has such blocks
   (a block of the last sub-pass has every neighbour fixed), and open-grid infallibility
   does not imply anything there: the pipes tileset is proved with 2x2 regions, yet a cell
