@@ -30,11 +30,18 @@ shortfall, and the load average of the machine:
    exceed the worker count);
 4. seam violations over N chunks: the chunks are stitched row by row, each row checked with
    the row before it (every seam counted once) by ``Problem.violations``: 0;
-5. identical bytes for R random visit orders (fresh worlds, a 3x3-chunk square).
+5. identical bytes for R random visit orders (fresh worlds, a 3x3-chunk square);
+6. the seams' two paths (:attr:`World.seams`): on a model whose every cell has a label
+   whatever its neighbours hold (pipes with all 16 sets of connections, dead ends included:
+   ``proved-infallible``, thin seams) against the general lattice of the same model, walk
+   and jump latencies as in 2 (CPU), the speed-up and the seam violations of a stitched
+   square; and what the open-grid prover (``csplab prove``) and the world say of
+   ``pipes.xml``, which the prover proves but whose blocks a ring can make fail.
 
 The issue's counts (10^5 chunks walked, 10^4 checked, 100 orders) take long on a shared
 2-core machine; ``--full`` runs them, the default runs smaller counts and says so on every
-line. ``--only`` runs some parts (``memory,latency,throughput,seams,orders``). Timings are
+line. ``--only`` runs some parts
+(``memory,latency,throughput,seams,orders,infallible``). Timings are
 printed, never asserted.
 
 Usage::
@@ -55,6 +62,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from csplab.engine.alg31 import run_alg31
+from csplab.io.ruleset import RuleSet
 from csplab.world import World
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -116,12 +124,12 @@ def reference_ms(w: World, seed: int) -> tuple[float, float]:
 Times = NDArray[np.float64]
 
 
-def latency(model: str, chunk: tuple[int, ...], n: int, jumps: int, seed: int
-            ) -> tuple[Times, Times, tuple[float, float], World]:  # fmt: skip
+def latency(model: object, chunk: tuple[int, ...], n: int, jumps: int, seed: int,
+            **kw: object) -> tuple[Times, Times, tuple[float, float], World]:  # fmt: skip
     """Wall and CPU milliseconds (columns) per new chunk on a straight walk (``n`` chunks)
     and per random far jump (``jumps`` chunks), and the reference; after one warm-up chunk
-    far away."""
-    w = World(model, seed=seed, chunk=chunk)
+    far away (``kw``: more settings of the world)."""
+    w = World(model, seed=seed, chunk=chunk, **kw)  # type: ignore[arg-type]
     w.chunk(-10**7, -10**7)  # warm-up: kernels, start model
     ref = reference_ms(w, seed)
     w.chunk(0, 0)
@@ -130,6 +138,43 @@ def latency(model: str, chunk: tuple[int, ...], n: int, jumps: int, seed: int
     coords = [tuple(int(v) for v in rng.integers(-10**6, 10**6, size=2)) for _ in range(jumps)]
     far = np.array([timed(lambda c=c: w.chunk(*c)) for c in coords])
     return walk, far, ref, w
+
+
+def complete_pipes() -> RuleSet:
+    """Pipe tiles of all 16 sets of connections (bits x-, x+, y-, y+), neighbours agreeing
+    on the side they share: every cell has a label whatever its neighbours hold."""
+    T = np.zeros((2, 16, 16), dtype=bool)
+    for a in range(16):
+        for b in range(16):
+            T[0, a, b] = (a >> 1 & 1) == (b & 1)
+            T[1, a, b] = (a >> 3 & 1) == (b >> 2 & 1)
+    return RuleSet(T, name="complete pipes")
+
+
+def infallible(n: int, jumps: int, seed: int, square: int) -> None:
+    """Part 6: the proved-infallible path (thin seams) against the general one."""
+    from csplab.analysis import decide_infallibility
+    from csplab.examples import load_model
+
+    for label, model in (("pipes.xml", load_model(str(DATA / "pipes.xml"))),
+                         ("complete pipes (16 tiles)", complete_pipes())):  # fmt: skip
+        v = decide_infallibility(model, time_limit=60)
+        print(f"{label}: csplab prove: {v.message}")
+        rows = {}
+        for seams in ("auto", "general"):
+            walk, far, _, w = latency(model, (32, 32), n, jumps, seed, seams=seams)
+            rows[seams] = (walk[:, 1].mean(), np.percentile(walk[:, 1], 99),
+                           np.percentile(far[:, 1], 50), np.percentile(far[:, 1], 99))  # fmt: skip
+            g = w.region((0, square * 32), (0, square * 32))
+            bad = len(w.problem(g.shape).violations(g))
+            print(f"  seams={seams}: World.seams {w.seams} ({w.seams_why}); CPU walk mean "
+                  f"{rows[seams][0]:.1f} ms, p99 {rows[seams][1]:.1f} ms; jump p50 "
+                  f"{rows[seams][2]:.1f} ms, p99 {rows[seams][3]:.1f} ms; {w.pyramid} blocks "
+                  f"per far chunk; {bad} violations over {square * square} stitched chunks; "
+                  f"{w.stats['exact']} exact, {w.stats['kept']} kept; {load()}")  # fmt: skip
+        a, b = rows["auto"], rows["general"]
+        print(f"  {label}: general / auto: walk mean {b[0] / a[0]:.2f}x, jump p50 "
+              f"{b[2] / a[2]:.2f}x, jump p99 {b[3] / a[3]:.2f}x")  # fmt: skip
 
 
 def throughput(side: int, seed: int) -> None:
@@ -166,7 +211,7 @@ def main() -> None:
     ap.add_argument("--square", type=int, default=8, help="side of the throughput square")
     ap.add_argument("--seams", type=int, default=1024, help="chunks checked for seams")
     ap.add_argument("--orders", type=int, default=20, help="random visit orders")
-    ap.add_argument("--only", default="memory,latency,throughput,seams,orders")
+    ap.add_argument("--only", default="memory,latency,throughput,seams,orders,infallible")
     a = ap.parse_args()
     if a.full:
         a.walk, a.seams, a.orders = 100_000, 10_000, 100
@@ -252,6 +297,10 @@ def main() -> None:
         ok = verdict(same == a.orders, f"{a.orders - same} differ")
         print(f"identical bytes for random visit orders{note}: {same}/{a.orders} "
               f"(target all): {ok}")  # fmt: skip
+
+    # 6. the proved-infallible path against the general one
+    if "infallible" in parts:
+        infallible(a.chunks, a.jumps, a.seed, a.square)
 
 
 if __name__ == "__main__":

@@ -64,8 +64,24 @@ chunk's cells, so every chunk meets them unless its ring admits no labels that d
 (:meth:`World.unmet_chunks` lists those); the pass is four more sub-passes of independent
 blocks keyed by their coordinates, so the induction above still holds.
 
+Seams and infallibility (:attr:`World.seams`). ``csplab prove`` proves that Alg. 3.1
+cannot fail on an *open* grid filled from nothing; a block here has its ring fixed, on its
+forward sides too, which no open-grid run has (a block of the last sub-pass always does),
+and open-grid infallibility does not reach it (pipes is proved, yet a ring with one pipe
+end pointing at a cell leaves it no label). What does: every cell has a label whatever its
+neighbours hold (:func:`csplab.analysis.rings.ring_completion`, checked on the template's
+centre column, cached per rule set); then no block of any shape with any consistent ring
+fails in any order. When it holds and no fixed cell, mask or per-chunk constraint restricts
+the blocks, ``seams`` is ``"proved-infallible"``: sub-passes 2, 3, 4 redraw only the lines
+between isolated blocks, as thin strips across ``x`` (``[k B - r - m, k B + m)`` by ``[b B
++ m, (b + 1) B - r - m)``), across ``y``, then their crossings (``m`` = :data:`THIN_MARGIN`
+times ``r``), with one Alg. 3.1 run each: no retry, no exact completion. Blocks of one
+sub-pass are at least ``r`` apart, so the induction above holds; the store key names this
+lattice. Otherwise ``seams`` is ``"general"`` (:attr:`World.seams_why` says why).
+
 Not honoured in an infinite world: global constraints over the whole world (counts,
-connectivity, symmetry; the reasons are :data:`UNHONOURED`): given as ``constraints=``
+connectivity, symmetry; the reasons are :data:`UNHONOURED`; for one network,
+:func:`network_per_chunk` matches the chunks' sides instead): given as ``constraints=``
 they are refused in one line, in a model file they are dropped with a warning
 (:attr:`World.dropped`); boundary faces on the infinite ``x``/``y`` axes (there is no
 outside: refused).
@@ -112,7 +128,16 @@ from csplab.grids import from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
-__all__ = ["BLOCK", "LATTICE", "MAX_PERIOD", "PER_CHUNK", "UNHONOURED", "World"]
+__all__ = [
+    "BLOCK",
+    "LATTICE",
+    "MAX_PERIOD",
+    "PER_CHUNK",
+    "THIN_MARGIN",
+    "UNHONOURED",
+    "World",
+    "network_per_chunk",
+]
 
 #: largest period of the start model ``M0`` tried before a model is refused
 MAX_PERIOD = 8
@@ -122,10 +147,13 @@ MAX_PERIOD = 8
 UNHONOURED = {
     "count": "an endless plane has no total to count (a count per chunk is honoured: "
     'chunk_constraints=, or "per": "chunk" in a constraints file)',
-    "connected": "one network is not local (whether two cells are joined can depend on "
-    "cells arbitrarily far away) while a chunk depends on a bounded neighbourhood only "
-    "(per chunk, one component reaching the chunk's four sides, it is honoured: "
-    'chunk_constraints=, or "per": "chunk" in a constraints file)',
+    "connected": "whether two cells are joined is not local: it can depend on cells "
+    "arbitrarily far away (one road made to join two far cities must pass somewhere between "
+    "them), while a chunk may depend only on a bounded neighbourhood, or it would not be a "
+    "function of its coordinates in any visit order; per chunk it is honoured "
+    '(chunk_constraints=, or "per": "chunk" in a constraints file: one component reaching '
+    "the chunk's four sides), and network_per_chunk() matches the sides so that any "
+    "4-connected set of chunks holds one network",
     "symmetric": "a mirror or rotation maps cells to cells arbitrarily far away (an endless "
     "plane has no centre)",
     "separation": "local, so it could hold as arcs of the blocks, but a block's subproblem "
@@ -143,6 +171,9 @@ PER_CHUNK = {
 }
 #: the largest default block side: blocks are ``min(chunk, BLOCK)`` cells wide unless given
 BLOCK = 12
+#: thin seams (:attr:`World.seams` ``"proved-infallible"``): a seam block reaches this many
+#: times the arcs' reach into the isolated blocks on each side of a line
+THIN_MARGIN = 2
 #: the version of the blocks' lattice, part of the store's key (chunks stored under another
 #: lattice are not read back)
 LATTICE = 2
@@ -179,10 +210,15 @@ class _BlockSolver:
         choice: str,
         exact: str,
         constraints: Sequence[Constraint] = (),
+        proved: bool = False,
     ) -> None:
         self.template, self.inner, self.arc_ids = template, inner, arc_ids
         self.block_shape, self.seed, self.retries = block_shape, seed, retries
         self.order, self.choice, self.exact = order, choice, exact
+        #: the blocks cannot fail (:attr:`World.seams`): one run, no exact completion
+        self.proved = proved
+        if proved:
+            self.retries, self.exact = 0, "none"
         #: global constraints on the block's cells (a chunk's, in the chunk pass)
         self.constraints = tuple(constraints)
         self.kernel = choice in ("uniform", "weighted") and order != "random"
@@ -235,6 +271,11 @@ class _BlockSolver:
                 labels, _ = ExactCompletion(self.exact)(sub, rng, None)
                 how = "exact"
         if labels is None:
+            if self.proved:
+                raise AssertionError(
+                    f"block {b} of sub-pass {s} failed although its ring cannot make it fail "
+                    "(World.seams): the ring-completion check is wrong"
+                )
             old = flat[self.inner]
             return old.reshape(self.block_shape).astype(np.int32), "kept"
         return np.asarray(labels, dtype=np.int32).reshape(self.block_shape), how
@@ -248,6 +289,9 @@ class _BlockSolver:
 
 
 _WORKER: tuple[_BlockSolver, ...] | None = None
+#: the ring-completion verdicts (:mod:`csplab.analysis.rings`) per block template (its
+#: relations, domains and arcs): a model's is computed once per process
+_RING_VERDICTS: dict[str, Any] = {}
 
 #: a block task: the solver's index (isolated, shifted, chunk pass), the sub-pass, the
 #: block, its window of the state before and the labels allowed in it
@@ -348,6 +392,13 @@ class World:
         coordinates). A last pass solves each chunk as one block with them, its ring
         fixed (module doc); a chunk whose ring admits no such labels keeps its labels
         and is listed by :meth:`unmet_chunks`.
+    seams : {"auto", "general"}
+        ``"auto"``: when every cell has a label whatever its neighbours hold
+        (:func:`csplab.analysis.rings.ring_completion` of the blocks' template, cached per
+        rule set), no block with any ring can fail, and the seams between the isolated
+        blocks are redrawn by thin strips (:data:`THIN_MARGIN`) instead of a shifted pass
+        of whole blocks: :attr:`seams` is ``"proved-infallible"`` (other bytes, another
+        store key). Otherwise, or with ``"general"``, the lattice above.
     scheduler : str, optional
         Solve them on Dask instead: ``"local"`` (a ``LocalCluster`` of ``max(workers, 1)``
         processes) or a scheduler address (as the ``blocks`` solver takes it); the same
@@ -382,6 +433,7 @@ class World:
         constraints: Sequence[Constraint] = (),
         block: Sequence[int] | None = None,
         chunk_constraints: Sequence[Constraint] = (),
+        seams: str = "auto",
     ) -> None:
         from csplab.examples import load_model
 
@@ -402,6 +454,8 @@ class World:
             raise InputError("passes must be >= 1, retries >= 0 and workers >= 0")
         if exact not in ("sat", "backtrack", "none"):
             raise InputError(f"exact must be sat, backtrack or none, not {exact!r}")
+        if seams not in ("auto", "general"):
+            raise InputError(f"seams must be auto or general, not {seams!r}")
         self.ndim = len(self.chunk_shape)
         self.passes, self.retries, self.exact = int(passes), int(retries), exact
         self.order, self.choice, self.workers = order, choice, int(workers)
@@ -447,10 +501,25 @@ class World:
         self.chunk_problem = self.problem(self.B).with_constraints(
             self._per_chunk(self.chunk_constraints)
         )
-        solvers = [self._solver(iso), self._solver(self.block)]
-        #: the sub-passes of the blocks' lattice; a last pass of chunks (4 colours) after
-        #: them when there are per-chunk constraints
-        self.S_blocks = 1 + 4 * self.passes
+        #: how blocks and seams are solved: ``"proved-infallible"`` (every cell has a label
+        #: whatever its neighbours hold, so no block with any ring can fail: one Alg. 3.1
+        #: run per block, no retry, no exact completion, same bytes) or ``"general"``;
+        #: :attr:`seams_why` says why (module doc, "Seams and infallibility")
+        self.seams, self.seams_why = self._seams(seams)
+        #: thin seams (proved-infallible only): how far a seam block reaches into the
+        #: isolated blocks on each side of a line (0: the general lattice)
+        self.margin = THIN_MARGIN * r if self.seams == "proved-infallible" else 0
+        if self.margin:
+            w = r + 2 * self.margin  # a seam's width; a strip's length below
+            strip = [b - w for b in self.block]
+            solvers = [self._solver(iso), self._solver((w, strip[1])),
+                       self._solver((strip[0], w)), self._solver((w, w))]  # fmt: skip
+            self.S_blocks = 4
+        else:
+            solvers = [self._solver(iso), self._solver(self.block)]
+            #: the sub-passes of the blocks' lattice; a last pass of chunks (4 colours)
+            #: after them when there are per-chunk constraints
+            self.S_blocks = 1 + 4 * self.passes
         self.S = self.S_blocks
         if self.chunk_constraints:
             if min(self.B) <= r:
@@ -533,8 +602,45 @@ class World:
         inner = idx[r : r + xy[0], r : r + xy[1]].reshape(-1)
         touch = np.isin(t.arcs[:, 0], inner) | np.isin(t.arcs[:, 1], inner)
         arc_ids = np.flatnonzero(touch).astype(np.int64)
+        proved = self.seams == "proved-infallible" and not constraints
         return _BlockSolver(t, inner, arc_ids, self._full(xy), self.seed, self.retries,
-                            self.order, self.choice, self.exact, constraints)  # fmt: skip
+                            self.order, self.choice, self.exact, constraints,
+                            proved=proved)  # fmt: skip
+
+    def _seams(self, mode: str) -> tuple[str, str]:
+        """The seams' path and why (:attr:`seams`): the ring-completion check of the
+        template's centre column (cached per rule set, :data:`_RING_VERDICTS`)."""
+        if mode == "general":
+            return "general", "asked for (seams='general')"
+        if self.fixed or self.mask is not None or self.chunk_constraints:
+            return "general", (
+                "fixed cells, a mask or per-chunk constraints restrict blocks beyond the "
+                "model's rules: those blocks may fail"
+            )
+        t = self.template
+        h = hashlib.sha256()
+        for arr in (t.relations, t.domains, t.arcs):
+            h.update(np.ascontiguousarray(arr).tobytes())
+        key = h.hexdigest()
+        v = _RING_VERDICTS.get(key)
+        if v is None:
+            from csplab.analysis.rings import ring_completion
+
+            idx = np.arange(t.n).reshape(t.shape)
+            centre = idx[t.shape[0] // 2, t.shape[1] // 2].reshape(-1)
+            v = _RING_VERDICTS[key] = ring_completion(t, centre.tolist())
+        if v.holds:
+            r = self.reach
+            w = r + 2 * THIN_MARGIN * r
+            if min(self.block) < w + r:
+                return "general", (
+                    f"{v.message}, but blocks {self.block} are too small for thin seams "
+                    f"(at least {w + r} per axis)"
+                )
+            return "proved-infallible", v.message
+        return "general", "ring completion " + (
+            f"fails: {v.message}" if v.holds is False else v.message
+        )
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
         if boundary in (None, "none"):
@@ -647,8 +753,16 @@ class World:
 
     # -- lattice --------------------------------------------------------------------------
     def _kind(self, s: int) -> int:
-        """The solver of sub-pass ``s``: 0 isolated blocks, 1 shifted blocks, 2 chunks."""
+        """The solver of sub-pass ``s``: 0 isolated blocks, 1 shifted blocks, 2 chunks;
+        thin seams: 0 isolated blocks, 1 strips across ``x``, 2 along ``x``, 3 crossings."""
+        if self.margin:
+            return s - 1
         return 0 if s == 1 else 1 if s <= self.S_blocks else 2
+
+    def _thin_axes(self, s: int) -> tuple[bool, bool]:
+        """Thin seams, sub-pass ``s >= 2``: per axis, whether its blocks are seams across
+        that axis (``[k * B - r - m, k * B + m)``) or spans between them."""
+        return (s in (2, 4), s in (3, 4))
 
     def _pass_colour(self, s: int) -> tuple[int, tuple[int, int]]:
         """Sub-pass ``s >= 2``: its pass ``q >= 1`` (``passes + 1``: the chunks) and colour."""
@@ -674,6 +788,16 @@ class World:
                 B = self.block[a]
                 ranges.append(range((lo - B + self.reach) // B + 1, (hi - 1) // B + 1))
             return [(bx, by) for bx in ranges[0] for by in ranges[1]]
+        if self.margin:  # a seam [k B - r - m, k B + m), a span [b B + m, (b + 1) B - r - m)
+            r, m = self.reach, self.margin
+            for a, seam in enumerate(self._thin_axes(s)):
+                lo, hi = rect[a]
+                B = self.block[a]
+                if seam:
+                    ranges.append(range((lo - m) // B + 1, (hi + r + m - 1) // B + 1))
+                else:
+                    ranges.append(range((lo + r + m) // B, (hi - m - 1) // B + 1))
+            return [(bx, by) for bx in ranges[0] for by in ranges[1]]
         _, col = self._pass_colour(s)
         off, size = self._lattice(s)
         for a in range(2):
@@ -688,6 +812,13 @@ class World:
         if s == 1:
             return tuple((b[a] * self.block[a], (b[a] + 1) * self.block[a] - self.reach)
                          for a in range(2))  # fmt: skip
+        if self.margin:
+            r, m = self.reach, self.margin
+            return tuple(
+                (b[a] * self.block[a] - r - m, b[a] * self.block[a] + m) if seam
+                else (b[a] * self.block[a] + m, (b[a] + 1) * self.block[a] - r - m)
+                for a, seam in enumerate(self._thin_axes(s))
+            )  # fmt: skip
         off, B = self._lattice(s)
         return tuple((off[a] + b[a] * B[a], off[a] + (b[a] + 1) * B[a]) for a in range(2))
 
@@ -813,7 +944,8 @@ class World:
         h = hashlib.sha256()
         for arr in (t.relations, t.domains, np.asarray(t.weights), t.arcs, self.M0):
             h.update(np.ascontiguousarray(arr).tobytes())
-        h.update(json.dumps([LATTICE, self.seed, self.chunk_shape, self.block, self.passes,
+        thin = ["thin seams", self.margin] if self.margin else []  # another lattice
+        h.update(json.dumps([LATTICE, *thin, self.seed, self.chunk_shape, self.block, self.passes,
                              self.retries, self.exact, self.order, self.choice, self.zfaces,
                              sorted(self.fixed.items()), _name_of(self.mask),
                              [c.to_json(self.chunk_problem) for c in self.chunk_constraints],
@@ -985,6 +1117,82 @@ class World:
             return []
         return [(i, j) for i, j in self.chunks_in(xs, ys)
                 if len(self.chunk_problem.violations(self.chunk(i, j)))]  # fmt: skip
+
+
+def network_per_chunk(
+    chunk: Sequence[int], labels: Sequence[int], ports: NDArray[np.bool_] | None = None
+) -> tuple[list[Constraint], Callable[..., Any] | None]:
+    """Per-chunk constraints (and a mask) under which every 4-connected set of chunks is
+    one network.
+
+    ``Connected(labels)`` per chunk (:data:`PER_CHUNK`) makes each chunk's set one
+    component touching its four sides, but two neighbouring chunks may touch their shared
+    side at different cells: their components need not meet. Matched sides: each chunk's
+    component holds the middle cell of each side (``(0, Y // 2)``, ``(X - 1, Y // 2)``,
+    ``(X // 2, 0)``, ``(X // 2, Y - 1)``), so across a shared side two cells of the set
+    face each other and join the two components. With ``ports`` (connections through open
+    tile edges) the mask also opens each middle cell's edge across its side, in world
+    coordinates (every pass sees it, so the chunk solved first does not fix a closed edge
+    its neighbour cannot open); the model's rules must join an open edge to an open edge
+    only (pipes, roads).
+
+    Parameters
+    ----------
+    chunk : sequence of int
+        The world's chunk ``(X, Y)`` (2D).
+    labels : sequence of int
+        The set (the roads).
+    ports : bool array ``(K, 4)``, optional
+        Open edges per label (``x-, x+, y-, y+``), as :class:`csplab.constraints.Connected`.
+
+    Returns
+    -------
+    list of Constraint
+        For ``World(chunk_constraints=...)``.
+    callable or None
+        For ``World(mask=...)`` (with ``ports``).
+
+    Raises
+    ------
+    InputError
+        For a 3D chunk, or one too small to have four middle cells.
+
+    Examples
+    --------
+    >>> cons, mask = network_per_chunk((8, 8), [1])
+    >>> [c.kind for c in cons], mask
+    (['connected'], None)
+    """
+    if len(chunk) != 2 or min(chunk) < 2:
+        raise InputError(f"a matched network needs a 2D chunk of at least 2x2, not {chunk!r}")
+    X, Y = (int(c) for c in chunk)
+    mids = [(0, Y // 2), (X - 1, Y // 2), (X // 2, 0), (X // 2, Y - 1)]
+    cons: list[Constraint] = [Connected(list(labels), [x * Y + y for x, y in mids], ports)]
+    if ports is None:
+        return cons, None
+    P = np.asarray(ports, dtype=bool)
+    inset = np.zeros(P.shape[0], dtype=bool)
+    inset[list(labels)] = True
+    return cons, _SideMask(X, Y, mids, P & inset[:, None])
+
+
+class _SideMask:
+    """The labels allowed at world cells: at each chunk's side middles, those of the set
+    whose edge across that side is open (:func:`network_per_chunk`); a plain object, so
+    workers can take it, named by its settings in the store's key."""
+
+    def __init__(
+        self, X: int, Y: int, mids: Sequence[tuple[int, int]], open_: NDArray[np.bool_]
+    ) -> None:
+        self.X, self.Y, self.mids, self.open = X, Y, list(mids), open_
+        digest = hashlib.sha256(np.ascontiguousarray(open_).tobytes()).hexdigest()[:12]
+        self.__qualname__ = f"_SideMask({X}x{Y}, {digest})"
+
+    def __call__(self, xs: NDArray[np.int64], ys: NDArray[np.int64]) -> NDArray[np.bool_]:
+        al = np.ones((*np.shape(xs), self.open.shape[0]), dtype=bool)
+        for face, (x, y) in enumerate(self.mids):
+            al[(xs % self.X == x) & (ys % self.Y == y)] = self.open[:, face]
+        return al
 
 
 def _name_of(f: Callable[..., Any] | None) -> str | None:

@@ -200,6 +200,7 @@ def test_castle_3d_world() -> None:
     assert len(w.problem(g.shape).violations(g)) == 0
     w2 = World("castle", seed=1, chunk=(12, 12, 8))
     assert w2.chunk(1, 1).tobytes() == w.chunk(1, 1).tobytes()
+    assert w.seams == "general" and w.margin == 0  # fallible: no thin seams
 
 
 @pytest.mark.skipif(not (SHARED / "DeBroglie").is_dir(), reason="no shared anchors-data")
@@ -224,6 +225,7 @@ def test_cli_world_writes_the_region_and_checks_it(
 
     summary = json.loads(capsys.readouterr().out)
     assert summary["violations"] == 0 and summary["shape"] == [48, 16]
+    assert summary["seams"] == "general"  # pipes has no dead end: a ring can leave no label
     g = np.load(out)
     w = World(str(DATA / "pipes.xml"), seed=3, chunk=(16, 16), order=summary["order"],
               choice=summary["choice"])  # fmt: skip
@@ -423,3 +425,129 @@ def test_per_chunk_constraints_on_workers_give_the_same_bytes() -> None:
                chunk_constraints=[Count([11], 2, 2)]) as w:  # fmt: skip
         assert w.region((0, 32), (-16, 16)).tobytes() == a.tobytes()
     assert (a == 11).reshape(2, 16, 2, 16).sum(axis=(1, 3)).tolist() == [[2, 2], [2, 2]]
+
+
+def complete_pipes(drop: int | None = None) -> RuleSet:
+    """Pipe tiles of every set of connections (bits x-, x+, y-, y+: 16 labels, dead ends
+    included), two neighbours agreeing on the side they share; ``drop`` leaves one out."""
+    K = 16
+    T = np.zeros((2, K, K), dtype=bool)
+    for a in range(K):
+        for b in range(K):
+            T[0, a, b] = (a >> 1 & 1) == (b & 1)
+            T[1, a, b] = (a >> 3 & 1) == (b >> 2 & 1)
+    if drop is not None:
+        T[:, drop, :] = T[:, :, drop] = False
+    return RuleSet(T, name="complete pipes")
+
+
+def test_ring_completion_decides_which_worlds_take_thin_seams() -> None:
+    w = World(complete_pipes(), seed=2, chunk=(16, 16))
+    assert w.seams == "proved-infallible" and w.margin > 0
+    for model in (three_colours(), str(DATA / "pipes.xml"), complete_pipes(drop=0b0010)):
+        g = World(model, seed=2, chunk=(16, 16))
+        assert g.seams == "general" and g.margin == 0, g.seams_why
+    # the witness is real: checked on the rules themselves, not by the check's code
+    T = complete_pipes(drop=0b0010).transitions()
+    wit = World(complete_pipes(drop=0b0010), seed=2, chunk=(16, 16)).seams_why
+    assert "has no label" in wit
+    from csplab.analysis.rings import ring_completion
+
+    P = complete_pipes(drop=0b0010).problem((5, 5), boundary="none")
+    v = ring_completion(P, [P.cell((2, 2))])
+    nb = {tuple(int(t) for t in np.unravel_index(q, P.shape)): lab
+          for q, lab in v.witness["neighbours"].items()}  # fmt: skip
+    ok = [c for c in range(16) if P.domains[12, c]
+          and (nb.get((1, 2)) is None or T[0, nb[(1, 2)], c])
+          and (nb.get((3, 2)) is None or T[0, c, nb[(3, 2)]])
+          and (nb.get((2, 1)) is None or T[1, nb[(2, 1)], c])
+          and (nb.get((2, 3)) is None or T[1, c, nb[(2, 3)]])]  # fmt: skip
+    assert v.holds is False and ok == []
+    # fixed cells restrict blocks beyond the rules: the general path
+    assert World(complete_pipes(), seed=2, chunk=(16, 16), fixed={(0, 0): 5}).seams == "general"
+    assert World(complete_pipes(), seed=2, chunk=(16, 16), seams="general").margin == 0
+
+
+def test_thin_seams_cover_every_line_with_independent_blocks() -> None:
+    w = World(complete_pipes(), seed=2, chunk=(16, 16), block=(12, 10))
+    rect = ((-30, 40), (-25, 35))
+    cover = np.zeros((70, 60), dtype=int)
+    for s in range(1, w.S + 1):
+        rects = [w._block_rect(s, b) for b in w._blocks_in(s, rect)]
+        for (x0, x1), (y0, y1) in rects:  # each block of a sub-pass sees no other's cells
+            for (u0, u1), (v0, v1) in rects:
+                if (x0, y0) != (u0, v0):
+                    assert max(u0 - x1, x0 - u1, v0 - y1, y0 - v1) >= w.reach
+            if s == 1:
+                cover[max(x0 + 30, 0) : x1 + 30, max(y0 + 25, 0) : y1 + 25] += 1
+            else:
+                cover[max(x0 + 30, 0) : x1 + 30, max(y0 + 25, 0) : y1 + 25] += 10
+    assert (cover > 0).all()  # every cell is drawn: no line of the start model is left
+    assert (cover % 10 <= 1).all() and (cover // 10 <= 1).all()  # at most once per kind
+
+
+@settings(max_examples=4, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(order=st.permutations(CHUNKS))
+def test_thin_seams_world_is_consistent_and_order_independent(
+    order: list[tuple[int, int]],
+) -> None:
+    ref = reference_thin()
+    w = World(complete_pipes(), seed=4, chunk=(16, 16))
+    for c in order:
+        assert w.chunk(*c).tobytes() == ref[c].tobytes()
+    g = w.region((-16, 32), (-16, 32))
+    assert len(w.problem(g.shape).violations(g)) == 0
+    assert w.stats["exact"] == w.stats["kept"] == 0
+    assert len(np.unique(g)) == 16
+    general = World(complete_pipes(), seed=4, chunk=(16, 16), seams="general")
+    assert general.key != w.key  # another lattice, other bytes: another store key
+    assert general.chunk(0, 0).tobytes() != ref[(0, 0)].tobytes()
+
+
+def reference_thin() -> dict[tuple[int, int], np.ndarray]:
+    if "thin" not in _REF:
+        w = World(complete_pipes(), seed=4, chunk=(16, 16))
+        _REF["thin"] = {c: w.chunk(*c) for c in CHUNKS}
+    return _REF["thin"]
+
+
+def pipe_networks(g: np.ndarray, ports: np.ndarray) -> int:
+    """Components of the pipes of ``g`` joined through open edges facing each other
+    (a plain flood fill: not the constraints' code)."""
+    seen = np.zeros(g.shape, dtype=bool)
+    n = 0
+    steps = ((1, 0, 1, 0), (-1, 0, 0, 1), (0, 1, 3, 2), (0, -1, 2, 3))
+    for start in zip(*np.nonzero(ports[g].any(axis=-1)), strict=True):
+        if seen[start]:
+            continue
+        n += 1
+        seen[start] = True
+        stack = [start]
+        while stack:
+            x, y = stack.pop()
+            for dx, dy, out, back in steps:
+                u, v = x + dx, y + dy
+                if (0 <= u < g.shape[0] and 0 <= v < g.shape[1] and not seen[u, v]
+                        and ports[g[x, y], out] and ports[g[u, v], back]):  # fmt: skip
+                    seen[u, v] = True
+                    stack.append((u, v))
+    return n
+
+
+def test_matched_sides_make_one_network_over_a_stitched_region() -> None:
+    from csplab.world import network_per_chunk
+
+    pipes = World(str(DATA / "pipes.xml"), seed=1, chunk=(8, 8))
+    rel = pipes.model.transitions()
+    # an edge is open where the empty tile (0) cannot face it
+    ports = np.stack([~rel[0, 0, :], ~rel[0, :, 0], ~rel[1, 0, :], ~rel[1, :, 0]], axis=1)
+    free = pipes.region((0, 32), (0, 32))
+    assert pipe_networks(free, ports) > 1  # without the constraints: many networks
+    cons, mask = network_per_chunk((8, 8), ROADS, ports)
+    w = World(str(DATA / "pipes.xml"), seed=1, chunk=(8, 8), chunk_constraints=cons, mask=mask)
+    g = w.region((0, 32), (0, 32))  # 4x4 chunks
+    assert len(w.problem(g.shape).violations(g)) == 0 and w.unmet_chunks((0, 32), (0, 32)) == []
+    assert pipe_networks(g, ports) == 1
+    assert pipe_networks(g[8:24, 0:16], ports) == 1  # any 4-connected set of chunks
+    with pytest.raises(InputError, match="2D chunk"):
+        network_per_chunk((8, 8, 4), ROADS)

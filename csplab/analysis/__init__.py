@@ -10,6 +10,9 @@ stats and a one-line message).
 - :mod:`csplab.analysis.decide`: the decision procedure behind ``csplab prove``: region
   proofs of growing size and reach, refined by Alg. 3.6's real failures, and a search for
   a failing run of Alg. 3.1, within a time budget.
+- :mod:`csplab.analysis.rings`: blocks with a fixed ring (modify in blocks, worlds): what
+  the region proof covers there, and the closed-form condition under which no ring can
+  make a block fail (:func:`ring_completion`).
 - :mod:`csplab.analysis.refine`: label refinements E_I of a fallible E_F with
   f(E_I) = E_F (Sec. 3.3.8), checked against Eq. 3.13 and proven infallible.
 """
@@ -24,6 +27,7 @@ from csplab.analysis.infallible import (
     region_catalog,
 )
 from csplab.analysis.refine import lift_check, refine_labels, to_infallible
+from csplab.analysis.rings import ring_completion
 from csplab.analysis.witness import alg31_exhaustive, find_failure, replay
 
 __all__ = [
@@ -37,5 +41,6 @@ __all__ = [
     "refine_labels",
     "region_catalog",
     "replay",
+    "ring_completion",
     "to_infallible",
 ]

@@ -4,7 +4,9 @@ Generate the region X0:X1,Y0:Y1 of an endless world of MODEL (:class:`csplab.Wor
 chunks of ``--chunk`` cells, infinite in x and y (a 3D world has the chunk's height), whose
 content depends only on the model, the seed, the settings and the coordinates -- not on
 the visit order, the number of ``--jobs`` or earlier runs. Blocks that random choice cannot
-complete are completed exactly (SAT with their border fixed). The stitched region is
+complete are completed exactly (SAT with their border fixed); the path the seams take is
+printed (``proved-infallible`` when every cell has a label whatever its neighbours hold, so
+no block can fail; else ``general``). The stitched region is
 checked against the model (its violations are printed). Constraints file entries with
 ``"per": "chunk"`` (count and connected) hold in every chunk; other entries are refused with
 the reason.
@@ -57,6 +59,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         help="shifted colour passes of blocks after the isolated blocks (1)",
     )  # fmt: skip
     p.add_argument("--retries", type=int, default=20, help="Alg. 3.1 retries per block (20)")
+    p.add_argument(
+        "--seams", choices=("auto", "general"), default="auto",
+        help="auto (default): when every cell of the model has a label whatever its "
+        "neighbours hold, no block can fail: one Alg. 3.1 run each, no retry or exact "
+        "completion (the same bytes); general: always keep them ready",
+    )  # fmt: skip
     p.add_argument(
         "--exact",
         choices=("sat", "backtrack", "none"),
@@ -131,6 +139,7 @@ def run(args: argparse.Namespace) -> int:
         choice=choice, workers=args.jobs if args.jobs > 1 else 0, store=args.store,
         scheduler=args.scheduler, constraints=constraints, chunk_constraints=per_chunk,
         block=parse_shape(args.block, what="--block") if args.block else None,
+        seams=args.seams,
     )  # fmt: skip
     try:
         grid = world.region(xs, ys, progress=True)
@@ -150,6 +159,8 @@ def run(args: argparse.Namespace) -> int:
         "order": order,
         "choice": choice,
         "blocks": dict(world.stats),
+        "seams": world.seams,
+        "seams_why": world.seams_why,
         "violations": violations,
         "chunks_breaking_constraints": [list(c) for c in unmet],
         "dropped_constraints": world.dropped,
@@ -169,6 +180,7 @@ def run(args: argparse.Namespace) -> int:
             f"{st['alg31']} Alg. 3.1, {st['exact']} exact, {st['kept']} kept, "
             f"{st['stored']} chunks from the store)"
         )
+        print(f"  seams: {world.seams} ({world.seams_why})")
         if per_chunk:
             print(f"  per-chunk constraints: {len(unmet)} of {n_chunks} chunks break them"
                   + (f" {unmet[:5]}" if unmet else ""))  # fmt: skip
