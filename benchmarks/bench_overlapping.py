@@ -8,8 +8,17 @@ outputs (checked with ``Problem.violations``) and the wall time per valid output
 count: that is what a user waits for), with the in-process reference run: the same problem in
 scanline order (the thesis' order, no entropy maintenance), and their ratio.
 
-Targets (performance issue): <= 6 ms per valid output at 48x48 (>= 2x fast-wfc's 12-26 ms)
-and <= 0.3 s at 200x200. Timings are printed, never asserted.
+Targets (performance issues 16 and 29): <= 6 ms per valid output at 48x48 (>= 2x fast-wfc's
+12-26 ms) and <= 0.3 s at 200x200. Each target line says "meets" or the shortfall. Issue 29
+item 1 asks for >= 2x fast-wfc per valid 48x48 output (N=3, periodic input, 8 symmetries)
+against its quoted figures City 5.6 ms, Rooms 15.0 ms, Knot 13.9 ms, and >= 3x at 200x200,
+where neither issue quotes an absolute fast-wfc figure (issue 29 only ratios: csplab 2.7x on
+City, 5.3x on Qud); issue 16 pairs its 0.3 s target with ">= 3x fast-wfc", so 0.9 s is the
+200x200 figure used here. Those samples are not in the repository (WaveFunctionCollapse's
+sample pictures), and fast-wfc is on no package registry, so this sample's time is set
+against the quoted figures: a comparison across samples of 40-170 patterns, not a run of
+fast-wfc. CPU time per valid output is printed beside the wall time (the machine is shared:
+its load average is printed too).
 
 ``--split`` first prints where the time of one small output goes (issue 29, item 1: measure
 before optimising): reading the sample and extracting its patterns, building the problem,
@@ -34,21 +43,44 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGETS = {48: 0.006, 200: 0.3}
+#: fast-wfc's seconds per valid output quoted by issue 29 (48x48) and implied by issue 16's
+#: "<= 0.3 s (>= 3x fast-wfc)" (200x200), with the speed-up each target asks for
+FAST_WFC = {48: ({"City": 0.0056, "Rooms": 0.0150, "Knot": 0.0139}, 2.0),
+            200: ({"issue 16: 0.3 s = 3x": 0.9}, 3.0)}  # fmt: skip
 
 
-def _per_valid(P: object, order: str, seconds: float) -> tuple[int, int, float]:
+def _per_valid(P: object, order: str, seconds: float) -> tuple[int, int, float, float]:
+    """Runs, valid outputs, wall and CPU seconds per valid output."""
     from csplab.solvers import solve
 
     solve(P, "catalog", rng=0, order=order, choice="weighted")  # warm-up
     runs = valid = 0
-    t0 = time.perf_counter()
-    while time.perf_counter() - t0 < seconds or valid == 0:
+    wall = cpu = 0.0  # of the solve calls (each checks its grid); the bench's check is extra
+    while wall < seconds or valid == 0:
+        t, c = time.perf_counter(), time.process_time()
         r = solve(P, "catalog", rng=runs + 1, order=order, choice="weighted")
+        wall += time.perf_counter() - t
+        cpu += time.process_time() - c
         runs += 1
         valid += int(r.ok and len(P.violations(r.grid)) == 0)  # type: ignore[attr-defined]
         if runs > 10_000:
             break
-    return runs, valid, (time.perf_counter() - t0) / max(valid, 1)
+    return runs, valid, wall / max(valid, 1), cpu / max(valid, 1)
+
+
+def verdict(t: float, target: float) -> str:
+    """``meets`` or the shortfall of ``t`` seconds against ``target`` seconds.
+
+    Examples
+    --------
+    >>> verdict(0.005, 0.006)
+    'meets'
+    >>> verdict(0.009, 0.006)
+    'misses by 3.00 ms (1.50x the target)'
+    """
+    if t <= target:
+        return "meets"
+    return f"misses by {1000 * (t - target):.2f} ms ({t / target:.2f}x the target)"
 
 
 def split(sample: str, runs: int, side: int = 48) -> None:
@@ -82,7 +114,7 @@ def split(sample: str, runs: int, side: int = 48) -> None:
         walls.append(time.perf_counter() - t)
     kernel = sum(
         tt for (path, _, name), (_, _, tt, _, _) in pstats.Stats(prof).stats.items()  # type: ignore[attr-defined]
-        if name == "alg31" and path.endswith("_kernels.py")
+        if name in ("alg31", "alg31_flat") and path.endswith("_kernels.py")
     )  # fmt: skip
     total = sum(walls)
     print(f"where the time of one {side}x{side} output goes (K={model.K}, load average "  # type: ignore[union-attr]
@@ -103,21 +135,32 @@ def main() -> None:
     a = ap.parse_args()
     if a.split:
         split(a.sample, a.split_runs)
+    import os
+
     from csplab.examples import load_model
 
     model = load_model(a.sample)
-    print(f"{Path(a.sample).name}: overlapping model, K={model.K} patterns")  # type: ignore[union-attr]
-    print("size      order         runs  valid   per valid output   ref (scanline)   ratio  target")
+    print(f"{Path(a.sample).name}: overlapping model, K={model.K} patterns; load average "  # type: ignore[union-attr]
+          f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} CPUs")  # fmt: skip
+    print("size      order         runs  valid  per valid: wall       cpu   ref (scanline) "
+          "wall/cpu   ratio")  # fmt: skip
     for side, target in TARGETS.items():
         P = model.problem((side, side))  # type: ignore[union-attr]
-        runs, valid, t = _per_valid(P, "min-entropy", a.seconds)
-        _, _, rt = _per_valid(P, "scanline", a.seconds)
-        verdict = "meets" if t <= target else "misses"
+        runs, valid, t, c = _per_valid(P, "min-entropy", a.seconds)
+        _, _, rt, rc = _per_valid(P, "scanline", a.seconds)
         print(
-            f"{side}x{side:<5} min-entropy {runs:>6} {valid:>6} {1000 * t:>15.2f} ms "
-            f"{1000 * rt:>13.2f} ms {t / rt:>7.2f}  {verdict} (<= {1000 * target:g} ms)",
+            f"{side}x{side:<5} min-entropy {runs:>6} {valid:>6} {1000 * t:>12.2f} ms "
+            f"{1000 * c:>6.2f} ms {1000 * rt:>8.2f}/{1000 * rc:.2f} ms {t / rt:>7.2f}",
             flush=True,
         )
+        print(f"  target <= {1000 * target:g} ms per valid output: {verdict(t, target)} "
+              f"(wall {1000 * t:.2f} ms; cpu {1000 * c:.2f} ms: {verdict(c, target)})")  # fmt: skip
+        figures, times = FAST_WFC[side]
+        for name, fw in figures.items():
+            need = fw / times
+            print(f"  target >= {times:g}x fast-wfc {name} ({1000 * fw:g} ms, so <= "
+                  f"{1000 * need:.2f} ms): {fw / t:.2f}x, {verdict(t, need)} (cpu: "
+                  f"{fw / c:.2f}x, {verdict(c, need)})")  # fmt: skip
 
 
 if __name__ == "__main__":

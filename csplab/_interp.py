@@ -13,9 +13,11 @@ of queue pops and label removals for every order and choice, on random problems)
 are Python integers used as bitsets (bit ``b``: label ``b``); the support of a domain in an
 arc direction is memoised per direction. The queue is the kernels' FIFO, cells are revised in
 the same order, so the statistics agree pop for pop. The union of the supports of ``D(u)``
-equals what each of the kernel's three revision branches keeps. ``min-entropy`` and
+equals what each of the kernel's four revision branches keeps. ``min-entropy`` and
 ``min-domain`` pick the unassigned cell of least key from a binary heap of ``(key, cell)``
-entries with stale entries skipped; the keys are computed with the kernels' formulas in the
+entries with stale entries skipped; as in the kernels, the key of a changed cell is computed
+once, when the queue is empty (its weight sums are updated at each change, in the kernels'
+order); the keys are computed with the kernels' formulas in the
 same order of operations (``math.log`` is the C library's ``log``, as numba's ``np.log``
 on a scalar), so the pick is the same unless two cells have bit-identical keys, which the
 random tie-breaking term makes practically impossible.
@@ -237,6 +239,7 @@ def _revise(
             queue.append(c)
     pops = removals = 0
     wiped = -1
+    dirty: dict[int, None] = {}  # cells whose key changed, updated once the queue is empty
     while queue:
         u = queue.popleft()
         inq[u] = 0
@@ -264,12 +267,15 @@ def _revise(
                     wiped = v
                     break
                 if inheap:
-                    keys.update(v, new)  # type: ignore[union-attr]
+                    dirty[v] = None
                 if not inq[v]:
                     inq[v] = 1
                     queue.append(v)
         if wiped >= 0:
             break
+    if keys is not None and wiped < 0:
+        for v in dirty:
+            keys.update(v, dom[v])
     for q in queue:  # cells left in the queue are not at their fixpoint
         prev[q] = 0
     stats[0] += pops

@@ -9,7 +9,9 @@ into a numba dispatcher with the recorded options (``cache=True`` keeps numba's 
 cache: the cached machine code is keyed by the same file and function) and puts the
 dispatchers into the module's namespace, so kernels that call kernels of their own module
 (:mod:`csplab._kernels`) resolve to dispatchers when numba types them. A module's ``prange``
-placeholder (:data:`prange`) is replaced by :func:`numba.prange` at the same moment.
+placeholder (:data:`prange`) is replaced by :func:`numba.prange` at the same moment, and its
+``trailing_zeros`` placeholder (:func:`trailing_zeros`) by numba's intrinsic of that name
+(one ``tzcnt`` instruction, where a multiply-and-lookup took six).
 
 :func:`on_load` registers a callback run once per module just after its kernels became
 dispatchers (before any compiles): the CLI registers there a listener of numba's
@@ -34,7 +36,17 @@ import threading
 from collections.abc import Callable
 from typing import Any, TypeVar, overload
 
-__all__ = ["Kernel", "compile_seconds", "compiled", "load", "loaded", "njit", "on_load", "prange"]
+__all__ = [
+    "Kernel",
+    "compile_seconds",
+    "compiled",
+    "load",
+    "loaded",
+    "njit",
+    "on_load",
+    "prange",
+    "trailing_zeros",
+]
 
 _PENDING: dict[str, list[Kernel]] = {}
 _HOOKS: list[Callable[[str], None]] = []
@@ -46,6 +58,20 @@ _TIMER: list[Any] = [None]
 def prange(*args: int) -> range:
     """Placeholder for :func:`numba.prange` until a module's kernels are compiled."""
     return range(*args)
+
+
+def trailing_zeros(x: Any) -> int:
+    """Placeholder for numba's ``trailing_zeros`` intrinsic (LLVM's ``cttz``: one ``tzcnt``
+    instruction) until a module's kernels are compiled: the index of the lowest set bit of
+    a non-zero integer.
+
+    Examples
+    --------
+    >>> trailing_zeros(40)
+    3
+    """
+    v = int(x)
+    return (v & -v).bit_length() - 1
 
 
 class Kernel:
@@ -117,6 +143,10 @@ def _materialize(module: str) -> None:
         mod = sys.modules[module]
         if getattr(mod, "prange", None) is prange:
             mod.prange = numba.prange  # type: ignore[attr-defined]
+        if getattr(mod, "trailing_zeros", None) is trailing_zeros:
+            from numba.cpython.unsafe.numbers import trailing_zeros as cttz
+
+            mod.trailing_zeros = cttz  # type: ignore[attr-defined]
         for k in kernels:
             k._real = numba.njit(*k._args, **k._kwargs)(k.py_func)
             if getattr(mod, k.py_func.__name__, None) is k:

@@ -125,6 +125,49 @@ class SupportTables(NamedTuple):
     wlogw: NDArray[np.float64]  #: ``(T, K)`` ``w log w`` (0 where ``w = 0``)
     #: ``(n,)`` each cell's weight class, or ``(1,)``: class 0 for every cell
     wclass: NDArray[np.int64]
+    #: ``(ceil(K / 4), 16, 2R * W)`` :func:`nibble_supports` (``(0, 16, 0)``: none)
+    nib: NDArray[np.uint64]
+
+
+#: the most labels for which :func:`support_tables` builds the nibble table (its size grows
+#: as ``K**2``; beyond it a revision ORs the supports of the labels one by one)
+NIBBLE_MAX_K = 256
+
+
+def nibble_supports(sup: NDArray[np.uint64]) -> NDArray[np.uint64]:
+    """The union of the supports of every 4-label slice of a domain, in every direction.
+
+    ``nib[j, x, s * W + w]`` is word ``w`` of the union of ``sup[s, a]`` over the labels
+    ``a = 4 j + b`` with bit ``b`` set in ``x``, so the support of a whole domain ``D`` in
+    every direction at once is the OR of ``nib[j, (D >> 4 j) & 15]`` over the nibbles of
+    ``D``: ``ceil(K / 4)`` contiguous rows, whatever the domain size (the kernels' revision
+    of the neighbours of a cell that lost many labels, :func:`csplab._kernels.propagate`).
+
+    Parameters
+    ----------
+    sup : uint64 array ``(S, K, W)``
+        The support bitsets of each label in each direction (:class:`SupportTables`).
+
+    Returns
+    -------
+    uint64 array ``(ceil(K / 4), 16, S * W)``
+
+    Examples
+    --------
+    >>> sup = pack(np.eye(3, dtype=bool)[[1, 2, 0]]).reshape(1, 3, 1)  # a -> a + 1 mod 3
+    >>> nibble_supports(sup)[0, 0b011, 0] == pack(np.array([[0, 1, 1]], dtype=bool))[0, 0]
+    True
+    """
+    S, K, W = sup.shape
+    J = -(-K // 4)
+    padded = np.zeros((S, 4 * J, W), dtype=np.uint64)
+    padded[:, :K] = sup
+    quads = padded.reshape(S, J, 4, W)
+    out = np.zeros((J, 16, S, W), dtype=np.uint64)
+    for x in range(1, 16):
+        low = (x & -x).bit_length() - 1  # the row of x without its lowest bit, plus that bit
+        out[:, x] = out[:, x & (x - 1)] | quads[:, :, low].transpose(1, 0, 2)
+    return np.ascontiguousarray(out.reshape(J, 16, S * W))
 
 
 def support_tables(
@@ -145,7 +188,9 @@ def support_tables(
         wlogw = np.ascontiguousarray(np.where(w > 0, w * np.log(np.where(w > 0, w, 1.0)), 0.0))
     wc = np.zeros(1, dtype=np.int64) if wclass is None else np.ascontiguousarray(
         np.asarray(wclass, dtype=np.int64).reshape(-1))  # fmt: skip
-    return SupportTables(full, sup, supall, w, wlogw, wc)
+    nib = (nibble_supports(sup) if K <= NIBBLE_MAX_K
+           else np.zeros((0, 16, 0), dtype=np.uint64))  # fmt: skip
+    return SupportTables(full, sup, supall, w, wlogw, wc, nib)
 
 
 class _Compiled:
@@ -177,7 +222,7 @@ class _Compiled:
             self.sidx = np.empty(ends, dtype=np.int64)
             kern.arc_csr(np.ascontiguousarray(a, dtype=np.int64), self.ptr, self.nbr, self.sidx)
         t = support_tables(problem.relations, *problem.weight_classes())
-        self.sup, self.supall, self.full = t.sup, t.supall, t.full
+        self.sup, self.supall, self.full, self.nib = t.sup, t.supall, t.full, t.nib
         self.n, self.K, self.W = n, K, W
         #: the arc-consistent catalog of the problem's own domains (bits, prev, stats, ok,
         #: wiped): every solve of the problem starts from it, so it is computed once
@@ -189,7 +234,7 @@ class _Compiled:
         # the same arrays as one kernel argument
         self.arcs = kern.Arcs(
             self.full, self.ptr, self.nbr, self.sidx, self.sup, self.supall, self.weights,
-            self.wlogw, self.wclass,
+            self.wlogw, self.wclass, self.nib,
         )  # fmt: skip
 
     def packed_domains(self, problem: Problem) -> NDArray[np.uint64]:
@@ -239,30 +284,34 @@ class Propagator:
     ) -> None:
         self.problem = problem
         self.c = _compiled_for(problem)
-        self.bits = pack(problem.domains if domains is None else _check_catalog(problem, domains))
-        # D(u) when u was last processed by the kernel (zero = unknown)
-        self.prev = np.zeros_like(self.bits)
         n = problem.n
         self._queue = np.zeros(max(n, 1), dtype=np.int64)
         self._inq = np.zeros(max(n, 1), dtype=np.bool_)
-        self.stats = np.zeros(2, dtype=np.int64)  # pops, removals
         self.refuted_by: str | None = None  # the global constraint :meth:`constrain` broke
         # per constraint: its last fixpoint (can, must) and the calls skipped since
         self._last: list[tuple[NDArray[np.bool_], NDArray[np.bool_]] | None] = []
         self._skips: list[int] = []
+        self.bits: NDArray[np.uint64]
+        self.prev: NDArray[np.uint64]  # D(u) when u was last processed by the kernel (0: unknown)
+        self.stats: NDArray[np.int64]  # pops, removals
+        self.ok: bool
+        self.wiped: int
+        init = self.c.initial if propagate_initial and domains is None else None
+        if init is not None:  # the problem's own fixpoint, computed once per problem
+            self.bits, self.prev = init[0].copy(), init[1].copy()
+            self.stats = init[2].copy()
+            self.ok, self.wiped = init[3], init[4]
+            return
+        self.bits = pack(problem.domains if domains is None else _check_catalog(problem, domains))
+        self.prev = np.zeros_like(self.bits)
+        self.stats = np.zeros(2, dtype=np.int64)
         self.ok = bool(np.all(self.bits.any(axis=1))) if n else True
-        self.wiped: int = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
+        self.wiped = -1 if self.ok else int(np.flatnonzero(~self.bits.any(axis=1))[0])
         if propagate_initial and self.ok:
-            init = self.c.initial if domains is None else None
-            if init is not None:  # the problem's own fixpoint, computed once per problem
-                self.bits, self.prev = init[0].copy(), init[1].copy()
-                self.stats = init[2].copy()
-                self.ok, self.wiped = init[3], init[4]
-            else:
-                self.propagate(None)
-                if domains is None:
-                    self.c.initial = (self.bits.copy(), self.prev.copy(), self.stats.copy(),
-                                      self.ok, self.wiped)  # fmt: skip
+            self.propagate(None)
+            if domains is None:
+                self.c.initial = (self.bits.copy(), self.prev.copy(), self.stats.copy(),
+                                  self.ok, self.wiped)  # fmt: skip
 
     # --------------------------------------------------------------- core
     def propagate(self, changed: ArrayLike | None = None) -> bool:
@@ -469,8 +518,8 @@ class Propagator:
         else:
             if heap is not None and run.steps == 0:  # a new run: its cells, by key
                 kern.heap_build(heap.heap, heap.pos, heap.key, int(run.state[1]))
-            code = kern.alg31(
-                self.c.arcs, self._ac(), run, _NO_HEAP if heap is None else heap,
+            code = kern.alg31_flat(  # the bundles' fields: numba types them faster
+                *self.c.arcs, *self._ac(), *run, *(_NO_HEAP if heap is None else heap),
                 heap is not None, weighted, weighted if key_weighted is None else key_weighted,
                 n + 1 if max_steps is None else int(max_steps),
             )  # fmt: skip
@@ -592,7 +641,7 @@ def solve_block_arrays(
 
     local = kern.Arcs(tables.full, i64(block.lptr), i64(block.lnbr), i64(block.lsidx),
                       tables.sup, tables.supall, tables.weights, tables.wlogw,
-                      tables.wclass)  # fmt: skip
+                      tables.wclass, tables.nib)  # fmt: skip
     nb = block.dom0.shape[0]
     lgrid = np.empty(nb, dtype=np.int32)
     counters = np.zeros(4, dtype=np.int64)

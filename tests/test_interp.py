@@ -9,7 +9,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from csplab import ExampleModel, Problem, _interp, _jit, load_example
+from csplab import ExampleModel, Problem, _interp, _jit, catalog, load_example
 from csplab.catalog import Propagator, unpack
 from csplab.engine.alg31 import run_alg31
 from csplab.grids import from_example
@@ -64,6 +64,28 @@ def test_alg31_same_as_kernels_on_random_examples(engine, order, choice):
         _same(a, b)
         statuses.add(a.status)
     assert statuses & {"solved", "failed"}
+
+
+@pytest.mark.parametrize("order", ["scanline", "min-entropy"])
+def test_alg31_same_with_and_without_the_nibble_table(engine, monkeypatch, order):
+    """The kernels' revision by nibble table (K <= NIBBLE_MAX_K) and label by label (larger
+    K) give the interpreted twin's run: grid, trace, pops and removals."""
+    rng = np.random.default_rng(11)
+    cases = [(load_example("city"), (6, 6, 4), {"boundary": "auto"})]  # K = 119: two words
+    for _ in range(4):
+        cases.append((_random_example(rng, int(rng.integers(3, 12)), (6, 5)), (11, 9), {}))
+    for E, shape, kw in cases:
+        for seed in range(2):
+            runs = []
+            for limit in (catalog.NIBBLE_MAX_K, 0):
+                monkeypatch.setattr(catalog, "NIBBLE_MAX_K", limit)
+                P = from_example(E, shape, **kw)
+                assert (Propagator(P).c.nib.shape[0] > 0) == (limit > 0)
+                runs.append(_both(engine, lambda P=P: P, seed, order=order, choice="weighted"))
+            (a, b), (c, d) = runs
+            _same(a, b)
+            _same(c, d)
+            _same(a, c)
 
 
 def test_propagate_stops_at_a_wipe_out_of_cell_0(engine):
