@@ -205,7 +205,8 @@ class CpsatSolver(Solver):
             stats["hint"] = "catalog solution" if whole is not None else "random labels"
         if supports == "auto":
             supports = "forward" if whole is not None else "both"
-        stats["supports"] = supports
+        if model == "onehot":  # the table model uses the encoding's catalog, not its clauses
+            stats["supports"] = supports
         try:
             enc = encode(problem, supports=supports, deadline=deadline)
         except DeadlineExceeded:
