@@ -14,19 +14,21 @@ import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeAlias, TypeGuard, cast
 
 import numpy as np
 from numpy.typing import NDArray
 
-from csplab.continuous.model import PolygonModel
-from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import FormatError, InputError
 from csplab.example import ExampleModel
 from csplab.grids import from_example, parse_boundary, parse_shape
 from csplab.io.registry import input_help, option_help
 from csplab.io.ruleset import RuleSet
 from csplab.problem import Problem
+
+if TYPE_CHECKING:
+    from csplab.continuous.model import PolygonModel
+    from csplab.continuous.polyhedra import PolyhedralModel
 
 __all__ = [
     "COMPILING",
@@ -40,6 +42,7 @@ __all__ = [
     "check_output_path",
     "check_time_limit",
     "input_files",
+    "is_continuous",
     "load_grid",
     "load_model",
     "model_options",
@@ -49,7 +52,26 @@ __all__ = [
 #: The line the CLI prints on stderr before numba compiles csplab's kernels for the first time.
 COMPILING = "compiling csplab's kernels once (about 5 s; cached afterwards)"
 
-Model = ExampleModel | RuleSet | PolygonModel | PolyhedralModel
+Model: TypeAlias = "ExampleModel | RuleSet | PolygonModel | PolyhedralModel"
+
+
+def is_continuous(model: object) -> TypeGuard[PolygonModel | PolyhedralModel]:
+    """Whether ``model`` is a continuous model (polygons or polyhedra).
+
+    :mod:`csplab.continuous` (shapely, scipy; about 0.07 s of CPU) is imported by the
+    loaders that make such models, not by the CLI: a grid command does not pay for it.
+
+    Examples
+    --------
+    >>> is_continuous(ExampleModel([[0, 1]]))
+    False
+    """
+    for module, name in (("csplab.continuous.model", "PolygonModel"),
+                         ("csplab.continuous.polyhedra", "PolyhedralModel")):  # fmt: skip
+        mod = sys.modules.get(module)
+        if mod is not None and isinstance(model, getattr(mod, name)):
+            return True
+    return False
 
 
 def key_values(items: list[str] | None, flag: str, form: str = "KEY=VALUE") -> dict[str, Any]:
@@ -432,15 +454,16 @@ def add_model_option(p: argparse.ArgumentParser, of: str = "the model file") -> 
 
 
 def problem_from_args(
-    args: argparse.Namespace, model: Model, shape: tuple[int, ...] | None = None
+    args: argparse.Namespace, given: Model, shape: tuple[int, ...] | None = None
 ) -> Problem:
     """The problem for ``--size`` (or ``shape``), ``--boundary`` and ``--periodic``."""
-    if isinstance(model, PolygonModel | PolyhedralModel):
+    if is_continuous(given):
         raise InputError(
-            f"{model.name or args.model} is a {model.kind} model (continuous model synthesis): "
+            f"{given.name or args.model} is a {given.kind} model (continuous model synthesis): "
             "`csplab synthesize`, `check` and `show` take it; this command takes grid "
             "examples and tilesets"
         )
+    model = cast("ExampleModel | RuleSet", given)
     if shape is None and args.size:
         shape = parse_shape(args.size, what="--size")
     boundary = parse_boundary(args.boundary)

@@ -27,14 +27,13 @@ from csplab.cli.common import (
     explain,
     fallback_setting,
     input_files,
+    is_continuous,
     key_values,
     model_from_args,
     not_written,
     outcome,
     problem_from_args,
 )
-from csplab.continuous.model import PolygonModel
-from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.errors import InputError
 from csplab.grids import parse_shape
 
@@ -240,7 +239,7 @@ def run(args: argparse.Namespace) -> int:
     if args.seed is not None and args.seed < 0:
         raise InputError("--seed must be non-negative")
     example = model_from_args(args)
-    if isinstance(example, PolygonModel | PolyhedralModel):
+    if is_continuous(example):
         from csplab.cli import _continuous
 
         return _continuous.synthesize(args, example, _options(args))

@@ -16,6 +16,7 @@ True
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -134,23 +135,23 @@ def load_model(
     csplab.errors.InputError: model options apply to model files only, not to the built-in \
 example 'line'
     """
-    from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
-    from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
     from csplab.io import read_model
 
     p = Path(spec)
     if p.exists():
         return read_model(p, **(options or {}))
     text = str(spec)
-    builtin = (
-        load_example
-        if text in EXAMPLES or text in ALIASES
-        else load_polygon_example
-        if text in CONTINUOUS_EXAMPLES
-        else load_polyhedral_example
-        if text in POLYHEDRAL_EXAMPLES
-        else None
-    )
+    builtin: Callable[[str], ExampleModel | PolygonModel | PolyhedralModel] | None = None
+    if text in EXAMPLES or text in ALIASES:
+        builtin = load_example
+    else:  # csplab.continuous (shapely, scipy) only for the continuous examples
+        from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
+        from csplab.examples.continuous3d import POLYHEDRAL_EXAMPLES, load_polyhedral_example
+
+        if text in CONTINUOUS_EXAMPLES:
+            builtin = load_polygon_example
+        elif text in POLYHEDRAL_EXAMPLES:
+            builtin = load_polyhedral_example
     if builtin is not None:
         if options:
             raise InputError(

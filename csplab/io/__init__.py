@@ -25,18 +25,20 @@ Examples
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from numpy.typing import ArrayLike
 
-from csplab.continuous.model import PolygonModel
-from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.example import ExampleModel
 from csplab.io.common import Output
 from csplab.io.gridtext import format_grid, grid_safe_names, parse_grid
 from csplab.io.merrell import format_merrell, parse_merrell
 from csplab.io.registry import FORMATS, Format, detect, get_format, output_format, sniff
 from csplab.io.ruleset import RuleSet
+
+if TYPE_CHECKING:  # csplab.continuous is imported by the loaders of continuous models
+    from csplab.continuous.model import PolygonModel
+    from csplab.continuous.polyhedra import PolyhedralModel
 
 __all__ = [
     "FORMATS",

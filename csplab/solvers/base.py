@@ -283,6 +283,7 @@ STATS: dict[str, str] = {
     "free_s": "seconds spent freeing the solver",
     "model": "the model flavour (CP-SAT)",
     "diversity": "how outputs are diversified across seeds",
+    "hint": "the solution hint given (CP-SAT): a catalog solution or random labels",
     "sat": "figures of the SAT oracle used (a dict with these names)",
     "atoms": "ground atoms (ASP)",
     "rules": "ground rules (ASP)",

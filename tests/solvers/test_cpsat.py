@@ -14,7 +14,7 @@ pytest.importorskip("ortools")
 
 
 @given(csp_problems(max_cells=9), st.sampled_from(["onehot", "table"]),
-       st.sampled_from(["hint", "none", "polarity"]), st.integers(0, 2**31))  # fmt: skip
+       st.sampled_from(["hint", "catalog", "none", "polarity"]), st.integers(0, 2**31))  # fmt: skip
 def test_both_models_agree_with_brute_force(P, model, diversity, seed):
     r = solve(P, "cpsat", rng=seed, model=model, diversity=diversity)
     assert r.status in ("solved", "unsat")
@@ -38,6 +38,26 @@ def test_hints_make_outputs_differ_and_seeds_repeat():
     # without diversity CP-SAT gives the same solution for every seed (documented)
     c, d = (solve(P, "cpsat", rng=s, diversity="none") for s in (1, 2))
     assert np.array_equal(c.grid, d.grid)
+
+
+def test_catalog_hint_is_confirmed_on_the_forward_model():
+    from csplab.engine.alg31 import run_alg31
+
+    P = from_example(box_town(1, rng=0), (8, 8, 6), boundary="auto")
+    r = solve(P, "cpsat", rng=5)  # default: diversity="catalog", supports="auto"
+    assert r.stats["hint"] == "catalog solution" and r.stats["supports"] == "forward"
+    rng = np.random.default_rng(5)
+    rng.integers(2**31 - 1)  # the solver draws CP-SAT's seed first
+    hint = run_alg31(P, rng)
+    assert hint.status == "solved"
+    assert np.array_equal(r.grid, hint.grid)  # a complete feasible hint is kept as it is
+    assert len(P.violations(r.grid)) == 0
+    both = solve(P, "cpsat", rng=5, supports="both")
+    assert both.stats["supports"] == "both" and np.array_equal(both.grid, r.grid)
+    # random labels as the hint (the former default): both directions, CP-SAT repairs
+    h = solve(P, "cpsat", rng=5, diversity="hint")
+    assert "hint" not in h.stats and h.stats["supports"] == "both"
+    assert len(P.violations(h.grid)) == 0
 
 
 def test_options_and_time_limit():
