@@ -262,6 +262,11 @@ def synthesize(
             # curved geometry back (the proxy is what was synthesized, not what it resembles)
             like = s.bounded.example if s.bounded is not None else snapped
             d["resemblance"] = resemblance3(like, s.model, ground=floor).to_dict()
+        elif isinstance(snapped, PolygonModel) and isinstance(s.model, PolygonModel):
+            from csplab.continuous.resemblance import resemblance2
+
+            floor = csp.region()[1] if "y-" in opened else None  # the ground's height
+            d["resemblance"] = resemblance2(snapped, s.model, ground=floor).to_dict()
         if s.bounded is not None:
             d["bounding_volumes"] = s.bounded.describe()
         print(json.dumps(d))
