@@ -173,7 +173,7 @@ def synthesize(
             settings[key] = (
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
-    if dim == 3 and "choice" not in opts and cls.option("choice") is not None:
+    if "choice" not in opts and cls.option("choice") is not None:
         o = cls.option("choice")
         if o is not None and (o.values is None or "weighted" in o.values):
             settings["choice"] = ("weighted (continuous default: by how much of the example "
