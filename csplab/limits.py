@@ -28,6 +28,9 @@ of 1.0 GB: use a smaller --size, or raise --memory-limit
 from __future__ import annotations
 
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 
 from csplab.errors import InputError, MemoryLimitError
 
@@ -40,6 +43,7 @@ __all__ = [
     "check_label",
     "check_memory",
     "memory_budget",
+    "memory_limit",
 ]
 
 #: The largest object label of a polygon or polyhedral model (16 bits).
@@ -85,10 +89,44 @@ def total_ram() -> float | None:
         return None
 
 
+#: the command's ``--memory-limit`` (GB) while it runs (:func:`memory_limit`), else None
+_LIMIT_GB: ContextVar[float | None] = ContextVar("csplab_memory_limit", default=None)
+
+
+@contextmanager
+def memory_limit(limit_gb: float | None) -> Iterator[None]:
+    """Within the block, :func:`memory_budget` without an argument (so every estimate
+    checked against the default budget: the mesh readers' face counts, the synthesis
+    estimates) is ``limit_gb`` GB; ``None`` keeps the default. The CLI runs each command
+    inside its ``--memory-limit``.
+
+    Raises
+    ------
+    InputError
+        When ``limit_gb`` is not a positive finite number.
+
+    Examples
+    --------
+    >>> with memory_limit(2.5):
+    ...     memory_budget()
+    2500000000.0
+    """
+    if limit_gb is not None:
+        memory_budget(limit_gb)  # refused here when not a positive number
+    token = _LIMIT_GB.set(limit_gb)
+    try:
+        yield
+    finally:
+        _LIMIT_GB.reset(token)
+
+
 def memory_budget(limit_gb: float | None = None) -> float:
-    """The bytes a command may plan to use: ``limit_gb`` GB when given, else
+    """The bytes a command may plan to use: ``limit_gb`` GB when given, else the limit of
+    the enclosing :func:`memory_limit` (the command's ``--memory-limit``), else
     :data:`MEMORY_SHARE` of the machine's RAM, or the memory available now when that is
     less (:func:`available_memory`)."""
+    if limit_gb is None:
+        limit_gb = _LIMIT_GB.get()
     if limit_gb is not None:
         if not limit_gb > 0 or limit_gb == float("inf"):
             raise InputError(f"--memory-limit must be a positive number of GB, not {limit_gb:g}")

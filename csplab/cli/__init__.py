@@ -24,6 +24,7 @@ from typing import Any
 
 from csplab.cli.common import readable
 from csplab.errors import CsplabError
+from csplab.limits import memory_limit
 
 __all__ = ["COMMANDS", "main"]
 
@@ -232,7 +233,10 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
     try:
         with warnings.catch_warnings():  # library warnings: one line each, no source line
             warnings.showwarning = _show_warning
-            code: int = args._run(args)
+            # --memory-limit reaches every estimate, the readers' included (not only the
+            # ones a command passes it to)
+            with memory_limit(getattr(args, "memory_limit", None)):
+                code: int = args._run(args)
         return code
     except CsplabError as e:
         msg = readable(str(e)).strip().splitlines()

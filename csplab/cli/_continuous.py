@@ -173,7 +173,7 @@ def synthesize(
             settings[key] = (
                 f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
             )
-    if dim == 3 and "choice" not in opts and cls.option("choice") is not None:
+    if "choice" not in opts and cls.option("choice") is not None:
         o = cls.option("choice")
         if o is not None and (o.values is None or "weighted" in o.values):
             settings["choice"] = ("weighted (continuous default: by how much of the example "
@@ -262,6 +262,11 @@ def synthesize(
             # curved geometry back (the proxy is what was synthesized, not what it resembles)
             like = s.bounded.example if s.bounded is not None else snapped
             d["resemblance"] = resemblance3(like, s.model, ground=floor).to_dict()
+        elif isinstance(snapped, PolygonModel) and isinstance(s.model, PolygonModel):
+            from csplab.continuous.resemblance import resemblance2
+
+            floor = csp.region()[1] if "y-" in opened else None  # the ground's height
+            d["resemblance"] = resemblance2(snapped, s.model, ground=floor).to_dict()
         if s.bounded is not None:
             d["bounding_volumes"] = s.bounded.describe()
         print(json.dumps(d))

@@ -339,6 +339,7 @@ def example_signatures3(
     ground: Sequence[str] = (),
     coverage: dict[Labeling, int] | None = None,
     on_ground: dict[str, set[Labeling]] | None = None,
+    type_coverage: dict[tuple[int, Labeling], int] | None = None,
 ) -> set[Labeling]:
     """Every neighbourhood of ``example`` (labels compacted by ``index``) as a full labeling
     of the central cells: vertices and edges of its own arrangement (its bounding box plus
@@ -349,10 +350,14 @@ def example_signatures3(
     surface). ``coverage``, if given, receives how much of the example each neighbourhood
     covers: the number of vertices and edges of the arrangement inside the example's
     bounding box where it occurs (volume, area, length or a count of corners, in plane
-    spacings). ``on_ground``, if given, receives per ``ground`` face the neighbourhoods
-    at the example's vertices and edges on that face of its box, and empty space (what
-    the output may have on the region's face: its bottom layer is like the example's, or
-    bare ground)."""
+    spacings). ``type_coverage``, if given, receives the same counts per kind of point:
+    ``(planes, labeling)`` with ``planes`` the bit mask of the plane families through the
+    vertex or containing the edge. ``on_ground``, if given, receives per ``ground`` face
+    the neighbourhoods at the example's vertices and edges on that face of its box, and
+    empty space (what the output may have on the region's face: its bottom layer is like
+    the example's, or bare ground, unless a face perpendicular to it is open too: then
+    the example is a window onto an endless ground and the face shows only its own
+    neighbourhoods)."""
     pts = np.concatenate([np.asarray(s.vertices, dtype=np.float64) for s in example.solids])
     lo = np.floor(lattice.to_lattice(pts).min(axis=0) + 1e-9)
     hi = np.ceil(lattice.to_lattice(pts).max(axis=0) - 1e-9)
@@ -382,12 +387,14 @@ def example_signatures3(
     Lall = _local_labels(A, epos[esel], efam, tris, index, clamp)
     L, which = _unique_rows(Lall)  # few distinct edge labelings
     sigs |= set(map(tuple, L.tolist()))
-    if coverage is not None or (ground and on_ground is not None):
+    if coverage is not None or type_coverage is not None or (ground and on_ground is not None):
         compact = np.zeros(max(index) + 1, dtype=np.int64)
         for b, i in index.items():
             compact[b] = i
         tol = 1e-9
-        for pos, on, found in ((vpos, von, vsigs), (epos, eon, Lall)):
+        bits = 1 << np.arange(A.F, dtype=np.int64)
+        for pos, on, found, kind in ((vpos, von, vsigs, A.on.astype(np.int64) @ bits),
+                                     (epos, eon, Lall, efam_all.astype(np.int64) @ bits)):
             inside = ((pos >= clamp[0] - tol) & (pos <= clamp[1] + tol)).all(axis=1)
             # every point inside the box: its labeling (uniform off the face planes)
             rows = np.empty((len(pos), len(signs)), dtype=np.int64)
@@ -399,13 +406,25 @@ def example_signatures3(
                 counts = np.bincount(inv, minlength=len(u))
                 for r, c in zip(map(tuple, u.tolist()), counts.tolist(), strict=True):
                     coverage[r] = coverage.get(r, 0) + int(c)
+            if type_coverage is not None:  # the same, per kind of point (planes through it)
+                keyed = np.column_stack([kind[inside], rows[inside]])
+                u, inv = _unique_rows(keyed)
+                counts = np.bincount(inv, minlength=len(u))
+                for r, c in zip(u.tolist(), counts.tolist(), strict=True):
+                    key = (int(r[0]), tuple(int(x) for x in r[1:]))
+                    type_coverage[key] = type_coverage.get(key, 0) + int(c)
             for face in ground:
                 if on_ground is None:
                     break
                 a = "xyz".index(face[0])
                 at = clamp[1][a] if face[1] == "+" else clamp[0][a]
                 at_face = inside & (np.abs(pos[:, a] - at) <= tol)
-                seen = on_ground.setdefault(face, {(0,) * len(signs)})  # bare ground
+                # bare ground (empty space on the face) is added, so that objects standing
+                # on it may stand apart, unless the example is also open across the face
+                # (a window: a face perpendicular to it is open too, so the face cuts
+                # through an endless ground and shows only what it has)
+                window = any(f[0] != face[0] for f in ground)
+                seen = on_ground.setdefault(face, set() if window else {(0,) * len(signs)})
                 seen.update(map(tuple, _unique_rows(rows[at_face])[0].tolist()))
     # faces beside each edge: in each plane through the edge, both half-planes; the cells
     # whose label a face takes depend only on the edge's planes and line (one index map)
@@ -498,9 +517,12 @@ class ContinuousCSP3:
         #: per ground face, the example's neighbourhoods on that face of its box: the only
         #: ones a vertex or edge on that face of the region may take
         self.on_ground: dict[str, set[Labeling]] = {}
+        #: the same per kind of point, ``(planes, labeling)``: the weights of a vertex or
+        #: edge type are the counts among the example's points on the same planes
+        self.type_coverage: dict[tuple[int, Labeling], int] = {}
         self.signatures = example_signatures3(example, self.lattice, index, max_memory,
                                               self.ground, self.coverage,
-                                              self.on_ground)  # fmt: skip
+                                              self.on_ground, self.type_coverage)  # fmt: skip
         self.arrangement = Arrangement3(self.lattice, size, max_memory=max_memory,
                                         where=example.source)  # fmt: skip
         self._types(index)
@@ -518,8 +540,13 @@ class ContinuousCSP3:
         """The vertex and edge types (planes through them, region sides they lie on) with
         their states, cell groups and outside labels (Sec. 4.5.4)."""
         sig = np.array(sorted(self.signatures), dtype=np.int64)
-        cover = np.array([self.coverage.get(tuple(int(x) for x in r), 0) for r in sig.tolist()],
-                         dtype=np.float64)  # fmt: skip
+        sig_keys = [tuple(int(x) for x in r) for r in sig.tolist()]
+        cover = np.array([self.coverage.get(r, 0) for r in sig_keys], dtype=np.float64)
+        by_kind: dict[int, NDArray[np.float64]] = {}  # planes -> counts per row of sig
+        row_of = {r: k for k, r in enumerate(sig_keys)}
+        for (mask, lab), c in self.type_coverage.items():
+            if lab in row_of:
+                by_kind.setdefault(mask, np.zeros(len(sig_keys)))[row_of[lab]] += c
         A = self.arrangement
         signs, _ = A.cells
         F, N = A.F, A.normals
@@ -588,9 +615,14 @@ class ContinuousCSP3:
             found = sorted({tuple(int(x) for x in row) for row in local[ok]},
                            key=lambda st: (any(st), st))  # fmt: skip
             # Sec. 4.5.4's states, each weighted by the example it covers (+1: every state
-            # stays possible): the neighbourhoods that look like it here
+            # stays possible): how often the example's points on the same planes have it
+            # (a rock's corner among the vertices where its planes meet, not among every
+            # point of the flat ground, of any planes); all its points where the example
+            # has none on these planes
+            mask = int((1 << fams).sum()) if len(fams) else 0
+            here = by_kind.get(mask, cover)
             w = dict.fromkeys(found, 1.0)
-            for row, c in zip(local[ok].tolist(), cover[ok].tolist(), strict=True):
+            for row, c in zip(local[ok].tolist(), here[ok].tolist(), strict=True):
                 w[tuple(row)] += c
             weights.append(np.array([w[st] for st in found], dtype=np.float64))
             return found, (g, ng, out)

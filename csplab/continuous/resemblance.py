@@ -1,5 +1,6 @@
-"""How much a synthesized polyhedral model resembles its example: a few figures computed
-from the geometry alone (no planes, lattice or CSP), to read beside Eq. 4.1's violations.
+"""How much a synthesized polyhedral (or polygon) model resembles its example: a few
+figures computed from the geometry alone (no planes, lattice or CSP), to read beside Eq.
+4.1's violations.
 
 :func:`resemblance3` gives, for an example and an output
 (:class:`~csplab.continuous.polyhedra.PolyhedralModel`):
@@ -20,6 +21,13 @@ from the geometry alone (no planes, lattice or CSP), to read beside Eq. 4.1's vi
   of another solid that faces upwards. Floating solids in an output of an example without
   any are a defect a human sees at once.
 
+:func:`resemblance2` gives the same figures for polygon models
+(:class:`~csplab.continuous.model.PolygonModel`), one dimension down: polygons for
+solids, areas for volumes, corners for edges (the pair of edge directions meeting at a
+corner of each label's union, shapely, and whether the corner is convex or reflex),
+edge directions (outward normals) for face orientations, and ``y`` for up (a polygon
+rests on the ground, the model's lowest ``y``, or on an upward-facing edge of another).
+
 Examples
 --------
 >>> from csplab.continuous.polyhedra import PolyhedralModel
@@ -37,6 +45,15 @@ Examples
 (3, 1, 0, 1.0, 1.0)
 >>> r.median_volume_ratio
 0.25
+>>> from csplab.continuous.model import PolygonModel
+>>> ex2 = PolygonModel.from_json({"polygons": [
+...     {"label": 1, "points": [[0, 0], [4, 0], [4, 2], [0, 2]]}]})
+>>> out2 = PolygonModel.from_json({"polygons": [
+...     {"label": 1, "points": [[0, 0], [4, 0], [4, 2], [0, 2]]},
+...     {"label": 1, "points": [[6, 3], [7, 3], [6, 4]]}]})
+>>> r2 = resemblance2(ex2, out2)
+>>> r2.solids, r2.floating, r2.face_orientations, r2.edge_kinds, r2.median_volume_ratio
+(2, 1, 1.0, 1.0, 0.53125)
 """
 
 from __future__ import annotations
@@ -48,10 +65,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
 
-__all__ = ["Resemblance", "edge_kinds", "floating_solids", "resemblance3"]
+__all__ = [
+    "Resemblance",
+    "corner_kinds",
+    "edge_kinds",
+    "floating_polygons",
+    "floating_solids",
+    "resemblance2",
+    "resemblance3",
+]
 
 #: normals closer than this (radians) are one face orientation
 ANGLE_TOL = 1e-3
@@ -59,7 +85,9 @@ ANGLE_TOL = 1e-3
 
 @dataclass(frozen=True)
 class Resemblance:
-    """The figures of :func:`resemblance3` (see the module docstring)."""
+    """The figures of :func:`resemblance3` and :func:`resemblance2` (see the module
+    docstring; for polygons ``solids`` counts polygons, volumes are areas, edge kinds are
+    corner kinds and face orientations are edge directions)."""
 
     solids: int
     example_solids: int
@@ -244,4 +272,153 @@ def resemblance3(
         example_face_orientations=len(ex_faces),
         floating=len(floating_solids(output, ground)),
         example_floating=len(floating_solids(example)),
+    )
+
+
+# ---------------------------------------------------------------------------- polygons
+def _rings2(model: PolygonModel) -> list[NDArray[np.float64]]:
+    """The rings of each label's union (shapely), interior on the left of each (exterior
+    counter-clockwise, holes clockwise), without a repeated closing point."""
+    from shapely import unary_union
+    from shapely.geometry import Polygon as ShapelyPolygon
+    from shapely.geometry.polygon import orient
+
+    out = []
+    for b in model.labels:
+        u = unary_union([p.shape for p in model.polygons if p.label == b])
+        parts = list(getattr(u, "geoms", [u]))
+        for g in parts:
+            if not isinstance(g, ShapelyPolygon) or g.is_empty:
+                continue
+            g = orient(g, 1.0)
+            for ring in (g.exterior, *g.interiors):
+                out.append(np.asarray(ring.coords, dtype=np.float64)[:-1])
+    return out
+
+
+def corner_kinds(
+    model: PolygonModel, normals: _Normals, grow: bool = True
+) -> tuple[set[tuple[int, int, bool]], set[int]]:
+    """The model's corner kinds ``(direction, direction, convex)`` (the outward normals
+    of the two edges meeting at a corner of a label's union, as clusters of ``normals``,
+    sorted) and its edge directions (new clusters added when ``grow``; otherwise an
+    unknown direction is ``-1``). Collinear points make no corner."""
+    kinds: set[tuple[int, int, bool]] = set()
+    dirs: set[int] = set()
+    for r in _rings2(model):
+        e = np.roll(r, -1, axis=0) - r  # edge k: point k -> point k + 1
+        ln = np.linalg.norm(e, axis=1)
+        ok = ln > 0
+        e, ln = e[ok], ln[ok]
+        if len(e) < 3:
+            continue
+        n = np.column_stack([e[:, 1] / ln, -e[:, 0] / ln, np.zeros(len(e))])  # outward
+        cid = normals.ids(n, grow)
+        dirs |= set(cid.tolist())
+        prev = np.roll(np.arange(len(e)), 1)
+        turn = e[prev, 0] * e[:, 1] - e[prev, 1] * e[:, 0]  # > 0: a left turn, convex
+        for a, c, t in zip(cid[prev].tolist(), cid.tolist(), turn.tolist(), strict=True):
+            if a != c:
+                kinds.add((min(a, c), max(a, c), t > 0))
+    return kinds, dirs
+
+
+def _segment_distance(p: NDArray[np.float64], A: NDArray[np.float64],
+                      B: NDArray[np.float64]) -> NDArray[np.float64]:  # fmt: skip
+    """The distance of point ``p`` to each segment ``A[k] B[k]`` (or of each point
+    ``p[k]`` to one segment ``A[0] B[0]``)."""
+    d = B - A
+    dd = (d * d).sum(axis=1)
+    t = np.clip(((p - A) * d).sum(axis=1) / np.maximum(dd, 1e-300), 0.0, 1.0)
+    q = A + t[:, None] * d
+    return np.asarray(np.linalg.norm(p - q, axis=1), dtype=np.float64)
+
+
+def floating_polygons(model: PolygonModel, ground: float | None = None) -> list[int]:
+    """The indices of the polygons that rest neither on the ground (``ground``, default
+    the model's lowest ``y``) nor on another polygon (an edge of it whose outward normal
+    points upwards touches the polygon's bottom: its lowest points and the edges between
+    them, so a slab on two posts rests on them), within ``1e-6`` of the model's
+    extent."""
+    polys = model.polygons
+    if not polys:
+        return []
+    x0, y0, x1, y1 = model.bounds
+    tol = 1e-6 * max(x1 - x0, y1 - y0, 1e-300)
+    pts = [np.asarray(p.points, dtype=np.float64) for p in polys]
+    lo = np.array([q[:, 1].min() for q in pts])
+    g = float(lo.min()) if ground is None else ground
+    As, Bs, owners = [], [], []
+    for k, p in enumerate(polys):
+        for ring in p.rings():  # interior on the left: an upward outward normal is -dx > 0
+            a = np.asarray(ring, dtype=np.float64)
+            b = np.roll(a, -1, axis=0)
+            up = b[:, 0] < a[:, 0]
+            As.append(a[up])
+            Bs.append(b[up])
+            owners.append(np.full(int(up.sum()), k, dtype=np.int64))
+    A, B, owner = np.concatenate(As), np.concatenate(Bs), np.concatenate(owners)
+    out = []
+    for i, q in enumerate(pts):
+        if abs(lo[i] - g) <= tol:
+            continue
+        near = (owner != i) & (np.minimum(A[:, 1], B[:, 1]) <= lo[i] + tol) & (
+            np.maximum(A[:, 1], B[:, 1]) >= lo[i] - tol)  # fmt: skip
+        a, b = A[near], B[near]
+        bottom = q[:, 1] <= lo[i] + tol  # the bottom: its points, and edges between two
+        r = np.roll(q, -1, axis=0)
+        segs = [(p, p) for p in q[bottom]] + [
+            (u, w) for u, w, z in zip(q, r, bottom & np.roll(bottom, -1), strict=True) if z]
+        touch = len(a) > 0 and any(  # segments that do not cross: the nearest endpoints
+            min(_segment_distance(u, a, b).min(), _segment_distance(w, a, b).min(),
+                _segment_distance(a, u[None], w[None]).min(),
+                _segment_distance(b, u[None], w[None]).min()) <= tol
+            for u, w in segs)  # fmt: skip
+        if not touch:
+            out.append(i)
+    return out
+
+
+def resemblance2(
+    example: PolygonModel, output: PolygonModel, *, angle_tol: float = ANGLE_TOL,
+    ground: float | None = None,
+) -> Resemblance:
+    """The resemblance figures of polygon model ``output`` against ``example`` (module
+    docstring: :func:`resemblance3` one dimension down).
+
+    Parameters
+    ----------
+    example, output : PolygonModel
+        The example and a synthesized model (any polygon models).
+    angle_tol : float
+        Edge normals closer than this many radians are one edge direction.
+    ground : float, optional
+        The ``y`` of the output's ground (a synthesis with a ground below: the region's
+        bottom); default the output's lowest ``y``. The example's ground is its own lowest
+        ``y``.
+
+    Returns
+    -------
+    Resemblance
+        The figures (polygons, areas, corner kinds, edge directions).
+    """
+    normals = _Normals(angle_tol)
+    ex_kinds, ex_dirs = corner_kinds(example, normals, grow=True)
+    out_kinds, out_dirs = (
+        corner_kinds(output, normals, grow=False) if output.polygons else (set(), set())
+    )
+    ex_area, out_area = (
+        float(np.median([p.shape.area for p in m.polygons])) if m.polygons else 0.0
+        for m in (example, output)
+    )
+    return Resemblance(
+        solids=len(output.polygons),
+        example_solids=len(example.polygons),
+        median_volume_ratio=out_area / ex_area if ex_area > 0 else 0.0,
+        edge_kinds=len(ex_kinds & out_kinds) / len(ex_kinds) if ex_kinds else 1.0,
+        example_edge_kinds=len(ex_kinds),
+        face_orientations=len(ex_dirs & out_dirs) / len(ex_dirs) if ex_dirs else 1.0,
+        example_face_orientations=len(ex_dirs),
+        floating=len(floating_polygons(output, ground)),
+        example_floating=len(floating_polygons(example)),
     )

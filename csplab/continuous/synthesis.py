@@ -73,13 +73,14 @@ def auto_ground(
 def default_choice(problem: Any, solver: str) -> str | None:
     """The label choice continuous synthesis gives ``solver`` when the caller names none:
     ``"weighted"`` when the problem weighs its values per cell (``value_weights``, the
-    CSP's coverage of the example) and is a 3D one, and the solver takes that choice, else
-    ``None`` (the solver's own default). Polygon models (2D) keep the thesis' uniform
-    choice by default (their built-in outputs stay as published); ``choice="weighted"``
-    gives them the coverage weights too."""
+    CSP's coverage of the example; polygon and polyhedral models alike) and the solver
+    takes that choice, else ``None`` (the solver's own default). ``choice="uniform"`` is
+    the thesis' equal choice. On the built-in polygon examples the weighted choice solves
+    as often or more often, gives fewer, larger polygons and keeps every corner kind and
+    edge direction (``python benchmarks/bench_resemblance.py --polygons``)."""
     from csplab.solvers import solver_class
 
-    if getattr(problem, "value_weights", None) is None or problem.meta.get("dim") != 3:
+    if getattr(problem, "value_weights", None) is None:
         return None
     o = solver_class(solver.partition(":")[0]).option("choice")
     return "weighted" if o is not None and (o.values is None or "weighted" in o.values) else None
@@ -234,7 +235,7 @@ def synthesize(
     **options
         Solver options (``time_limit=``, ``order=``, ``block=`` ...), passed to
         :func:`csplab.solvers.solve`. ``choice`` defaults to ``"weighted"`` for a solver
-        that takes it when the CSP weighs its states (3D: by the example each state covers,
+        that takes it when the CSP weighs its states (by the example each state covers,
         :func:`default_choice`); ``choice="uniform"`` is the thesis' choice.
 
     Returns

@@ -128,12 +128,12 @@ def test_a_million_faces_over_the_memory_budget_is_one_line_before_reading(
 ):
     # the faces' memory (4 kB each) is estimated from the counts and refused in one line
     # naming the number, before a face is read (a machine whose budget is 1 GB)
-    import csplab.io.mesh_repair as repair
+    import csplab.io.meshes as meshes  # (the reader's own name of the first repair)
     import csplab.limits
 
     monkeypatch.setattr(csplab.limits, "memory_budget", lambda limit_gb=None: 1e9)
     read = []
-    monkeypatch.setattr(repair, "merge_duplicates", lambda *a: read.append(1))
+    monkeypatch.setattr(meshes, "merge_duplicates", lambda *a: read.append(1))
     p = make(tmp_path)
     out = tmp_path / "out.obj"
     code, _, err = run(capsys, "synthesize", str(p), "--size", "10x10x5", "--seed", "1",
@@ -144,6 +144,45 @@ def test_a_million_faces_over_the_memory_budget_is_one_line_before_reading(
         f"csplab: error: {p}: reading 1000000 faces would need about 4.1 GB, over the memory "
         "budget of 1.0 GB: simplify the mesh first, or raise --memory-limit"
     ]
+
+
+def test_memory_limit_reaches_the_mesh_readers_lowering_the_budget(tmp_path, capsys):
+    # --memory-limit is the readers' budget too: a mesh of a few faces over the limit
+    # (10 kB) is refused while reading (the faces named), not later by synthesis' estimate
+    from csplab.io.mesh_repair import BYTES_PER_FACE
+
+    p = cad.export(cad.build("tetra"), tmp_path / "t.stl")
+    n = int.from_bytes(p.read_bytes()[80:84], "little")
+    assert n * BYTES_PER_FACE > 10e3
+    code, _, err = run(capsys, "synthesize", str(p), "--size", "4x4x2", "--seed", "1",
+                       "--memory-limit", "0.00001")  # fmt: skip
+    assert code == 2
+    assert err.strip().splitlines() == [
+        f"csplab: error: {p}: reading {n} faces would need about {n * BYTES_PER_FACE / 1e3:.0f} "
+        "kB, over the memory budget of 10 kB: simplify the mesh first, or raise --memory-limit"
+    ]
+
+
+def test_memory_limit_reaches_the_mesh_readers_raising_the_budget(tmp_path, capsys, monkeypatch):
+    # a machine whose default budget (1 GB) refuses a million faces reads them under
+    # --memory-limit 5 (the reading stopped at its first repair)
+    import csplab.io.meshes as meshes
+    import csplab.limits
+    from csplab.errors import InputError
+
+    monkeypatch.setattr(csplab.limits, "total_ram", lambda: 2e9)
+    monkeypatch.setattr(csplab.limits, "available_memory", lambda: 10**9)
+
+    def stop(*a):
+        raise InputError("read past the count")
+
+    monkeypatch.setattr(meshes, "merge_duplicates", stop)
+    p = _million(tmp_path)
+    code, _, err = run(capsys, "synthesize", str(p), "--size", "10x10x5", "--seed", "1")
+    assert code == 2 and "over the memory budget of 1.0 GB" in err
+    code, _, err = run(capsys, "synthesize", str(p), "--size", "10x10x5", "--seed", "1",
+                       "--memory-limit", "5")  # fmt: skip
+    assert code == 2 and err.strip().splitlines()[-1] == "csplab: error: read past the count"
 
 
 @pytest.mark.parametrize("name", ["engraved", "holes", "slanted", "tetra"])

@@ -121,9 +121,19 @@ def test_weighted_choice_moves_edge_frequencies_toward_coverage(seed: int) -> No
     assert abs(share["weighted"] - example) < abs(share["uniform"] - example)
 
 
-def test_uniform_stays_the_2d_default() -> None:
-    from csplab.continuous.synthesis import default_choice
+def test_weighted_is_the_2d_default_as_in_3d() -> None:
+    from csplab.continuous.synthesis import default_choice, synthesize
 
     C = ContinuousCSP(TOWERS, (6, 4))
-    assert C.problem.value_weights is not None  # the weights are there for --choice weighted
-    assert default_choice(C.problem, "catalog") is None
+    assert C.problem.value_weights is not None
+    assert default_choice(C.problem, "catalog") == "weighted"
+    assert default_choice(C.problem, "sat") == "weighted"
+    # a solver without a weighted choice keeps its own
+    assert default_choice(C.problem, "asp") is None
+    # the default run is the weighted one, not the uniform one
+    runs = {k: synthesize(TOWERS, (24, 16), rng=2, **kw).model
+            for k, kw in (("default", {}), ("weighted", {"choice": "weighted"}),
+                          ("uniform", {"choice": "uniform"}))}  # fmt: skip
+    assert runs["default"] is not None and runs["uniform"] is not None
+    assert runs["default"].to_json() == runs["weighted"].to_json()
+    assert runs["default"].to_json() != runs["uniform"].to_json()

@@ -90,11 +90,43 @@ def test_window_terrain_is_one_ground_with_rocks() -> None:
     assert s.ok and s.model is not None and s.csp.ground == WINDOW
     slab = [sol for sol in s.model.solids if sol.label == 1]
     assert floating_solids(s.model, s.csp.region()[2]) == []
-    if slab:  # a ground in the region: one piece spanning it
-        assert len(slab) == 1
-        b = np.array(s.model.bounds)
-        lo, hi = slab[0].vertices.min(axis=0), slab[0].vertices.max(axis=0)
-        assert np.allclose(lo[:2], b[:2]) and np.allclose(hi[:2], b[3:5])
+    assert len(slab) == 1  # a ground in the region: one piece spanning it
+    b = np.array(s.model.bounds)
+    lo, hi = slab[0].vertices.min(axis=0), slab[0].vertices.max(axis=0)
+    assert np.allclose(lo[:2], b[:2]) and np.allclose(hi[:2], b[3:5])
+
+
+def test_a_window_shows_no_bare_ground_and_a_ground_below_does() -> None:
+    """Through a window (terrain: open below and on every side) the bottom face cuts an
+    endless slab: the region's bottom may only have what the example's has (no empty
+    bottom, so no output without its ground); objects on a ground below only (skyscrapers)
+    may stand apart: bare ground is one of their bottom's neighbourhoods."""
+    T = ContinuousCSP3(load_polyhedral_example("terrain"), (4, 4, 3), ground="window")
+    S = ContinuousCSP3(load_polyhedral_example("skyscrapers"), (4, 4, 3), ground="z-")
+    assert T.ground == WINDOW and S.ground == ("z-",)
+    empty_t, empty_s = (0,) * len(next(iter(T.signatures))), (0,) * len(next(iter(S.signatures)))
+    assert empty_t not in T.on_ground["z-"] and empty_s in S.on_ground["z-"]
+    assert empty_t in T.on_ground["x-"]  # the air above the slab, seen on the window's side
+
+
+def test_window_terrain_keeps_its_ground_and_its_rocks() -> None:
+    """Seeds 0-7 at 10x10x6: every output has the one ground slab, and rocks stand on it in
+    most (weights counted among the example's points on the same planes: a rock's corner
+    is weighed against the flat ground at points where the rock's planes meet, not
+    against every flat point). Measured 8/8 slabs and 5/8 with rocks; with the weights
+    summed over every kind of point and bare ground in the window, 6/8 and 0/8."""
+    from csplab.solvers import solve
+
+    T = load_polyhedral_example("terrain")
+    s = synthesize(T, (10, 10, 6), rng=0, restarts=5, check=False)
+    slabs, rocks = 0, 0
+    for seed in range(8):
+        r = solve(s.csp.problem, "catalog", rng=seed, restarts=5, choice="weighted")
+        assert r.ok
+        m = s.csp.model(r.grid)
+        slabs += sum(1 for sol in m.solids if sol.label == 1) == 1
+        rocks += any(sol.label == 2 for sol in m.solids)
+    assert slabs == 8 and rocks >= 3, (slabs, rocks)
 
 
 # ---------------------------------------------------------------------------- weights
@@ -132,8 +164,10 @@ def _coverage_loglik(P: Problem, grid: np.ndarray) -> float:
 
 def test_weighted_histogram_moves_toward_coverage() -> None:
     """Fixed seeds: the states weighted choice picks are likelier under the example's
-    coverage than the uniform choice's, on every seed, by a margin (measured margins
-    0.03-0.11 on houses 10x10x6, seeds 0-3)."""
+    coverage than the uniform choice's, on average by a margin and on most seeds
+    (houses 10x10x6, seeds 0-3: measured margins 0.049, -0.001, 0.032, 0.023 with the
+    weights counted among points on the same planes; 0.03-0.11 when they were summed
+    over every kind of point, a more peaked distribution)."""
     E = load_polyhedral_example("houses")
     ll: dict[str, list[float]] = {"weighted": [], "uniform": []}
     solids: dict[str, list[int]] = {"weighted": [], "uniform": []}
@@ -143,8 +177,8 @@ def test_weighted_histogram_moves_toward_coverage() -> None:
             assert s.result.ok and s.model is not None
             ll[choice].append(_coverage_loglik(s.csp.problem, s.result.grid))
             solids[choice].append(len(s.model.solids))
-    for w, u in zip(ll["weighted"], ll["uniform"], strict=True):
-        assert w > u + 0.02, ll
+    assert np.mean(ll["weighted"]) > np.mean(ll["uniform"]) + 0.01, ll
+    assert sum(w > u for w, u in zip(ll["weighted"], ll["uniform"], strict=True)) >= 3, ll
     # fewer, larger houses (the example is one house, not a heap of small pieces)
     assert sum(solids["weighted"]) < sum(solids["uniform"])
 
