@@ -72,6 +72,8 @@ from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
+import numpy as np
+
 from csplab.errors import InputError
 
 __all__ = ["check_certificate", "load_certificate", "rules_hash"]
@@ -310,12 +312,14 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     ]  # fmt: skip
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
-    nstates = 0
-    # shared by every configuration: support sets, frames (configurations that differ only
-    # in which frame edges lie on a face have the same frame) and catalogs
+    # shared by every configuration: frames (configurations that differ only in which
+    # frame edges lie on a face have the same frame), domains and catalogs
     memo = _Memo()
-    for c, (_, _, a, b) in zip(configs, got, strict=True):
-        nstates += _check_config(c, region, back, axes, fwd, bwd, used, face_rules, a, b, memo)
+    plans = [
+        _check_config(c, region, back, axes, used, face_rules, a, b, memo)
+        for c, (_, _, a, b) in zip(configs, got, strict=True)
+    ]
+    nstates = _check_states(configs, plans, fwd, bwd, used, memo)
     rtxt = "x".join(map(str, region)) + (
         "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
     )
@@ -326,44 +330,161 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     )
 
 
+class _Frame:
+    """The frame of a configuration, its ``keys`` verified, as arrays over its ``P`` cells
+    (C order of the box of extent ``ext``) and its ``n`` steps (the frame's cells in scan
+    order, the point last): the step's region (``box``), the cells labelled before it
+    (``rank < step``), where each cell's label sits in the step's state (``keypos``, -1:
+    not recorded), the step's cell (``cell``) and its labelled backward neighbours
+    (``near``). The small graph of a step is built only when a state needs arc consistency.
+    """
+
+    def __init__(
+        self,
+        lo: Cell,
+        hi: Cell,
+        keys: list[list[int]],
+        region: list[int],
+        back: list[int],
+        axes: tuple[int, ...],
+        where: str,
+    ) -> None:
+        ndim = len(lo)
+        ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
+        coords = np.indices(ext).reshape(ndim, -1).T  # (P, ndim), C order
+        P = len(coords)
+        ax = list(axes)
+        rank = np.ravel_multi_index(tuple(coords[:, ax].T), tuple(ext[a] for a in ax))
+        q = int(np.ravel_multi_index(tuple(lo[a] for a in ax), tuple(ext[a] for a in ax)))
+        n = q + 1  # the cells before the point in scan order, then the point
+        cell = np.argsort(rank)[:n]  # the P index of each step's cell
+        if len(keys) != n or keys[0]:
+            raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
+        prev: set[int] = set()
+        for i, k in enumerate(keys):
+            if k != sorted(set(k)) or any(not 0 <= j < i for j in k):
+                raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
+            if i and not set(k) <= prev | {i - 1}:
+                raise _Invalid(f"{where}: keys[{i}] records a label step {i - 1} forgot")
+            prev = set(k)
+        lens = np.array([len(k) for k in keys], dtype=np.int64)
+        flat = np.array([j for k in keys for j in k], dtype=np.int64)
+        rows = np.repeat(np.arange(n), lens)
+        slot = np.arange(len(flat)) - np.repeat(np.cumsum(lens) - lens, lens)
+        keypos = np.full((n, P), -1, dtype=np.int64)
+        keypos[rows, cell[flat]] = slot
+        # the region of each step's cell, clipped to the frame
+        at = coords[cell]  # (n, ndim)
+        blo = np.maximum(at - np.array(back), 0)
+        bhi = np.minimum(at + np.array(region) - 2, np.array(ext) - 1)
+        box = ((coords[None] >= blo[:, None]) & (coords[None] <= bhi[:, None])).all(-1)
+        done = rank[None, :] < np.arange(n)[:, None]
+        # a labelled cell of the region bordering one not yet labelled must be recorded
+        free = (box & ~done).reshape((n, *ext))
+        near_free = np.zeros_like(free)
+        for d in range(ndim):
+            a, b = [slice(None)] * (ndim + 1), [slice(None)] * (ndim + 1)
+            a[d + 1], b[d + 1] = slice(1, None), slice(None, -1)
+            near_free[tuple(a)] |= free[tuple(b)]
+            near_free[tuple(b)] |= free[tuple(a)]
+        miss = box & done & near_free.reshape(n, P) & (keypos < 0)
+        if miss.any():
+            i, x = (int(t) for t in np.argwhere(miss)[0])
+            raise _Invalid(
+                f"{where}: step {i} depends on cell {coords[x].tolist()}, not in keys[{i}]"
+            )
+        self.ext, self.n, self.coords, self.rank = ext, n, coords, rank
+        self.keys, self.cell, self.box, self.done, self.keypos = keys, cell, box, done, keypos
+        # the labelled backward (-1) and forward (+1) neighbours of each step's cell in its
+        # region: (slot in the state, table 2d + (1 if the neighbour is + else 0)), or the
+        # slot 0 and the table 2 ndim (every label) when there is none
+        near_pos, near_tab = [], []
+        steps = np.arange(n)
+        for d in range(ndim):
+            for s in (-1, 1):
+                y = at.copy()
+                y[:, d] += s
+                inside = (y[:, d] >= 0) & (y[:, d] < ext[d])
+                yi = np.ravel_multi_index(tuple(np.clip(y, 0, np.array(ext) - 1).T), ext)
+                ok = inside & box[steps, yi] & done[steps, yi]
+                near_pos.append(np.where(ok, keypos[steps, yi], 0))
+                near_tab.append(np.where(ok, 2 * d + (s > 0), 2 * ndim))
+        self.near_pos = np.stack(near_pos, 1)
+        self.near_tab = np.stack(near_tab, 1)
+        self.graphs: dict[int, tuple[_Graph, list[int], list[int]]] = {}
+
+    def nxt(self, width: int) -> Any:
+        """Per step, where each label of the next state comes from: a slot of the state,
+        ``width`` (the label just chosen) or ``width + 1`` (padding)."""
+        n, keys = self.n, self.keys
+        out = np.full((n, width), width + 1, dtype=np.int64)
+        for i in range(n - 1):
+            for k, j in enumerate(keys[i + 1]):
+                out[i, k] = width if j == i else self.keypos[i, self.cell[j]]
+        return out
+
+    def graph(self, i: int) -> tuple[_Graph, list[int], list[int]]:
+        """Step ``i``'s region as a small graph (:func:`_graph`), the slots of the state
+        holding its labelled nodes' labels and its nodes' cells (indices in ``coords``)."""
+        hit = self.graphs.get(i)
+        if hit is None:
+            cells = [tuple(c) for c in self.coords.tolist()]
+            at = {c: x for x, c in enumerate(cells)}
+            index = {cells[int(x)]: s for s, x in enumerate(self.cell)}
+            box = [cells[x] for x in np.flatnonzero(self.box[i])]
+            g = _graph(box, index, i, self.keys[i], cells[int(self.cell[i])])
+            pos = {j: k for k, j in enumerate(self.keys[i])}
+            hit = (g, [pos[j] for j in g[0] if j >= 0], [at[c] for c in g[3]])
+            self.graphs[i] = hit
+        return hit
+
+
+class _Plan(NamedTuple):
+    """A configuration to check: its frame (and the frame's id) and the domain of each of
+    the frame's cells before arc consistency (labels in use, edited by the face rules)."""
+
+    frame: _Frame
+    fid: int
+    bases: tuple[int, ...]
+
+
 def _check_config(
     conf: Mapping[str, Any],
     region: list[int],
     back: list[int],
     axes: tuple[int, ...],
-    fwd: list[list[int]],
-    bwd: list[list[int]],
     used: int,
     face_rules: list[FaceRule],
     at_lo: tuple[bool, ...],
     at_hi: tuple[bool, ...],
     memo: _Memo,
-) -> int:
+) -> _Plan:
+    """A configuration's frame (shared, keys verified) and its cells' domains."""
     lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
-    ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     keys = [list(k) for k in conf["keys"]]
-    where = f"configuration lower={list(lo)} upper={list(hi)}"
     fkey = (lo, hi, tuple(map(tuple, keys)))
-    frame = memo.frames.get(fkey)
-    if frame is None:
-        frame = memo.frames[fkey] = (
-            len(memo.frames),
-            _frame_graphs(lo, hi, ext, keys, region, back, axes, where),
-        )
-    gid, graphs = frame
-
-    def base(x: Cell) -> int:
-        on = frozenset(
-            {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
-            | {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
-        )
-        dom = memo.domains.get(on)
+    hit = memo.frames.get(fkey)
+    if hit is None:
+        where = f"configuration lower={list(lo)} upper={list(hi)}"
+        hit = memo.frames[fkey] = (len(memo.frames), _Frame(lo, hi, keys, region, back, axes, where))
+    fid, frame = hit
+    if not face_rules:
+        return _Plan(frame, fid, (used,) * len(frame.coords))
+    # the faces each cell lies on, as bits 2d (lower) and 2d + 1 (upper)
+    on = np.zeros(len(frame.coords), dtype=np.int64)
+    for d in range(len(lo)):
+        if at_lo[d]:
+            on |= (frame.coords[:, d] == 0) << (2 * d)
+        if at_hi[d]:
+            on |= (frame.coords[:, d] == frame.ext[d] - 1) << (2 * d + 1)
+    doms = []
+    for sig in on.tolist():
+        dom = memo.domains.get(sig)
         if dom is None:
-            dom = memo.domains[on] = _domain(face_rules, set(on), used)
-        return dom
-
-    bases = [tuple(base(x) for x in g[3]) for g in graphs]
-    return _check_states(conf, keys, graphs, bases, gid, fwd, bwd, used, memo, where)
+            faces = {_AXES[b // 2] + "-+"[b % 2] for b in range(2 * len(lo)) if sig >> b & 1}
+            dom = memo.domains[sig] = _domain(face_rules, faces, used)
+        doms.append(dom)
+    return _Plan(frame, fid, tuple(doms))
 
 
 class _Memo:
@@ -371,128 +492,204 @@ class _Memo:
 
     def __init__(self) -> None:
         self.union: dict[tuple[int, int, int], int] = {}
-        self.frames: dict[Any, tuple[int, list[_Graph]]] = {}
-        self.domains: dict[frozenset[str], int] = {}
-        self.catalogs: dict[Any, list[int]] = {}
+        self.frames: dict[Any, tuple[int, _Frame]] = {}
+        self.domains: dict[int, int] = {}
+        self.catalogs: dict[Any, int] = {}
 
 
 _Graph = tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]
 
-
-def _frame_graphs(
-    lo: Cell,
-    hi: Cell,
-    ext: Cell,
-    keys: list[list[int]],
-    region: list[int],
-    back: list[int],
-    axes: tuple[int, ...],
-    where: str,
-) -> list[_Graph]:
-    """The frame of a configuration, its ``keys`` verified, as one small graph per step."""
-
-    def order_key(c: Cell) -> Cell:
-        return tuple(c[a] for a in axes)
-
-    cells = sorted(itertools.product(*[range(e) for e in ext]), key=order_key)
-    cells = [c for c in cells if order_key(c) < order_key(lo)] + [lo]
-    index = {c: i for i, c in enumerate(cells)}
-    n = len(cells)
-    if len(keys) != n or keys[0]:
-        raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
-    boxes: list[list[Cell]] = []
-    for i, c in enumerate(cells):
-        if keys[i] != sorted(set(keys[i])) or any(not 0 <= j < i for j in keys[i]):
-            raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
-        if i + 1 < n and not set(keys[i + 1]) <= set(keys[i]) | {i}:
-            raise _Invalid(f"{where}: keys[{i + 1}] records a label step {i} forgot")
-        box = list(itertools.product(*[
-            range(max(0, c[d] - back[d]), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
-            for d in range(len(c))
-        ]))  # fmt: skip
-        inbox = set(box)
-        labelled = {x for x in box if x in index and index[x] < i}
-        for x in labelled:
-            near = ((*x[:d], x[d] + s, *x[d + 1 :]) for d in range(len(x)) for s in (-1, 1))
-            if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
-                raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
-        boxes.append(box)
-    return [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
+# bytes per state and label the array check holds at once, above which it refuses
+_MAX_BYTES = 2 << 30
 
 
 def _check_states(
-    conf: Mapping[str, Any],
-    keys: list[list[int]],
-    graphs: list[_Graph],
-    bases: list[tuple[int, ...]],
-    gid: int,
+    configs: Sequence[Mapping[str, Any]],
+    plans: list[_Plan],
     fwd: list[list[int]],
     bwd: list[list[int]],
     used: int,
     memo: _Memo,
-    where: str,
 ) -> int:
-    """The states of a configuration: present at the start, closed, never an empty point."""
-    n = len(graphs)
-    by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
-    try:
-        for i, labs in conf["states"]:
-            by_step[i if i >= 0 else n].add(tuple(labs))
-    except (IndexError, TypeError):
-        raise _Invalid(f"{where}: a state's step is not one of its {n} steps") from None
-    in_use = set(_bits(used))
-    for i, group in enumerate(by_step):
-        if any(len(t) != len(keys[i]) for t in group):
-            raise _Invalid(f"{where}: a state at step {i} does not fit keys[{i}]")
-        labels = set(itertools.chain.from_iterable(group))
-        if not labels <= in_use:
-            raise _Invalid(f"{where}: a state at step {i} has a label not in use")
-    if () not in by_step[0]:
-        raise _Invalid(f"{where}: no start state")
-    for i in range(n):
-        src, arcs, target, _ = graphs[i]
-        pos = {j: k for k, j in enumerate(keys[i])}
-        # where each fixed node's label, and each label of the next state, sits in a state
-        src_at = [pos[j] for j in src if j >= 0]
-        nxt_at = [-1 if j == i else pos[j] for j in keys[i + 1]] if i + 1 < n else []
-        later = by_step[i + 1] if i + 1 < n else set()
-        cats = memo.catalogs
-        here = (gid, i, bases[i])
-        # the labels of cell i that agree with its labelled neighbours: a superset of its
-        # catalog (arc consistency only removes more), enough when every one leads on
-        near = [(pos[src[v]], bwd[d] if plus else fwd[d]) for v, d, plus in arcs[target]
-                if src[v] >= 0]  # fmt: skip
-        base_t = bases[i][target]
-        for labs in by_step[i]:
-            if i < n - 1:
-                fc = base_t
-                for k, table in near:
-                    fc &= table[labs[k]]
-                if all(
-                    tuple([b if k < 0 else labs[k] for k in nxt_at]) in later for b in _bits(fc)
-                ):
-                    continue
-            mk = tuple([labs[k] for k in src_at])
-            cat = cats.get((here, mk))
+    """The states of every configuration, at once: present at the start, closed, never an
+    empty point. A *group* is a step of a configuration; each state is a row of labels
+    (padded with -1 to the widest state) in its group."""
+    K = len(fwd[0])
+    ndim = len(fwd)
+    width = max(len(k) for p in plans for k in p.frame.keys)
+    # per group: the group of the next step (-1 at the point), the state's width, the
+    # neighbours' slots and tables, the next state's slots, the domain of the step's cell
+    first, nexts, widths, npos, ntab, nxt, base, acid = [], [], [], [], [], [], [], []
+    nxt_of: dict[int, Any] = {}
+    ac_ids: dict[tuple[int, int, int], int] = {}
+    base_ids: dict[tuple[int, ...], int] = {}
+    ac_of: list[tuple[_Plan, int]] = []
+    G = 0
+    for p in plans:
+        f = p.frame
+        first.append(G)
+        nexts.extend(range(G + 1, G + f.n))
+        nexts.append(-1)
+        widths.extend(len(k) for k in f.keys)
+        npos.append(f.near_pos)
+        ntab.append(f.near_tab)
+        if p.fid not in nxt_of:
+            nxt_of[p.fid] = f.nxt(width)
+        nxt.append(nxt_of[p.fid])
+        base.extend(p.bases[x] for x in f.cell.tolist())
+        bid = base_ids.setdefault(p.bases, len(base_ids))
+        for i in range(f.n):
+            k = (p.fid, i, bid)
+            if k not in ac_ids:
+                ac_ids[k] = len(ac_of)
+                ac_of.append((p, i))
+            acid.append(ac_ids[k])
+        G += f.n
+    g_next, g_width, g_acid = (np.array(v, dtype=np.int64) for v in (nexts, widths, acid))
+    g_npos, g_ntab, g_nxt = (np.concatenate(v) for v in (npos, ntab, nxt))
+    bits = sorted(set(base))
+    g_base = np.searchsorted(bits, base)
+    base_rows = np.array([[b >> k & 1 for k in range(K)] for b in bits], dtype=bool)
+    # the states: group, labels
+    grp_parts, lens, flat = [], [], []
+    for c, (conf, p) in enumerate(zip(configs, plans, strict=True)):
+        sts = conf["states"]
+        steps = _ints([s[0] for s in sts])
+        if len(steps) and (steps.min() < 0 or steps.max() >= p.frame.n):
+            where = f"configuration lower={list(conf['lower'])} upper={list(conf['upper'])}"
+            raise _Invalid(f"{where}: a state's step is not one of its {p.frame.n} steps")
+        grp_parts.append(steps + first[c])
+        lens.extend(len(s[1]) for s in sts)
+        flat.extend(itertools.chain.from_iterable(s[1] for s in sts))
+    grp = np.concatenate(grp_parts) if grp_parts else np.zeros(0, dtype=np.int64)
+    N = len(grp)
+    if N * (K + width) * 24 > _MAX_BYTES:
+        raise InputError(
+            f"certificate: checking {N} states of {K} labels needs about "
+            f"{N * (K + width) * 24 / 1e9:.1f} GB, more than {_MAX_BYTES / 1e9:.1f} GB"
+        )
+    n_len = np.array(lens, dtype=np.int64)
+    labels = _ints(flat)
+
+    def where(g: int) -> str:
+        c = int(np.searchsorted(first, g, side="right")) - 1
+        conf = configs[c]
+        return f"configuration lower={list(conf['lower'])} upper={list(conf['upper'])}"
+
+    def state(r: int) -> list[Any]:
+        g = int(grp[r])
+        c = int(np.searchsorted(first, g, side="right")) - 1
+        return [g - first[c], labs[r, : g_width[g]].tolist()]
+
+    bad = np.flatnonzero(n_len != g_width[grp])
+    if len(bad):
+        g = int(grp[bad[0]])
+        c = int(np.searchsorted(first, g, side="right")) - 1
+        raise _Invalid(f"{where(g)}: a state at step {g - first[c]} does not fit keys[{g - first[c]}]")
+    in_use = np.array([used >> k & 1 for k in range(K)], dtype=bool)
+    if len(labels) and (labels.min() < 0 or labels.max() >= K or not in_use[labels].all()):
+        r = int(np.searchsorted(np.cumsum(n_len), np.flatnonzero(
+            (labels < 0) | (labels >= K) | ~in_use[np.clip(labels, 0, K - 1)])[0], side="right"))
+        g = int(grp[r])
+        c = int(np.searchsorted(first, g, side="right")) - 1
+        raise _Invalid(f"{where(g)}: a state at step {g - first[c]} has a label not in use")
+    inrow = np.arange(width)[None, :] < n_len[:, None]
+    labs = np.full((N, width), -1, dtype=np.int64)
+    labs[inrow] = labels
+    have = np.zeros(G, dtype=bool)
+    have[grp[n_len == 0]] = True  # a state of width 0 is the empty state
+    start = np.array(first, dtype=np.int64)
+    if not have[start].all():
+        raise _Invalid(f"{where(int(start[~have[start]][0]))}: no start state")
+    # the labels of each step's cell that agree with its labelled neighbours: a superset
+    # of its catalog (arc consistency only removes more), enough when every one leads on
+    tables = np.ones((2 * ndim + 1, K + 1, K), dtype=bool)
+    for d in range(ndim):
+        for t, table in ((2 * d, fwd[d]), (2 * d + 1, bwd[d])):
+            tables[t, :K] = [[b >> k & 1 for k in range(K)] for b in table]
+    fc = base_rows[g_base[grp]]
+    rows = np.arange(N)
+    for j in range(g_npos.shape[1]):
+        fc &= tables[g_ntab[grp, j], labs[rows, g_npos[grp, j]]]
+    last = g_next[grp] < 0
+    st, lab = np.nonzero(fc & ~last[:, None])
+    ext = np.concatenate(
+        [labs[st], lab[:, None], np.full((len(st), 1), -1, dtype=np.int64)], axis=1
+    )
+    cand = np.take_along_axis(ext, g_nxt[grp[st]], axis=1)
+    codes = _row_codes(np.concatenate([grp, g_next[grp[st]]]), np.concatenate([labs, cand]), K)
+    known = np.sort(codes[:N])
+    at = np.minimum(np.searchsorted(known, codes[N:]), max(N - 1, 0))
+    present = known[at] == codes[N:] if N else np.zeros(0, dtype=bool)
+    leads = np.zeros((N, K), dtype=bool)
+    leads[st[present], lab[present]] = True
+    # the rest need the catalog: arc consistency on the step's region, once per group
+    # kind (frame, step, domains) and labels of the region's labelled cells
+    need = np.flatnonzero(last | (fc & ~leads).any(1))
+    if len(need):
+        kinds = np.unique(g_acid[grp[need]])
+        slots = {int(a): ac_of[a][0].frame.graph(ac_of[a][1])[1] for a in kinds.tolist()}
+        S = max((len(v) for v in slots.values()), default=0)
+        gather = np.full((len(ac_of), S + 1), width, dtype=np.int64)  # width: padding
+        for a, v in slots.items():
+            gather[a, : len(v)] = v
+        padded = np.concatenate([labs[need], np.full((len(need), 1), -1)], axis=1)
+        mk = np.take_along_axis(padded, gather[g_acid[grp[need]]], axis=1)
+        _, which, inv = np.unique(
+            _row_codes(g_acid[grp[need]], mk, K), return_index=True, return_inverse=True
+        )
+        cats = np.zeros((len(which), K), dtype=bool)
+        for u, r in enumerate(which.tolist()):
+            a = int(g_acid[grp[need[r]]])
+            p, i = ac_of[a]
+            (src, arcs, target, _), at_slots, nodes = p.frame.graph(i)
+            key = (a, tuple(mk[r, : len(at_slots)].tolist()))
+            cat = memo.catalogs.get(key)
             if cat is None:
-                it = iter(mk)
-                dom = [b0 if j < 0 else 1 << next(it) for j, b0 in zip(src, bases[i], strict=True)]
+                it = iter(key[1])
+                dom = [p.bases[x] if j < 0 else 1 << next(it)
+                       for j, x in zip(src, nodes, strict=True)]  # fmt: skip
                 out = _small_ac(dom, arcs, fwd, bwd, memo.union)
-                cat = cats[(here, mk)] = [] if out is None else list(_bits(out[target]))
-            if i == n - 1:
-                if not cat:
-                    raise _Invalid(
-                        f"{where}: the point's catalog is empty in state {[i, list(labs)]}"
-                    )
-                continue
-            for b in cat:
-                nxt = tuple([b if k < 0 else labs[k] for k in nxt_at])
-                if nxt not in later:
-                    raise _Invalid(
-                        f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
-                        f"{[i + 1, list(nxt)]}, which is missing"
-                    )
-    return sum(len(s) for s in by_step)
+                cat = memo.catalogs[key] = 0 if out is None else out[target]
+            cats[u] = [cat >> k & 1 for k in range(K)]
+        cat_rows = cats[inv.reshape(-1)]
+        empty = last[need] & ~cat_rows.any(1)
+        if empty.any():
+            r = int(need[np.flatnonzero(empty)[0]])
+            raise _Invalid(f"{where(int(grp[r]))}: the point's catalog is empty in state {state(r)}")
+        open_ = ~last[need, None] & cat_rows & ~leads[need]
+        if open_.any():
+            k, b = (int(t) for t in np.argwhere(open_)[0])
+            r = int(need[k])
+            i, labs_r = state(r)
+            g = int(grp[r])
+            nx = [b if s == width else labs[r, s] for s in g_nxt[g, : g_width[g + 1]].tolist()]
+            raise _Invalid(
+                f"{where(g)}: not closed: state {[i, labs_r]} with label {b} leads to "
+                f"{[i + 1, [int(t) for t in nx]]}, which is missing"
+            )
+    return N
+
+
+def _ints(values: list[Any]) -> Any:
+    """``values`` as an int64 array; anything but integers is a malformed certificate."""
+    out = np.array(values) if values else np.zeros(0, dtype=np.int64)
+    if out.ndim != 1 or out.dtype.kind not in "iu":
+        raise _Invalid("a state's step or labels are not integers")
+    return out.astype(np.int64)
+
+
+def _row_codes(group: Any, rows: Any, K: int) -> Any:
+    """Exact int64 codes of ``(group, row)`` pairs (rows of labels -1 .. K - 1): equal
+    codes for equal pairs, ranked again whenever the next column would overflow."""
+    code = np.unique(group, return_inverse=True)[1].reshape(-1).astype(np.int64)
+    top = (1 << 62) // (K + 1)
+    for k in range(rows.shape[1]):
+        if len(code) and int(code.max()) >= top:
+            code = np.unique(code, return_inverse=True)[1].reshape(-1).astype(np.int64)
+        code = code * (K + 1) + (rows[:, k] + 1)
+    return code
+
 
 
 def _graph(
