@@ -68,6 +68,7 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -315,9 +316,19 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and catalogs
     memo = _Memo()
+    specs: list[tuple[Cell, Cell, list[list[int]]]] = []
+    fid_of: dict[Any, int] = {}
+    fids = []
+    for c in configs:
+        key = (tuple(c["lower"]), tuple(c["upper"]), tuple(map(tuple, c["keys"])))
+        if key not in fid_of:
+            fid_of[key] = len(specs)
+            specs.append((key[0], key[1], [list(k) for k in c["keys"]]))
+        fids.append(fid_of[key])
+    frames = _frames(specs, region, back, axes)
     plans = [
-        _check_config(c, region, back, axes, used, face_rules, a, b, memo)
-        for c, (_, _, a, b) in zip(configs, got, strict=True)
+        _check_config(frames[f], f, used, face_rules, a, b, memo)
+        for f, (_, _, a, b) in zip(fids, got, strict=True)
     ]
     nstates = _check_states(configs, plans, fwd, bwd, used, memo)
     rtxt = "x".join(map(str, region)) + (
@@ -330,113 +341,178 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     )
 
 
-class _Frame:
-    """The frame of a configuration, its ``keys`` verified, as arrays over its ``P`` cells
-    (C order of the box of extent ``ext``) and its ``n`` steps (the frame's cells in scan
-    order, the point last): the step's region (``box``), the cells labelled before it
-    (``rank < step``), where each cell's label sits in the step's state (``keypos``, -1:
-    not recorded), the step's cell (``cell``) and its labelled backward neighbours
-    (``near``). The small graph of a step is built only when a state needs arc consistency.
-    """
+class _Frame(NamedTuple):
+    """The frame of a configuration, its ``keys`` verified, as arrays over the ``P`` cells
+    of a box holding every frame of the certificate (C order; a frame's own box, of extent
+    ``ext``, sits at the origin) and its ``n`` steps (the frame's cells in scan order, the
+    point last): each step's region (``box``), the cells labelled before it (``done``),
+    where each cell's label sits in the step's state (``keypos``, -1: not recorded), the
+    step's cell (``cell``), its labelled backward neighbours (``near_pos``: slot in the
+    state, ``near_tab``: axis, or ``ndim`` for none), and where each label of the next
+    state comes from (``nxt_at`` step and slot, ``nxt_from`` slot or -1: the label the
+    step chooses). The small graph of a step is built only when a state needs arc
+    consistency (:func:`_step_graph`)."""
 
-    def __init__(
-        self,
-        lo: Cell,
-        hi: Cell,
-        keys: list[list[int]],
-        region: list[int],
-        back: list[int],
-        axes: tuple[int, ...],
-        where: str,
-    ) -> None:
-        ndim = len(lo)
-        ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
-        coords = np.indices(ext).reshape(ndim, -1).T  # (P, ndim), C order
-        P = len(coords)
-        ax = list(axes)
-        rank = np.ravel_multi_index(tuple(coords[:, ax].T), tuple(ext[a] for a in ax))
-        q = int(np.ravel_multi_index(tuple(lo[a] for a in ax), tuple(ext[a] for a in ax)))
-        n = q + 1  # the cells before the point in scan order, then the point
-        cell = np.argsort(rank)[:n]  # the P index of each step's cell
-        if len(keys) != n or keys[0]:
-            raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
-        prev: set[int] = set()
-        for i, k in enumerate(keys):
-            if k != sorted(set(k)) or any(not 0 <= j < i for j in k):
-                raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
-            if i and not set(k) <= prev | {i - 1}:
-                raise _Invalid(f"{where}: keys[{i}] records a label step {i - 1} forgot")
-            prev = set(k)
-        lens = np.array([len(k) for k in keys], dtype=np.int64)
-        flat = np.array([j for k in keys for j in k], dtype=np.int64)
-        rows = np.repeat(np.arange(n), lens)
-        slot = np.arange(len(flat)) - np.repeat(np.cumsum(lens) - lens, lens)
-        keypos = np.full((n, P), -1, dtype=np.int64)
-        keypos[rows, cell[flat]] = slot
-        # the region of each step's cell, clipped to the frame
-        at = coords[cell]  # (n, ndim)
-        blo = np.maximum(at - np.array(back), 0)
-        bhi = np.minimum(at + np.array(region) - 2, np.array(ext) - 1)
-        box = ((coords[None] >= blo[:, None]) & (coords[None] <= bhi[:, None])).all(-1)
-        done = rank[None, :] < np.arange(n)[:, None]
-        # a labelled cell of the region bordering one not yet labelled must be recorded
-        free = (box & ~done).reshape((n, *ext))
-        near_free = np.zeros_like(free)
-        for d in range(ndim):
-            a, b = [slice(None)] * (ndim + 1), [slice(None)] * (ndim + 1)
-            a[d + 1], b[d + 1] = slice(1, None), slice(None, -1)
-            near_free[tuple(a)] |= free[tuple(b)]
-            near_free[tuple(b)] |= free[tuple(a)]
-        miss = box & done & near_free.reshape(n, P) & (keypos < 0)
-        if miss.any():
-            i, x = (int(t) for t in np.argwhere(miss)[0])
-            raise _Invalid(
-                f"{where}: step {i} depends on cell {coords[x].tolist()}, not in keys[{i}]"
-            )
-        self.ext, self.n, self.coords, self.rank = ext, n, coords, rank
-        self.keys, self.cell, self.box, self.done, self.keypos = keys, cell, box, done, keypos
-        # the labelled backward (-1) and forward (+1) neighbours of each step's cell in its
-        # region: (slot in the state, table 2d + (1 if the neighbour is + else 0)), or the
-        # slot 0 and the table 2 ndim (every label) when there is none
-        near_pos, near_tab = [], []
-        steps = np.arange(n)
-        for d in range(ndim):
-            for s in (-1, 1):
-                y = at.copy()
-                y[:, d] += s
-                inside = (y[:, d] >= 0) & (y[:, d] < ext[d])
-                yi = np.ravel_multi_index(tuple(np.clip(y, 0, np.array(ext) - 1).T), ext)
-                ok = inside & box[steps, yi] & done[steps, yi]
-                near_pos.append(np.where(ok, keypos[steps, yi], 0))
-                near_tab.append(np.where(ok, 2 * d + (s > 0), 2 * ndim))
-        self.near_pos = np.stack(near_pos, 1)
-        self.near_tab = np.stack(near_tab, 1)
-        self.graphs: dict[int, tuple[_Graph, list[int], list[int]]] = {}
+    ext: Cell
+    n: int
+    coords: Any
+    keys: list[list[int]]
+    cell: Any
+    box: Any
+    done: Any
+    keypos: Any
+    near_pos: Any
+    near_tab: Any
+    nxt_at: tuple[Any, Any]
+    nxt_from: Any
+    graphs: dict[int, tuple[_Graph, list[int], list[int]]]
 
-    def nxt(self, width: int) -> Any:
-        """Per step, where each label of the next state comes from: a slot of the state,
-        ``width`` (the label just chosen) or ``width + 1`` (padding)."""
-        n, keys = self.n, self.keys
-        out = np.full((n, width), width + 1, dtype=np.int64)
-        for i in range(n - 1):
-            for k, j in enumerate(keys[i + 1]):
-                out[i, k] = width if j == i else self.keypos[i, self.cell[j]]
-        return out
 
-    def graph(self, i: int) -> tuple[_Graph, list[int], list[int]]:
-        """Step ``i``'s region as a small graph (:func:`_graph`), the slots of the state
-        holding its labelled nodes' labels and its nodes' cells (indices in ``coords``)."""
-        hit = self.graphs.get(i)
-        if hit is None:
-            cells = [tuple(c) for c in self.coords.tolist()]
-            at = {c: x for x, c in enumerate(cells)}
-            index = {cells[int(x)]: s for s, x in enumerate(self.cell)}
-            box = [cells[x] for x in np.flatnonzero(self.box[i])]
-            g = _graph(box, index, i, self.keys[i], cells[int(self.cell[i])])
-            pos = {j: k for k, j in enumerate(self.keys[i])}
-            hit = (g, [pos[j] for j in g[0] if j >= 0], [at[c] for c in g[3]])
-            self.graphs[i] = hit
-        return hit
+# cells x steps x frames the frame arrays hold at once
+_FRAME_CHUNK = 1 << 21
+
+
+def _frames(
+    specs: list[tuple[Cell, Cell, list[list[int]]]],
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+) -> list[_Frame]:
+    """The frames of ``(lower, upper, keys)``, verified together, in chunks."""
+    ndim = len(region)
+    exts = np.array([[a + 1 + b for a, b in zip(lo, hi, strict=True)] for lo, hi, _ in specs])
+    E = tuple(int(e) for e in exts.max(0))
+    P = math.prod(E)
+    per = max(1, _FRAME_CHUNK // (P * P))
+    out: list[_Frame] = []
+    for s in range(0, len(specs), per):
+        out += _frame_chunk(specs[s : s + per], exts[s : s + per], E, region, back, axes)
+    return out
+
+
+def _frame_chunk(
+    specs: list[tuple[Cell, Cell, list[list[int]]]],
+    ext: Any,
+    E: Cell,
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+) -> list[_Frame]:
+    ndim, F = len(E), len(specs)
+    coords = np.indices(E).reshape(ndim, -1).T  # (P, ndim), C order
+    P = len(coords)
+    ax = list(axes)
+    # each axis' stride in a frame's scan order (outermost axis first)
+    sc = np.ones((F, ndim), dtype=np.int64)
+    for k in range(ndim - 2, -1, -1):
+        sc[:, ax[k]] = sc[:, ax[k + 1]] * ext[:, ax[k + 1]]
+    valid = (coords[None] < ext[:, None]).all(-1)
+    rank = np.where(valid, (coords @ sc.T).T, P)
+    lo = np.array([s[0] for s in specs])
+    n = (lo * sc).sum(1) + 1  # the cells before the point in scan order, then the point
+    nmax = int(n.max())
+    cell = np.argsort(rank, axis=1, kind="stable")[:, :nmax]  # (F, nmax) each step's cell
+    steps = np.arange(nmax)
+    live = steps[None, :] < n[:, None]
+    fr, rows, slot, flat = [], [], [], []
+    for f, (lo_f, hi_f, keys) in enumerate(specs):
+        if len(keys) != n[f] or keys[0]:
+            raise _Invalid(f"{_where(lo_f, hi_f)}: keys must list {n[f]} steps, the first empty")
+        lens = list(map(len, keys))
+        fr.append(np.full(sum(lens), f))
+        rows.append(np.repeat(np.arange(len(keys)), lens))
+        slot.extend(itertools.chain.from_iterable(map(range, lens)))
+        flat.extend(itertools.chain.from_iterable(keys))
+    fr_a, rows_a = np.concatenate(fr), np.concatenate(rows)
+    slot_a, j = np.array(slot, dtype=np.int64), _ints(flat)
+    bad = (j < 0) | (j >= rows_a)
+    bad[1:] |= (fr_a[1:] == fr_a[:-1]) & (rows_a[1:] == rows_a[:-1]) & (j[1:] <= j[:-1])
+    if bad.any():
+        t = int(np.flatnonzero(bad)[0])
+        lo_f, hi_f, _ = specs[fr_a[t]]
+        raise _Invalid(f"{_where(lo_f, hi_f)}: keys[{rows_a[t]}] must be sorted earlier steps")
+    keypos = np.full((F, nmax, P), -1, dtype=np.int64)
+    keypos[fr_a, rows_a, cell[fr_a, j]] = slot_a
+    # keys[i + 1] holds only labels of keys[i] and of step i
+    later = rows_a > 0
+    fi, ii, ji = fr_a[later], rows_a[later] - 1, j[later]
+    src = keypos[fi, ii, cell[fi, ji]]
+    forgot = (ji != ii) & (src < 0)
+    if forgot.any():
+        t = int(np.flatnonzero(forgot)[0])
+        lo_f, hi_f, _ = specs[fi[t]]
+        raise _Invalid(
+            f"{_where(lo_f, hi_f)}: keys[{ii[t] + 1}] records a label step {ii[t]} forgot"
+        )
+    # the region of each step's cell, clipped to the frame
+    at = coords[cell]  # (F, nmax, ndim)
+    blo = np.maximum(at - np.array(back), 0)
+    bhi = np.minimum(at + np.array(region) - 2, ext[:, None, :] - 1)
+    box = ((coords >= blo[:, :, None]) & (coords <= bhi[:, :, None])).all(-1) & live[:, :, None]
+    done = rank[:, None, :] < steps[None, :, None]
+    # a labelled cell of the region bordering one not yet labelled must be recorded
+    free = (box & ~done).reshape((F, nmax, *E))
+    near_free = np.zeros_like(free)
+    for d in range(ndim):
+        a, b = [slice(None)] * (ndim + 2), [slice(None)] * (ndim + 2)
+        a[d + 2], b[d + 2] = slice(1, None), slice(None, -1)
+        near_free[tuple(a)] |= free[tuple(b)]
+        near_free[tuple(b)] |= free[tuple(a)]
+    miss = box & done & near_free.reshape(F, nmax, P) & (keypos < 0)
+    if miss.any():
+        f, i, x = (int(t) for t in np.argwhere(miss)[0])
+        lo_f, hi_f, _ = specs[f]
+        raise _Invalid(
+            f"{_where(lo_f, hi_f)}: step {i} depends on cell {coords[x].tolist()}, "
+            f"not in keys[{i}]"
+        )
+    # the labelled backward neighbours of each step's cell in its region (a forward
+    # neighbour comes later in any scan order)
+    strides = np.cumprod((1, *E[:0:-1]))[::-1]
+    y = np.maximum(cell[:, :, None] - strides, 0)  # (F, nmax, ndim)
+    ok = (at > 0) & np.take_along_axis(box & done, y, axis=2)
+    near_pos = np.where(ok, np.take_along_axis(keypos, y, axis=2), 0)
+    near_tab = np.where(ok, np.arange(ndim), ndim)
+    nxt_from = np.where(ji == ii, -1, src)
+    cut = np.searchsorted(fi, np.arange(F + 1))
+    nxt_slot = slot_a[later]
+    out = []
+    for f, (lo_f, hi_f, keys) in enumerate(specs):
+        m, a, b = int(n[f]), cut[f], cut[f + 1]
+        out.append(_Frame(
+            tuple(int(e) for e in ext[f]), m, coords, keys, cell[f, :m], box[f, :m],
+            done[f, :m], keypos[f, :m], near_pos[f, :m], near_tab[f, :m],
+            (ii[a:b], nxt_slot[a:b]), nxt_from[a:b], {},
+        ))  # fmt: skip
+    return out
+
+
+def _where(lo: Sequence[int], hi: Sequence[int]) -> str:
+    return f"configuration lower={list(lo)} upper={list(hi)}"
+
+
+def _nxt(frame: _Frame, width: int) -> Any:
+    """Per step, where each label of the next state comes from: a slot of the state,
+    ``width`` (the label just chosen) or ``width + 1`` (padding)."""
+    out = np.full((frame.n, width), width + 1, dtype=np.int64)
+    out[frame.nxt_at] = np.where(frame.nxt_from < 0, width, frame.nxt_from)
+    return out
+
+
+def _step_graph(frame: _Frame, i: int) -> tuple[_Graph, list[int], list[int]]:
+    """Step ``i``'s region as a small graph (:func:`_graph`), the slots of the state
+    holding its labelled nodes' labels and its nodes' cells (indices in ``coords``)."""
+    hit = frame.graphs.get(i)
+    if hit is None:
+        cells = [tuple(c) for c in frame.coords.tolist()]
+        at = {c: x for x, c in enumerate(cells)}
+        index = {cells[x]: s for s, x in enumerate(frame.cell.tolist())}
+        box = [cells[x] for x in np.flatnonzero(frame.box[i])]
+        g = _graph(box, index, i, frame.keys[i], cells[int(frame.cell[i])])
+        pos = {j: k for k, j in enumerate(frame.keys[i])}
+        hit = (g, [pos[j] for j in g[0] if j >= 0], [at[c] for c in g[3]])
+        frame.graphs[i] = hit
+    return hit
 
 
 class _Plan(NamedTuple):
@@ -449,30 +525,20 @@ class _Plan(NamedTuple):
 
 
 def _check_config(
-    conf: Mapping[str, Any],
-    region: list[int],
-    back: list[int],
-    axes: tuple[int, ...],
+    frame: _Frame,
+    fid: int,
     used: int,
     face_rules: list[FaceRule],
     at_lo: tuple[bool, ...],
     at_hi: tuple[bool, ...],
     memo: _Memo,
 ) -> _Plan:
-    """A configuration's frame (shared, keys verified) and its cells' domains."""
-    lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
-    keys = [list(k) for k in conf["keys"]]
-    fkey = (lo, hi, tuple(map(tuple, keys)))
-    hit = memo.frames.get(fkey)
-    if hit is None:
-        where = f"configuration lower={list(lo)} upper={list(hi)}"
-        hit = memo.frames[fkey] = (len(memo.frames), _Frame(lo, hi, keys, region, back, axes, where))
-    fid, frame = hit
+    """A configuration's frame and the domain of each of its cells."""
     if not face_rules:
         return _Plan(frame, fid, (used,) * len(frame.coords))
     # the faces each cell lies on, as bits 2d (lower) and 2d + 1 (upper)
     on = np.zeros(len(frame.coords), dtype=np.int64)
-    for d in range(len(lo)):
+    for d in range(len(at_lo)):
         if at_lo[d]:
             on |= (frame.coords[:, d] == 0) << (2 * d)
         if at_hi[d]:
@@ -481,7 +547,7 @@ def _check_config(
     for sig in on.tolist():
         dom = memo.domains.get(sig)
         if dom is None:
-            faces = {_AXES[b // 2] + "-+"[b % 2] for b in range(2 * len(lo)) if sig >> b & 1}
+            faces = {_AXES[b // 2] + "-+"[b % 2] for b in range(2 * len(at_lo)) if sig >> b & 1}
             dom = memo.domains[sig] = _domain(face_rules, faces, used)
         doms.append(dom)
     return _Plan(frame, fid, tuple(doms))
@@ -492,7 +558,6 @@ class _Memo:
 
     def __init__(self) -> None:
         self.union: dict[tuple[int, int, int], int] = {}
-        self.frames: dict[Any, tuple[int, _Frame]] = {}
         self.domains: dict[int, int] = {}
         self.catalogs: dict[Any, int] = {}
 
@@ -534,7 +599,7 @@ def _check_states(
         npos.append(f.near_pos)
         ntab.append(f.near_tab)
         if p.fid not in nxt_of:
-            nxt_of[p.fid] = f.nxt(width)
+            nxt_of[p.fid] = _nxt(f, width)
         nxt.append(nxt_of[p.fid])
         base.extend(p.bases[x] for x in f.cell.tolist())
         bid = base_ids.setdefault(p.bases, len(base_ids))
@@ -554,13 +619,16 @@ def _check_states(
     grp_parts, lens, flat = [], [], []
     for c, (conf, p) in enumerate(zip(configs, plans, strict=True)):
         sts = conf["states"]
-        steps = _ints([s[0] for s in sts])
+        if set(map(len, sts)) - {2}:
+            raise _Invalid("a state is not a pair [step, labels]")
+        st_i, st_l = zip(*sts) if sts else ((), ())
+        steps = _ints(list(st_i))
         if len(steps) and (steps.min() < 0 or steps.max() >= p.frame.n):
             where = f"configuration lower={list(conf['lower'])} upper={list(conf['upper'])}"
             raise _Invalid(f"{where}: a state's step is not one of its {p.frame.n} steps")
         grp_parts.append(steps + first[c])
-        lens.extend(len(s[1]) for s in sts)
-        flat.extend(itertools.chain.from_iterable(s[1] for s in sts))
+        lens.extend(map(len, st_l))
+        flat.extend(itertools.chain.from_iterable(st_l))
     grp = np.concatenate(grp_parts) if grp_parts else np.zeros(0, dtype=np.int64)
     N = len(grp)
     if N * (K + width) * 24 > _MAX_BYTES:
@@ -603,10 +671,9 @@ def _check_states(
         raise _Invalid(f"{where(int(start[~have[start]][0]))}: no start state")
     # the labels of each step's cell that agree with its labelled neighbours: a superset
     # of its catalog (arc consistency only removes more), enough when every one leads on
-    tables = np.ones((2 * ndim + 1, K + 1, K), dtype=bool)
+    tables = np.ones((ndim + 1, K + 1, K), dtype=bool)
     for d in range(ndim):
-        for t, table in ((2 * d, fwd[d]), (2 * d + 1, bwd[d])):
-            tables[t, :K] = [[b >> k & 1 for k in range(K)] for b in table]
+        tables[d, :K] = [[b >> k & 1 for k in range(K)] for b in fwd[d]]
     fc = base_rows[g_base[grp]]
     rows = np.arange(N)
     for j in range(g_npos.shape[1]):
@@ -628,7 +695,7 @@ def _check_states(
     need = np.flatnonzero(last | (fc & ~leads).any(1))
     if len(need):
         kinds = np.unique(g_acid[grp[need]])
-        slots = {int(a): ac_of[a][0].frame.graph(ac_of[a][1])[1] for a in kinds.tolist()}
+        slots = {int(a): _step_graph(ac_of[a][0].frame, ac_of[a][1])[1] for a in kinds.tolist()}
         S = max((len(v) for v in slots.values()), default=0)
         gather = np.full((len(ac_of), S + 1), width, dtype=np.int64)  # width: padding
         for a, v in slots.items():
@@ -642,7 +709,7 @@ def _check_states(
         for u, r in enumerate(which.tolist()):
             a = int(g_acid[grp[need[r]]])
             p, i = ac_of[a]
-            (src, arcs, target, _), at_slots, nodes = p.frame.graph(i)
+            (src, arcs, target, _), at_slots, nodes = _step_graph(p.frame, i)
             key = (a, tuple(mk[r, : len(at_slots)].tolist()))
             cat = memo.catalogs.get(key)
             if cat is None:
