@@ -365,7 +365,8 @@ class _Frame(NamedTuple):
     near_tab: Any
     nxt_at: tuple[Any, Any]
     nxt_from: Any
-    graphs: dict[int, tuple[_Graph, list[int], list[int]]]
+    cells: list[Cell]
+    graphs: dict[int, tuple[list[int], list[int], list[bool], bytes]]
 
 
 # cells x steps x frames the frame arrays hold at once
@@ -476,13 +477,14 @@ def _frame_chunk(
     nxt_from = np.where(ji == ii, -1, src)
     cut = np.searchsorted(fi, np.arange(F + 1))
     nxt_slot = slot_a[later]
+    cells = [tuple(c) for c in coords.tolist()]
     out = []
     for f, (lo_f, hi_f, keys) in enumerate(specs):
         m, a, b = int(n[f]), cut[f], cut[f + 1]
         out.append(_Frame(
             tuple(int(e) for e in ext[f]), m, coords, keys, cell[f, :m], box[f, :m],
             done[f, :m], keypos[f, :m], near_pos[f, :m], near_tab[f, :m],
-            (ii[a:b], nxt_slot[a:b]), nxt_from[a:b], {},
+            (ii[a:b], nxt_slot[a:b]), nxt_from[a:b], cells, {},
         ))  # fmt: skip
     return out
 
@@ -499,18 +501,21 @@ def _nxt(frame: _Frame, width: int) -> Any:
     return out
 
 
-def _step_graph(frame: _Frame, i: int) -> tuple[_Graph, list[int], list[int]]:
-    """Step ``i``'s region as a small graph (:func:`_graph`), the slots of the state
-    holding its labelled nodes' labels and its nodes' cells (indices in ``coords``)."""
+def _step_graph(frame: _Frame, i: int) -> tuple[list[int], list[int], list[bool], bytes]:
+    """Step ``i``'s region as a small graph: the slots of the state holding its labelled
+    nodes' labels, its nodes (cells of ``coords`` in C order: those not yet labelled and
+    those the state records), which are labelled, and its shape (the nodes relative to
+    the step's cell and which are labelled: steps of one shape, in any frame, have the
+    same catalogs for the same labels and domains)."""
     hit = frame.graphs.get(i)
     if hit is None:
-        cells = [tuple(c) for c in frame.coords.tolist()]
-        at = {c: x for x, c in enumerate(cells)}
-        index = {cells[x]: s for s, x in enumerate(frame.cell.tolist())}
-        box = [cells[x] for x in np.flatnonzero(frame.box[i])]
-        g = _graph(box, index, i, frame.keys[i], cells[int(frame.cell[i])])
-        pos = {j: k for k, j in enumerate(frame.keys[i])}
-        hit = (g, [pos[j] for j in g[0] if j >= 0], [at[c] for c in g[3]])
+        keep = frame.box[i] & (~frame.done[i] | (frame.keypos[i] >= 0))
+        nodes = np.flatnonzero(keep)
+        fixed = frame.done[i, nodes]
+        rel = frame.coords[nodes] - frame.coords[frame.cell[i]]
+        shape = rel.astype(np.int64).tobytes() + fixed.tobytes()
+        slots = frame.keypos[i, nodes[fixed]]
+        hit = (slots.tolist(), nodes.tolist(), fixed.tolist(), shape)
         frame.graphs[i] = hit
     return hit
 
@@ -560,9 +565,9 @@ class _Memo:
         self.union: dict[tuple[int, int, int], int] = {}
         self.domains: dict[int, int] = {}
         self.catalogs: dict[Any, int] = {}
+        self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
 
 
-_Graph = tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]
 
 # bytes per state and label the array check holds at once, above which it refuses
 _MAX_BYTES = 2 << 30
@@ -614,7 +619,7 @@ def _check_states(
     g_npos, g_ntab, g_nxt = (np.concatenate(v) for v in (npos, ntab, nxt))
     bits = sorted(set(base))
     g_base = np.searchsorted(bits, base)
-    base_rows = np.array([[b >> k & 1 for k in range(K)] for b in bits], dtype=bool)
+    base_rows = _unpack(bits, K)
     # the states: group, labels
     grp_parts, lens, flat = [], [], []
     for c, (conf, p) in enumerate(zip(configs, plans, strict=True)):
@@ -654,7 +659,7 @@ def _check_states(
         g = int(grp[bad[0]])
         c = int(np.searchsorted(first, g, side="right")) - 1
         raise _Invalid(f"{where(g)}: a state at step {g - first[c]} does not fit keys[{g - first[c]}]")
-    in_use = np.array([used >> k & 1 for k in range(K)], dtype=bool)
+    in_use = _unpack([used], K)[0]
     if len(labels) and (labels.min() < 0 or labels.max() >= K or not in_use[labels].all()):
         r = int(np.searchsorted(np.cumsum(n_len), np.flatnonzero(
             (labels < 0) | (labels >= K) | ~in_use[np.clip(labels, 0, K - 1)])[0], side="right"))
@@ -673,7 +678,7 @@ def _check_states(
     # of its catalog (arc consistency only removes more), enough when every one leads on
     tables = np.ones((ndim + 1, K + 1, K), dtype=bool)
     for d in range(ndim):
-        tables[d, :K] = [[b >> k & 1 for k in range(K)] for b in fwd[d]]
+        tables[d, :K] = _unpack(fwd[d], K)
     fc = base_rows[g_base[grp]]
     rows = np.arange(N)
     for j in range(g_npos.shape[1]):
@@ -695,7 +700,7 @@ def _check_states(
     need = np.flatnonzero(last | (fc & ~leads).any(1))
     if len(need):
         kinds = np.unique(g_acid[grp[need]])
-        slots = {int(a): _step_graph(ac_of[a][0].frame, ac_of[a][1])[1] for a in kinds.tolist()}
+        slots = {int(a): _step_graph(ac_of[a][0].frame, ac_of[a][1])[0] for a in kinds.tolist()}
         S = max((len(v) for v in slots.values()), default=0)
         gather = np.full((len(ac_of), S + 1), width, dtype=np.int64)  # width: padding
         for a, v in slots.items():
@@ -705,21 +710,32 @@ def _check_states(
         _, which, inv = np.unique(
             _row_codes(g_acid[grp[need]], mk, K), return_index=True, return_inverse=True
         )
-        cats = np.zeros((len(which), K), dtype=bool)
-        for u, r in enumerate(which.tolist()):
+        cats = []
+        shapes: dict[int, Any] = {}
+        for r in which.tolist():
             a = int(g_acid[grp[need[r]]])
             p, i = ac_of[a]
-            (src, arcs, target, _), at_slots, nodes = _step_graph(p.frame, i)
-            key = (a, tuple(mk[r, : len(at_slots)].tolist()))
+            at_slots, nodes, fixed, shape = _step_graph(p.frame, i)
+            if a not in shapes:  # the shape and the domains of the unlabelled nodes
+                shapes[a] = (shape, tuple(p.bases[x] for x, f in zip(nodes, fixed) if not f))
+            key = (shapes[a], tuple(mk[r, : len(at_slots)].tolist()))
             cat = memo.catalogs.get(key)
             if cat is None:
+                graph = memo.graphs.get(shape)
+                if graph is None:
+                    c = p.frame.cells[int(p.frame.cell[i])]
+                    graph = memo.graphs[shape] = (
+                        _arcs([p.frame.cells[x] for x in nodes]),
+                        [p.frame.cells[x] for x in nodes].index(c),
+                    )
+                arcs, target = graph
                 it = iter(key[1])
-                dom = [p.bases[x] if j < 0 else 1 << next(it)
-                       for j, x in zip(src, nodes, strict=True)]  # fmt: skip
+                dom = [1 << next(it) if f else p.bases[x]
+                       for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
                 out = _small_ac(dom, arcs, fwd, bwd, memo.union)
                 cat = memo.catalogs[key] = 0 if out is None else out[target]
-            cats[u] = [cat >> k & 1 for k in range(K)]
-        cat_rows = cats[inv.reshape(-1)]
+            cats.append(cat)
+        cat_rows = _unpack(cats, K)[inv.reshape(-1)]
         empty = last[need] & ~cat_rows.any(1)
         if empty.any():
             r = int(need[np.flatnonzero(empty)[0]])
@@ -736,6 +752,13 @@ def _check_states(
                 f"{[i + 1, [int(t) for t in nx]]}, which is missing"
             )
     return N
+
+
+def _unpack(bitsets: list[int], K: int) -> Any:
+    """Bit sets of ``K`` labels as rows of booleans."""
+    nb = (K + 7) // 8
+    raw = np.frombuffer(b"".join(b.to_bytes(nb, "little") for b in bitsets), dtype=np.uint8)
+    return np.unpackbits(raw.reshape(-1, nb), axis=1, bitorder="little")[:, :K].astype(bool)
 
 
 def _ints(values: list[Any]) -> Any:
@@ -757,18 +780,6 @@ def _row_codes(group: Any, rows: Any, K: int) -> Any:
         code = code * (K + 1) + (rows[:, k] + 1)
     return code
 
-
-
-def _graph(
-    box: list[Cell], index: Mapping[Cell, int], i: int, key: Sequence[int], cell: Cell
-) -> tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]:
-    """The region of step ``i`` as a small graph: its unlabelled cells (``src`` -1) and its
-    labelled cells whose label the state records (``src`` = their step); arcs
-    ``(node, axis, node is the + neighbour)``; the node of cell ``i``; the nodes' cells."""
-    known = set(key)
-    nodes = [x for x in box if not (x in index and index[x] < i) or index[x] in known]
-    src = [index[x] if x in index and index[x] < i else -1 for x in nodes]
-    return src, _arcs(nodes), nodes.index(cell), nodes
 
 
 def _arcs(nodes: Sequence[Cell]) -> list[list[tuple[int, int, bool]]]:
