@@ -621,51 +621,45 @@ def _check_states(
     g_base = np.searchsorted(bits, base)
     base_rows = _unpack(bits, K)
     # the states: group, labels
-    grp_parts, lens, flat = [], [], []
-    for c, (conf, p) in enumerate(zip(configs, plans, strict=True)):
-        sts = conf["states"]
-        if set(map(len, sts)) - {2}:
-            raise _Invalid("a state is not a pair [step, labels]")
-        st_i, st_l = zip(*sts) if sts else ((), ())
-        steps = _ints(list(st_i))
-        if len(steps) and (steps.min() < 0 or steps.max() >= p.frame.n):
-            where = f"configuration lower={list(conf['lower'])} upper={list(conf['upper'])}"
-            raise _Invalid(f"{where}: a state's step is not one of its {p.frame.n} steps")
-        grp_parts.append(steps + first[c])
-        lens.extend(map(len, st_l))
-        flat.extend(itertools.chain.from_iterable(st_l))
-    grp = np.concatenate(grp_parts) if grp_parts else np.zeros(0, dtype=np.int64)
-    N = len(grp)
+    every = list(itertools.chain.from_iterable(c["states"] for c in configs))
+    if set(map(len, every)) - {2}:
+        raise _Invalid("a state is not a pair [step, labels]")
+    steps = _ints([s[0] for s in every])
+    rows_l = [s[1] for s in every]
+    n_len = np.fromiter(map(len, rows_l), dtype=np.int64, count=len(rows_l))
+    labels = _ints(list(itertools.chain.from_iterable(rows_l)))
+    cfg = np.repeat(np.arange(len(configs)), [len(c["states"]) for c in configs])
+    n_of = np.array([p.frame.n for p in plans], dtype=np.int64)
+    N = len(steps)
+
+    def where(c: int) -> str:
+        return _where(configs[c]["lower"], configs[c]["upper"])
+
+    out = np.flatnonzero((steps < 0) | (steps >= n_of[cfg]))
+    if len(out):
+        c = int(cfg[out[0]])
+        raise _Invalid(f"{where(c)}: a state's step is not one of its {n_of[c]} steps")
+    grp = np.array(first, dtype=np.int64)[cfg] + steps
     if N * (K + width) * 24 > _MAX_BYTES:
         raise InputError(
             f"certificate: checking {N} states of {K} labels needs about "
             f"{N * (K + width) * 24 / 1e9:.1f} GB, more than {_MAX_BYTES / 1e9:.1f} GB"
         )
-    n_len = np.array(lens, dtype=np.int64)
-    labels = _ints(flat)
-
-    def where(g: int) -> str:
-        c = int(np.searchsorted(first, g, side="right")) - 1
-        conf = configs[c]
-        return f"configuration lower={list(conf['lower'])} upper={list(conf['upper'])}"
 
     def state(r: int) -> list[Any]:
-        g = int(grp[r])
-        c = int(np.searchsorted(first, g, side="right")) - 1
-        return [g - first[c], labs[r, : g_width[g]].tolist()]
+        return [int(steps[r]), labs[r, : g_width[grp[r]]].tolist()]
 
     bad = np.flatnonzero(n_len != g_width[grp])
     if len(bad):
-        g = int(grp[bad[0]])
-        c = int(np.searchsorted(first, g, side="right")) - 1
-        raise _Invalid(f"{where(g)}: a state at step {g - first[c]} does not fit keys[{g - first[c]}]")
+        r = int(bad[0])
+        raise _Invalid(
+            f"{where(int(cfg[r]))}: a state at step {steps[r]} does not fit keys[{steps[r]}]"
+        )
     in_use = _unpack([used], K)[0]
-    if len(labels) and (labels.min() < 0 or labels.max() >= K or not in_use[labels].all()):
-        r = int(np.searchsorted(np.cumsum(n_len), np.flatnonzero(
-            (labels < 0) | (labels >= K) | ~in_use[np.clip(labels, 0, K - 1)])[0], side="right"))
-        g = int(grp[r])
-        c = int(np.searchsorted(first, g, side="right")) - 1
-        raise _Invalid(f"{where(g)}: a state at step {g - first[c]} has a label not in use")
+    wrong = (labels < 0) | (labels >= K) | ~in_use[np.clip(labels, 0, K - 1)]
+    if wrong.any():
+        r = int(np.searchsorted(np.cumsum(n_len), np.flatnonzero(wrong)[0], side="right"))
+        raise _Invalid(f"{where(int(cfg[r]))}: a state at step {steps[r]} has a label not in use")
     inrow = np.arange(width)[None, :] < n_len[:, None]
     labs = np.full((N, width), -1, dtype=np.int64)
     labs[inrow] = labels
@@ -685,14 +679,10 @@ def _check_states(
         fc &= tables[g_ntab[grp, j], labs[rows, g_npos[grp, j]]]
     last = g_next[grp] < 0
     st, lab = np.nonzero(fc & ~last[:, None])
-    ext = np.concatenate(
-        [labs[st], lab[:, None], np.full((len(st), 1), -1, dtype=np.int64)], axis=1
-    )
-    cand = np.take_along_axis(ext, g_nxt[grp[st]], axis=1)
-    codes = _row_codes(np.concatenate([grp, g_next[grp[st]]]), np.concatenate([labs, cand]), K)
-    known = np.sort(codes[:N])
-    at = np.minimum(np.searchsorted(known, codes[N:]), max(N - 1, 0))
-    present = known[at] == codes[N:] if N else np.zeros(0, dtype=bool)
+    codes, next_codes = _state_codes(grp, labs, st, lab, g_next, g_nxt, K)
+    known = np.sort(codes)
+    at = np.minimum(np.searchsorted(known, next_codes), max(N - 1, 0))
+    present = known[at] == next_codes
     leads = np.zeros((N, K), dtype=bool)
     leads[st[present], lab[present]] = True
     # the rest need the catalog: arc consistency on the step's region, once per group
@@ -767,6 +757,35 @@ def _ints(values: list[Any]) -> Any:
     if out.ndim != 1 or out.dtype.kind not in "iu":
         raise _Invalid("a state's step or labels are not integers")
     return out.astype(np.int64)
+
+
+# the largest code of a state (group and labels) computed as a polynomial in its labels
+_CODE_LIMIT = 1 << 62
+
+
+def _state_codes(
+    grp: Any, labs: Any, st: Any, lab: Any, g_next: Any, g_nxt: Any, K: int
+) -> tuple[Any, Any]:
+    """Exact codes of the states (``grp``, ``labs``) and of the states ``(g_next[grp[st]],
+    labs[st] rearranged by g_nxt with lab chosen)`` that they lead to: equal codes for equal
+    states. A polynomial in the labels (the padding -1 adds nothing) when it stays below
+    ``_CODE_LIMIT``; else the rows are built and ranked (:func:`_row_codes`)."""
+    N, width = labs.shape
+    G = len(g_next)
+    ext = np.concatenate([labs, np.full((N, 2), -1, dtype=np.int64)], axis=1)
+    if G * (K + 1) ** width < _CODE_LIMIT:
+        w = (K + 1) ** np.arange(width - 1, -1, -1, dtype=np.int64)
+        gw = (K + 1) ** width
+        codes = grp * gw + (labs + 1) @ w
+        # the next state: its labels kept from this one, plus the chosen label's term
+        kept = g_next[grp] * gw + (np.take_along_axis(ext, g_nxt[grp], axis=1) + 1) @ w
+        chosen = ((g_nxt == width) * w).sum(1)
+        return codes, kept[st] + (lab + 1) * chosen[grp[st]]
+    e = ext[st]
+    e[:, width] = lab
+    cand = np.take_along_axis(e, g_nxt[grp[st]], axis=1)
+    both = _row_codes(np.concatenate([grp, g_next[grp[st]]]), np.concatenate([labs, cand]), K)
+    return both[:N], both[N:]
 
 
 def _row_codes(group: Any, rows: Any, K: int) -> Any:
