@@ -667,7 +667,7 @@ def _check_states(
     have[grp[n_len == 0]] = True  # a state of width 0 is the empty state
     start = np.array(first, dtype=np.int64)
     if not have[start].all():
-        raise _Invalid(f"{where(int(start[~have[start]][0]))}: no start state")
+        raise _Invalid(f"{where(int(np.flatnonzero(~have[start])[0]))}: no start state")
     # the labels of each step's cell that agree with its labelled neighbours: a superset
     # of its catalog (arc consistency only removes more), enough when every one leads on
     tables = np.ones((ndim + 1, K + 1, K), dtype=bool)
@@ -729,7 +729,7 @@ def _check_states(
         empty = last[need] & ~cat_rows.any(1)
         if empty.any():
             r = int(need[np.flatnonzero(empty)[0]])
-            raise _Invalid(f"{where(int(grp[r]))}: the point's catalog is empty in state {state(r)}")
+            raise _Invalid(f"{where(int(cfg[r]))}: the point's catalog is empty in state {state(r)}")
         open_ = ~last[need, None] & cat_rows & ~leads[need]
         if open_.any():
             k, b = (int(t) for t in np.argwhere(open_)[0])
@@ -738,7 +738,7 @@ def _check_states(
             g = int(grp[r])
             nx = [b if s == width else labs[r, s] for s in g_nxt[g, : g_width[g + 1]].tolist()]
             raise _Invalid(
-                f"{where(g)}: not closed: state {[i, labs_r]} with label {b} leads to "
+                f"{where(int(cfg[r]))}: not closed: state {[i, labs_r]} with label {b} leads to "
                 f"{[i + 1, [int(t) for t in nx]]}, which is missing"
             )
     return N
