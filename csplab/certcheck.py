@@ -75,7 +75,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from csplab.errors import InputError
+from csplab.errors import InputError, MemoryLimitError
 
 __all__ = ["check_certificate", "load_certificate", "rules_hash"]
 
@@ -380,7 +380,6 @@ def _frames(
     axes: tuple[int, ...],
 ) -> list[_Frame]:
     """The frames of ``(lower, upper, keys)``, verified together, in chunks."""
-    ndim = len(region)
     exts = np.array([[a + 1 + b for a, b in zip(lo, hi, strict=True)] for lo, hi, _ in specs])
     E = tuple(int(e) for e in exts.max(0))
     P = math.prod(E)
@@ -415,7 +414,9 @@ def _frame_chunk(
     cell = np.argsort(rank, axis=1, kind="stable")[:, :nmax]  # (F, nmax) each step's cell
     steps = np.arange(nmax)
     live = steps[None, :] < n[:, None]
-    fr, rows, slot, flat = [], [], [], []
+    fr, rows = [], []
+    slot: list[int] = []
+    flat: list[int] = []
     for f, (lo_f, hi_f, keys) in enumerate(specs):
         if len(keys) != n[f] or keys[0]:
             raise _Invalid(f"{_where(lo_f, hi_f)}: keys must list {n[f]} steps, the first empty")
@@ -479,7 +480,7 @@ def _frame_chunk(
     nxt_slot = slot_a[later]
     cells = [tuple(c) for c in coords.tolist()]
     out = []
-    for f, (lo_f, hi_f, keys) in enumerate(specs):
+    for f, (_, _, keys) in enumerate(specs):
         m, a, b = int(n[f]), cut[f], cut[f + 1]
         out.append(_Frame(
             tuple(int(e) for e in ext[f]), m, coords, keys, cell[f, :m], box[f, :m],
@@ -568,7 +569,6 @@ class _Memo:
         self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
 
 
-
 # bytes per state and label the array check holds at once, above which it refuses
 _MAX_BYTES = 2 << 30
 
@@ -589,7 +589,12 @@ def _check_states(
     width = max(len(k) for p in plans for k in p.frame.keys)
     # per group: the group of the next step (-1 at the point), the state's width, the
     # neighbours' slots and tables, the next state's slots, the domain of the step's cell
-    first, nexts, widths, npos, ntab, nxt, base, acid = [], [], [], [], [], [], [], []
+    first: list[int] = []
+    nexts: list[int] = []
+    widths: list[int] = []
+    base: list[int] = []
+    acid: list[int] = []
+    npos, ntab, nxt = [], [], []
     nxt_of: dict[int, Any] = {}
     ac_ids: dict[tuple[int, int, int], int] = {}
     base_ids: dict[tuple[int, ...], int] = {}
@@ -641,7 +646,7 @@ def _check_states(
         raise _Invalid(f"{where(c)}: a state's step is not one of its {n_of[c]} steps")
     grp = np.array(first, dtype=np.int64)[cfg] + steps
     if N * (K + width) * 24 > _MAX_BYTES:
-        raise InputError(
+        raise MemoryLimitError(
             f"certificate: checking {N} states of {K} labels needs about "
             f"{N * (K + width) * 24 / 1e9:.1f} GB, more than {_MAX_BYTES / 1e9:.1f} GB"
         )
@@ -700,46 +705,46 @@ def _check_states(
         _, which, inv = np.unique(
             _row_codes(g_acid[grp[need]], mk, K), return_index=True, return_inverse=True
         )
-        cats = []
+        cats: list[int] = []
         shapes: dict[int, Any] = {}
         for r in which.tolist():
             a = int(g_acid[grp[need[r]]])
             p, i = ac_of[a]
             at_slots, nodes, fixed, shape = _step_graph(p.frame, i)
             if a not in shapes:  # the shape and the domains of the unlabelled nodes
-                shapes[a] = (shape, tuple(p.bases[x] for x, f in zip(nodes, fixed) if not f))
+                free = [p.bases[x] for x, f in zip(nodes, fixed, strict=True) if not f]
+                shapes[a] = (shape, tuple(free))
             key = (shapes[a], tuple(mk[r, : len(at_slots)].tolist()))
             cat = memo.catalogs.get(key)
             if cat is None:
                 graph = memo.graphs.get(shape)
                 if graph is None:
-                    c = p.frame.cells[int(p.frame.cell[i])]
-                    graph = memo.graphs[shape] = (
-                        _arcs([p.frame.cells[x] for x in nodes]),
-                        [p.frame.cells[x] for x in nodes].index(c),
-                    )
+                    there = [p.frame.cells[x] for x in nodes]
+                    here = p.frame.cells[int(p.frame.cell[i])]
+                    graph = memo.graphs[shape] = (_arcs(there), there.index(here))
                 arcs, target = graph
                 it = iter(key[1])
                 dom = [1 << next(it) if f else p.bases[x]
                        for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
-                out = _small_ac(dom, arcs, fwd, bwd, memo.union)
-                cat = memo.catalogs[key] = 0 if out is None else out[target]
+                ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
+                cat = memo.catalogs[key] = 0 if ac is None else ac[target]
             cats.append(cat)
         cat_rows = _unpack(cats, K)[inv.reshape(-1)]
         empty = last[need] & ~cat_rows.any(1)
         if empty.any():
             r = int(need[np.flatnonzero(empty)[0]])
-            raise _Invalid(f"{where(int(cfg[r]))}: the point's catalog is empty in state {state(r)}")
+            raise _Invalid(
+                f"{where(int(cfg[r]))}: the point's catalog is empty in state {state(r)}"
+            )
         open_ = ~last[need, None] & cat_rows & ~leads[need]
         if open_.any():
-            k, b = (int(t) for t in np.argwhere(open_)[0])
-            r = int(need[k])
-            i, labs_r = state(r)
+            row, b = (int(t) for t in np.argwhere(open_)[0])
+            r = int(need[row])
             g = int(grp[r])
             nx = [b if s == width else labs[r, s] for s in g_nxt[g, : g_width[g + 1]].tolist()]
             raise _Invalid(
-                f"{where(int(cfg[r]))}: not closed: state {[i, labs_r]} with label {b} leads to "
-                f"{[i + 1, [int(t) for t in nx]]}, which is missing"
+                f"{where(int(cfg[r]))}: not closed: state {state(r)} with label {b} leads to "
+                f"{[int(steps[r]) + 1, [int(t) for t in nx]]}, which is missing"
             )
     return N
 
@@ -798,7 +803,6 @@ def _row_codes(group: Any, rows: Any, K: int) -> Any:
             code = np.unique(code, return_inverse=True)[1].reshape(-1).astype(np.int64)
         code = code * (K + 1) + (rows[:, k] + 1)
     return code
-
 
 
 def _arcs(nodes: Sequence[Cell]) -> list[list[tuple[int, int, bool]]]:
