@@ -24,6 +24,7 @@ import sys
 import time
 import warnings
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 from csplab.analysis import prove_infallible
@@ -59,22 +60,24 @@ def main(specs: list[str]) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             E = load_model(name)
-        find, v = best(lambda: decide_infallibility(
-            E, boundary=bnd or None, time_limit=600, certificate=True))  # fmt: skip
+        find, v = best(partial(decide_infallibility, E, boundary=bnd or None,
+                               time_limit=600, certificate=True))  # fmt: skip
         cert = v.witness.get("certificate") if isinstance(v.witness, dict) else None
         if cert is None:
             print(f"{spec:28} {'undecided':8} {'':7} {find:8.3f}  (no certificate)")
             continue
         one = float("nan")
         if v.holds:
-            one, _ = best(lambda: prove_infallible(
-                E, cert["region"], order=cert["order"], history=cert["history"],
-                back=cert.get("back", 1), boundary=bnd or None, refute=False, certificate=True))  # fmt: skip
+            one, _ = best(partial(
+                prove_infallible, E, cert["region"], order=cert["order"],
+                history=cert["history"], back=cert.get("back", 1), boundary=bnd or None,
+                refute=False, certificate=True,
+            ))  # fmt: skip
         text = json.dumps(cert)
         t0 = time.perf_counter()
         decoded = json.loads(text)
         parse = time.perf_counter() - t0
-        check, (ok, msg) = best(lambda: check_certificate(decoded))
+        check, (ok, msg) = best(partial(check_certificate, decoded))
         assert ok, msg
         ratio = check / find
         worst, n = max(worst, ratio), n + 1
