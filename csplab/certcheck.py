@@ -6,6 +6,14 @@ no code with the prover (:mod:`csplab.analysis.infallible`; an import-linter con
 forbids importing it, or anything of csplab but :mod:`csplab.errors`): the frames, regions,
 arc consistency and grid replay below are written again, plainly.
 
+How the closure is checked: every frame of the certificate is verified in one batch of
+boolean arrays (regions, labelled cells, recorded keys); every state of every
+configuration is a row of one label array, and its successors are looked up among the
+states by exact integer codes. A state needs arc consistency only when some label that
+its cell's labelled neighbours allow (a superset of the catalog) leads to no recorded
+state, and at the point; the catalog is computed once per region shape (the region's
+cells relative to the step's cell, which are labelled, their domains) and labels.
+
 Format ``csplab-certificate``, version 1 (JSON)
 -----------------------------------------------
 ``rules``: ``labels`` (K), ``used`` (K flags: the labels a cell may take) and ``pairs``
