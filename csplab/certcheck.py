@@ -702,7 +702,7 @@ def _check_states(
     # kind (frame, step, domains) and labels of the region's labelled cells
     need = np.flatnonzero(last | (fc & ~leads).any(1))
     if len(need):
-        kinds = np.unique(g_acid[grp[need]])
+        kinds = np.flatnonzero(np.bincount(g_acid[grp[need]], minlength=len(ac_of)))
         slots = {int(a): _step_graph(ac_of[a][0].frame, ac_of[a][1])[0] for a in kinds.tolist()}
         S = max((len(v) for v in slots.values()), default=0)
         gather = np.full((len(ac_of), S + 1), width, dtype=np.int64)  # width: padding
@@ -710,9 +710,7 @@ def _check_states(
             gather[a, : len(v)] = v
         padded = np.concatenate([labs[need], np.full((len(need), 1), -1)], axis=1)
         mk = np.take_along_axis(padded, gather[g_acid[grp[need]]], axis=1)
-        _, which, inv = np.unique(
-            _row_codes(g_acid[grp[need]], mk, K), return_index=True, return_inverse=True
-        )
+        inv, which = _ranks(_row_codes(g_acid[grp[need]], mk, K))
         cats: list[int] = []
         shapes: dict[int, Any] = {}
         for r in which.tolist():
@@ -737,7 +735,7 @@ def _check_states(
                 ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
                 cat = memo.catalogs[key] = 0 if ac is None else ac[target]
             cats.append(cat)
-        cat_rows = _unpack(cats, K)[inv.reshape(-1)]
+        cat_rows = _unpack(cats, K)[inv]
         empty = last[need] & ~cat_rows.any(1)
         if empty.any():
             r = int(need[np.flatnonzero(empty)[0]])
@@ -801,14 +799,26 @@ def _state_codes(
     return both[:N], both[N:]
 
 
+def _ranks(values: Any) -> tuple[Any, Any]:
+    """The rank of each value among the distinct ``values`` (0, 1, ...), and the index of
+    the first occurrence of each distinct value."""
+    order = np.argsort(values, kind="stable")
+    ordered = values[order]
+    new = np.ones(len(values), dtype=bool)
+    new[1:] = ordered[1:] != ordered[:-1]
+    rank = np.empty(len(values), dtype=np.int64)
+    rank[order] = np.cumsum(new) - 1
+    return rank, order[new]
+
+
 def _row_codes(group: Any, rows: Any, K: int) -> Any:
     """Exact int64 codes of ``(group, row)`` pairs (rows of labels -1 .. K - 1): equal
     codes for equal pairs, ranked again whenever the next column would overflow."""
-    code = np.unique(group, return_inverse=True)[1].reshape(-1).astype(np.int64)
+    code = _ranks(group)[0]
     top = (1 << 62) // (K + 1)
     for k in range(rows.shape[1]):
         if len(code) and int(code.max()) >= top:
-            code = np.unique(code, return_inverse=True)[1].reshape(-1).astype(np.int64)
+            code = _ranks(code)[0]
         code = code * (K + 1) + (rows[:, k] + 1)
     return code
 
