@@ -322,7 +322,7 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
     # shared by every configuration: frames (configurations that differ only in which
-    # frame edges lie on a face have the same frame), domains and catalogs
+    # frame edges lie on a face have the same frame), domains and region graphs
     memo = _Memo()
     specs: list[tuple[Cell, Cell, list[list[int]]]] = []
     fid_of: dict[Any, int] = {}
@@ -573,7 +573,6 @@ class _Memo:
     def __init__(self) -> None:
         self.union: dict[tuple[int, int, int], int] = {}
         self.domains: dict[int, int] = {}
-        self.catalogs: dict[Any, int] = {}
         self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
 
 
@@ -702,39 +701,38 @@ def _check_states(
     # kind (frame, step, domains) and labels of the region's labelled cells
     need = np.flatnonzero(last | (fc & ~leads).any(1))
     if len(need):
+        # the steps' kinds in play, merged by shape and domains of the unlabelled nodes
         kinds = np.flatnonzero(np.bincount(g_acid[grp[need]], minlength=len(ac_of)))
-        slots = {int(a): _step_graph(ac_of[a][0].frame, ac_of[a][1])[0] for a in kinds.tolist()}
-        S = max((len(v) for v in slots.values()), default=0)
-        gather = np.full((len(ac_of), S + 1), width, dtype=np.int64)  # width: padding
-        for a, v in slots.items():
-            gather[a, : len(v)] = v
-        padded = np.concatenate([labs[need], np.full((len(need), 1), -1)], axis=1)
-        mk = np.take_along_axis(padded, gather[g_acid[grp[need]]], axis=1)
-        inv, which = _ranks(_row_codes(g_acid[grp[need]], mk, K))
-        cats: list[int] = []
-        shapes: dict[int, Any] = {}
-        for r in which.tolist():
-            a = int(g_acid[grp[need[r]]])
+        gather = np.full((len(ac_of), width + 1), width)  # width: padding
+        same = np.zeros(len(ac_of), dtype=np.int64)
+        S = 0
+        ids: dict[tuple[bytes, tuple[int, ...]], int] = {}
+        for a in kinds.tolist():
             p, i = ac_of[a]
-            at_slots, nodes, fixed, shape = _step_graph(p.frame, i)
-            if a not in shapes:  # the shape and the domains of the unlabelled nodes
-                free = [p.bases[x] for x, f in zip(nodes, fixed, strict=True) if not f]
-                shapes[a] = (shape, tuple(free))
-            key = (shapes[a], tuple(mk[r, : len(at_slots)].tolist()))
-            cat = memo.catalogs.get(key)
-            if cat is None:
-                graph = memo.graphs.get(shape)
-                if graph is None:
-                    there = [p.frame.cells[x] for x in nodes]
-                    here = p.frame.cells[int(p.frame.cell[i])]
-                    graph = memo.graphs[shape] = (_arcs(there), there.index(here))
-                arcs, target = graph
-                it = iter(key[1])
-                dom = [1 << next(it) if f else p.bases[x]
-                       for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
-                ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
-                cat = memo.catalogs[key] = 0 if ac is None else ac[target]
-            cats.append(cat)
+            slots, nodes, fixed, shape = _step_graph(p.frame, i)
+            free = tuple(p.bases[x] for x, f in zip(nodes, fixed, strict=True) if not f)
+            same[a] = ids.setdefault((shape, free), len(ids))
+            gather[a, : len(slots)] = slots
+            S = max(S, len(slots))
+        padded = np.concatenate([labs[need], np.full((len(need), 1), -1)], axis=1)
+        mk = np.take_along_axis(padded, gather[g_acid[grp[need]], : S + 1], axis=1)
+        # one catalog per shape, domains and labels of the labelled nodes
+        inv, which = _ranks(_row_codes(same[g_acid[grp[need]]], mk, K))
+        cats: list[int] = []
+        for r in which.tolist():
+            p, i = ac_of[int(g_acid[grp[need[r]]])]
+            slots, nodes, fixed, shape = _step_graph(p.frame, i)
+            graph = memo.graphs.get(shape)
+            if graph is None:
+                there = [p.frame.cells[x] for x in nodes]
+                here = p.frame.cells[int(p.frame.cell[i])]
+                graph = memo.graphs[shape] = (_arcs(there), there.index(here))
+            arcs, target = graph
+            it = iter(mk[r, : len(slots)].tolist())
+            dom = [1 << next(it) if f else p.bases[x]
+                   for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
+            ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
+            cats.append(0 if ac is None else ac[target])
         cat_rows = _unpack(cats, K)[inv]
         empty = last[need] & ~cat_rows.any(1)
         if empty.any():
