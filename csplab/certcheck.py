@@ -6,6 +6,14 @@ no code with the prover (:mod:`csplab.analysis.infallible`; an import-linter con
 forbids importing it, or anything of csplab but :mod:`csplab.errors`): the frames, regions,
 arc consistency and grid replay below are written again, plainly.
 
+How the closure is checked: every frame of the certificate is verified in one batch of
+boolean arrays (regions, labelled cells, recorded keys); every state of every
+configuration is a row of one label array, and its successors are looked up among the
+states by exact integer codes. A state needs arc consistency only when some label that
+its cell's labelled neighbours allow (a superset of the catalog) leads to no recorded
+state, and at the point; the catalog is computed once per region shape (the region's
+cells relative to the step's cell, which are labelled, their domains) and labels.
+
 Format ``csplab-certificate``, version 1 (JSON)
 -----------------------------------------------
 ``rules``: ``labels`` (K), ``used`` (K flags: the labels a cell may take) and ``pairs``
@@ -68,11 +76,14 @@ from __future__ import annotations
 import hashlib
 import itertools
 import json
+import math
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from csplab.errors import InputError
+import numpy as np
+
+from csplab.errors import InputError, MemoryLimitError
 
 __all__ = ["check_certificate", "load_certificate", "rules_hash"]
 
@@ -310,12 +321,24 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     ]  # fmt: skip
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
-    nstates = 0
-    # shared by every configuration: support sets, frames (configurations that differ only
-    # in which frame edges lie on a face have the same frame) and catalogs
+    # shared by every configuration: frames (configurations that differ only in which
+    # frame edges lie on a face have the same frame), domains and region graphs
     memo = _Memo()
-    for c, (_, _, a, b) in zip(configs, got, strict=True):
-        nstates += _check_config(c, region, back, axes, fwd, bwd, used, face_rules, a, b, memo)
+    specs: list[tuple[Cell, Cell, list[list[int]]]] = []
+    fid_of: dict[Any, int] = {}
+    fids = []
+    for c in configs:
+        key = (tuple(c["lower"]), tuple(c["upper"]), tuple(map(tuple, c["keys"])))
+        if key not in fid_of:
+            fid_of[key] = len(specs)
+            specs.append((key[0], key[1], [list(k) for k in c["keys"]]))
+        fids.append(fid_of[key])
+    frames = _frames(specs, region, back, axes)
+    plans = [
+        _check_config(frames[f], f, used, face_rules, a, b, memo)
+        for f, (_, _, a, b) in zip(fids, got, strict=True)
+    ]
+    nstates = _check_states(configs, plans, fwd, bwd, used, memo)
     rtxt = "x".join(map(str, region)) + (
         "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
     )
@@ -326,44 +349,222 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
     )
 
 
-def _check_config(
-    conf: Mapping[str, Any],
+class _Frame(NamedTuple):
+    """The frame of a configuration, its ``keys`` verified, as arrays over the ``P`` cells
+    of a box holding every frame of the certificate (C order; a frame's own box, of extent
+    ``ext``, sits at the origin) and its ``n`` steps (the frame's cells in scan order, the
+    point last): each step's region (``box``), the cells labelled before it (``done``),
+    where each cell's label sits in the step's state (``keypos``, -1: not recorded), the
+    step's cell (``cell``), its labelled backward neighbours (``near_pos``: slot in the
+    state, ``near_tab``: axis, or ``ndim`` for none), and where each label of the next
+    state comes from (``nxt_at`` step and slot, ``nxt_from`` slot or -1: the label the
+    step chooses). The small graph of a step is built only when a state needs arc
+    consistency (:func:`_step_graph`)."""
+
+    ext: Cell
+    n: int
+    coords: Any
+    keys: list[list[int]]
+    cell: Any
+    box: Any
+    done: Any
+    keypos: Any
+    near_pos: Any
+    near_tab: Any
+    nxt_at: tuple[Any, Any]
+    nxt_from: Any
+    cells: list[Cell]
+    graphs: dict[int, tuple[list[int], list[int], list[bool], bytes]]
+
+
+# cells x steps x frames the frame arrays hold at once
+_FRAME_CHUNK = 1 << 21
+
+
+def _frames(
+    specs: list[tuple[Cell, Cell, list[list[int]]]],
     region: list[int],
     back: list[int],
     axes: tuple[int, ...],
-    fwd: list[list[int]],
-    bwd: list[list[int]],
+) -> list[_Frame]:
+    """The frames of ``(lower, upper, keys)``, verified together, in chunks."""
+    exts = np.array([[a + 1 + b for a, b in zip(lo, hi, strict=True)] for lo, hi, _ in specs])
+    E = tuple(int(e) for e in exts.max(0))
+    P = math.prod(E)
+    per = max(1, _FRAME_CHUNK // (P * P))
+    out: list[_Frame] = []
+    for s in range(0, len(specs), per):
+        out += _frame_chunk(specs[s : s + per], exts[s : s + per], E, region, back, axes)
+    return out
+
+
+def _frame_chunk(
+    specs: list[tuple[Cell, Cell, list[list[int]]]],
+    ext: Any,
+    E: Cell,
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+) -> list[_Frame]:
+    ndim, F = len(E), len(specs)
+    coords = np.indices(E).reshape(ndim, -1).T  # (P, ndim), C order
+    P = len(coords)
+    ax = list(axes)
+    # each axis' stride in a frame's scan order (outermost axis first)
+    sc = np.ones((F, ndim), dtype=np.int64)
+    for k in range(ndim - 2, -1, -1):
+        sc[:, ax[k]] = sc[:, ax[k + 1]] * ext[:, ax[k + 1]]
+    valid = (coords[None] < ext[:, None]).all(-1)
+    rank = np.where(valid, (coords @ sc.T).T, P)
+    lo = np.array([s[0] for s in specs])
+    n = (lo * sc).sum(1) + 1  # the cells before the point in scan order, then the point
+    nmax = int(n.max())
+    cell = np.argsort(rank, axis=1, kind="stable")[:, :nmax]  # (F, nmax) each step's cell
+    steps = np.arange(nmax)
+    live = steps[None, :] < n[:, None]
+    fr, rows = [], []
+    slot: list[int] = []
+    flat: list[int] = []
+    for f, (lo_f, hi_f, keys) in enumerate(specs):
+        if len(keys) != n[f] or keys[0]:
+            raise _Invalid(f"{_where(lo_f, hi_f)}: keys must list {n[f]} steps, the first empty")
+        lens = list(map(len, keys))
+        fr.append(np.full(sum(lens), f))
+        rows.append(np.repeat(np.arange(len(keys)), lens))
+        slot.extend(itertools.chain.from_iterable(map(range, lens)))
+        flat.extend(itertools.chain.from_iterable(keys))
+    fr_a, rows_a = np.concatenate(fr), np.concatenate(rows)
+    slot_a, j = np.array(slot, dtype=np.int64), _ints(flat)
+    bad = (j < 0) | (j >= rows_a)
+    bad[1:] |= (fr_a[1:] == fr_a[:-1]) & (rows_a[1:] == rows_a[:-1]) & (j[1:] <= j[:-1])
+    if bad.any():
+        t = int(np.flatnonzero(bad)[0])
+        lo_f, hi_f, _ = specs[fr_a[t]]
+        raise _Invalid(f"{_where(lo_f, hi_f)}: keys[{rows_a[t]}] must be sorted earlier steps")
+    keypos = np.full((F, nmax, P), -1, dtype=np.int64)
+    keypos[fr_a, rows_a, cell[fr_a, j]] = slot_a
+    # keys[i + 1] holds only labels of keys[i] and of step i
+    later = rows_a > 0
+    fi, ii, ji = fr_a[later], rows_a[later] - 1, j[later]
+    src = keypos[fi, ii, cell[fi, ji]]
+    forgot = (ji != ii) & (src < 0)
+    if forgot.any():
+        t = int(np.flatnonzero(forgot)[0])
+        lo_f, hi_f, _ = specs[fi[t]]
+        raise _Invalid(
+            f"{_where(lo_f, hi_f)}: keys[{ii[t] + 1}] records a label step {ii[t]} forgot"
+        )
+    # the region of each step's cell, clipped to the frame
+    at = coords[cell]  # (F, nmax, ndim)
+    blo = np.maximum(at - np.array(back), 0)
+    bhi = np.minimum(at + np.array(region) - 2, ext[:, None, :] - 1)
+    box = ((coords >= blo[:, :, None]) & (coords <= bhi[:, :, None])).all(-1) & live[:, :, None]
+    done = rank[:, None, :] < steps[None, :, None]
+    # a labelled cell of the region bordering one not yet labelled must be recorded
+    free = (box & ~done).reshape((F, nmax, *E))
+    near_free = np.zeros_like(free)
+    for d in range(ndim):
+        a, b = [slice(None)] * (ndim + 2), [slice(None)] * (ndim + 2)
+        a[d + 2], b[d + 2] = slice(1, None), slice(None, -1)
+        near_free[tuple(a)] |= free[tuple(b)]
+        near_free[tuple(b)] |= free[tuple(a)]
+    miss = box & done & near_free.reshape(F, nmax, P) & (keypos < 0)
+    if miss.any():
+        f, i, x = (int(t) for t in np.argwhere(miss)[0])
+        lo_f, hi_f, _ = specs[f]
+        raise _Invalid(
+            f"{_where(lo_f, hi_f)}: step {i} depends on cell {coords[x].tolist()}, "
+            f"not in keys[{i}]"
+        )
+    # the labelled backward neighbours of each step's cell in its region (a forward
+    # neighbour comes later in any scan order)
+    strides = np.cumprod((1, *E[:0:-1]))[::-1]
+    y = np.maximum(cell[:, :, None] - strides, 0)  # (F, nmax, ndim)
+    ok = (at > 0) & np.take_along_axis(box & done, y, axis=2)
+    near_pos = np.where(ok, np.take_along_axis(keypos, y, axis=2), 0)
+    near_tab = np.where(ok, np.arange(ndim), ndim)
+    nxt_from = np.where(ji == ii, -1, src)
+    cut = np.searchsorted(fi, np.arange(F + 1))
+    nxt_slot = slot_a[later]
+    cells = [tuple(c) for c in coords.tolist()]
+    out = []
+    for f, (_, _, keys) in enumerate(specs):
+        m, a, b = int(n[f]), cut[f], cut[f + 1]
+        out.append(_Frame(
+            tuple(int(e) for e in ext[f]), m, coords, keys, cell[f, :m], box[f, :m],
+            done[f, :m], keypos[f, :m], near_pos[f, :m], near_tab[f, :m],
+            (ii[a:b], nxt_slot[a:b]), nxt_from[a:b], cells, {},
+        ))  # fmt: skip
+    return out
+
+
+def _where(lo: Sequence[int], hi: Sequence[int]) -> str:
+    return f"configuration lower={list(lo)} upper={list(hi)}"
+
+
+def _nxt(frame: _Frame, width: int) -> Any:
+    """Per step, where each label of the next state comes from: a slot of the state,
+    ``width`` (the label just chosen) or ``width + 1`` (padding)."""
+    out = np.full((frame.n, width), width + 1, dtype=np.int64)
+    out[frame.nxt_at] = np.where(frame.nxt_from < 0, width, frame.nxt_from)
+    return out
+
+
+def _step_graph(frame: _Frame, i: int) -> tuple[list[int], list[int], list[bool], bytes]:
+    """Step ``i``'s region as a small graph: the slots of the state holding its labelled
+    nodes' labels, its nodes (cells of ``coords`` in C order: those not yet labelled and
+    those the state records), which are labelled, and its shape (the nodes relative to
+    the step's cell and which are labelled: steps of one shape, in any frame, have the
+    same catalogs for the same labels and domains)."""
+    hit = frame.graphs.get(i)
+    if hit is None:
+        keep = frame.box[i] & (~frame.done[i] | (frame.keypos[i] >= 0))
+        nodes = np.flatnonzero(keep)
+        fixed = frame.done[i, nodes]
+        rel = frame.coords[nodes] - frame.coords[frame.cell[i]]
+        shape = rel.astype(np.int64).tobytes() + fixed.tobytes()
+        slots = frame.keypos[i, nodes[fixed]]
+        hit = (slots.tolist(), nodes.tolist(), fixed.tolist(), shape)
+        frame.graphs[i] = hit
+    return hit
+
+
+class _Plan(NamedTuple):
+    """A configuration to check: its frame (and the frame's id) and the domain of each of
+    the frame's cells before arc consistency (labels in use, edited by the face rules)."""
+
+    frame: _Frame
+    fid: int
+    bases: tuple[int, ...]
+
+
+def _check_config(
+    frame: _Frame,
+    fid: int,
     used: int,
     face_rules: list[FaceRule],
     at_lo: tuple[bool, ...],
     at_hi: tuple[bool, ...],
     memo: _Memo,
-) -> int:
-    lo, hi = tuple(conf["lower"]), tuple(conf["upper"])
-    ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
-    keys = [list(k) for k in conf["keys"]]
-    where = f"configuration lower={list(lo)} upper={list(hi)}"
-    fkey = (lo, hi, tuple(map(tuple, keys)))
-    frame = memo.frames.get(fkey)
-    if frame is None:
-        frame = memo.frames[fkey] = (
-            len(memo.frames),
-            _frame_graphs(lo, hi, ext, keys, region, back, axes, where),
-        )
-    gid, graphs = frame
-
-    def base(x: Cell) -> int:
-        on = frozenset(
-            {_AXES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
-            | {_AXES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
-        )
-        dom = memo.domains.get(on)
+) -> _Plan:
+    """A configuration's frame and the domain of each of its cells."""
+    if not face_rules:
+        return _Plan(frame, fid, (used,) * len(frame.coords))
+    # the faces each cell lies on, as bits 2d (lower) and 2d + 1 (upper)
+    on = np.zeros(len(frame.coords), dtype=np.int64)
+    for d in range(len(at_lo)):
+        if at_lo[d]:
+            on |= (frame.coords[:, d] == 0) << (2 * d)
+        if at_hi[d]:
+            on |= (frame.coords[:, d] == frame.ext[d] - 1) << (2 * d + 1)
+    doms = []
+    for sig in on.tolist():
+        dom = memo.domains.get(sig)
         if dom is None:
-            dom = memo.domains[on] = _domain(face_rules, set(on), used)
-        return dom
-
-    bases = [tuple(base(x) for x in g[3]) for g in graphs]
-    return _check_states(conf, keys, graphs, bases, gid, fwd, bwd, used, memo, where)
+            faces = {_AXES[b // 2] + "-+"[b % 2] for b in range(2 * len(at_lo)) if sig >> b & 1}
+            dom = memo.domains[sig] = _domain(face_rules, faces, used)
+        doms.append(dom)
+    return _Plan(frame, fid, tuple(doms))
 
 
 class _Memo:
@@ -371,140 +572,253 @@ class _Memo:
 
     def __init__(self) -> None:
         self.union: dict[tuple[int, int, int], int] = {}
-        self.frames: dict[Any, tuple[int, list[_Graph]]] = {}
-        self.domains: dict[frozenset[str], int] = {}
-        self.catalogs: dict[Any, list[int]] = {}
+        self.domains: dict[int, int] = {}
+        self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
 
 
-_Graph = tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]
-
-
-def _frame_graphs(
-    lo: Cell,
-    hi: Cell,
-    ext: Cell,
-    keys: list[list[int]],
-    region: list[int],
-    back: list[int],
-    axes: tuple[int, ...],
-    where: str,
-) -> list[_Graph]:
-    """The frame of a configuration, its ``keys`` verified, as one small graph per step."""
-
-    def order_key(c: Cell) -> Cell:
-        return tuple(c[a] for a in axes)
-
-    cells = sorted(itertools.product(*[range(e) for e in ext]), key=order_key)
-    cells = [c for c in cells if order_key(c) < order_key(lo)] + [lo]
-    index = {c: i for i, c in enumerate(cells)}
-    n = len(cells)
-    if len(keys) != n or keys[0]:
-        raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
-    boxes: list[list[Cell]] = []
-    for i, c in enumerate(cells):
-        if keys[i] != sorted(set(keys[i])) or any(not 0 <= j < i for j in keys[i]):
-            raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
-        if i + 1 < n and not set(keys[i + 1]) <= set(keys[i]) | {i}:
-            raise _Invalid(f"{where}: keys[{i + 1}] records a label step {i} forgot")
-        box = list(itertools.product(*[
-            range(max(0, c[d] - back[d]), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
-            for d in range(len(c))
-        ]))  # fmt: skip
-        inbox = set(box)
-        labelled = {x for x in box if x in index and index[x] < i}
-        for x in labelled:
-            near = ((*x[:d], x[d] + s, *x[d + 1 :]) for d in range(len(x)) for s in (-1, 1))
-            if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
-                raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
-        boxes.append(box)
-    return [_graph(boxes[i], index, i, keys[i], cells[i]) for i in range(n)]
+# bytes per state and label the array check holds at once, above which it refuses
+_MAX_BYTES = 2 << 30
 
 
 def _check_states(
-    conf: Mapping[str, Any],
-    keys: list[list[int]],
-    graphs: list[_Graph],
-    bases: list[tuple[int, ...]],
-    gid: int,
+    configs: Sequence[Mapping[str, Any]],
+    plans: list[_Plan],
     fwd: list[list[int]],
     bwd: list[list[int]],
     used: int,
     memo: _Memo,
-    where: str,
 ) -> int:
-    """The states of a configuration: present at the start, closed, never an empty point."""
-    n = len(graphs)
-    by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
-    try:
-        for i, labs in conf["states"]:
-            by_step[i if i >= 0 else n].add(tuple(labs))
-    except (IndexError, TypeError):
-        raise _Invalid(f"{where}: a state's step is not one of its {n} steps") from None
-    in_use = set(_bits(used))
-    for i, group in enumerate(by_step):
-        if any(len(t) != len(keys[i]) for t in group):
-            raise _Invalid(f"{where}: a state at step {i} does not fit keys[{i}]")
-        labels = set(itertools.chain.from_iterable(group))
-        if not labels <= in_use:
-            raise _Invalid(f"{where}: a state at step {i} has a label not in use")
-    if () not in by_step[0]:
-        raise _Invalid(f"{where}: no start state")
-    for i in range(n):
-        src, arcs, target, _ = graphs[i]
-        pos = {j: k for k, j in enumerate(keys[i])}
-        # where each fixed node's label, and each label of the next state, sits in a state
-        src_at = [pos[j] for j in src if j >= 0]
-        nxt_at = [-1 if j == i else pos[j] for j in keys[i + 1]] if i + 1 < n else []
-        later = by_step[i + 1] if i + 1 < n else set()
-        cats = memo.catalogs
-        here = (gid, i, bases[i])
-        # the labels of cell i that agree with its labelled neighbours: a superset of its
-        # catalog (arc consistency only removes more), enough when every one leads on
-        near = [(pos[src[v]], bwd[d] if plus else fwd[d]) for v, d, plus in arcs[target]
-                if src[v] >= 0]  # fmt: skip
-        base_t = bases[i][target]
-        for labs in by_step[i]:
-            if i < n - 1:
-                fc = base_t
-                for k, table in near:
-                    fc &= table[labs[k]]
-                if all(
-                    tuple([b if k < 0 else labs[k] for k in nxt_at]) in later for b in _bits(fc)
-                ):
-                    continue
-            mk = tuple([labs[k] for k in src_at])
-            cat = cats.get((here, mk))
-            if cat is None:
-                it = iter(mk)
-                dom = [b0 if j < 0 else 1 << next(it) for j, b0 in zip(src, bases[i], strict=True)]
-                out = _small_ac(dom, arcs, fwd, bwd, memo.union)
-                cat = cats[(here, mk)] = [] if out is None else list(_bits(out[target]))
-            if i == n - 1:
-                if not cat:
-                    raise _Invalid(
-                        f"{where}: the point's catalog is empty in state {[i, list(labs)]}"
-                    )
-                continue
-            for b in cat:
-                nxt = tuple([b if k < 0 else labs[k] for k in nxt_at])
-                if nxt not in later:
-                    raise _Invalid(
-                        f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
-                        f"{[i + 1, list(nxt)]}, which is missing"
-                    )
-    return sum(len(s) for s in by_step)
+    """The states of every configuration, at once: present at the start, closed, never an
+    empty point. A *group* is a step of a configuration; each state is a row of labels
+    (padded with -1 to the widest state) in its group."""
+    K = len(fwd[0])
+    ndim = len(fwd)
+    width = max(len(k) for p in plans for k in p.frame.keys)
+    # per group: the group of the next step (-1 at the point), the state's width, the
+    # neighbours' slots and tables, the next state's slots, the domain of the step's cell
+    first: list[int] = []
+    nexts: list[int] = []
+    widths: list[int] = []
+    base: list[int] = []
+    acid: list[int] = []
+    npos, ntab, nxt = [], [], []
+    nxt_of: dict[int, Any] = {}
+    ac_ids: dict[tuple[int, int, int], int] = {}
+    base_ids: dict[tuple[int, ...], int] = {}
+    ac_of: list[tuple[_Plan, int]] = []
+    G = 0
+    for p in plans:
+        f = p.frame
+        first.append(G)
+        nexts.extend(range(G + 1, G + f.n))
+        nexts.append(-1)
+        widths.extend(len(k) for k in f.keys)
+        npos.append(f.near_pos)
+        ntab.append(f.near_tab)
+        if p.fid not in nxt_of:
+            nxt_of[p.fid] = _nxt(f, width)
+        nxt.append(nxt_of[p.fid])
+        base.extend(p.bases[x] for x in f.cell.tolist())
+        bid = base_ids.setdefault(p.bases, len(base_ids))
+        for i in range(f.n):
+            k = (p.fid, i, bid)
+            if k not in ac_ids:
+                ac_ids[k] = len(ac_of)
+                ac_of.append((p, i))
+            acid.append(ac_ids[k])
+        G += f.n
+    g_next, g_width, g_acid = (np.array(v, dtype=np.int64) for v in (nexts, widths, acid))
+    g_npos, g_ntab, g_nxt = (np.concatenate(v) for v in (npos, ntab, nxt))
+    bits = sorted(set(base))
+    g_base = np.searchsorted(bits, base)
+    base_rows = _unpack(bits, K)
+    # the states: group, labels
+    every = list(itertools.chain.from_iterable(c["states"] for c in configs))
+    if set(map(len, every)) - {2}:
+        raise _Invalid("a state is not a pair [step, labels]")
+    steps = _ints([s[0] for s in every])
+    rows_l = [s[1] for s in every]
+    n_len = np.fromiter(map(len, rows_l), dtype=np.int64, count=len(rows_l))
+    labels = _ints(list(itertools.chain.from_iterable(rows_l)))
+    cfg = np.repeat(np.arange(len(configs)), [len(c["states"]) for c in configs])
+    n_of = np.array([p.frame.n for p in plans], dtype=np.int64)
+    N = len(steps)
+
+    def where(c: int) -> str:
+        return _where(configs[c]["lower"], configs[c]["upper"])
+
+    out = np.flatnonzero((steps < 0) | (steps >= n_of[cfg]))
+    if len(out):
+        c = int(cfg[out[0]])
+        raise _Invalid(f"{where(c)}: a state's step is not one of its {n_of[c]} steps")
+    grp = np.array(first, dtype=np.int64)[cfg] + steps
+    if N * (K + width) * 24 > _MAX_BYTES:
+        raise MemoryLimitError(
+            f"certificate: checking {N} states of {K} labels needs about "
+            f"{N * (K + width) * 24 / 1e9:.1f} GB, more than {_MAX_BYTES / 1e9:.1f} GB"
+        )
+
+    def state(r: int) -> list[Any]:
+        return [int(steps[r]), labs[r, : g_width[grp[r]]].tolist()]
+
+    bad = np.flatnonzero(n_len != g_width[grp])
+    if len(bad):
+        r = int(bad[0])
+        raise _Invalid(
+            f"{where(int(cfg[r]))}: a state at step {steps[r]} does not fit keys[{steps[r]}]"
+        )
+    in_use = _unpack([used], K)[0]
+    wrong = (labels < 0) | (labels >= K) | ~in_use[np.clip(labels, 0, K - 1)]
+    if wrong.any():
+        r = int(np.searchsorted(np.cumsum(n_len), np.flatnonzero(wrong)[0], side="right"))
+        raise _Invalid(f"{where(int(cfg[r]))}: a state at step {steps[r]} has a label not in use")
+    inrow = np.arange(width)[None, :] < n_len[:, None]
+    labs = np.full((N, width), -1, dtype=np.int64)
+    labs[inrow] = labels
+    have = np.zeros(G, dtype=bool)
+    have[grp[n_len == 0]] = True  # a state of width 0 is the empty state
+    start = np.array(first, dtype=np.int64)
+    if not have[start].all():
+        raise _Invalid(f"{where(int(np.flatnonzero(~have[start])[0]))}: no start state")
+    # the labels of each step's cell that agree with its labelled neighbours: a superset
+    # of its catalog (arc consistency only removes more), enough when every one leads on
+    tables = np.ones((ndim + 1, K + 1, K), dtype=bool)
+    for d in range(ndim):
+        tables[d, :K] = _unpack(fwd[d], K)
+    fc = base_rows[g_base[grp]]
+    rows = np.arange(N)
+    for j in range(g_npos.shape[1]):
+        fc &= tables[g_ntab[grp, j], labs[rows, g_npos[grp, j]]]
+    last = g_next[grp] < 0
+    st, lab = np.nonzero(fc & ~last[:, None])
+    codes, next_codes = _state_codes(grp, labs, st, lab, g_next, g_nxt, K)
+    known = np.sort(codes)
+    at = np.minimum(np.searchsorted(known, next_codes), max(N - 1, 0))
+    present = known[at] == next_codes
+    leads = np.zeros((N, K), dtype=bool)
+    leads[st[present], lab[present]] = True
+    # the rest need the catalog: arc consistency on the step's region, once per group
+    # kind (frame, step, domains) and labels of the region's labelled cells
+    need = np.flatnonzero(last | (fc & ~leads).any(1))
+    if len(need):
+        # the steps' kinds in play, merged by shape and domains of the unlabelled nodes
+        kinds = np.flatnonzero(np.bincount(g_acid[grp[need]], minlength=len(ac_of)))
+        gather = np.full((len(ac_of), width + 1), width)  # width: padding
+        same = np.zeros(len(ac_of), dtype=np.int64)
+        S = 0
+        ids: dict[tuple[bytes, tuple[int, ...]], int] = {}
+        for a in kinds.tolist():
+            p, i = ac_of[a]
+            slots, nodes, fixed, shape = _step_graph(p.frame, i)
+            free = tuple(p.bases[x] for x, f in zip(nodes, fixed, strict=True) if not f)
+            same[a] = ids.setdefault((shape, free), len(ids))
+            gather[a, : len(slots)] = slots
+            S = max(S, len(slots))
+        padded = np.concatenate([labs[need], np.full((len(need), 1), -1)], axis=1)
+        mk = np.take_along_axis(padded, gather[g_acid[grp[need]], : S + 1], axis=1)
+        # one catalog per shape, domains and labels of the labelled nodes
+        inv, which = _ranks(_row_codes(same[g_acid[grp[need]]], mk, K))
+        cats: list[int] = []
+        for r in which.tolist():
+            p, i = ac_of[int(g_acid[grp[need[r]]])]
+            slots, nodes, fixed, shape = _step_graph(p.frame, i)
+            graph = memo.graphs.get(shape)
+            if graph is None:
+                there = [p.frame.cells[x] for x in nodes]
+                here = p.frame.cells[int(p.frame.cell[i])]
+                graph = memo.graphs[shape] = (_arcs(there), there.index(here))
+            arcs, target = graph
+            it = iter(mk[r, : len(slots)].tolist())
+            dom = [1 << next(it) if f else p.bases[x]
+                   for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
+            ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
+            cats.append(0 if ac is None else ac[target])
+        cat_rows = _unpack(cats, K)[inv]
+        empty = last[need] & ~cat_rows.any(1)
+        if empty.any():
+            r = int(need[np.flatnonzero(empty)[0]])
+            raise _Invalid(
+                f"{where(int(cfg[r]))}: the point's catalog is empty in state {state(r)}"
+            )
+        open_ = ~last[need, None] & cat_rows & ~leads[need]
+        if open_.any():
+            row, b = (int(t) for t in np.argwhere(open_)[0])
+            r = int(need[row])
+            g = int(grp[r])
+            nx = [b if s == width else labs[r, s] for s in g_nxt[g, : g_width[g + 1]].tolist()]
+            raise _Invalid(
+                f"{where(int(cfg[r]))}: not closed: state {state(r)} with label {b} leads to "
+                f"{[int(steps[r]) + 1, [int(t) for t in nx]]}, which is missing"
+            )
+    return N
 
 
-def _graph(
-    box: list[Cell], index: Mapping[Cell, int], i: int, key: Sequence[int], cell: Cell
-) -> tuple[list[int], list[list[tuple[int, int, bool]]], int, list[Cell]]:
-    """The region of step ``i`` as a small graph: its unlabelled cells (``src`` -1) and its
-    labelled cells whose label the state records (``src`` = their step); arcs
-    ``(node, axis, node is the + neighbour)``; the node of cell ``i``; the nodes' cells."""
-    known = set(key)
-    nodes = [x for x in box if not (x in index and index[x] < i) or index[x] in known]
-    src = [index[x] if x in index and index[x] < i else -1 for x in nodes]
-    return src, _arcs(nodes), nodes.index(cell), nodes
+def _unpack(bitsets: list[int], K: int) -> Any:
+    """Bit sets of ``K`` labels as rows of booleans."""
+    nb = (K + 7) // 8
+    raw = np.frombuffer(b"".join(b.to_bytes(nb, "little") for b in bitsets), dtype=np.uint8)
+    return np.unpackbits(raw.reshape(-1, nb), axis=1, bitorder="little")[:, :K].astype(bool)
+
+
+def _ints(values: list[Any]) -> Any:
+    """``values`` as an int64 array; anything but integers is a malformed certificate."""
+    out = np.array(values) if values else np.zeros(0, dtype=np.int64)
+    if out.ndim != 1 or out.dtype.kind not in "iu":
+        raise _Invalid("a state's step or labels are not integers")
+    return out.astype(np.int64)
+
+
+# the largest code of a state (group and labels) computed as a polynomial in its labels
+_CODE_LIMIT = 1 << 62
+
+
+def _state_codes(
+    grp: Any, labs: Any, st: Any, lab: Any, g_next: Any, g_nxt: Any, K: int
+) -> tuple[Any, Any]:
+    """Exact codes of the states (``grp``, ``labs``) and of the states ``(g_next[grp[st]],
+    labs[st] rearranged by g_nxt with lab chosen)`` that they lead to: equal codes for equal
+    states. A polynomial in the labels (the padding -1 adds nothing) when it stays below
+    ``_CODE_LIMIT``; else the rows are built and ranked (:func:`_row_codes`)."""
+    N, width = labs.shape
+    G = len(g_next)
+    ext = np.concatenate([labs, np.full((N, 2), -1, dtype=np.int64)], axis=1)
+    if G * (K + 1) ** width < _CODE_LIMIT:
+        w = (K + 1) ** np.arange(width - 1, -1, -1, dtype=np.int64)
+        gw = (K + 1) ** width
+        codes = grp * gw + (labs + 1) @ w
+        # the next state: its labels kept from this one, plus the chosen label's term
+        kept = g_next[grp] * gw + (np.take_along_axis(ext, g_nxt[grp], axis=1) + 1) @ w
+        chosen = ((g_nxt == width) * w).sum(1)
+        return codes, kept[st] + (lab + 1) * chosen[grp[st]]
+    e = ext[st]
+    e[:, width] = lab
+    cand = np.take_along_axis(e, g_nxt[grp[st]], axis=1)
+    both = _row_codes(np.concatenate([grp, g_next[grp[st]]]), np.concatenate([labs, cand]), K)
+    return both[:N], both[N:]
+
+
+def _ranks(values: Any) -> tuple[Any, Any]:
+    """The rank of each value among the distinct ``values`` (0, 1, ...), and the index of
+    the first occurrence of each distinct value."""
+    order = np.argsort(values, kind="stable")
+    ordered = values[order]
+    new = np.ones(len(values), dtype=bool)
+    new[1:] = ordered[1:] != ordered[:-1]
+    rank = np.empty(len(values), dtype=np.int64)
+    rank[order] = np.cumsum(new) - 1
+    return rank, order[new]
+
+
+def _row_codes(group: Any, rows: Any, K: int) -> Any:
+    """Exact int64 codes of ``(group, row)`` pairs (rows of labels -1 .. K - 1): equal
+    codes for equal pairs, ranked again whenever the next column would overflow."""
+    code = _ranks(group)[0]
+    top = (1 << 62) // (K + 1)
+    for k in range(rows.shape[1]):
+        if len(code) and int(code.max()) >= top:
+            code = _ranks(code)[0]
+        code = code * (K + 1) + (rows[:, k] + 1)
+    return code
 
 
 def _arcs(nodes: Sequence[Cell]) -> list[list[tuple[int, int, bool]]]:

@@ -266,3 +266,203 @@ def test_face_rule_refutations_check(rs):
         cert = json.loads(json.dumps(v.witness["certificate"]))
         ok, msg = check_certificate(cert)
         assert ok, msg
+
+
+# ----------------------------------------------------------------------------- one defect per check
+#
+# Each planted defect below can be seen by one part of the checker only; the message says
+# which. The prover's state set is the least closed one (every state is reached from the
+# start), so removing any state must leave a state whose successor is missing.
+
+
+@pytest.fixture(scope="module")
+def small_cert():
+    """fig3_15 with 2x2 regions, scan:yx: 9 configurations, ~400 states, 10 labels."""
+    return _cert("fig3_15", "2x2", "scan:yx")
+
+
+@pytest.fixture(scope="module")
+def face_cert():
+    """fig3_4a with its ground and empty space (face rules), 2x4 regions."""
+    v = prove_infallible(load_model("fig3_4a"), "2x4", boundary="auto", refute=False,
+                         certificate=True)  # fmt: skip
+    return json.loads(json.dumps(v.witness["certificate"]))
+
+
+@pytest.fixture(params=["polynomial codes", "ranked codes", "one frame per chunk"])
+def checker_path(request, monkeypatch):
+    """The checker's alternative paths: state codes as a polynomial in the labels or ranked
+    column by column (past _CODE_LIMIT), frames verified together or one at a time."""
+    import csplab.certcheck as cc
+
+    if request.param == "ranked codes":
+        monkeypatch.setattr(cc, "_CODE_LIMIT", 0)
+    elif request.param == "one frame per chunk":
+        monkeypatch.setattr(cc, "_FRAME_CHUNK", 1)
+    return request.param
+
+
+def _without_state(cert: dict, k: int) -> tuple[dict, list]:
+    """``cert`` without its ``k``-th state (over all configurations, start states skipped)."""
+    bad = copy.deepcopy(cert)
+    for conf in bad["configs"]:
+        rest = [s for s in conf["states"] if s[0] != 0]
+        if k < len(rest):
+            gone = rest[k]
+            conf["states"] = [s for s in conf["states"] if s is not gone]
+            return bad, gone
+        k -= len(rest)
+    raise IndexError(k)
+
+
+@pytest.mark.parametrize("which", ["small_cert", "face_cert"])
+def test_removing_any_state_breaks_the_closure(which, checker_path, request):
+    cert = request.getfixturevalue(which)
+    assert check_certificate(cert)[0]
+    total = sum(len(c["states"]) - 1 for c in cert["configs"])
+    rng = np.random.default_rng(26)
+    for k in sorted(rng.choice(total, size=min(total, 60), replace=False).tolist()):
+        bad, gone = _without_state(cert, k)
+        ok, msg = check_certificate(bad)
+        assert not ok and "not closed" in msg, (gone, msg)
+        assert f"leads to {gone}" in msg or "which is missing" in msg
+
+
+def test_a_state_with_a_wrong_label_is_rejected(small_cert, checker_path):
+    bad = copy.deepcopy(small_cert)
+    K = small_cert["rules"]["labels"]
+
+    def other() -> tuple[list, int, int]:  # a state changed into one the set lacks
+        for conf in bad["configs"]:
+            have = {(s[0], tuple(s[1])) for s in conf["states"]}
+            for k, (step, labs) in enumerate(conf["states"]):
+                for b in range(K):
+                    if labs and (step, (b, *labs[1:])) not in have:
+                        return conf["states"], k, b
+        raise AssertionError("every variant is present")
+
+    states, k, b = other()
+    states[k] = [states[k][0], [b, *states[k][1][1:]]]
+    ok, msg = check_certificate(bad)
+    assert not ok and "not closed" in msg, msg
+
+
+def test_no_start_state(small_cert, checker_path):
+    bad = copy.deepcopy(small_cert)
+    bad["configs"][3]["states"] = [s for s in bad["configs"][3]["states"] if s[0] != 0]
+    ok, msg = check_certificate(bad)
+    assert not ok and "no start state" in msg, msg
+
+
+def test_a_point_with_an_empty_catalog(small_cert, checker_path):
+    # the catalog of every point of some state is empty once a label loses its successors
+    bad = copy.deepcopy(small_cert)
+    a0 = bad["rules"]["pairs"][0][0][0]
+    bad["rules"]["pairs"][0] = [p for p in bad["rules"]["pairs"][0] if p[0] != a0]
+    bad["rules_sha256"] = rules_hash(bad["rules"])
+    ok, msg = check_certificate(bad)
+    assert not ok and "the point's catalog is empty" in msg, msg
+
+
+def _conf_with_keys(cert: dict) -> tuple[dict, int]:
+    """A copy of ``cert`` and the index of a configuration with at least 4 steps."""
+    bad = copy.deepcopy(cert)
+    return bad, next(k for k, c in enumerate(bad["configs"]) if len(c["keys"]) >= 4)
+
+
+def test_keys_defects(small_cert):
+    def rejected(bad: dict, what: str) -> None:
+        ok, msg = check_certificate(bad)
+        assert not ok and what in msg, (what, msg)
+
+    bad, c = _conf_with_keys(small_cert)
+    bad["configs"][c]["keys"] = bad["configs"][c]["keys"][:-1]
+    rejected(bad, "keys must list")
+    bad, c = _conf_with_keys(small_cert)
+    bad["configs"][c]["keys"][0] = [0]
+    rejected(bad, "keys must list")
+    bad, c = _conf_with_keys(small_cert)
+    keys = bad["configs"][c]["keys"]
+    i = next(i for i, k in enumerate(keys) if len(k) >= 2)
+    keys[i] = keys[i][::-1]
+    rejected(bad, f"keys[{i}] must be sorted earlier steps")
+    bad, c = _conf_with_keys(small_cert)
+    keys = bad["configs"][c]["keys"]
+    keys[1] = [1]  # step 1 recording itself
+    rejected(bad, "keys[1] must be sorted earlier steps")
+    # a label recorded again after a step forgot it
+    bad, c = _conf_with_keys(small_cert)
+    keys = bad["configs"][c]["keys"]
+    i = next(i for i in range(1, len(keys) - 1) if set(keys[i + 1]) - {i})
+    j = sorted(set(keys[i + 1]) - {i})[0]
+    keys[i] = [t for t in keys[i] if t != j]
+    rejected(bad, f"keys[{i + 1}] records a label step {i} forgot")
+    # a label a step's own region needs, not recorded (nor later)
+    bad, c = _conf_with_keys(small_cert)
+    keys = bad["configs"][c]["keys"]
+    n = len(keys)
+    i = next(i for i in range(n) if set(keys[i]) - set(keys[i + 1] if i + 1 < n else []))
+    j = sorted(set(keys[i]) - set(keys[i + 1] if i + 1 < n else []))[0]
+    keys[i] = [t for t in keys[i] if t != j]
+    rejected(bad, f"step {i} depends on cell")
+
+
+def test_state_shape_defects(small_cert, checker_path):
+    def rejected(change, what: str) -> None:
+        bad = copy.deepcopy(small_cert)
+        conf = max(bad["configs"], key=lambda c: len(c["states"]))
+        k = next(i for i, s in enumerate(conf["states"]) if len(s[1]) >= 2)
+        change(bad, conf, k)
+        ok, msg = check_certificate(bad)
+        assert not ok and what in msg, (what, msg)
+
+    def step_out(bad, conf, k):
+        conf["states"][k][0] = len(conf["keys"])
+
+    def negative_step(bad, conf, k):
+        conf["states"][k][0] = -1
+
+    def short(bad, conf, k):
+        conf["states"][k][1] = conf["states"][k][1][1:]
+
+    def out_of_range(bad, conf, k):
+        conf["states"][k][1][0] = bad["rules"]["labels"]
+
+    def not_in_use(bad, conf, k):
+        b = conf["states"][k][1][0]
+        bad["rules"]["used"][b] = 0
+        bad["rules_sha256"] = rules_hash(bad["rules"])
+
+    def fractional(bad, conf, k):
+        conf["states"][k][1][0] += 0.5
+
+    def triple(bad, conf, k):
+        conf["states"][k].append(0)
+
+    rejected(step_out, "is not one of its")
+    rejected(negative_step, "is not one of its")
+    rejected(short, "does not fit keys")
+    rejected(out_of_range, "has a label not in use")
+    rejected(not_in_use, "has a label not in use")
+    rejected(fractional, "not integers")
+    rejected(triple, "not a pair")
+
+
+def test_configuration_defects(small_cert):
+    bad = copy.deepcopy(small_cert)
+    bad["configs"].append(copy.deepcopy(bad["configs"][0]))
+    ok, msg = check_certificate(bad)
+    assert not ok and "positions of a point" in msg, msg
+    bad = copy.deepcopy(small_cert)
+    bad["configs"][0]["lower"] = [9, 9]
+    ok, msg = check_certificate(bad)
+    assert not ok and "positions of a point" in msg, msg
+
+
+def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
+    import csplab.certcheck as cc
+    from csplab.errors import MemoryLimitError
+
+    monkeypatch.setattr(cc, "_MAX_BYTES", 1000)
+    with pytest.raises(MemoryLimitError, match="GB"):
+        check_certificate(small_cert)
