@@ -256,22 +256,37 @@ def resemblance3(
         The figures.
     """
     normals = _Normals(angle_tol)
-    ex_kinds, ex_faces = edge_kinds(example, normals, grow=True)
-    out_kinds, out_faces = (
-        edge_kinds(output, normals, grow=False) if output.solids else (set(), set())
+    return _figures(
+        edge_kinds(example, normals, grow=True),
+        edge_kinds(output, normals, grow=False) if output.solids else (set(), set()),
+        [s.volume for s in example.solids],
+        [s.volume for s in output.solids],
+        (len(floating_solids(example)), len(floating_solids(output, ground))),
     )
-    ex_vol = float(np.median([s.volume for s in example.solids])) if example.solids else 0.0
-    out_vol = float(np.median([s.volume for s in output.solids])) if output.solids else 0.0
+
+
+def _figures(
+    ex: tuple[set[Any], set[Any]],
+    out: tuple[set[Any], set[Any]],
+    ex_sizes: list[float],
+    out_sizes: list[float],
+    floating: tuple[int, int],
+) -> Resemblance:
+    """The :class:`Resemblance` of either dimension from the example's and the output's
+    (kinds, orientations), part sizes (volumes or areas) and floating parts."""
+    (ex_kinds, ex_dirs), (out_kinds, out_dirs) = ex, out
+    ex_med = float(np.median(ex_sizes)) if ex_sizes else 0.0
+    out_med = float(np.median(out_sizes)) if out_sizes else 0.0
     return Resemblance(
-        solids=len(output.solids),
-        example_solids=len(example.solids),
-        median_volume_ratio=out_vol / ex_vol if ex_vol > 0 else 0.0,
+        solids=len(out_sizes),
+        example_solids=len(ex_sizes),
+        median_volume_ratio=out_med / ex_med if ex_med > 0 else 0.0,
         edge_kinds=len(ex_kinds & out_kinds) / len(ex_kinds) if ex_kinds else 1.0,
         example_edge_kinds=len(ex_kinds),
-        face_orientations=len(ex_faces & out_faces) / len(ex_faces) if ex_faces else 1.0,
-        example_face_orientations=len(ex_faces),
-        floating=len(floating_solids(output, ground)),
-        example_floating=len(floating_solids(example)),
+        face_orientations=len(ex_dirs & out_dirs) / len(ex_dirs) if ex_dirs else 1.0,
+        example_face_orientations=len(ex_dirs),
+        floating=floating[1],
+        example_floating=floating[0],
     )
 
 
@@ -403,22 +418,10 @@ def resemblance2(
         The figures (polygons, areas, corner kinds, edge directions).
     """
     normals = _Normals(angle_tol)
-    ex_kinds, ex_dirs = corner_kinds(example, normals, grow=True)
-    out_kinds, out_dirs = (
-        corner_kinds(output, normals, grow=False) if output.polygons else (set(), set())
-    )
-    ex_area, out_area = (
-        float(np.median([p.shape.area for p in m.polygons])) if m.polygons else 0.0
-        for m in (example, output)
-    )
-    return Resemblance(
-        solids=len(output.polygons),
-        example_solids=len(example.polygons),
-        median_volume_ratio=out_area / ex_area if ex_area > 0 else 0.0,
-        edge_kinds=len(ex_kinds & out_kinds) / len(ex_kinds) if ex_kinds else 1.0,
-        example_edge_kinds=len(ex_kinds),
-        face_orientations=len(ex_dirs & out_dirs) / len(ex_dirs) if ex_dirs else 1.0,
-        example_face_orientations=len(ex_dirs),
-        floating=len(floating_polygons(output, ground)),
-        example_floating=len(floating_polygons(example)),
+    return _figures(
+        corner_kinds(example, normals, grow=True),
+        corner_kinds(output, normals, grow=False) if output.polygons else (set(), set()),
+        [p.shape.area for p in example.polygons],
+        [p.shape.area for p in output.polygons],
+        (len(floating_polygons(example)), len(floating_polygons(output, ground))),
     )
