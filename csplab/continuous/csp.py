@@ -52,7 +52,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.continuous.arrangement import Arrangement, Lattice
 from csplab.continuous.csp3d import ContinuousCSP3
-from csplab.continuous.lattice import check_snap
+from csplab.continuous.lattice import check_snap, open_sides
 from csplab.continuous.model import Polygon, PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -92,21 +92,9 @@ def ground_sides(ground: str | Sequence[str] | None) -> tuple[str, ...]:
     >>> ground_sides("z-")
     Traceback (most recent call last):
     ...
-    csplab.errors.InputError: ground: polygon model sides are x-, x+, y-, y+ (window, none), not z-
+    csplab.errors.InputError: ground: polygon sides are x-, x+, y-, y+ (or window, none), not z-
     """
-    if ground is None or (isinstance(ground, str) and ground.strip() in ("", "none")):
-        return ()
-    if isinstance(ground, str):
-        if ground.strip() == "window":
-            return WINDOW2
-        items = [g.strip() for g in ground.split(",") if g.strip()]
-    else:
-        items = [str(g) for g in ground]
-    bad = [g for g in items if g not in SIDES]
-    if bad:
-        raise InputError(f"ground: polygon model sides are {', '.join(SIDES)} (window, none), "
-                         f"not {', '.join(bad)}")  # fmt: skip
-    return tuple(f for f in SIDES if f in items)
+    return open_sides(ground, SIDES, WINDOW2, "polygon sides")
 
 
 def _continued(

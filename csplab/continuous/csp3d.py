@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from csplab.constraints import Connected
 from csplab.continuous._geom import labels_at
-from csplab.continuous.lattice import Lattice, check_snap, face_planes
+from csplab.continuous.lattice import Lattice, check_snap, face_planes, open_sides
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.space import Arrangement3, check_budget3
 from csplab.continuous.surface import surface_of
@@ -87,19 +87,7 @@ def ground_faces(ground: str | Sequence[str] | None) -> tuple[str, ...]:
     ...
     csplab.errors.InputError: ground: faces are z-, z+, x-, x+, y-, y+ (or window, none), not floor
     """
-    if ground is None or (isinstance(ground, str) and ground.strip() in ("", "none")):
-        return ()
-    if isinstance(ground, str):
-        if ground.strip() == "window":
-            return WINDOW
-        items = [g.strip() for g in ground.split(",") if g.strip()]
-    else:
-        items = [str(g) for g in ground]
-    bad = [g for g in items if g not in FACE_ORDER]
-    if bad:
-        raise InputError(f"ground: faces are {', '.join(FACE_ORDER)} (or window, none), not "
-                         f"{', '.join(bad)}")  # fmt: skip
-    return tuple(f for f in FACE_ORDER if f in items)
+    return open_sides(ground, FACE_ORDER, WINDOW, "faces")
 
 
 def _clamped(

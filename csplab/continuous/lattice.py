@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Collection, Iterable, Sequence
 from dataclasses import dataclass, field
 from fractions import Fraction
 from typing import TYPE_CHECKING, Protocol
@@ -104,6 +104,45 @@ PLANES = ("auto", "lattice", "equal")
 #: snapping may make; beyond it the example is not the one given (an icosphere of radius 1
 #: snapped onto spacing 1 becomes a cube of twice its volume)
 MAX_SNAP_CHANGE = 0.5
+
+
+def open_sides(
+    ground: str | Sequence[str] | None,
+    order: Collection[str],
+    window: tuple[str, ...],
+    what: str,
+) -> tuple[str, ...]:
+    """The open sides of a region from a ``ground`` declaration, in ``order``: ``None``,
+    ``""`` or ``"none"``: none; ``"window"``: ``window``; otherwise sides of ``order``, as a
+    comma-separated string or a sequence. ``what`` names the sides in the error.
+
+    Raises
+    ------
+    InputError
+        For a side not in ``order``.
+
+    Examples
+    --------
+    >>> open_sides("y-,x+", ("x-", "x+", "y-", "y+"), ("y-",), "sides")
+    ('x+', 'y-')
+    >>> open_sides("floor", ("x-", "x+"), (), "sides")
+    Traceback (most recent call last):
+    ...
+    csplab.errors.InputError: ground: sides are x-, x+ (or window, none), not floor
+    """
+    if ground is None or (isinstance(ground, str) and ground.strip() in ("", "none")):
+        return ()
+    if isinstance(ground, str):
+        if ground.strip() == "window":
+            return window
+        items = [g.strip() for g in ground.split(",") if g.strip()]
+    else:
+        items = [str(g) for g in ground]
+    bad = [g for g in items if g not in order]
+    if bad:
+        raise InputError(f"ground: {what} are {', '.join(order)} (or window, none), not "
+                         f"{', '.join(bad)}")  # fmt: skip
+    return tuple(f for f in order if f in items)
 
 
 def check_snap(where: str, spacing: float, what: str, before: float, after: float) -> None:
