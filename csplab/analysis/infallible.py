@@ -98,6 +98,7 @@ __all__ = [
     "alg36_failure",
     "corner_condition",
     "face_rules_of",
+    "label_classes",
     "proof_scope",
     "prove_infallible",
     "region_box",
@@ -185,6 +186,52 @@ def _graph_ac(
                     inq[v] = True
                     queue.append(v)
     return dom
+
+
+def label_classes(rules: Rules, axes: Sequence[int] | None = None) -> list[int]:
+    """Each label's class: the least label that supports the same labels as it forward
+    along every axis of ``axes`` (default: all; ``fwd[d][a]`` equal for these ``d``).
+
+    A frame cell whose forward neighbour along an axis is labelled (or outside the frame)
+    no longer acts along it, so the prover's memoisation key records its label by its
+    class along the other axes only.
+
+    Why the prover may record a frame label as its class: a labelled frame cell ``x``
+    changes a later catalog only through arcs to unlabelled cells, and in a scan order
+    those are its forward neighbours (``x - e_d`` comes before ``x``, so inside the frame
+    it is labelled). Along a forward arc, ``x``'s label ``a`` narrows the neighbour to
+    ``fwd[d][a]`` and keeps ``a`` iff the neighbour's domain meets ``fwd[d][a]``: both
+    depend on ``a`` only through its class. Arcs between two labelled cells hold in every
+    run (each label was drawn from a catalog of a region holding its backward
+    neighbours), so leaving them out of arc consistency changes no catalog of a real run.
+
+    Parameters
+    ----------
+    rules : Rules
+    axes : sequence of int, optional
+        The axes compared.
+
+    Returns
+    -------
+    list of int
+        ``K`` entries; unused labels are their own class.
+
+    Examples
+    --------
+    >>> label_classes(Rules([[[1, 1, 0], [1, 1, 0], [0, 0, 1]]]))
+    [0, 0, 2]
+    >>> label_classes(Rules([[[1, 1, 0], [1, 1, 0], [0, 0, 1]]]), axes=[])
+    [0, 0, 0]
+    """
+    first: dict[tuple[int, ...], int] = {}
+    out = []
+    for a in range(rules.K):
+        if not rules.used >> a & 1:
+            out.append(a)
+            continue
+        ax = range(rules.ndim) if axes is None else axes
+        out.append(first.setdefault(tuple(rules.fwd[d][a] for d in ax), a))
+    return out
 
 
 # ----------------------------------------------------------------------------- orders, regions
@@ -311,8 +358,15 @@ class _Walk:
         region: Coords,
         base: Callable[[Coords], int] | None = None,
         back: Coords | None = None,
+        reduce: Rules | None = None,
     ) -> None:
         self.ext, self.cells, self.region = ext, cells, region
+        # with ``reduce``: labels are drawn as their class (:func:`label_classes`), the
+        # memoisation key records each label by its class along the axes on which the
+        # cell's forward neighbour is not yet labelled, and arcs between two labelled cells
+        # are left out (see :func:`label_classes`)
+        classes = None if reduce is None else label_classes(reduce)
+        self.classes = classes
         index = {c: i for i, c in enumerate(cells)}
         ndim = len(ext)
         self.steps: list[tuple[list[int], list[list[tuple[int, int, bool]]], int]] = []
@@ -349,7 +403,7 @@ class _Walk:
                 for d in range(ndim):
                     y = (*x[:d], x[d] + 1, *x[d + 1 :])
                     m = pos.get(y)
-                    if m is not None:
+                    if m is not None and (classes is None or not (fixed(x) and fixed(y))):
                         arcs[k].append((m, d, True))
                         arcs[m].append((k, d, False))
             src = [index[x] if fixed(x) else -1 for x in keep]
@@ -363,6 +417,29 @@ class _Walk:
         for i in range(n - 1, -1, -1):
             need |= set(relfixed[i])
             self.key_at[i] = sorted(j for j in need if j < i)
+        # per step, per key cell: label -> the label recorded in the memoisation key
+        self.proj: list[list[list[int]]] | None = None
+        if reduce is not None:
+            canon: dict[frozenset[int], list[int]] = {}
+
+            def open_axes(j: int, i: int) -> frozenset[int]:
+                x = cells[j]
+                out = set()
+                for d in range(ndim):
+                    y = (*x[:d], x[d] + 1, *x[d + 1 :])
+                    if y[d] < ext[d] and index.get(y, n) >= i:
+                        out.add(d)
+                return frozenset(out)
+
+            self.proj = []
+            for i in range(n + 1):
+                row = []
+                for j in self.key_at[i]:
+                    ax = open_axes(j, i)
+                    if ax not in canon:
+                        canon[ax] = label_classes(reduce, sorted(ax))
+                    row.append(canon[ax])
+                self.proj.append(row)
         self._cache: dict[tuple[int, tuple[int, ...]], int] = {}
 
     def catalog(self, rules: Rules, i: int, labels: Sequence[int]) -> int:
@@ -435,6 +512,7 @@ def _frame(
     edges: Edges | None = None,
     face_domain: Callable[[frozenset[str]], int] | None = None,
     back: Coords | None = None,
+    reduce: Rules | None = None,
 ) -> tuple[_Walk, Coords, Coords]:
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     q = lo
@@ -450,7 +528,7 @@ def _frame(
             on |= {AXIS_NAMES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
             return face_domain(frozenset(on))
 
-    return _Walk(ext, cells, region, base, back), ext, q
+    return _Walk(ext, cells, region, base, back, reduce), ext, q
 
 
 def prove_infallible(
@@ -466,6 +544,7 @@ def prove_infallible(
     boundary: Mapping[str, int] | str | None = None,
     time_limit: float | None = None,
     back: Sequence[int] | int = 1,
+    classes: bool = False,
 ) -> Verdict:
     """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
 
@@ -505,6 +584,10 @@ def prove_infallible(
     back : int or sequence
         How far each region reaches before its point, per axis (Alg. 3.7: 1). Larger
         values see more of the assigned cells (:func:`region_box`).
+    classes : bool
+        Record each frame label as its class (:func:`label_classes`: labels that support
+        the same labels along every axis forward have equal futures in the frame), so
+        equal futures are explored once; the certificate then lists the classes.
 
     Raises
     ------
@@ -564,12 +647,18 @@ def prove_infallible(
         digest.update(repr(bk).encode())
     if face_rules:
         digest.update(repr(face_rules).encode())
+    cls = label_classes(rules) if classes else None
+    if cls is not None:
+        digest.update(repr(cls).encode())
+        stats["classes"] = len(set(cls))
     failure: dict[str, Any] | None = None
     closed: list[dict[str, Any]] = []
     deadline = None if time_limit is None else t0 + float(time_limit)
     try:
         for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules), bk):
-            walk, ext, q = _frame(lo, hi, axes, r, edges, face_domain, bk)
+            walk, ext, q = _frame(
+                lo, hi, axes, r, edges, face_domain, bk, rules if classes else None
+            )
             stats["configs"] += 1
             seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
             fail, nstates, windows = _enumerate(
@@ -628,7 +717,8 @@ def prove_infallible(
             proof["certificate"] = _certificate(
                 example, rules, face_rules, "infallible", stats,
                 {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
-                 "back": list(bk), "configs": closed},
+                 "back": list(bk), "configs": closed}
+                | ({} if cls is None else {"label_classes": True}),
             )  # fmt: skip
         return Verdict(
             True,
@@ -973,8 +1063,13 @@ def _dfs(
     labels: list[int] = []
     last = len(walk.cells) - 1
 
+    proj = walk.proj
+
     def rec(i: int) -> _R | None:
-        key = (i, tuple(labels[j] for j in walk.key_at[i]))
+        if proj is None:
+            key = (i, tuple(labels[j] for j in walk.key_at[i]))
+        else:
+            key = (i, tuple(m[labels[j]] for m, j in zip(proj[i], walk.key_at[i], strict=True)))
         if key in seen:
             return None
         seen.add(key)
@@ -986,7 +1081,8 @@ def _dfs(
         res = found(i, cat, labels)
         if res is not None or i == last:
             return res
-        opts = list(set_bits(cat))
+        cls = walk.classes
+        opts = list(set_bits(cat)) if cls is None else sorted({cls[b] for b in set_bits(cat)})
         want = None if first is None else first.get(i)
         if want is not None and want in opts:
             opts.remove(want)
