@@ -43,7 +43,11 @@ frame (the cells before the point ``q = lower`` in scan order, in the box of ext
 4. at the last step (the point) ``C_R`` is never empty.
 
 Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 never fails
-(Theorem 3.3.6, the prover's docstring has the argument). *fallible*: ``run`` (``shape``,
+(Theorem 3.3.6, the prover's docstring has the argument). With ``label_classes`` true, a
+state records each label by its class -- the least label in use with the same forward
+supports along the axes on which the cell's + neighbour is in the frame and not yet
+labelled at that step -- and arc consistency leaves out arcs between labelled cells
+(:func:`_check_classes` says why that is sound). *fallible*: ``run`` (``shape``,
 ``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``: a mapping face ->
 label, or ``"auto"`` for the face rules): the checker replays
 it with arc consistency on the whole grid -- the cells in scan order, each label in its
