@@ -178,6 +178,8 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
         fwd, bwd, used, ndim = _tables(rules)
         model = _Rules(fwd, bwd, used, ndim, _face_rules(rules.get("faces") or [], ndim, rules))
         claim = cert.get("claim")
+        if claim == "infallible" and cert.get("dead"):
+            model = _without(model, _check_dead(cert["dead"], model))
         if claim == "infallible" and cert.get("label_classes"):
             msg = _check_classes(cert, model)
         elif claim == "infallible":
@@ -736,6 +738,61 @@ def _check_class_config(
                         f"{[i + 1, list(new)]}, which is missing"
                     )
     return sum(len(s) for s in by_step)
+
+
+# ----------------------------------------------------------------------------- dead labels
+
+
+def _check_dead(stages: Sequence[Any], rules: _Rules) -> int:
+    """The labels of an *infallible* certificate's ``dead`` stages ``[face, labels]``,
+    verified: no cell on ``face`` (whatever other faces it lies on) may take one, and every
+    label supporting one of them from the neighbour toward ``face`` is in this stage or an
+    earlier one.
+
+    Why then no catalog of Alg. 3.1 ever holds one: its catalogs lie inside the greatest
+    arc-consistent domains before any choice, where a label has a support in each
+    neighbour. Take a dead label there at the cell nearest the face among those of the
+    first stage that has one: on the face its domain excludes it; elsewhere its support in
+    the neighbour nearer the face is dead at an earlier stage or at this one, nearer the
+    face -- either way a contradiction. So Alg. 3.1 runs the same with the dead labels out
+    of use, and the rest of the certificate is checked with them out of use.
+    """
+    fwd, bwd, used, ndim, face_rules = rules
+    every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
+    dead = 0
+    for face, labels in stages:
+        if face not in every:
+            raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
+        bits = 0
+        for b in labels:
+            if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
+                raise _Invalid(f"dead labels: {b!r} is not a label in use")
+            bits |= 1 << b
+        others = [f for f in every if f != face]
+        for mask in range(1 << len(others)):
+            on = {face} | {f for k, f in enumerate(others) if mask >> k & 1}
+            if _domain(face_rules, on, used) & bits:
+                raise _Invalid(f"dead labels {labels}: a cell on {sorted(on)} may take one")
+        d = _AXES.index(face[0])
+        table = bwd[d] if face[1] == "-" else fwd[d]
+        for b in _bits(bits):
+            if table[b] & ~(dead | bits):
+                raise _Invalid(
+                    f"dead labels: {b} has a support toward {face} that is not dead: "
+                    f"{sorted(_bits(table[b] & ~(dead | bits)))}"
+                )
+        dead |= bits
+    return dead
+
+
+def _without(rules: _Rules, dead: int) -> _Rules:
+    """The rules with the ``dead`` labels out of use."""
+    keep = rules.used & ~dead
+
+    def cut(table: list[list[int]]) -> list[list[int]]:
+        return [[row & keep if keep >> a & 1 else 0 for a, row in enumerate(t)] for t in table]
+
+    return _Rules(cut(rules.fwd), cut(rules.bwd), keep, rules.ndim, rules.faces)
 
 
 # ----------------------------------------------------------------------------- fallible

@@ -31,7 +31,7 @@ Examples
 >>> from csplab.examples import load_example
 >>> v = decide_infallibility(load_example("fig3_4a"), order="scan:yx", time_limit=30)
 >>> v.holds, v.stats["method"]
-(True, 'region 3x2 (Alg. 3.6)')
+(True, 'region 3x2 history 0 (Alg. 3.6)')
 >>> v = decide_infallibility(load_example("fig3_5a"), order="scan:yx", time_limit=30)
 >>> v.holds, v.stats["method"] in ("Alg. 3.6 run = Alg. 3.1 run", "failure search")
 (False, True)

@@ -97,6 +97,7 @@ __all__ = [
     "Rules",
     "alg36_failure",
     "corner_condition",
+    "dead_labels",
     "face_rules_of",
     "label_classes",
     "proof_scope",
@@ -620,6 +621,13 @@ def prove_infallible(
     axes = scan_axes(ndim, order)
     r = parse_region(region, ndim)
     face_rules = face_rules_of(example, boundary)
+    rules0 = rules  # the certificate's rules; ``rules`` without the dead labels
+    dead = dead_labels(rules, face_rules)
+    if dead:
+        gone = np.zeros(rules.K, dtype=bool)
+        for _, labels in dead:
+            gone[labels] = True
+        rules = Rules(rules.T, rules.used_mask & ~gone)
     face_domain = _face_domain(face_rules, rules) if face_rules else None
     if face_rules:
         realize = False  # exhaustive Alg. 3.6 on a concrete output ignores the face rules
@@ -647,6 +655,9 @@ def prove_infallible(
         digest.update(repr(bk).encode())
     if face_rules:
         digest.update(repr(face_rules).encode())
+    if dead:
+        digest.update(repr(dead).encode())
+        stats["dead"] = sum(len(b) for _, b in dead)
     cls = label_classes(rules) if classes else None
     if cls is not None:
         digest.update(repr(cls).encode())
@@ -715,17 +726,21 @@ def prove_infallible(
         }
         if certificate:
             proof["certificate"] = _certificate(
-                example, rules, face_rules, "infallible", stats,
+                example, rules0, face_rules, "infallible", stats,
                 {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
                  "back": list(bk), "configs": closed}
-                | ({} if cls is None else {"label_classes": True}),
+                | ({} if cls is None else {"label_classes": True})
+                | ({"dead": [[f, b] for f, b in dead]} if dead else {}),
             )  # fmt: skip
+        dtxt = f"(labels {sorted(b for _, bs in dead for b in bs)} never in a catalog; "
+        dtxt = dtxt if dead else "("
         return Verdict(
             True,
             proof,
             stats,
             f"infallible: Alg. 3.6 with {rtxt} regions ({order}) cannot fail "
-            f"({stats['windows']} windows, {stats['states']} states, "
+            + dtxt
+            + f"{stats['windows']} windows, {stats['states']} states, "
             f"{stats['configs']} configurations, {stats['time_s']:.2f} s)",
         )
     # the window check failed: is the failure real?
@@ -750,7 +765,7 @@ def prove_infallible(
             if certificate:
                 stats["time_s"] = time.perf_counter() - t0
                 wit["certificate"] = _certificate(
-                    example, rules, face_rules, "fallible", stats, {"run": alg31}
+                    example, rules0, face_rules, "fallible", stats, {"run": alg31}
                 )
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
     if refute:
@@ -769,7 +784,7 @@ def prove_infallible(
                 if face_rules:  # the run's boundary is the certificate's face rules
                     run["boundary"] = "auto"
                 wit["certificate"] = _certificate(
-                    example, rules, face_rules, "fallible", stats, {"run": run}
+                    example, rules0, face_rules, "fallible", stats, {"run": run}
                 )
             return Verdict(False, wit, stats, msg + "; Alg. 3.1 fails too: fallible")
         size = "x".join(map(str, _refute_size(ndim)))
@@ -917,6 +932,71 @@ def face_rules_of(
         assert face is not None  # proof_scope refused the others
         out.append((str(op.op), face, np.flatnonzero(op.labels).tolist()))
     return out
+
+
+def dead_labels(
+    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]]
+) -> list[tuple[str, list[int]]]:
+    """Labels that arc consistency removes from every cell of every output before the
+    first choice, with why: stages ``(face, labels)`` in order.
+
+    A stage's labels are in no domain of a cell on ``face`` (whatever other faces the cell
+    lies on), and every label that supports one of them from the neighbour toward
+    ``face`` is dead already or in the same stage. Then none is in the initial catalog
+    ``C_0`` (the greatest arc-consistent domains) of any cell: on the face the domain
+    excludes it; elsewhere it would need a support in ``C_0`` of the neighbour one cell
+    nearer the face, which by induction (over the stages, then the distance to the face)
+    is not there. Alg. 3.1's catalogs lie inside ``C_0``, so its runs are the same with
+    these labels out of use; :func:`prove_infallible` proves that model. Only domain rules
+    on faces (a boundary) kill labels: on open edges a label needs no support.
+
+    Parameters
+    ----------
+    rules : Rules
+    face_rules : sequence of (op, where, labels)
+        As :func:`face_rules_of` returns them.
+
+    Returns
+    -------
+    list of (str, list of int)
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> E = load_example("fig3_5a")    # its objects stand on the bottom edge: with empty
+    >>> dead_labels(Rules.of(E), face_rules_of(E, "auto"))   # space all around, none fits
+    [('y-', [1, 2, 3, 5, 6, 7]), ('x-', [4, 8])]
+    >>> dead_labels(Rules.of(E), [])
+    []
+    """
+    if not face_rules:
+        return []
+    domain = _face_domain(face_rules, rules)
+    ndim = rules.ndim
+    faces = [f"{AXIS_NAMES[d]}{s}" for d in range(ndim) for s in "-+"]
+    dead, stages = 0, []
+    grew = True
+    while grew:
+        grew = False
+        for face in faces:
+            d = AXIS_NAMES.index(face[0])
+            others = [f for f in faces if f != face]
+            allowed = 0
+            for k in range(len(others) + 1):
+                for sub in itertools.combinations(others, k):
+                    allowed |= domain(frozenset((face, *sub)))
+            table = rules.bwd[d] if face[1] == "-" else rules.fwd[d]
+            B = rules.used & ~allowed & ~dead
+            while True:  # the greatest set whose supports toward the face are dead or in it
+                keep = sum(1 << b for b in set_bits(B) if not table[b] & ~(dead | B))
+                if keep == B:
+                    break
+                B = keep
+            if B:
+                stages.append((face, list(set_bits(B))))
+                dead |= B
+                grew = True
+    return stages
 
 
 def _face_domain(

@@ -96,3 +96,53 @@ def test_classes_agree_with_plain_labels_on_small_models():
                     for shape in [(3, 3), (4, 3)]:
                         P = from_example(E, shape)
                         assert alg31_exhaustive(P, order, 200_000).holds is True
+
+
+# ----------------------------------------------------------------------------- dead labels
+
+
+@pytest.mark.parametrize("name", ["fig3_5a", "fig3_16", "pillar"])
+def test_dead_labels_are_in_no_initial_catalog(name):
+    # Alg. 3.1's own arc consistency, on outputs thin and wide, never keeps a dead label
+    import itertools
+
+    from csplab.analysis.infallible import dead_labels, face_rules_of
+    from csplab.analysis.witness import model_problem
+    from csplab.catalog import Propagator
+
+    E = load_example(name)
+    stages = dead_labels(Rules.of(E), face_rules_of(E, "auto"))
+    dead = {b for _, labels in stages for b in labels}
+    assert dead
+    shapes = [(1, 5), (2, 2), (2, 7), (3, 3), (6, 4), (9, 9)]
+    if E.ndim == 3:
+        shapes = [(1, 1, 4), (2, 2, 2), (3, 2, 5), (4, 4, 4)]
+    for shape in shapes:
+        P = model_problem(E, shape, "auto")
+        eng = Propagator(P)
+        if not eng.ok:
+            continue
+        for c in itertools.product(*map(range, shape)):
+            assert not dead & set(eng.domain(P.cell(c)).tolist()), (shape, c)
+    assert dead_labels(Rules.of(E), face_rules_of(E, None)) == []  # open edges kill nothing
+
+
+def test_dead_labels_prove_fig3_5a_with_its_boundary_and_checker_verifies():
+    E = load_example("fig3_5a")
+    v = decide_infallibility(E, order="scanline", boundary="auto", time_limit=60,
+                             certificate=True)  # fmt: skip
+    assert v.holds is True, v.message
+    cert = json.loads(json.dumps(v.witness["certificate"]))
+    assert cert["dead"] and check_certificate(cert)[0]
+    # planted defects: a live label (0, the empty space) claimed dead; the stages swapped
+    # (4 and 8 are dead only because their supports toward x- died first); no stages
+    bad = copy.deepcopy(cert)
+    bad["dead"][0][1] = [0, *bad["dead"][0][1]]
+    assert not check_certificate(bad)[0]
+    bad = copy.deepcopy(cert)
+    bad["dead"] = bad["dead"][::-1]
+    ok, msg = check_certificate(bad)
+    assert not ok and "not dead" in msg
+    bad = copy.deepcopy(cert)
+    del bad["dead"]
+    assert not check_certificate(bad)[0]
