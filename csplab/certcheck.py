@@ -47,7 +47,10 @@ Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 n
 state records each label by its class -- the least label in use with the same forward
 supports along the axes on which the cell's + neighbour is in the frame and not yet
 labelled at that step -- and arc consistency leaves out arcs between labelled cells
-(:func:`_check_classes` says why that is sound). *fallible*: ``run`` (``shape``,
+(:func:`_check_classes` says why that is sound). ``dead`` (optional): stages ``[face,
+labels]`` of labels no catalog of Alg. 3.1 ever holds (no cell on the face may take one;
+each one's supports toward the face are dead at this stage or before:
+:func:`_check_dead`); the checks above then run with these labels out of use. *fallible*: ``run`` (``shape``,
 ``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``: a mapping face ->
 label, or ``"auto"`` for the face rules): the checker replays
 it with arc consistency on the whole grid -- the cells in scan order, each label in its
