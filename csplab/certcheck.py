@@ -47,10 +47,12 @@ Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 n
 state records each label by its class -- the least label in use with the same forward
 supports along the axes on which the cell's + neighbour is in the frame and not yet
 labelled at that step -- and arc consistency leaves out arcs between labelled cells
-(:func:`_check_classes` says why that is sound). ``dead`` (optional): stages ``[face,
-labels]`` of labels no catalog of Alg. 3.1 ever holds (no cell on the face may take one;
-each one's supports toward the face are dead at this stage or before:
-:func:`_check_dead`); the checks above then run with these labels out of use. *fallible*: ``run`` (``shape``,
+(:func:`_check_classes` says why that is sound). ``dead`` (optional, with
+``label_classes``): ``cap`` and ``stages`` ``[face, [[where, labels], ...]]`` of labels no
+catalog of Alg. 3.1 holds at cells whose capped distances to the faces are ``where``
+(each one's supports toward the face are dead at this stage or before:
+:func:`_check_dead`); the checks above then run with each frame cell's dead labels out of
+its domain. *fallible*: ``run`` (``shape``,
 ``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``: a mapping face ->
 label, or ``"auto"`` for the face rules): the checker replays
 it with arc consistency on the whole grid -- the cells in scan order, each label in its
@@ -181,10 +183,17 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
         fwd, bwd, used, ndim = _tables(rules)
         model = _Rules(fwd, bwd, used, ndim, _face_rules(rules.get("faces") or [], ndim, rules))
         claim = cert.get("claim")
+        dead: dict[Where, int] | None = None
         if claim == "infallible" and cert.get("dead"):
-            model = _without(model, _check_dead(cert["dead"], model))
+            if not cert.get("label_classes"):
+                raise _Invalid("dead labels are checked with label classes only")
+            dead = _check_dead(cert["dead"], model)
+            everywhere = -1
+            for bits in dead.values():
+                everywhere &= bits
+            model = _without(model, everywhere)
         if claim == "infallible" and cert.get("label_classes"):
-            msg = _check_classes(cert, model)
+            msg = _check_classes(cert, model, dead)
         elif claim == "infallible":
             msg = _check_closed(cert, model)
         elif claim == "fallible":
@@ -575,7 +584,9 @@ def _small_ac(
 # labels recorded by their class
 
 
-def _check_classes(cert: Mapping[str, Any], rules: _Rules) -> str:
+def _check_classes(
+    cert: Mapping[str, Any], rules: _Rules, dead: Mapping[Where, int] | None = None
+) -> str:
     """An *infallible* certificate with ``label_classes``: as above, except that a state
     records each label by its class -- the least label in use with the same forward
     supports (``fwd[d]``) along the axes on which the cell's + neighbour lies in the frame
@@ -620,7 +631,9 @@ def _check_classes(cert: Mapping[str, Any], rules: _Rules) -> str:
     canon: dict[frozenset[int], list[int]] = {}
     nstates = 0
     for conf, (lo, hi, on_lo, on_hi) in zip(cert["configs"], got, strict=True):
-        nstates += _check_class_config(conf, lo, hi, on_lo, on_hi, region, back, axes, rules, canon)
+        nstates += _check_class_config(
+            conf, lo, hi, on_lo, on_hi, region, back, axes, rules, canon, dead or {}
+        )
     return (
         f"valid: {nstates} states (labels by class) in {len(got)} configurations are closed "
         f"under Alg. 3.6 with {'x'.join(map(str, region))} regions ({cert['order']}) and no "
@@ -648,6 +661,7 @@ def _check_class_config(
     axes: tuple[int, ...],
     rules: _Rules,
     canon: dict[frozenset[int], list[int]],
+    dead: Mapping[Where, int],
 ) -> int:
     fwd, bwd, used, ndim, face_rules = rules
     where = f"configuration lower={list(lo)} upper={list(hi)}"
@@ -664,10 +678,28 @@ def _check_class_config(
     if len(keys) != n or keys[0]:
         raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
 
+    cap = max((v for k in dead for a in k for v in a), default=0)
+    doms: dict[Cell, int] = {}
+
     def face_dom(x: Cell) -> int:
+        if x in doms:
+            return doms[x]
         on = {_AXES[d] + "-" for d in range(ndim) if at_lo[d] and x[d] == 0}
         on |= {_AXES[d] + "+" for d in range(ndim) if at_hi[d] and x[d] == ext[d] - 1}
-        return _domain(face_rules, on, used)
+        dom = _domain(face_rules, on, used)
+        if dead:  # minus the labels dead wherever in an output this cell may lie
+            per_axis = []
+            for d in range(ndim):
+                lo_d, hi_d = x[d], ext[d] - 1 - x[d]  # distances, exact on a face edge
+                los = [min(lo_d, cap)] if at_lo[d] else range(min(lo_d + 1, cap), cap + 1)
+                his = [min(hi_d, cap)] if at_hi[d] else range(min(hi_d + 1, cap), cap + 1)
+                per_axis.append([(a, b) for a in los for b in his])
+            alive = 0
+            for k in itertools.product(*per_axis):
+                alive |= ~dead[k]
+            dom &= alive
+        doms[x] = dom
+        return dom
 
     def classes(j: int, i: int) -> list[int]:
         """Label of step j -> its class at step i (axes whose + neighbour is open)."""
@@ -746,46 +778,68 @@ def _check_class_config(
 # ----------------------------------------------------------------------------- dead labels
 
 
-def _check_dead(stages: Sequence[Any], rules: _Rules) -> int:
-    """The labels of an *infallible* certificate's ``dead`` stages ``[face, labels]``,
-    verified: no cell on ``face`` (whatever other faces it lies on) may take one, and every
-    label supporting one of them from the neighbour toward ``face`` is in this stage or an
-    earlier one.
+Where = tuple[tuple[int, ...], ...]
 
-    Why then no catalog of Alg. 3.1 ever holds one: its catalogs lie inside the greatest
-    arc-consistent domains before any choice, where a label has a support in each
-    neighbour. Take a dead label there at the cell nearest the face among those of the
-    first stage that has one: on the face its domain excludes it; elsewhere its support in
-    the neighbour nearer the face is dead at an earlier stage or at this one, nearer the
-    face -- either way a contradiction. So Alg. 3.1 runs the same with the dead labels out
-    of use, and the rest of the certificate is checked with them out of use.
+
+def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
+    """The labels dead at each ``where`` (per axis the distances to the lower and upper
+    face, capped at ``cap``, which means "at least"): those the faces' domain rules
+    exclude there, and those of the ``stages`` ``[face, [[where, labels], ...]]``, each
+    verified: ``where`` is not on ``face``, and at every ``where`` the neighbour one cell
+    nearer ``face`` may have, every label supporting one of the labels from there is dead
+    -- earlier, or in this stage.
+
+    Why no catalog of Alg. 3.1 ever holds one at such a cell: its catalogs lie inside the
+    greatest arc-consistent domains before any choice, ``C_0``, where a label has a
+    support in each neighbour. Take a stage label in ``C_0`` at a cell, of the first stage
+    that has one, nearest the stage's face: its support in the neighbour nearer the face
+    is dead earlier (so not in ``C_0``) or in this stage nearer the face -- a
+    contradiction either way. So Alg. 3.1 runs the same with a cell's dead labels out of
+    its domain, and the states are checked with them out.
     """
     fwd, bwd, used, ndim, face_rules = rules
+    cap = int(dead["cap"])
+    if not 1 <= cap <= 8:
+        raise _Invalid("dead labels: cap must be 1 to 8")
+    span = list(itertools.product(range(cap + 1), repeat=2))
+    known: dict[Where, int] = {}
+    for k in itertools.product(span, repeat=ndim):
+        on = {_AXES[d] + "-" for d in range(ndim) if k[d][0] == 0}
+        on |= {_AXES[d] + "+" for d in range(ndim) if k[d][1] == 0}
+        known[k] = used & ~_domain(face_rules, on, used)
     every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
-    dead = 0
-    for face, labels in stages:
+    for face, got in dead["stages"]:
         if face not in every:
             raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
-        bits = 0
-        for b in labels:
-            if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
-                raise _Invalid(f"dead labels: {b!r} is not a label in use")
-            bits |= 1 << b
-        others = [f for f in every if f != face]
-        for mask in range(1 << len(others)):
-            on = {face} | {f for k, f in enumerate(others) if mask >> k & 1}
-            if _domain(face_rules, on, used) & bits:
-                raise _Invalid(f"dead labels {labels}: a cell on {sorted(on)} may take one")
-        d = _AXES.index(face[0])
-        table = bwd[d] if face[1] == "-" else fwd[d]
-        for b in _bits(bits):
-            if table[b] & ~(dead | bits):
-                raise _Invalid(
-                    f"dead labels: {b} has a support toward {face} that is not dead: "
-                    f"{sorted(_bits(table[b] & ~(dead | bits)))}"
-                )
-        dead |= bits
-    return dead
+        d, minus = _AXES.index(face[0]), face[1] == "-"
+        stage: dict[Where, int] = {}
+        for where, labels in got:
+            k = tuple((int(a), int(b)) for a, b in where)
+            if k not in known or k[d][0 if minus else 1] == 0:
+                raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
+            for b in labels:
+                if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
+                    raise _Invalid(f"dead labels: {b!r} is not a label in use")
+                stage[k] = stage.get(k, 0) | 1 << b
+        table = bwd[d] if minus else fwd[d]
+        for k, bits in stage.items():
+            lo, hi = k[d]
+            if minus:
+                los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+            else:
+                los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+            for a, c in itertools.product(los, his):
+                n = (*k[:d], (a, c), *k[d + 1 :])
+                gone = known[n] | stage.get(n, 0)
+                for b in _bits(bits):
+                    if table[b] & ~gone:
+                        raise _Invalid(
+                            f"dead labels: {b} at {[list(t) for t in k]} has a support toward "
+                            f"{face} that is not dead: {sorted(_bits(table[b] & ~gone))}"
+                        )
+        for k, bits in stage.items():
+            known[k] |= bits
+    return known
 
 
 def _without(rules: _Rules, dead: int) -> _Rules:

@@ -73,6 +73,7 @@ True
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import time
@@ -97,6 +98,7 @@ __all__ = [
     "Rules",
     "alg36_failure",
     "corner_condition",
+    "dead_at",
     "dead_labels",
     "face_rules_of",
     "label_classes",
@@ -157,6 +159,10 @@ class Rules:
         if len(self._union) < 2_000_000:
             self._union[key] = out
         return out
+
+
+def _bools(bits: int, K: int) -> NDArray[np.bool_]:
+    return np.array([bool(bits >> b & 1) for b in range(K)], dtype=bool)
 
 
 def _to_bits(mask: ArrayLike) -> int:
@@ -514,6 +520,7 @@ def _frame(
     face_domain: Callable[[frozenset[str]], int] | None = None,
     back: Coords | None = None,
     reduce: Rules | None = None,
+    dead_where: Mapping[Where, int] | None = None,
 ) -> tuple[_Walk, Coords, Coords]:
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     q = lo
@@ -527,7 +534,13 @@ def _frame(
         def base(x: Coords) -> int:
             on = {AXIS_NAMES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
             on |= {AXIS_NAMES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
-            return face_domain(frozenset(on))
+            dom = face_domain(frozenset(on))
+            if dead_where:  # the labels alive wherever the cell may be
+                alive = 0
+                for k in itertools.product(*_where_options(x, ext, at_lo, at_hi, DEAD_CAP)):
+                    alive |= ~dead_where[k]
+                dom &= alive
+            return dom
 
     return _Walk(ext, cells, region, base, back, reduce), ext, q
 
@@ -621,13 +634,15 @@ def prove_infallible(
     axes = scan_axes(ndim, order)
     r = parse_region(region, ndim)
     face_rules = face_rules_of(example, boundary)
-    rules0 = rules  # the certificate's rules; ``rules`` without the dead labels
-    dead = dead_labels(rules, face_rules)
+    rules0 = rules  # the certificate's rules; ``rules`` without the labels dead everywhere
+    # dead labels by where a cell is (with label classes only: their certificates are
+    # checked with per-cell domains)
+    dead = dead_labels(rules, face_rules) if classes else []
+    dead_where: dict[Where, int] = {}
     if dead:
-        gone = np.zeros(rules.K, dtype=bool)
-        for _, labels in dead:
-            gone[labels] = True
-        rules = Rules(rules.T, rules.used_mask & ~gone)
+        dead_where = dead_at(rules, face_rules)
+        everywhere = functools.reduce(lambda a, b: a & b, dead_where.values())
+        rules = Rules(rules.T, rules.used_mask & ~_bools(everywhere, rules.K))
     face_domain = _face_domain(face_rules, rules) if face_rules else None
     if face_rules:
         realize = False  # exhaustive Alg. 3.6 on a concrete output ignores the face rules
@@ -657,7 +672,7 @@ def prove_infallible(
         digest.update(repr(face_rules).encode())
     if dead:
         digest.update(repr(dead).encode())
-        stats["dead"] = sum(len(b) for _, b in dead)
+        stats["dead"] = sum(len(b) for _, got in dead for _, b in got)
     cls = label_classes(rules) if classes else None
     if cls is not None:
         digest.update(repr(cls).encode())
@@ -668,7 +683,7 @@ def prove_infallible(
     try:
         for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules), bk):
             walk, ext, q = _frame(
-                lo, hi, axes, r, edges, face_domain, bk, rules if classes else None
+                lo, hi, axes, r, edges, face_domain, bk, rules if classes else None, dead_where
             )
             stats["configs"] += 1
             seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
@@ -730,10 +745,11 @@ def prove_infallible(
                 {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
                  "back": list(bk), "configs": closed}
                 | ({} if cls is None else {"label_classes": True})
-                | ({"dead": [[f, b] for f, b in dead]} if dead else {}),
+                | ({"dead": {"cap": DEAD_CAP, "stages": [
+                    [f, [[[list(a) for a in k], b] for k, b in got]] for f, got in dead
+                ]}} if dead else {}),
             )  # fmt: skip
-        dtxt = f"(labels {sorted(b for _, bs in dead for b in bs)} never in a catalog; "
-        dtxt = dtxt if dead else "("
+        dtxt = f"({stats['dead']} labels dead near faces; " if dead else "("
         return Verdict(
             True,
             proof,
@@ -934,69 +950,129 @@ def face_rules_of(
     return out
 
 
-def dead_labels(
-    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]]
-) -> list[tuple[str, list[int]]]:
-    """Labels that arc consistency removes from every cell of every output before the
-    first choice, with why: stages ``(face, labels)`` in order.
+Where = tuple[tuple[int, ...], ...]
+DEAD_CAP = 3
 
-    A stage's labels are in no domain of a cell on ``face`` (whatever other faces the cell
-    lies on), and every label that supports one of them from the neighbour toward
-    ``face`` is dead already or in the same stage. Then none is in the initial catalog
-    ``C_0`` (the greatest arc-consistent domains) of any cell: on the face the domain
-    excludes it; elsewhere it would need a support in ``C_0`` of the neighbour one cell
-    nearer the face, which by induction (over the stages, then the distance to the face)
-    is not there. Alg. 3.1's catalogs lie inside ``C_0``, so its runs are the same with
-    these labels out of use; :func:`prove_infallible` proves that model. Only domain rules
-    on faces (a boundary) kill labels: on open edges a label needs no support.
+
+def dead_labels(
+    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]], cap: int = DEAD_CAP
+) -> list[tuple[str, list[tuple[Where, list[int]]]]]:
+    """Labels that arc consistency removes before the first choice, by where the cell
+    is: stages ``(face, [(where, labels), ...])`` in order.
+
+    ``where`` is a cell's distance to the lower and upper face on each axis, capped at
+    ``cap`` (``cap`` meaning "at least"). A label is dead at ``where`` when no cell there
+    may take it (its faces' domain rules), or when a stage says so: for each neighbour
+    one cell nearer ``face`` (each ``where`` it may have), every label that supports it
+    from there is dead, earlier or in this stage. Then it is in no initial catalog ``C_0``
+    (the greatest arc-consistent domains) of a cell there, of any output: by induction
+    over the stages and then the distance to the face (a label of ``C_0`` has a support
+    in ``C_0`` of each neighbour). Alg. 3.1's catalogs lie inside ``C_0``, so
+    :func:`prove_infallible` takes the dead labels out of each frame cell's domain (out
+    of use where dead everywhere). Only domain rules on faces kill labels.
 
     Parameters
     ----------
     rules : Rules
     face_rules : sequence of (op, where, labels)
         As :func:`face_rules_of` returns them.
+    cap : int
+        Distances from which on cells count as equally far.
 
     Returns
     -------
-    list of (str, list of int)
+    list of (str, list of (tuple, list of int))
 
     Examples
     --------
     >>> from csplab.examples import load_example
     >>> E = load_example("fig3_5a")    # its objects stand on the bottom edge: with empty
-    >>> dead_labels(Rules.of(E), face_rules_of(E, "auto"))   # space all around, none fits
-    [('y-', [1, 2, 3, 5, 6, 7]), ('x-', [4, 8])]
+    >>> d = dead_at(Rules.of(E), face_rules_of(E, "auto"))   # space all round, none fits
+    >>> sorted(set.intersection(*({b for b in range(9) if k >> b & 1} for k in d.values())))
+    [1, 2, 3, 4, 5, 6, 7, 8]
     >>> dead_labels(Rules.of(E), [])
     []
     """
     if not face_rules:
         return []
-    domain = _face_domain(face_rules, rules)
     ndim = rules.ndim
-    faces = [f"{AXIS_NAMES[d]}{s}" for d in range(ndim) for s in "-+"]
-    dead, stages = 0, []
+    dead = _domain_dead(rules, face_rules, cap)
+    stages = []
     grew = True
     while grew:
         grew = False
-        for face in faces:
-            d = AXIS_NAMES.index(face[0])
-            others = [f for f in faces if f != face]
-            allowed = 0
-            for k in range(len(others) + 1):
-                for sub in itertools.combinations(others, k):
-                    allowed |= domain(frozenset((face, *sub)))
-            table = rules.bwd[d] if face[1] == "-" else rules.fwd[d]
-            B = rules.used & ~allowed & ~dead
-            while True:  # the greatest set whose supports toward the face are dead or in it
-                keep = sum(1 << b for b in set_bits(B) if not table[b] & ~(dead | B))
-                if keep == B:
-                    break
-                B = keep
-            if B:
-                stages.append((face, list(set_bits(B))))
-                dead |= B
-                grew = True
+        for d in range(ndim):
+            for s, face in ((-1, AXIS_NAMES[d] + "-"), (1, AXIS_NAMES[d] + "+")):
+                table = rules.bwd[d] if s < 0 else rules.fwd[d]
+                near = {k: _toward(k, d, s, cap) for k in dead if k[d][0 if s < 0 else 1] > 0}
+                B = {k: rules.used & ~dead[k] for k in near}
+                changed = True
+                while changed:  # the greatest set whose supports toward the face are dead
+                    changed = False
+                    for k, ns in near.items():
+                        keep = sum(
+                            1 << b for b in set_bits(B[k])
+                            if all(not table[b] & ~(dead[n] | B.get(n, 0)) for n in ns)
+                        )  # fmt: skip
+                        if keep != B[k]:
+                            B[k], changed = keep, True
+                got = [(k, list(set_bits(b))) for k, b in B.items() if b]
+                if got:
+                    stages.append((face, got))
+                    for k, b in B.items():
+                        dead[k] |= b
+                    grew = True
     return stages
+
+
+def dead_at(
+    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]], cap: int = DEAD_CAP
+) -> dict[Where, int]:
+    """The dead labels (a bit set) at each ``where`` (see :func:`dead_labels`)."""
+    dead = _domain_dead(rules, face_rules, cap)
+    for _, got in dead_labels(rules, face_rules, cap):
+        for k, labels in got:
+            for b in labels:
+                dead[k] |= 1 << b
+    return dead
+
+
+def _domain_dead(
+    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]], cap: int
+) -> dict[Where, int]:
+    """Per ``where``: the labels in use that the faces' domain rules exclude there."""
+    domain = _face_domain(face_rules, rules)
+    ndim = rules.ndim
+    out = {}
+    for k in itertools.product(itertools.product(range(cap + 1), repeat=2), repeat=ndim):
+        on = {AXIS_NAMES[d] + "-" for d in range(ndim) if k[d][0] == 0}
+        on |= {AXIS_NAMES[d] + "+" for d in range(ndim) if k[d][1] == 0}
+        out[k] = rules.used & ~domain(frozenset(on))
+    return out
+
+
+def _toward(k: Where, d: int, s: int, cap: int) -> list[Where]:
+    """Where the neighbour along ``s * e_d`` of a cell at ``k`` may be."""
+    lo, hi = k[d]
+    if s < 0:
+        los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+    else:
+        los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+    return [(*k[:d], (a, b), *k[d + 1 :]) for a in los for b in his]
+
+
+def _where_options(
+    x: Coords, ext: Coords, at_lo: Sequence[bool], at_hi: Sequence[bool], cap: int
+) -> list[list[tuple[int, int]]]:
+    """Per axis, the capped distances to the faces a frame cell ``x`` may have (exact
+    where the frame's first / last cell lies on the face, else one more at least)."""
+    out = []
+    for d in range(len(x)):
+        up = ext[d] - 1 - x[d]
+        los = [min(x[d], cap)] if at_lo[d] else list(range(min(x[d] + 1, cap), cap + 1))
+        his = [min(up, cap)] if at_hi[d] else list(range(min(up + 1, cap), cap + 1))
+        out.append([(a, b) for a in los for b in his])
+    return out
 
 
 def _face_domain(

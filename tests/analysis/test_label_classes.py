@@ -101,48 +101,76 @@ def test_classes_agree_with_plain_labels_on_small_models():
 # ----------------------------------------------------------------------------- dead labels
 
 
-@pytest.mark.parametrize("name", ["fig3_5a", "fig3_16", "pillar"])
+def _where(c, shape, cap):
+    return tuple((min(x, cap), min(n - 1 - x, cap)) for x, n in zip(c, shape, strict=True))
+
+
+@pytest.mark.parametrize("name", ["fig3_5a", "loops", "fig3_16", "pillar"])
 def test_dead_labels_are_in_no_initial_catalog(name):
-    # Alg. 3.1's own arc consistency, on outputs thin and wide, never keeps a dead label
+    # Alg. 3.1's own arc consistency, on outputs thin and wide, never keeps a label
+    # where it is dead
     import itertools
 
-    from csplab.analysis.infallible import dead_labels, face_rules_of
+    from csplab.analysis.infallible import DEAD_CAP, dead_at, dead_labels, face_rules_of
     from csplab.analysis.witness import model_problem
     from csplab.catalog import Propagator
 
     E = load_example(name)
-    stages = dead_labels(Rules.of(E), face_rules_of(E, "auto"))
-    dead = {b for _, labels in stages for b in labels}
-    assert dead
-    shapes = [(1, 5), (2, 2), (2, 7), (3, 3), (6, 4), (9, 9)]
+    dead = dead_at(Rules.of(E), face_rules_of(E, "auto"))
+    shapes = [(1, 5), (2, 2), (2, 7), (3, 3), (3, 8), (4, 6), (6, 4), (9, 9)]
     if E.ndim == 3:
-        shapes = [(1, 1, 4), (2, 2, 2), (3, 2, 5), (4, 4, 4)]
+        shapes = [(1, 1, 4), (2, 2, 2), (3, 2, 5), (4, 4, 4), (5, 3, 6)]
+    killed = 0
     for shape in shapes:
         P = model_problem(E, shape, "auto")
         eng = Propagator(P)
         if not eng.ok:
             continue
         for c in itertools.product(*map(range, shape)):
-            assert not dead & set(eng.domain(P.cell(c)).tolist()), (shape, c)
+            gone = dead[_where(c, shape, DEAD_CAP)]
+            assert not any(gone >> b & 1 for b in eng.domain(P.cell(c)).tolist()), (shape, c)
+            killed += bin(gone).count("1")
+    assert killed
     assert dead_labels(Rules.of(E), face_rules_of(E, None)) == []  # open edges kill nothing
 
 
-def test_dead_labels_prove_fig3_5a_with_its_boundary_and_checker_verifies():
-    E = load_example("fig3_5a")
-    v = decide_infallibility(E, order="scanline", boundary="auto", time_limit=60,
-                             certificate=True)  # fmt: skip
+@pytest.mark.parametrize(("name", "region"), [("castle", "2x2x2"), ("canal", "2x2x2")])
+def test_fallible_models_with_a_boundary_are_not_proved(name, region):
+    # castle and canal fail with empty space all round (the table's witnesses)
+    v = prove_infallible(load_example(name), region, boundary="auto", classes=True, history=0,
+                         refute=False, time_limit=20)  # fmt: skip
+    assert v.holds is not True
+
+
+def test_dead_labels_prove_loops_with_its_boundary_and_checker_verifies():
+    E = load_example("loops")
+    v = decide_infallibility(E, boundary="auto", time_limit=60, certificate=True)
     assert v.holds is True, v.message
     cert = json.loads(json.dumps(v.witness["certificate"]))
-    assert cert["dead"] and check_certificate(cert)[0]
-    # planted defects: a live label (0, the empty space) claimed dead; the stages swapped
-    # (4 and 8 are dead only because their supports toward x- died first); no stages
+    assert cert["dead"]["stages"] and check_certificate(cert)[0]
+    # planted defects: a live label (0, the empty space) claimed dead in a stage; the
+    # stages reversed; the stages gone (the states then miss runs); no label classes
     bad = copy.deepcopy(cert)
-    bad["dead"][0][1] = [0, *bad["dead"][0][1]]
+    bad["dead"]["stages"][0][1][0][1] = [0, *bad["dead"]["stages"][0][1][0][1]]
     assert not check_certificate(bad)[0]
     bad = copy.deepcopy(cert)
-    bad["dead"] = bad["dead"][::-1]
-    ok, msg = check_certificate(bad)
-    assert not ok and "not dead" in msg
+    bad["dead"]["stages"] = bad["dead"]["stages"][::-1]
+    assert not check_certificate(bad)[0]
     bad = copy.deepcopy(cert)
     del bad["dead"]
     assert not check_certificate(bad)[0]
+    bad = copy.deepcopy(cert)
+    del bad["label_classes"]
+    ok, msg = check_certificate(bad)
+    assert not ok and "label classes" in msg
+
+
+def test_dead_labels_prove_fig3_5a_with_its_boundary():
+    # every object of fig3_5a stands on the bottom edge: with empty space all round only
+    # the empty label is left, in both orders
+    for order in ("scanline", "scan:yx"):
+        v = prove_infallible(load_example("fig3_5a"), "2x2", order=order, boundary="auto",
+                             classes=True, history=0, certificate=True)  # fmt: skip
+        assert v.holds is True
+        cert = json.loads(json.dumps(v.witness["certificate"]))
+        assert cert["rules"]["used"] == [1] * 9 and check_certificate(cert)[0]
