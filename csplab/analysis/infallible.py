@@ -637,10 +637,17 @@ def prove_infallible(
     rules0 = rules  # the certificate's rules; ``rules`` without the labels dead everywhere
     # dead labels by where a cell is (with label classes only: their certificates are
     # checked with per-cell domains)
-    dead = dead_labels(rules, face_rules) if classes else []
+    dead: list[tuple[str, list[tuple[Where, list[int]]]]] = []
     dead_where: dict[Where, int] = {}
+    if classes and face_rules:  # the same for every region the decision ladder tries
+        key = (example.hash(), repr(face_rules))
+        if key not in _DEAD_SEEN:
+            if len(_DEAD_SEEN) > 32:
+                _DEAD_SEEN.clear()
+            stages = dead_labels(rules, face_rules)
+            _DEAD_SEEN[key] = (stages, dead_at(rules, face_rules, stages=stages))
+        dead, dead_where = _DEAD_SEEN[key]
     if dead:
-        dead_where = dead_at(rules, face_rules)
         everywhere = functools.reduce(lambda a, b: a & b, dead_where.values())
         rules = Rules(rules.T, rules.used_mask & ~_bools(everywhere, rules.K))
     face_domain = _face_domain(face_rules, rules) if face_rules else None
@@ -952,6 +959,8 @@ def face_rules_of(
 
 Where = tuple[tuple[int, ...], ...]
 DEAD_CAP = 3
+# dead labels per (model hash, face rules): the stages and the bit sets per place
+_DEAD_SEEN: dict[tuple[str, str], tuple[list[Any], dict[Where, int]]] = {}
 
 
 def dead_labels(
@@ -1026,11 +1035,17 @@ def dead_labels(
 
 
 def dead_at(
-    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]], cap: int = DEAD_CAP
+    rules: Rules,
+    face_rules: Sequence[tuple[str, str, list[int]]],
+    cap: int = DEAD_CAP,
+    stages: Sequence[tuple[str, list[tuple[Where, list[int]]]]] | None = None,
 ) -> dict[Where, int]:
-    """The dead labels (a bit set) at each ``where`` (see :func:`dead_labels`)."""
+    """The dead labels (a bit set) at each ``where`` (see :func:`dead_labels`; ``stages``:
+    its result, if at hand)."""
     dead = _domain_dead(rules, face_rules, cap)
-    for _, got in dead_labels(rules, face_rules, cap):
+    if stages is None:
+        stages = dead_labels(rules, face_rules, cap)
+    for _, got in stages:
         for k, labels in got:
             for b in labels:
                 dead[k] |= 1 << b
