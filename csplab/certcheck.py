@@ -51,7 +51,16 @@ frame (the cells before the point ``q = lower`` in scan order, in the box of ext
 4. at the last step (the point) ``C_R`` is never empty.
 
 Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 never fails
-(Theorem 3.3.6, the prover's docstring has the argument). *fallible*: ``run`` (``shape``,
+(Theorem 3.3.6, the prover's docstring has the argument). With ``label_classes`` true, a
+state records each label by its class -- the least label in use with the same forward
+supports along the axes on which the cell's + neighbour is in the frame and not yet
+labelled at that step -- and arc consistency leaves out arcs between labelled cells
+(:func:`_check_classes` says why that is sound). ``dead`` (optional, with
+``label_classes``): ``cap`` and ``stages`` ``[face, [[where, labels], ...]]`` of labels no
+catalog of Alg. 3.1 holds at cells whose capped distances to the faces are ``where``
+(each one's supports toward the face are dead at this stage or before:
+:func:`_check_dead`); the checks above then run with each frame cell's dead labels out of
+its domain. *fallible*: ``run`` (``shape``,
 ``order``, ``choices`` ``[[cell, label], ...]``, optional ``boundary``: a mapping face ->
 label, or ``"auto"`` for the face rules): the checker replays
 it with arc consistency on the whole grid -- the cells in scan order, each label in its
@@ -185,7 +194,18 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
         fwd, bwd, used, ndim = _tables(rules)
         model = _Rules(fwd, bwd, used, ndim, _face_rules(rules.get("faces") or [], ndim, rules))
         claim = cert.get("claim")
-        if claim == "infallible":
+        dead: dict[Where, int] | None = None
+        if claim == "infallible" and cert.get("dead"):
+            if not cert.get("label_classes"):
+                raise _Invalid("dead labels are checked with label classes only")
+            dead = _check_dead(cert["dead"], model)
+            everywhere = -1
+            for bits in dead.values():
+                everywhere &= bits
+            model = _without(model, everywhere)
+        if claim == "infallible" and cert.get("label_classes"):
+            msg = _check_classes(cert, model, dead)
+        elif claim == "infallible":
             msg = _check_closed(cert, model)
         elif claim == "fallible":
             msg = _check_run(cert, model)
@@ -872,6 +892,278 @@ def _small_ac(
                     waiting[v] = True
                     queue.append(v)
     return dom
+
+
+# ----------------------------------------------------------------------------- infallible,
+# labels recorded by their class
+
+
+def _check_classes(
+    cert: Mapping[str, Any], rules: _Rules, dead: Mapping[Where, int] | None = None
+) -> str:
+    """An *infallible* certificate with ``label_classes``: as above, except that a state
+    records each label by its class -- the least label in use with the same forward
+    supports (``fwd[d]``) along the axes on which the cell's + neighbour lies in the frame
+    box and is not yet labelled at that step -- and arc consistency leaves out the arcs
+    between two labelled cells.
+
+    Why this suffices: inside the frame a labelled cell's - neighbours are labelled
+    (scan order), so it meets unlabelled cells only along those axes; there its label
+    acts only through ``fwd[d][label]`` (narrowing the neighbour, and keeping the label
+    iff the neighbour's domain meets it). Arcs between labelled cells hold in every real
+    run (each label agreed with its - neighbours, which its region holds). So arc
+    consistency with the classes gives the catalogs of the real labels, and a real run's
+    labels, mapped to their classes, stay in a closed set that holds the start state.
+    """
+    ndim, face_rules = rules.ndim, rules.faces
+    region = [int(t) for t in cert["region"]]
+    history = [int(t) for t in cert["history"]]
+    back = [int(t) for t in cert.get("back", [1] * ndim)]
+    axes = tuple(int(a) for a in cert["axes"])
+    if len(region) != ndim or len(history) != ndim or len(back) != ndim:
+        raise _Invalid("region, history and back need a value on every axis of the rules")
+    if any(r < 2 for r in region) or any(h < 0 for h in history) or any(b < 1 for b in back):
+        raise _Invalid("region needs >= 2, history >= 0 and back >= 1 on every axis")
+    if _axes_of(str(cert["order"]), ndim) != axes:
+        raise _Invalid("axes do not match the order")
+    both = (False, True) if face_rules else (False,)
+    want = set()
+    for lo in itertools.product(*[range(1 + b + h) for b, h in zip(back, history, strict=True)]):
+        for hi in itertools.product(*[range(r - 1) for r in region]):
+            at_lo = [(True,) if lo[d] < back[d] + history[d] else both for d in range(ndim)]
+            at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
+            for a in itertools.product(*at_lo):
+                for b in itertools.product(*at_hi):
+                    want.add((lo, hi, a, b))
+    got = [
+        (tuple(c["lower"]), tuple(c["upper"]), tuple(bool(t) for t in c["at_lower"]),
+         tuple(bool(t) for t in c["at_upper"]))
+        for c in cert["configs"]
+    ]  # fmt: skip
+    if len(got) != len(set(got)) or set(got) != want:
+        raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
+    canon: dict[frozenset[int], list[int]] = {}
+    nstates = 0
+    for conf, (lo, hi, on_lo, on_hi) in zip(cert["configs"], got, strict=True):
+        nstates += _check_class_config(
+            conf, lo, hi, on_lo, on_hi, region, back, axes, rules, canon, dead or {}
+        )
+    return (
+        f"valid: {nstates} states (labels by class) in {len(got)} configurations are closed "
+        f"under Alg. 3.6 with {'x'.join(map(str, region))} regions ({cert['order']}) and no "
+        "catalog of a point is empty: Alg. 3.1 never fails (Theorem 3.3.6)"
+    )
+
+
+def _class_of(fwd: list[list[int]], used: int, ax: frozenset[int]) -> list[int]:
+    """Label -> the least label in use with the same ``fwd[d]`` for every ``d`` in ``ax``."""
+    first: dict[tuple[int, ...], int] = {}
+    return [
+        first.setdefault(tuple(fwd[d][a] for d in sorted(ax)), a) if used >> a & 1 else a
+        for a in range(len(fwd[0]))
+    ]
+
+
+def _check_class_config(
+    conf: Mapping[str, Any],
+    lo: Cell,
+    hi: Cell,
+    at_lo: tuple[bool, ...],
+    at_hi: tuple[bool, ...],
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+    rules: _Rules,
+    canon: dict[frozenset[int], list[int]],
+    dead: Mapping[Where, int],
+) -> int:
+    fwd, bwd, used, ndim, face_rules = rules
+    where = f"configuration lower={list(lo)} upper={list(hi)}"
+    ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
+
+    def okey(c: Cell) -> Cell:
+        return tuple(c[a] for a in axes)
+
+    cells = [c for c in itertools.product(*[range(e) for e in ext]) if okey(c) < okey(lo)]
+    cells = [*sorted(cells, key=okey), lo]
+    index = {c: i for i, c in enumerate(cells)}
+    n = len(cells)
+    keys = [[int(j) for j in k] for k in conf["keys"]]
+    if len(keys) != n or keys[0]:
+        raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
+
+    cap = max((v for k in dead for a in k for v in a), default=0)
+    doms: dict[Cell, int] = {}
+
+    def face_dom(x: Cell) -> int:
+        if x in doms:
+            return doms[x]
+        on = {_AXES[d] + "-" for d in range(ndim) if at_lo[d] and x[d] == 0}
+        on |= {_AXES[d] + "+" for d in range(ndim) if at_hi[d] and x[d] == ext[d] - 1}
+        dom = _domain(face_rules, on, used)
+        if dead:  # minus the labels dead wherever in an output this cell may lie
+            per_axis = []
+            for d in range(ndim):
+                lo_d, hi_d = x[d], ext[d] - 1 - x[d]  # distances, exact on a face edge
+                los = [min(lo_d, cap)] if at_lo[d] else range(min(lo_d + 1, cap), cap + 1)
+                his = [min(hi_d, cap)] if at_hi[d] else range(min(hi_d + 1, cap), cap + 1)
+                per_axis.append([(a, b) for a in los for b in his])
+            alive = 0
+            for k in itertools.product(*per_axis):
+                alive |= ~dead[k]
+            dom &= alive
+        doms[x] = dom
+        return dom
+
+    def classes(j: int, i: int) -> list[int]:
+        """Label of step j -> its class at step i (axes whose + neighbour is open)."""
+        x = cells[j]
+        ax = frozenset(
+            d for d in range(ndim)
+            if x[d] + 1 < ext[d] and index.get((*x[:d], x[d] + 1, *x[d + 1 :]), n) >= i
+        )  # fmt: skip
+        if ax not in canon:
+            canon[ax] = _class_of(fwd, used, ax)
+        return canon[ax]
+
+    steps = []
+    for i, c in enumerate(cells):
+        if keys[i] != sorted(set(keys[i])) or any(not 0 <= j < i for j in keys[i]):
+            raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
+        if i + 1 < n and not set(keys[i + 1]) <= set(keys[i]) | {i}:
+            raise _Invalid(f"{where}: keys[{i + 1}] records a label step {i} forgot")
+        box = list(itertools.product(*[
+            range(max(0, c[d] - back[d]), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
+            for d in range(ndim)
+        ]))  # fmt: skip
+        labelled = {x for x in box if index.get(x, n) < i}
+        nodes = [x for x in box if x not in labelled or index[x] in keys[i]]
+        inbox = set(box)
+        for x in labelled:
+            near = ((*x[:d], x[d] + s, *x[d + 1 :]) for d in range(ndim) for s in (-1, 1))
+            if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
+                raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
+        arcs = [
+            [(v, d, plus) for v, d, plus in row if not (x in labelled and nodes[v] in labelled)]
+            for x, row in zip(nodes, _arcs(nodes), strict=True)
+        ]
+        pos = {j: k for k, j in enumerate(keys[i])}
+        src = [pos[index[x]] if x in labelled else -1 for x in nodes]
+        base = [face_dom(x) for x in nodes]
+        nxt = (
+            [(-1 if j == i else pos[j], classes(j, i + 1)) for j in keys[i + 1]]
+            if i + 1 < n else []
+        )  # fmt: skip
+        steps.append((src, arcs, nodes.index(c), base, nxt))
+    by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
+    for i, labs in conf["states"]:
+        if not 0 <= i < n or len(labs) != len(keys[i]):
+            raise _Invalid(f"{where}: state {[i, labs]} does not fit keys[{i}]")
+        if any(not (0 <= b < len(fwd[0]) and used >> b & 1) for b in labs):
+            raise _Invalid(f"{where}: state {[i, labs]} has a label not in use")
+        by_step[i].add(tuple(labs))
+    if () not in by_step[0]:
+        raise _Invalid(f"{where}: no start state")
+    union: dict[tuple[int, int, int], int] = {}
+    for i, (src, arcs, target, base, nxt) in enumerate(steps):
+        later = by_step[i + 1] if i + 1 < n else set()
+        cats: dict[tuple[int, ...], int] = {}
+        for labs in by_step[i]:
+            mk = tuple([labs[k] for k in src if k >= 0])
+            cat = cats.get(mk)
+            if cat is None:
+                dom = [b0 if k < 0 else 1 << labs[k] for k, b0 in zip(src, base, strict=True)]
+                out = _small_ac(dom, arcs, fwd, bwd, union)
+                cat = cats[mk] = 0 if out is None else out[target]
+            if i == n - 1:
+                if not cat:
+                    raise _Invalid(f"{where}: the point's catalog is empty in {[i, list(labs)]}")
+                continue
+            for b in _bits(cat):
+                new = tuple([m[b if k < 0 else labs[k]] for k, m in nxt])
+                if new not in later:
+                    raise _Invalid(
+                        f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
+                        f"{[i + 1, list(new)]}, which is missing"
+                    )
+    return sum(len(s) for s in by_step)
+
+
+# ----------------------------------------------------------------------------- dead labels
+
+
+Where = tuple[tuple[int, ...], ...]
+
+
+def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
+    """The labels dead at each ``where`` (per axis the distances to the lower and upper
+    face, capped at ``cap``, which means "at least"): those the faces' domain rules
+    exclude there, and those of the ``stages`` ``[face, [[where, labels], ...]]``, each
+    verified: ``where`` is not on ``face``, and at every ``where`` the neighbour one cell
+    nearer ``face`` may have, every label supporting one of the labels from there is dead
+    -- earlier, or in this stage.
+
+    Why no catalog of Alg. 3.1 ever holds one at such a cell: its catalogs lie inside the
+    greatest arc-consistent domains before any choice, ``C_0``, where a label has a
+    support in each neighbour. Take a stage label in ``C_0`` at a cell, of the first stage
+    that has one, nearest the stage's face: its support in the neighbour nearer the face
+    is dead earlier (so not in ``C_0``) or in this stage nearer the face -- a
+    contradiction either way. So Alg. 3.1 runs the same with a cell's dead labels out of
+    its domain, and the states are checked with them out.
+    """
+    fwd, bwd, used, ndim, face_rules = rules
+    cap = int(dead["cap"])
+    if not 1 <= cap <= 8:
+        raise _Invalid("dead labels: cap must be 1 to 8")
+    span = list(itertools.product(range(cap + 1), repeat=2))
+    known: dict[Where, int] = {}
+    for k in itertools.product(span, repeat=ndim):
+        on = {_AXES[d] + "-" for d in range(ndim) if k[d][0] == 0}
+        on |= {_AXES[d] + "+" for d in range(ndim) if k[d][1] == 0}
+        known[k] = used & ~_domain(face_rules, on, used)
+    every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
+    for face, got in dead["stages"]:
+        if face not in every:
+            raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
+        d, minus = _AXES.index(face[0]), face[1] == "-"
+        stage: dict[Where, int] = {}
+        for where, labels in got:
+            k = tuple((int(a), int(b)) for a, b in where)
+            if k not in known or k[d][0 if minus else 1] == 0:
+                raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
+            for b in labels:
+                if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
+                    raise _Invalid(f"dead labels: {b!r} is not a label in use")
+                stage[k] = stage.get(k, 0) | 1 << b
+        table = bwd[d] if minus else fwd[d]
+        for k, bits in stage.items():
+            lo, hi = k[d]
+            if minus:
+                los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+            else:
+                los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+            for a, c in itertools.product(los, his):
+                n = (*k[:d], (a, c), *k[d + 1 :])
+                gone = known[n] | stage.get(n, 0)
+                for b in _bits(bits):
+                    if table[b] & ~gone:
+                        raise _Invalid(
+                            f"dead labels: {b} at {[list(t) for t in k]} has a support toward "
+                            f"{face} that is not dead: {sorted(_bits(table[b] & ~gone))}"
+                        )
+        for k, bits in stage.items():
+            known[k] |= bits
+    return known
+
+
+def _without(rules: _Rules, dead: int) -> _Rules:
+    """The rules with the ``dead`` labels out of use."""
+    keep = rules.used & ~dead
+
+    def cut(table: list[list[int]]) -> list[list[int]]:
+        return [[row & keep if keep >> a & 1 else 0 for a, row in enumerate(t)] for t in table]
+
+    return _Rules(cut(rules.fwd), cut(rules.bwd), keep, rules.ndim, rules.faces)
 
 
 # ----------------------------------------------------------------------------- fallible

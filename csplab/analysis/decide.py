@@ -5,8 +5,12 @@ that stops at the first verdict:
 
 * **proof** -- :func:`~csplab.analysis.infallible.prove_infallible` (Alg. 3.6/3.7,
   Theorem 3.3.6) on a ladder of regions, fewest cells first: sizes 2 .. ``max_region`` per
-  axis, reaching 1 .. ``max_back`` cells before the point (Alg. 3.7 reaches 1); then once
-  more with one more cell of history. The ladder is *refined by the spurious failures*:
+  axis, reaching 1 .. ``max_back`` cells before the point (Alg. 3.7 reaches 1), each with
+  no frame history and then with ``history``; then once more with one more cell of
+  history. Frame labels are recorded by class
+  (:func:`~csplab.analysis.infallible.label_classes`), which with no history proves the
+  3D pipes rule set (MarkovJunior's Knots3D) with 2x2x3 regions in a fraction of a
+  second. The ladder is *refined by the spurious failures*:
   when Alg. 3.6 with a region fails for real on a concrete output, a region that sees the
   same cells of that output at every point (equal on each axis, or covering the output on
   that axis) fails on it the same way, so it is skipped.
@@ -27,7 +31,7 @@ Examples
 >>> from csplab.examples import load_example
 >>> v = decide_infallibility(load_example("fig3_4a"), order="scan:yx", time_limit=30)
 >>> v.holds, v.stats["method"]
-(True, 'region 3x2 (Alg. 3.6)')
+(True, 'region 3x2 history 0 (Alg. 3.6)')
 >>> v = decide_infallibility(load_example("fig3_5a"), order="scan:yx", time_limit=30)
 >>> v.holds, v.stats["method"] in ("Alg. 3.6 run = Alg. 3.1 run", "failure search")
 (False, True)
@@ -126,6 +130,7 @@ def decide_infallibility(
     max_size: Sequence[int] | str | None = None,
     rng: int = 0,
     certificate: bool = False,
+    classes: bool = True,
 ) -> Verdict:
     """Decide whether Alg. 3.1 (scan ``order``) can fail on ``example``, within a budget.
 
@@ -159,6 +164,9 @@ def decide_infallibility(
         Seed of the failure search's random runs (recorded in the witness).
     certificate : bool
         Put a certificate in ``witness["certificate"]`` (see :func:`prove_infallible`).
+    classes : bool
+        Let the region prover record frame labels by class
+        (:func:`~csplab.analysis.infallible.label_classes`).
 
     Returns
     -------
@@ -184,8 +192,11 @@ def decide_infallibility(
     deadline = t0 + float(time_limit)
     top = max_region or (8 if ndim <= 2 else 4)
     max_back = max_back or (6 if ndim <= 2 else 2)
-    ladder = [(r, b, history) for r, b in region_ladder(ndim, top, max_back)]
-    ladder += [(r, b, history + 1) for r, b, _ in ladder]
+    regions = region_ladder(ndim, top, max_back)
+    # each region with no history first (the smallest frames: with label classes often
+    # enough, and fast), then ``history``; then the ladder once more with one more
+    ladder = [(r, b, h) for r, b in regions for h in sorted({0, history})]
+    ladder += [(r, b, history + 1) for r, b in regions]
     if max_size is None and ndim <= 2:
         max_size = (40,) if ndim == 1 else (12, 12)
     attempts: list[str] = []
@@ -231,7 +242,7 @@ def decide_infallibility(
         left = ladder_end - time.perf_counter()
         v = prove_infallible(
             example, r, order=order, history=hist, max_states=max_states,
-            refute=False, certificate=certificate, boundary=boundary, back=b,
+            refute=False, certificate=certificate, boundary=boundary, back=b, classes=classes,
             time_limit=max(0.5, 0.5 * left if i else 0.25 * left),
         )  # fmt: skip
         rt = "x".join(map(str, r)) + ("" if set(b) == {1} else " back " + "x".join(map(str, b)))

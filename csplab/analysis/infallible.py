@@ -73,6 +73,7 @@ True
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import time
@@ -97,7 +98,10 @@ __all__ = [
     "Rules",
     "alg36_failure",
     "corner_condition",
+    "dead_at",
+    "dead_labels",
     "face_rules_of",
+    "label_classes",
     "proof_scope",
     "prove_infallible",
     "region_box",
@@ -157,6 +161,10 @@ class Rules:
         return out
 
 
+def _bools(bits: int, K: int) -> NDArray[np.bool_]:
+    return np.array([bool(bits >> b & 1) for b in range(K)], dtype=bool)
+
+
 def _to_bits(mask: ArrayLike) -> int:
     out = 0
     for b in np.flatnonzero(np.asarray(mask, dtype=bool)):
@@ -185,6 +193,52 @@ def _graph_ac(
                     inq[v] = True
                     queue.append(v)
     return dom
+
+
+def label_classes(rules: Rules, axes: Sequence[int] | None = None) -> list[int]:
+    """Each label's class: the least label that supports the same labels as it forward
+    along every axis of ``axes`` (default: all; ``fwd[d][a]`` equal for these ``d``).
+
+    A frame cell whose forward neighbour along an axis is labelled (or outside the frame)
+    no longer acts along it, so the prover's memoisation key records its label by its
+    class along the other axes only.
+
+    Why the prover may record a frame label as its class: a labelled frame cell ``x``
+    changes a later catalog only through arcs to unlabelled cells, and in a scan order
+    those are its forward neighbours (``x - e_d`` comes before ``x``, so inside the frame
+    it is labelled). Along a forward arc, ``x``'s label ``a`` narrows the neighbour to
+    ``fwd[d][a]`` and keeps ``a`` iff the neighbour's domain meets ``fwd[d][a]``: both
+    depend on ``a`` only through its class. Arcs between two labelled cells hold in every
+    run (each label was drawn from a catalog of a region holding its backward
+    neighbours), so leaving them out of arc consistency changes no catalog of a real run.
+
+    Parameters
+    ----------
+    rules : Rules
+    axes : sequence of int, optional
+        The axes compared.
+
+    Returns
+    -------
+    list of int
+        ``K`` entries; unused labels are their own class.
+
+    Examples
+    --------
+    >>> label_classes(Rules([[[1, 1, 0], [1, 1, 0], [0, 0, 1]]]))
+    [0, 0, 2]
+    >>> label_classes(Rules([[[1, 1, 0], [1, 1, 0], [0, 0, 1]]]), axes=[])
+    [0, 0, 0]
+    """
+    first: dict[tuple[int, ...], int] = {}
+    out = []
+    for a in range(rules.K):
+        if not rules.used >> a & 1:
+            out.append(a)
+            continue
+        ax = range(rules.ndim) if axes is None else axes
+        out.append(first.setdefault(tuple(rules.fwd[d][a] for d in ax), a))
+    return out
 
 
 # ----------------------------------------------------------------------------- orders, regions
@@ -311,8 +365,15 @@ class _Walk:
         region: Coords,
         base: Callable[[Coords], int] | None = None,
         back: Coords | None = None,
+        reduce: Rules | None = None,
     ) -> None:
         self.ext, self.cells, self.region = ext, cells, region
+        # with ``reduce``: labels are drawn as their class (:func:`label_classes`), the
+        # memoisation key records each label by its class along the axes on which the
+        # cell's forward neighbour is not yet labelled, and arcs between two labelled cells
+        # are left out (see :func:`label_classes`)
+        classes = None if reduce is None else label_classes(reduce)
+        self.classes = classes
         index = {c: i for i, c in enumerate(cells)}
         ndim = len(ext)
         self.steps: list[tuple[list[int], list[list[tuple[int, int, bool]]], int]] = []
@@ -349,7 +410,7 @@ class _Walk:
                 for d in range(ndim):
                     y = (*x[:d], x[d] + 1, *x[d + 1 :])
                     m = pos.get(y)
-                    if m is not None:
+                    if m is not None and (classes is None or not (fixed(x) and fixed(y))):
                         arcs[k].append((m, d, True))
                         arcs[m].append((k, d, False))
             src = [index[x] if fixed(x) else -1 for x in keep]
@@ -363,6 +424,29 @@ class _Walk:
         for i in range(n - 1, -1, -1):
             need |= set(relfixed[i])
             self.key_at[i] = sorted(j for j in need if j < i)
+        # per step, per key cell: label -> the label recorded in the memoisation key
+        self.proj: list[list[list[int]]] | None = None
+        if reduce is not None:
+            canon: dict[frozenset[int], list[int]] = {}
+
+            def open_axes(j: int, i: int) -> frozenset[int]:
+                x = cells[j]
+                out = set()
+                for d in range(ndim):
+                    y = (*x[:d], x[d] + 1, *x[d + 1 :])
+                    if y[d] < ext[d] and index.get(y, n) >= i:
+                        out.add(d)
+                return frozenset(out)
+
+            self.proj = []
+            for i in range(n + 1):
+                row = []
+                for j in self.key_at[i]:
+                    ax = open_axes(j, i)
+                    if ax not in canon:
+                        canon[ax] = label_classes(reduce, sorted(ax))
+                    row.append(canon[ax])
+                self.proj.append(row)
         self._cache: dict[tuple[int, tuple[int, ...]], int] = {}
 
     def catalog(self, rules: Rules, i: int, labels: Sequence[int]) -> int:
@@ -435,6 +519,8 @@ def _frame(
     edges: Edges | None = None,
     face_domain: Callable[[frozenset[str]], int] | None = None,
     back: Coords | None = None,
+    reduce: Rules | None = None,
+    dead_where: Mapping[Where, int] | None = None,
 ) -> tuple[_Walk, Coords, Coords]:
     ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
     q = lo
@@ -448,9 +534,15 @@ def _frame(
         def base(x: Coords) -> int:
             on = {AXIS_NAMES[d] + "-" for d in range(len(x)) if at_lo[d] and x[d] == 0}
             on |= {AXIS_NAMES[d] + "+" for d in range(len(x)) if at_hi[d] and x[d] == ext[d] - 1}
-            return face_domain(frozenset(on))
+            dom = face_domain(frozenset(on))
+            if dead_where:  # the labels alive wherever the cell may be
+                alive = 0
+                for k in itertools.product(*_where_options(x, ext, at_lo, at_hi, DEAD_CAP)):
+                    alive |= ~dead_where[k]
+                dom &= alive
+            return dom
 
-    return _Walk(ext, cells, region, base, back), ext, q
+    return _Walk(ext, cells, region, base, back, reduce), ext, q
 
 
 def prove_infallible(
@@ -466,6 +558,7 @@ def prove_infallible(
     boundary: Mapping[str, int] | str | None = None,
     time_limit: float | None = None,
     back: Sequence[int] | int = 1,
+    classes: bool = False,
 ) -> Verdict:
     """Prove that Alg. 3.1 never fails on ``example`` (any output size) via Alg. 3.6.
 
@@ -505,6 +598,10 @@ def prove_infallible(
     back : int or sequence
         How far each region reaches before its point, per axis (Alg. 3.7: 1). Larger
         values see more of the assigned cells (:func:`region_box`).
+    classes : bool
+        Record each frame label as its class (:func:`label_classes`: labels that support
+        the same labels along every axis forward have equal futures in the frame), so
+        equal futures are explored once; the certificate then lists the classes.
 
     Raises
     ------
@@ -537,6 +634,22 @@ def prove_infallible(
     axes = scan_axes(ndim, order)
     r = parse_region(region, ndim)
     face_rules = face_rules_of(example, boundary)
+    rules0 = rules  # the certificate's rules; ``rules`` without the labels dead everywhere
+    # dead labels by where a cell is (with label classes only: their certificates are
+    # checked with per-cell domains)
+    dead: list[tuple[str, list[tuple[Where, list[int]]]]] = []
+    dead_where: dict[Where, int] = {}
+    if classes and face_rules:  # the same for every region the decision ladder tries
+        key = (example.hash(), repr(face_rules))
+        if key not in _DEAD_SEEN:
+            if len(_DEAD_SEEN) > 32:
+                _DEAD_SEEN.clear()
+            stages = dead_labels(rules, face_rules)
+            _DEAD_SEEN[key] = (stages, dead_at(rules, face_rules, stages=stages))
+        dead, dead_where = _DEAD_SEEN[key]
+    if dead:
+        everywhere = functools.reduce(lambda a, b: a & b, dead_where.values())
+        rules = Rules(rules.T, rules.used_mask & ~_bools(everywhere, rules.K))
     face_domain = _face_domain(face_rules, rules) if face_rules else None
     if face_rules:
         realize = False  # exhaustive Alg. 3.6 on a concrete output ignores the face rules
@@ -564,12 +677,21 @@ def prove_infallible(
         digest.update(repr(bk).encode())
     if face_rules:
         digest.update(repr(face_rules).encode())
+    if dead:
+        digest.update(repr(dead).encode())
+        stats["dead"] = sum(len(b) for _, got in dead for _, b in got)
+    cls = label_classes(rules) if classes else None
+    if cls is not None:
+        digest.update(repr(cls).encode())
+        stats["classes"] = len(set(cls))
     failure: dict[str, Any] | None = None
     closed: list[dict[str, Any]] = []
     deadline = None if time_limit is None else t0 + float(time_limit)
     try:
         for lo, hi, edges in _configs(ndim, r, hist, bool(face_rules), bk):
-            walk, ext, q = _frame(lo, hi, axes, r, edges, face_domain, bk)
+            walk, ext, q = _frame(
+                lo, hi, axes, r, edges, face_domain, bk, rules if classes else None, dead_where
+            )
             stats["configs"] += 1
             seen: set[tuple[int, tuple[int, ...]]] | None = set() if certificate else None
             fail, nstates, windows = _enumerate(
@@ -626,16 +748,22 @@ def prove_infallible(
         }
         if certificate:
             proof["certificate"] = _certificate(
-                example, rules, face_rules, "infallible", stats,
+                example, rules0, face_rules, "infallible", stats,
                 {"region": list(r), "order": order, "axes": list(axes), "history": list(hist),
-                 "back": list(bk), "configs": closed},
+                 "back": list(bk), "configs": closed}
+                | ({} if cls is None else {"label_classes": True})
+                | ({"dead": {"cap": DEAD_CAP, "stages": [
+                    [f, [[[list(a) for a in k], b] for k, b in got]] for f, got in dead
+                ]}} if dead else {}),
             )  # fmt: skip
+        dtxt = f"({stats['dead']} labels dead near faces; " if dead else "("
         return Verdict(
             True,
             proof,
             stats,
             f"infallible: Alg. 3.6 with {rtxt} regions ({order}) cannot fail "
-            f"({stats['windows']} windows, {stats['states']} states, "
+            + dtxt
+            + f"{stats['windows']} windows, {stats['states']} states, "
             f"{stats['configs']} configurations, {stats['time_s']:.2f} s)",
         )
     # the window check failed: is the failure real?
@@ -660,7 +788,7 @@ def prove_infallible(
             if certificate:
                 stats["time_s"] = time.perf_counter() - t0
                 wit["certificate"] = _certificate(
-                    example, rules, face_rules, "fallible", stats, {"run": alg31}
+                    example, rules0, face_rules, "fallible", stats, {"run": alg31}
                 )
             return Verdict(False, wit, stats, msg + "; the same run fails in Alg. 3.1: fallible")
     if refute:
@@ -679,7 +807,7 @@ def prove_infallible(
                 if face_rules:  # the run's boundary is the certificate's face rules
                     run["boundary"] = "auto"
                 wit["certificate"] = _certificate(
-                    example, rules, face_rules, "fallible", stats, {"run": run}
+                    example, rules0, face_rules, "fallible", stats, {"run": run}
                 )
             return Verdict(False, wit, stats, msg + "; Alg. 3.1 fails too: fallible")
         size = "x".join(map(str, _refute_size(ndim)))
@@ -829,6 +957,139 @@ def face_rules_of(
     return out
 
 
+Where = tuple[tuple[int, ...], ...]
+DEAD_CAP = 3
+# dead labels per (model hash, face rules): the stages and the bit sets per place
+_DEAD_SEEN: dict[tuple[str, str], tuple[list[Any], dict[Where, int]]] = {}
+
+
+def dead_labels(
+    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]], cap: int = DEAD_CAP
+) -> list[tuple[str, list[tuple[Where, list[int]]]]]:
+    """Labels that arc consistency removes before the first choice, by where the cell
+    is: stages ``(face, [(where, labels), ...])`` in order.
+
+    ``where`` is a cell's distance to the lower and upper face on each axis, capped at
+    ``cap`` (``cap`` meaning "at least"). A label is dead at ``where`` when no cell there
+    may take it (its faces' domain rules), or when a stage says so: for each neighbour
+    one cell nearer ``face`` (each ``where`` it may have), every label that supports it
+    from there is dead, earlier or in this stage. Then it is in no initial catalog ``C_0``
+    (the greatest arc-consistent domains) of a cell there, of any output: by induction
+    over the stages and then the distance to the face (a label of ``C_0`` has a support
+    in ``C_0`` of each neighbour). Alg. 3.1's catalogs lie inside ``C_0``, so
+    :func:`prove_infallible` takes the dead labels out of each frame cell's domain (out
+    of use where dead everywhere). Only domain rules on faces kill labels.
+
+    Parameters
+    ----------
+    rules : Rules
+    face_rules : sequence of (op, where, labels)
+        As :func:`face_rules_of` returns them.
+    cap : int
+        Distances from which on cells count as equally far.
+
+    Returns
+    -------
+    list of (str, list of (tuple, list of int))
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> E = load_example("fig3_5a")    # its objects stand on the bottom edge: with empty
+    >>> d = dead_at(Rules.of(E), face_rules_of(E, "auto"))   # space all round, none fits
+    >>> sorted(set.intersection(*({b for b in range(9) if k >> b & 1} for k in d.values())))
+    [1, 2, 3, 4, 5, 6, 7, 8]
+    >>> dead_labels(Rules.of(E), [])
+    []
+    """
+    if not face_rules:
+        return []
+    ndim = rules.ndim
+    dead = _domain_dead(rules, face_rules, cap)
+    stages = []
+    grew = True
+    while grew:
+        grew = False
+        for d in range(ndim):
+            for s, face in ((-1, AXIS_NAMES[d] + "-"), (1, AXIS_NAMES[d] + "+")):
+                table = rules.bwd[d] if s < 0 else rules.fwd[d]
+                near = {k: _toward(k, d, s, cap) for k in dead if k[d][0 if s < 0 else 1] > 0}
+                B = {k: rules.used & ~dead[k] for k in near}
+                changed = True
+                while changed:  # the greatest set whose supports toward the face are dead
+                    changed = False
+                    for k, ns in near.items():
+                        keep = sum(
+                            1 << b for b in set_bits(B[k])
+                            if all(not table[b] & ~(dead[n] | B.get(n, 0)) for n in ns)
+                        )  # fmt: skip
+                        if keep != B[k]:
+                            B[k], changed = keep, True
+                got = [(k, list(set_bits(b))) for k, b in B.items() if b]
+                if got:
+                    stages.append((face, got))
+                    for k, b in B.items():
+                        dead[k] |= b
+                    grew = True
+    return stages
+
+
+def dead_at(
+    rules: Rules,
+    face_rules: Sequence[tuple[str, str, list[int]]],
+    cap: int = DEAD_CAP,
+    stages: Sequence[tuple[str, list[tuple[Where, list[int]]]]] | None = None,
+) -> dict[Where, int]:
+    """The dead labels (a bit set) at each ``where`` (see :func:`dead_labels`; ``stages``:
+    its result, if at hand)."""
+    dead = _domain_dead(rules, face_rules, cap)
+    if stages is None:
+        stages = dead_labels(rules, face_rules, cap)
+    for _, got in stages:
+        for k, labels in got:
+            for b in labels:
+                dead[k] |= 1 << b
+    return dead
+
+
+def _domain_dead(
+    rules: Rules, face_rules: Sequence[tuple[str, str, list[int]]], cap: int
+) -> dict[Where, int]:
+    """Per ``where``: the labels in use that the faces' domain rules exclude there."""
+    domain = _face_domain(face_rules, rules)
+    ndim = rules.ndim
+    out = {}
+    for k in itertools.product(itertools.product(range(cap + 1), repeat=2), repeat=ndim):
+        on = {AXIS_NAMES[d] + "-" for d in range(ndim) if k[d][0] == 0}
+        on |= {AXIS_NAMES[d] + "+" for d in range(ndim) if k[d][1] == 0}
+        out[k] = rules.used & ~domain(frozenset(on))
+    return out
+
+
+def _toward(k: Where, d: int, s: int, cap: int) -> list[Where]:
+    """Where the neighbour along ``s * e_d`` of a cell at ``k`` may be."""
+    lo, hi = k[d]
+    if s < 0:
+        los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+    else:
+        los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+    return [(*k[:d], (a, b), *k[d + 1 :]) for a in los for b in his]
+
+
+def _where_options(
+    x: Coords, ext: Coords, at_lo: Sequence[bool], at_hi: Sequence[bool], cap: int
+) -> list[list[tuple[int, int]]]:
+    """Per axis, the capped distances to the faces a frame cell ``x`` may have (exact
+    where the frame's first / last cell lies on the face, else one more at least)."""
+    out = []
+    for d in range(len(x)):
+        up = ext[d] - 1 - x[d]
+        los = [min(x[d], cap)] if at_lo[d] else list(range(min(x[d] + 1, cap), cap + 1))
+        his = [min(up, cap)] if at_hi[d] else list(range(min(up + 1, cap), cap + 1))
+        out.append([(a, b) for a in los for b in his])
+    return out
+
+
 def _face_domain(
     face_rules: Sequence[tuple[str, str, list[int]]], rules: Rules
 ) -> Callable[[frozenset[str]], int]:
@@ -973,8 +1234,13 @@ def _dfs(
     labels: list[int] = []
     last = len(walk.cells) - 1
 
+    proj = walk.proj
+
     def rec(i: int) -> _R | None:
-        key = (i, tuple(labels[j] for j in walk.key_at[i]))
+        if proj is None:
+            key = (i, tuple(labels[j] for j in walk.key_at[i]))
+        else:
+            key = (i, tuple(m[labels[j]] for m, j in zip(proj[i], walk.key_at[i], strict=True)))
         if key in seen:
             return None
         seen.add(key)
@@ -986,7 +1252,8 @@ def _dfs(
         res = found(i, cat, labels)
         if res is not None or i == last:
             return res
-        opts = list(set_bits(cat))
+        cls = walk.classes
+        opts = list(set_bits(cat)) if cls is None else sorted({cls[b] for b in set_bits(cat)})
         want = None if first is None else first.get(i)
         if want is not None and want in opts:
             opts.remove(want)

@@ -97,7 +97,7 @@ def run(args: argparse.Namespace) -> int:
         v = prove_infallible(
             E, args.region, order=args.order, history=history, max_states=args.max_states,
             certificate=bool(args.certificate), boundary=args.boundary,
-            back=bk[0] if len(bk) == 1 else bk,
+            back=bk[0] if len(bk) == 1 else bk, classes=True,  # as --region auto: one hash
         )  # fmt: skip
     cert = (v.witness or {}).pop("certificate", None) if args.certificate else None
     print_verdict(v, args.json)

@@ -17,7 +17,7 @@ from csplab.grids import from_example
 def test_fig3_4a_proved_with_the_thesis_region_and_checked():
     v = decide_infallibility(load_example("fig3_4a"), order="scan:yx", time_limit=60,
                              certificate=True)  # fmt: skip
-    assert v.holds is True and v.stats["method"] == "region 3x2 (Alg. 3.6)"
+    assert v.holds is True and v.stats["method"] == "region 3x2 history 0 (Alg. 3.6)"
     cert = json.loads(json.dumps(v.witness["certificate"]))
     ok, msg = check_certificate(cert)
     assert ok, msg

@@ -26,7 +26,7 @@ def test_prove_exit_codes(capsys):
     assert code == 0
     # the default decides: the smallest region that proves it (the thesis' 3x2)
     code, out, _ = run(capsys, "prove", "fig3_4a", "--order", "scan:yx", "--time-limit", "60")
-    assert code == 0 and "method: region 3x2 (Alg. 3.6)" in out
+    assert code == 0 and "method: region 3x2 history 0 (Alg. 3.6)" in out
     code, out, _ = run(capsys, "prove", "fig3_5a", "--order", "scan:yx")
     assert code == 1 and "fallible" in out and "inconsistent at choice" in out
 

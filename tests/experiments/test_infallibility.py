@@ -16,7 +16,7 @@ def test_quick_table_and_targets(tmp_path):
     assert all("0 failed" in r["cross-check"] for r in rows)
     text = (tmp_path / "infallibility.md").read_text()
     assert "Target 0 contradictions between verdicts and runs: 0: meets" in text
-    assert "| fig3_4a |" in text and "region 3x2 (Alg. 3.6)" in text
+    assert "| fig3_4a |" in text and "region 3x2 history 0 (Alg. 3.6)" in text
 
 
 def test_a_wrong_proof_is_reported_as_a_contradiction(tmp_path, monkeypatch):
