@@ -305,8 +305,15 @@ def _axes_of(order: str, ndim: int) -> tuple[int, ...]:
 # ----------------------------------------------------------------------------- infallible
 
 
-def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
-    fwd, bwd, used, ndim, face_rules = rules
+_Conf = tuple[tuple[int, ...], tuple[int, ...], tuple[bool, ...], tuple[bool, ...]]
+
+
+def _positions(
+    cert: Mapping[str, Any], ndim: int, face_rules: bool
+) -> tuple[list[int], list[int], tuple[int, ...], list[_Conf]]:
+    """The region, back and axes of an *infallible* certificate (its history checked), and its
+    configurations ``(lower, upper, at_lower, at_upper)`` in file order, checked to be
+    exactly the positions of a point in the region (each once)."""
     region = [int(t) for t in cert["region"]]
     history = [int(t) for t in cert["history"]]
     axes = tuple(int(a) for a in cert["axes"])
@@ -328,8 +335,7 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
             for a in itertools.product(*at_lo):
                 for b in itertools.product(*at_hi):
                     want.add((lo, hi, a, b))
-    configs = cert["configs"]
-    got = [
+    got: list[_Conf] = [
         (
             tuple(c["lower"]), tuple(c["upper"]),
             tuple(bool(t) for t in c.get("at_lower", [])) or tuple(
@@ -337,10 +343,17 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
             tuple(bool(t) for t in c.get("at_upper", [])) or tuple(
                 hi < r - 2 for hi, r in zip(c["upper"], region, strict=True)),
         )
-        for c in configs
+        for c in cert["configs"]
     ]  # fmt: skip
     if len(got) != len(set(got)) or set(got) != want:
         raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
+    return region, back, axes, got
+
+
+def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
+    fwd, bwd, used, ndim, face_rules = rules
+    region, back, axes, got = _positions(cert, ndim, bool(face_rules))
+    configs = cert["configs"]
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and region graphs
     memo = _Memo()
@@ -915,33 +928,7 @@ def _check_classes(
     consistency with the classes gives the catalogs of the real labels, and a real run's
     labels, mapped to their classes, stay in a closed set that holds the start state.
     """
-    ndim, face_rules = rules.ndim, rules.faces
-    region = [int(t) for t in cert["region"]]
-    history = [int(t) for t in cert["history"]]
-    back = [int(t) for t in cert.get("back", [1] * ndim)]
-    axes = tuple(int(a) for a in cert["axes"])
-    if len(region) != ndim or len(history) != ndim or len(back) != ndim:
-        raise _Invalid("region, history and back need a value on every axis of the rules")
-    if any(r < 2 for r in region) or any(h < 0 for h in history) or any(b < 1 for b in back):
-        raise _Invalid("region needs >= 2, history >= 0 and back >= 1 on every axis")
-    if _axes_of(str(cert["order"]), ndim) != axes:
-        raise _Invalid("axes do not match the order")
-    both = (False, True) if face_rules else (False,)
-    want = set()
-    for lo in itertools.product(*[range(1 + b + h) for b, h in zip(back, history, strict=True)]):
-        for hi in itertools.product(*[range(r - 1) for r in region]):
-            at_lo = [(True,) if lo[d] < back[d] + history[d] else both for d in range(ndim)]
-            at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
-            for a in itertools.product(*at_lo):
-                for b in itertools.product(*at_hi):
-                    want.add((lo, hi, a, b))
-    got = [
-        (tuple(c["lower"]), tuple(c["upper"]), tuple(bool(t) for t in c["at_lower"]),
-         tuple(bool(t) for t in c["at_upper"]))
-        for c in cert["configs"]
-    ]  # fmt: skip
-    if len(got) != len(set(got)) or set(got) != want:
-        raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
+    region, back, axes, got = _positions(cert, rules.ndim, bool(rules.faces))
     canon: dict[frozenset[int], list[int]] = {}
     nstates = 0
     for conf, (lo, hi, on_lo, on_hi) in zip(cert["configs"], got, strict=True):
