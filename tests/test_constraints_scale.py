@@ -158,3 +158,49 @@ def test_count_constraints_are_exact_in_sat_on_both_sides():
         r = csplab.solve(Q, "sat", rng=1)
         assert r.status == "solved" and not Q.violations(r.grid)
         assert lo <= int((r.grid == 1).sum()) <= hi
+
+
+def test_unchanged_judgement_with_chains_of_new_must_cells_hides_no_stray():
+    """New must cells joined to old ones only through other new must cells (a pipe tile
+    forcing its neighbour): when connected_unchanged skips, the full propagator removes
+    no cell from the set either."""
+    from csplab.constraints import grid_csr
+
+    rng = np.random.default_rng(5)
+    E = ExampleModel([[0, 1, 2, 0], [2, 0, 1, 1], [1, 2, 0, 2]])
+    E3D = ExampleModel(np.array([[[0, 1], [1, 2]], [[2, 0], [1, 1]], [[1, 2], [0, 0]]]))
+    judged = chains = 0
+    for shape in [(7, 7), (5, 4, 3)]:
+        P = from_example(E if len(shape) == 2 else E3D, shape)
+        con = Connected([1])
+        Q = P.with_constraints([con])
+        ptr, nbr = grid_csr(Q)
+        for _ in range(300):
+            can = rng.random(P.n) < 0.8
+            must = can & (rng.random(P.n) < 0.15)
+            got = con.prune_sets(Q, can.copy(), must.copy())
+            if got is None:
+                continue
+            can[got[0]] = False
+            must[got[1]] = True
+            if con.prune_sets(Q, can.copy(), must.copy()) is None:
+                continue
+            c2, m2 = can.copy(), must.copy()
+            # grow a chain of new must cells from an old one, and drop a may-cell
+            v = int(rng.choice(np.flatnonzero(must))) if must.any() else int(rng.integers(P.n))
+            for _ in range(int(rng.integers(1, 4))):
+                nb = [int(w) for w in nbr[ptr[v] : ptr[v + 1]] if c2[w] and not m2[w]]
+                if not nb:
+                    break
+                v = nb[int(rng.integers(len(nb)))]
+                m2[v] = True
+            x = int(rng.integers(P.n))
+            if c2[x] and not m2[x] and rng.random() < 0.5:
+                c2[x] = False
+            if con.prunes_nothing_new(Q, c2, m2, (can, must)):
+                judged += 1
+                fresh = np.flatnonzero(m2 & ~must)
+                chains += int(any(not must[nbr[ptr[w] : ptr[w + 1]]].any() for w in fresh))
+                again = con.prune_sets(Q, c2.copy(), m2.copy())
+                assert again is not None and again[0].size == 0
+    assert judged > 20 and chains > 5
