@@ -1368,8 +1368,9 @@ def connected_unchanged(
     ``True`` when no cell joined ``can``; every cell that left it had its may-neighbours
     joined around it through may-cells of its box (the cells within one step along every
     axis, diagonals included; ``xyz`` holds the cells' coordinates), so no path between
-    two cells was cut; and every new must cell touches an old one (a
-    vertex separating it from a must cell would separate its must neighbour too). A cut
+    two cells was cut; and every new must cell is joined to an old one through must cells
+    (a vertex separating it from a must cell, not being a must cell, would separate that
+    old one too). A cut
     path that is only rerouted can still create separating cells on the detour: the
     caller runs the full propagator again after a bounded number of such steps.
     """
@@ -1379,21 +1380,36 @@ def connected_unchanged(
         if pmust[v]:
             had = True
             break
+    seen = np.zeros(n, dtype=np.bool_)
+    queue = np.empty(n, dtype=np.int64)
+    fresh = 0  # new must cells
+    head = tail = 0  # those joined to an old must cell through must cells, to visit
     for v in range(n):
         if can[v] and not pcan[v]:
             return False
         if must[v] and not pmust[v]:
             if not had:
                 return False
-            ok = False
+            fresh += 1
             for e in range(ptr[v], ptr[v + 1]):
                 if pmust[nbr[e]]:
-                    ok = True
+                    seen[v] = True
+                    queue[tail] = v
+                    tail += 1
                     break
-            if not ok:
-                return False
-    seen = np.zeros(n, dtype=np.bool_)
-    queue = np.empty(n, dtype=np.int64)
+    while head < tail:  # new must cells next to joined ones are joined too
+        v = queue[head]
+        head += 1
+        for e in range(ptr[v], ptr[v + 1]):
+            w = nbr[e]
+            if must[w] and not pmust[w] and not seen[w]:
+                seen[w] = True
+                queue[tail] = w
+                tail += 1
+    if tail < fresh:
+        return False
+    for i in range(tail):
+        seen[queue[i]] = False
     for x in range(n):
         if pcan[x] and not can[x] and not _bypassed(ptr, nbr, xyz, can, x, seen, queue):
             return False

@@ -288,6 +288,7 @@ class Propagator:
         self._queue = np.zeros(max(n, 1), dtype=np.int64)
         self._inq = np.zeros(max(n, 1), dtype=np.bool_)
         self.refuted_by: str | None = None  # the global constraint :meth:`constrain` broke
+        self.prunings = 0  # calls of :meth:`constrain` whose propagators removed labels
         # per constraint: its last fixpoint (can, must) and the calls skipped since
         self._last: list[tuple[NDArray[np.bool_], NDArray[np.bool_]] | None] = []
         self._skips: list[int] = []
@@ -408,8 +409,12 @@ class Propagator:
         seen = self._last
         for _ in range(100_000):
             quiet = True
+            status: dict[bytes, tuple[NDArray[np.bool_], NDArray[np.bool_]]] = {}
             for i, (con, sp) in enumerate(sets):
-                can, must = kern.set_status(self.bits, sp)
+                key = sp.tobytes()  # constraints over one label set read one status
+                if key not in status:
+                    status[key] = kern.set_status(self.bits, sp)
+                can, must = status[key][0], status[key][1].copy()
                 last = seen[i]
                 if last is not None and (
                     (np.array_equal(last[0], can) and np.array_equal(last[1], must))
@@ -436,7 +441,10 @@ class Propagator:
                     seen[i] = (can, mine)
                     continue
                 seen[i] = None
+                if quiet:
+                    self.prunings += 1
                 quiet = False
+                status.clear()  # the catalog changes below
                 if search is None:
                     self.bits[cells] = rows
                     if not self.propagate(cells):

@@ -102,6 +102,10 @@ KINDS = ("count", "connected", "mirror", "rotate", "separation", "max-run")
 _AXES = "xyzw"
 
 Lit = int | bool
+#: registers (cells x bound) up to which a count is a sequential counter, else an adder
+#: (a counter of 2 million registers took 8 s to build and load at 16x16x6, one of 20
+#: million over 60 s at 24x24x8)
+_COUNTER_MAX = 1_000_000
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -275,13 +279,22 @@ class ClauseContext:
             return got
         lits: list[int] = []
         out: Lit = False
-        for b in np.flatnonzero(mask):
-            x = self.lit(int(cell), int(b))
-            if x is True:
-                out = True
-                break
-            if x is not False:
-                lits.append(int(x))
+        enc = getattr(self.lit, "__self__", None)  # an Encoding: read its arrays at once
+        var, const = getattr(enc, "var", None), getattr(enc, "const", None)
+        if isinstance(var, np.ndarray) and isinstance(const, np.ndarray):
+            if const[cell] >= 0:
+                out = bool(mask[int(const[cell])])
+            else:
+                row = var[cell][mask]
+                lits = row[row > 0].tolist()
+        else:
+            for b in np.flatnonzero(mask):
+                x = self.lit(int(cell), int(b))
+                if x is True:
+                    out = True
+                    break
+                if x is not False:
+                    lits.append(int(x))
         if out is not True:
             if len(lits) == 1:
                 out = lits[0]
@@ -330,7 +343,9 @@ class ClauseContext:
         for bound, atmost in ((up, True), (lo, False)):
             if bound is None or (atmost and bound >= n) or (not atmost and bound <= 0):
                 continue
-            if min(bound, n - bound) * n <= 2_000_000:
+            # the counter's registers: n * k for "at most k" (k = n - lo for "at least lo");
+            # above _COUNTER_MAX the adder's O(n) clauses load faster than the counter helps
+            if (bound if atmost else n - bound) * n <= _COUNTER_MAX:
                 # at most `bound` of the lits, or at most n - lo of their negations
                 xs = np.array(free if atmost else [-x for x in free], dtype=np.int64)
                 cl, self.top = seqcounter(xs, bound if atmost else n - bound, self.top)

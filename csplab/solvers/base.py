@@ -224,6 +224,8 @@ STATS: dict[str, str] = {
     "connectivity_propagations": "cells excluded by the SAT search's connectivity propagator",
     "constraint_prunings": "search steps where a global-constraint propagator removed labels",
     "constraint_conflicts": "decisions refuted by a global-constraint propagator",
+    "constraint_probes": "Alg. 3.1 choices refuted by arc consistency or a global-constraint "
+    "propagator and withdrawn (the label leaves the cell's catalog, the cell chooses again)",
     "final_violations": "violations of the final grid (modify in blocks)",
     "energy": "soft-constraint energy E(M) of the returned grid (csplab.soft)",
     "breaches": "excess of the global constraints in the returned grid (0: all hold; blocks)",
