@@ -512,7 +512,8 @@ class ContinuousCSP3:
         # the region's estimate first: refused before the example's arrangement is built
         check_budget3(self.lattice, size, max_memory, example.source)
         #: how much of the example each neighbourhood covers (vertices and edges of its
-        #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
+        #: arrangement inside its box where it occurs): with ``type_coverage``, the weights
+        #: of ``choice="weighted"``
         self.coverage: dict[Labeling, int] = {}
         #: per ground face, the example's neighbourhoods on that face of its box: the only
         #: ones a vertex or edge on that face of the region may take
