@@ -500,13 +500,15 @@ class ContinuousCSP3:
         # the region's estimate first: refused before the example's arrangement is built
         check_budget3(self.lattice, size, max_memory, example.source)
         #: how much of the example each neighbourhood covers (vertices and edges of its
-        #: arrangement inside its box where it occurs): the weights of ``choice="weighted"``
+        #: arrangement inside its box where it occurs): with ``type_coverage``, the weights
+        #: of ``choice="weighted"``
         self.coverage: dict[Labeling, int] = {}
         #: per ground face, the example's neighbourhoods on that face of its box: the only
         #: ones a vertex or edge on that face of the region may take
         self.on_ground: dict[str, set[Labeling]] = {}
-        #: the same per kind of point, ``(planes, labeling)``: the weights of a vertex or
-        #: edge type are the counts among the example's points on the same planes
+        #: the same per kind of point, ``(planes, labeling)``: a vertex or edge type's
+        #: weights are the geometric mean of its states' shares among the example's points
+        #: on the same planes and among all its points (``coverage``)
         self.type_coverage: dict[tuple[int, Labeling], int] = {}
         self.signatures = example_signatures3(example, self.lattice, index, max_memory,
                                               self.ground, self.coverage,
@@ -603,16 +605,24 @@ class ContinuousCSP3:
             found = sorted({tuple(int(x) for x in row) for row in local[ok]},
                            key=lambda st: (any(st), st))  # fmt: skip
             # Sec. 4.5.4's states, each weighted by the example it covers (+1: every state
-            # stays possible): how often the example's points on the same planes have it
-            # (a rock's corner among the vertices where its planes meet, not among every
-            # point of the flat ground, of any planes); all its points where the example
-            # has none on these planes
+            # stays possible), from two estimates of its share: among the example's points
+            # on the same planes (a rock's corner among the vertices where its planes meet,
+            # not among every flat point; all its points where it has none on these
+            # planes), and among all its points (an object's face or inside, which goes on
+            # through points of every kind, weighs more there than a corner ending it).
+            # The first alone draws each state at the example's rate, so extents are
+            # geometric and half the objects short; the second alone lets the inside of a
+            # ground grow over the rocks on it. Their normalized geometric mean: the q
+            # that minimizes KL(q || first) + KL(q || second)
             mask = int((1 << fams).sum()) if len(fams) else 0
-            here = by_kind.get(mask, cover)
-            w = dict.fromkeys(found, 1.0)
-            for row, c in zip(local[ok].tolist(), here[ok].tolist(), strict=True):
-                w[tuple(row)] += c
-            weights.append(np.array([w[st] for st in found], dtype=np.float64))
+            share = []
+            for counts in (by_kind.get(mask, cover), cover):
+                w = dict.fromkeys(found, 1.0)
+                for row, c in zip(local[ok].tolist(), counts[ok].tolist(), strict=True):
+                    w[tuple(row)] += c
+                v = np.array([w[st] for st in found], dtype=np.float64)
+                share.append(v / v.sum())
+            weights.append(np.sqrt(share[0] * share[1]))
             return found, (g, ng, out)
 
         weights: list[NDArray[np.float64]] = []  # per vertex type, then per edge type
