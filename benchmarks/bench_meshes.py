@@ -21,6 +21,10 @@ grow alike. Timings are printed, never asserted.
 Usage::
 
     python benchmarks/bench_meshes.py [--parts tetra slanted] [--size 40x40x20]
+        [--pictures docs]
+
+``--pictures DIR`` also writes ``DIR/cad-PART.png``: the part as exported beside the output
+of the end-to-end command (the README's pictures).
 """
 
 from __future__ import annotations
@@ -171,12 +175,25 @@ def report(name: str, orient: int, m: dict[str, Any], ref: dict[str, Any] | None
               f" and {e['seconds'] / ref['e2e']['seconds']:.2f})")
 
 
+def picture(path: Path, out: Path, size: str, folder: Path) -> None:
+    """``folder/cad-PART.png``: the exported part beside the command's output."""
+    from csplab.cli.common import load_model
+    from csplab.experiments.table1_continuous import side_by_side
+
+    result = load_model(str(out)) if out.exists() else None
+    folder.mkdir(parents=True, exist_ok=True)
+    side_by_side([(f"example {path.name} (CAD, float coordinates)", load_model(str(path))),
+                  (f"synthesize --size {size} --seed 1", result)],
+                 folder / f"cad-{path.stem}.png")  # fmt: skip
+
+
 def main(argv: list[str] | None = None) -> int:
     from csplab.testing import cad
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--parts", nargs="*", default=sorted(cad.BUILDERS))
     ap.add_argument("--size", default="40x40x20")
+    ap.add_argument("--pictures", type=Path, help="write DIR/cad-PART.png per part")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
@@ -191,6 +208,8 @@ def main(argv: list[str] | None = None) -> int:
         for name in args.parts:
             path = cad.export(cad.build(name), work / f"{name}.stl")
             report(name, orientations(path), measure(path, args.size, work), ref)
+            if args.pictures is not None:
+                picture(path, work / f"{path.stem}-out.obj", args.size, args.pictures)
     return 0
 
 

@@ -35,8 +35,9 @@ Examples
 from __future__ import annotations
 
 from collections import defaultdict
+from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
 from csplab.errors import InputError
 from csplab.experiments.base import Experiment, Report, sweep_defaults
@@ -44,7 +45,17 @@ from csplab.experiments.stats import median_iqr
 from csplab.experiments.trial import Trial
 from csplab.grids import parse_shape
 
-__all__ = ["PAPER_TABLE1", "TARGETS", "Table1Continuous", "measure_synthesis3", "targets_met"]
+if TYPE_CHECKING:
+    from csplab.continuous.polyhedra import PolyhedralModel
+
+__all__ = [
+    "PAPER_TABLE1",
+    "TARGETS",
+    "Table1Continuous",
+    "measure_synthesis3",
+    "side_by_side",
+    "targets_met",
+]
 
 #: Merrell & Manocha 2008, Table 1: input polygons, output polygons, minutes
 PAPER_TABLE1: dict[str, tuple[int, int, float]] = {
@@ -339,7 +350,7 @@ class Table1Continuous(Experiment):
                     g = ",".join(s.csp.ground) or "none"
                     panels.append((f"{choice}, ground {g}", s.model))
             path = out / f"{self.name}_{name}.png"
-            _side_by_side(panels, path)
+            side_by_side(panels, path)
             files.append(path)
         return files
 
@@ -351,8 +362,22 @@ def _setting(row: dict[str, Any]) -> tuple[str, str]:
     return str(p.get("choice", "uniform")), str(p.get("ground", "none"))
 
 
-def _side_by_side(panels: list[tuple[str, Any]], path: Path) -> None:
-    """The models' PNG previews in one row, each captioned (``None``: not solved)."""
+def side_by_side(panels: Sequence[tuple[str, PolyhedralModel | None]], path: Path) -> None:
+    """Write the models' PNG previews in one row, each captioned.
+
+    Parameters
+    ----------
+    panels : sequence of (str, PolyhedralModel or None)
+        Caption and model, left to right; ``None`` or an empty model: a blank panel
+        captioned "(nothing)".
+    path : Path
+        The PNG to write (atomically).
+
+    Raises
+    ------
+    DependencyError
+        When the ``mesh`` extra (trimesh, for the previews) is missing.
+    """
     import tempfile
 
     from PIL import Image, ImageDraw, ImageFont
