@@ -19,6 +19,15 @@ numbers in the same order as the Python sweep and gives the same grid and counts
 the ``random`` order, ``choice="resemblance"`` and ``energy=`` keep the Python sweep. The
 wave schedule below does the same per block (one kernel call each, in the workers too).
 
+Streamed (thesis Sec. 3.3.6: a block needs its neighbourhood, not the model).
+:func:`stream_blocks` runs the same compiled sweep on a problem built window by window
+(:class:`csplab.grids.GridWindows`): the blocks of one ``x`` origin in one kernel call on
+the slab of the grid they touch, its domains and arcs those of a slab problem (a handful
+serve the whole sweep), so the same grid and counts for a seed with the output as the only
+array of the model's size; ``csplab synthesize --solver blocks`` takes it when the whole
+problem would need more than :data:`STREAM_BYTES` and the settings allow it
+(:func:`streams`).
+
 Parallel blocks (``workers >= 1``). Blocks that neither overlap nor share an arc are
 independent; :mod:`csplab.engine.waves` colours the blocks by their block index modulo 3 on
 each axis and runs the ``3 ** d`` colour classes as waves, in order, the blocks of a wave in
