@@ -35,6 +35,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -86,9 +87,9 @@ print(json.dumps({{"violations": W.violations(g), "s": time.perf_counter() - t}}
 """
 
 
-def child(argv: list[str]) -> tuple[float, float, str, int]:
-    """Run ``argv``; its wall seconds, peak RSS in GB (this child alone), stdout and exit
-    code."""
+def child(argv: list[str]) -> tuple[float, float, str, int, float]:
+    """Run ``argv``; its wall seconds, peak RSS in GB (this child alone), stdout, exit
+    code and CPU seconds (user + system: what the run costs whatever the machine's load)."""
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     t = time.perf_counter()
     with tempfile.TemporaryFile() as out:
@@ -98,13 +99,14 @@ def child(argv: list[str]) -> tuple[float, float, str, int]:
         out.seek(0)
         text = out.read().decode()
     code = os.waitstatus_to_exitcode(status)
-    return wall, usage.ru_maxrss / 2**20, text, code  # Linux: kB
+    cpu = usage.ru_utime + usage.ru_stime
+    return wall, usage.ru_maxrss / 2**20, text, code, cpu  # Linux: kB
 
 
-def python(code: str) -> tuple[float, float, dict[str, object], int]:
-    wall, gb, text, rc = child([sys.executable, "-c", code])
+def python(code: str) -> tuple[float, float, dict[str, Any], int, float]:
+    wall, gb, text, rc, cpu = child([sys.executable, "-c", code])
     lines = [ln for ln in text.splitlines() if ln.startswith("{")]
-    return wall, gb, (json.loads(lines[-1]) if lines else {}), rc
+    return wall, gb, (json.loads(lines[-1]) if lines else {}), rc, cpu
 
 
 def verdict(value: float, limit: float, unit: str) -> str:
@@ -138,9 +140,10 @@ def main() -> None:
           f"{args.seed}")  # fmt: skip
     runs = {}
     for name, code in (("whole problem", _WHOLE), ("streamed", _STREAMED)):
-        wall, gb, d, rc = python(code.format(**fill))
+        wall, gb, d, rc, cpu = python(code.format(**fill))
         runs[name] = d
-        print(f"  {name:<14} {d.get('s', math.nan):7.2f} s solve ({wall:6.2f} s wall), "
+        print(f"  {name:<14} {d.get('s', math.nan):7.2f} s solve ({wall:6.2f} s wall, "
+              f"{cpu:6.2f} s CPU), "
               f"peak {d.get('gb', math.nan):.2f} GB at the end of the solve ({gb:.2f} GB "
               f"with the whole check), {d.get('status')}, Problem.violations "
               f"{d.get('violations')} (exit {rc})")  # fmt: skip
@@ -157,19 +160,21 @@ def main() -> None:
                     "--boundary", "auto", "--solver", "blocks", "--block", str(args.block),
                     "--seed", str(args.seed), "--out", path, "--json"]  # fmt: skip
             print(f"\n{label}: csplab synthesize {' '.join(argv[4:])}")
-            wall, gb, text, rc = child(argv)
+            wall, gb, text, rc, cpu = child(argv)
             lines = [ln for ln in text.splitlines() if ln.startswith("{")]
             d = json.loads(lines[-1]) if lines else {}
             st = d.get("stats", {})
-            print(f"  {wall:.1f} s wall (solve {d.get('time_s', math.nan):.1f} s), peak "
+            solve_s = d.get("time_s", math.nan)
+            print(f"  {wall:.1f} s wall ({cpu:.1f} s CPU; solve {solve_s:.1f} s), peak "
                   f"{gb:.2f} GB, {d.get('status')}, {st.get('blocks_tried')} blocks, "
                   f"slab problems {st.get('streamed')}, final_violations "
                   f"{st.get('final_violations')} (exit {rc})")  # fmt: skip
-            if timed:
-                print(f"  time: {verdict(wall, TIME_S, 's')}")
+            if timed:  # one process on one core: its CPU time is its wall time on an idle core
+                print(f"  time, wall: {verdict(wall, TIME_S, 's')}")
+                print(f"  time, CPU (the wall time on an idle core): {verdict(cpu, TIME_S, 's')}")
             print(f"  memory: {verdict(gb, MEMORY_GB, 'GB')}")
             if rc == 0:
-                cw, cgb, c, crc = python(_CHECK.format(path=path, example=args.example,
+                cw, cgb, c, crc, _ = python(_CHECK.format(path=path, example=args.example,
                                                        shape=shape_of(size)))  # fmt: skip
                 print(f"  separate check of the .npy (memory map, slabs): violations "
                       f"{c.get('violations')} in {cw:.1f} s, peak {cgb:.2f} GB (exit {crc})")
