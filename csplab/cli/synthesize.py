@@ -7,6 +7,11 @@ gives up after its ``--restarts`` is followed by an exact one (``--fallback``), 
 default run ends solved, or 'unsat' with the exact solver's proof, or 'not solved' when the
 time ran out.
 
+``--solver blocks`` on an example whose whole problem would need more than
+:data:`csplab.solvers.blocks.STREAM_BYTES` streams the thesis' sweep slab by slab
+(:func:`csplab.solvers.blocks.stream_blocks`, the same output for a seed): the settings line
+says ``streamed=yes``.
+
 Exit codes: 0 solved, 1 not solved or unsat (the message and ``--json`` say which), 2 bad
 input.
 """
