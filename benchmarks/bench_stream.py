@@ -167,7 +167,7 @@ def main() -> None:
             solve_s = d.get("time_s", math.nan)
             print(f"  {wall:.1f} s wall ({cpu:.1f} s CPU; solve {solve_s:.1f} s), peak "
                   f"{gb:.2f} GB, {d.get('status')}, {st.get('blocks_tried')} blocks, "
-                  f"slab problems {st.get('streamed')}, final_violations "
+                  f"slab problems {st.get('slab_problems')}, final_violations "
                   f"{st.get('final_violations')} (exit {rc})")  # fmt: skip
             if timed:  # one process on one core: its CPU time is its wall time on an idle core
                 print(f"  time, wall: {verdict(wall, TIME_S, 's')}")

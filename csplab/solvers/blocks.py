@@ -473,7 +473,7 @@ def stream_blocks(
         ``failed`` only if the final check found a violation (never expected).
     grid : int32 array of the output's shape
     stats : dict
-        As :func:`run_blocks`'s, with ``streamed`` (the slab problems built).
+        As :func:`run_blocks`'s, with ``slab_problems`` (the slab problems built).
 
     Raises
     ------
@@ -543,7 +543,7 @@ def stream_blocks(
         "order": order,
         "choice": choice,
         "workers": 0,
-        "streamed": len(windows.built),
+        "slab_problems": len(windows.built),
     }
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
