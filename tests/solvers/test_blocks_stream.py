@@ -97,3 +97,15 @@ def test_cli_streams_a_large_blocks_run_with_the_same_bytes(kernels, monkeypatch
     assert "streamed" not in a["settings"] and "streamed" in b["settings"]
     assert a["status"] == b["status"] == "solved" and np.array_equal(ga, gb)
     assert a["stats"]["revisions"] == b["stats"]["revisions"]
+
+
+def test_cli_refuses_a_streamed_run_over_the_memory_limit(kernels, monkeypatch, capsys):
+    from csplab.cli import main
+    from csplab.solvers import blocks
+
+    monkeypatch.setattr(blocks, "STREAM_BYTES", 0)
+    monkeypatch.setattr(blocks, "stream_blocks", None)  # refused before the work
+    code = main(["synthesize", "castle", "--size", "400x400x10", "--boundary", "auto",
+                 "--solver", "blocks", "--memory-limit", "0.5"])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "streamed" in err and "would need about" in err, err
