@@ -1571,7 +1571,9 @@ def block_alg31(
     the block's subproblem, with the same draws from ``rng`` (per attempt one uniform per
     cell, then, for ``use_heap``, one tie-breaking number per cell), the same queue and the
     same result. On success ``lgrid`` holds the labels and ``True`` is returned.
-    ``counters[2] += retries``, ``counters[3] += queue pops``.
+    ``counters[2] += retries``, ``counters[3] += queue pops``. The block's arc-consistent
+    catalog, which no draw enters, is computed once and restored for each retry (its pops
+    counted per attempt, as a fresh propagation would).
     """
     nb = dom0.shape[0]
     W = dom0.shape[1]
@@ -1593,28 +1595,43 @@ def block_alg31(
     start = np.arange(nb, dtype=np.int64)
     tcell = np.empty(nb, dtype=np.int64)
     tlab = np.empty(nb, dtype=np.int64)
+    # the block's arc-consistent catalog is the same for every attempt (no draw enters it):
+    # computed once, restored per attempt with its pops counted each time
+    ok = True
+    for i in range(nb):
+        some = False
+        for w in range(W):
+            dom[i, w] = dom0[i, w]
+            prev[i, w] = 0
+            if dom0[i, w]:
+                some = True
+        if not some:
+            ok = False
+    stats[0] = 0
+    stats[1] = 0
+    wiped = 0
+    if ok:
+        wiped = _propagate(
+            dom, prev, full, local.ptr, local.nbr, local.sidx, sup, supall, queue, inq,
+            start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, wclass, False, zf, zf,
+            local.nib, zi, np.zeros(0, dtype=np.bool_),
+        )  # fmt: skip
+    dom_ac = dom.copy()
+    prev_ac = prev.copy()
+    pops0 = stats[0]
+    removed0 = stats[1]
     for attempt in range(retries + 1):
         us = rng.random(nb)
         noise = rng.random(nb) if use_heap else zf
-        ok = True
-        for i in range(nb):
-            some = False
-            for w in range(W):
-                dom[i, w] = dom0[i, w]
-                prev[i, w] = 0
-                if dom0[i, w]:
-                    some = True
-            if not some:
-                ok = False
-        stats[0] = 0
-        stats[1] = 0
+        stats[0] = pops0
+        stats[1] = removed0
         code = _FAILED
         if ok:
-            wiped = _propagate(
-                dom, prev, full, local.ptr, local.nbr, local.sidx, sup, supall, queue, inq,
-                start, nb, stats, zi, zi, zf, 0, zf, weights, wlogw, wclass, False, zf, zf,
-                local.nib, zi, np.zeros(0, dtype=np.bool_),
-            )  # fmt: skip
+            if attempt > 0:
+                for i in range(nb):
+                    for w in range(W):
+                        dom[i, w] = dom_ac[i, w]
+                        prev[i, w] = prev_ac[i, w]
             if wiped < 0:
                 if use_heap:
                     hheap = np.arange(nb, dtype=np.int64)

@@ -26,7 +26,7 @@ from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from csplab.errors import InputError
 from csplab.limits import check_memory
@@ -36,6 +36,8 @@ if TYPE_CHECKING:
     from csplab.example import ExampleModel
 
 __all__ = [
+    "GridWindows",
+    "arc_reach",
     "auto_boundary",
     "build_unary",
     "from_example",
@@ -604,3 +606,205 @@ def auto_boundary(example: ExampleModel, ndim: int | None = None) -> dict[str, i
         del result[bottom]
         result[bottom] = ground
     return result
+
+
+def arc_reach(problem: Problem, axes: Sequence[int] | None = None) -> int:
+    """The largest offset, along ``axes`` (default: every axis), between the two cells of
+    an arc of a grid problem (at least 1).
+
+    Examples
+    --------
+    >>> from csplab.example import ExampleModel
+    >>> arc_reach(from_example(ExampleModel([[0, 1], [1, 0]]), (4, 3)))
+    1
+    """
+    if not len(problem.arcs):
+        return 1
+    ax = list(range(problem.ndim)) if axes is None else list(axes)
+    c = np.stack(np.unravel_index(problem.arcs[:, :2].reshape(-1), problem.shape), axis=1)
+    c = c.reshape(len(problem.arcs), 2, problem.ndim)[:, :, ax]
+    return max(1, int(np.abs(c[:, 0] - c[:, 1]).max()))
+
+
+#: cells of one window of :meth:`GridWindows.violations` (its slabs along ``x``)
+CHECK_CELLS = 1 << 19
+
+
+class GridWindows:
+    """A grid problem too large to build, built window by window (thesis Sec. 3.3.6).
+
+    The problem of ``example`` at ``shape`` (square grid, no periodic axis) restricted to a
+    box of cells is the model's problem on the box's shape with the faces of the whole
+    that the box touches: its domains (the boundary labels of those faces, the labels in
+    use) and arcs (one relation per axis between neighbours) are those of the whole
+    problem, renumbered. :meth:`window` builds it (:func:`from_example`) and keeps one
+    per box shape and touched faces, so a sweep over a large output builds a handful;
+    nothing of the size of the whole model is held. ``boundary="auto"`` is decided once,
+    on the whole size (its small probe), as :func:`from_example` does.
+
+    Parameters
+    ----------
+    example : ExampleModel
+        The example model.
+    shape : sequence of int or str
+        The size of the whole output.
+    boundary : mapping ``{face: label}``, ``"auto"``, ``"none"`` or None
+        As :func:`from_example`'s.
+
+    Raises
+    ------
+    InputError
+        When the shape does not fit the example, the example is not on a square grid or
+        the boundary is not understood.
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> W = GridWindows(load_example("fig3_4a"), (30, 20), boundary="auto")
+    >>> P = W.window((10, 0), (16, 20))
+    >>> whole = from_example(load_example("fig3_4a"), (30, 20), boundary="auto")
+    >>> bool((P.domains == whole.domains.reshape(30, 20, -1)[10:16].reshape(-1, P.K)).all())
+    True
+    """
+
+    def __init__(
+        self,
+        example: ExampleModel,
+        shape: Sequence[int] | str,
+        *,
+        boundary: Mapping[str, int] | Literal["auto", "none"] | None = None,
+    ) -> None:
+        from csplab.topology import Topology
+
+        shp = parse_shape(shape) if isinstance(shape, str) else tuple(int(s) for s in shape)
+        self.shape = _match_ndim(shp, example.shape)
+        if not Topology.parse(example.meta.get("topology")).square:
+            raise InputError(f"{example.name or 'the example'} is not on a square grid: "
+                             "its problem cannot be built in windows")  # fmt: skip
+        self.example = example
+        self.rule: str | None = None
+        if boundary == "auto":
+            faces, self.rule = _auto_or_merrell(example, self.shape, False)
+        elif boundary in (None, "none"):
+            faces = {}
+        elif isinstance(boundary, Mapping):
+            faces = {str(f): int(b) for f, b in boundary.items()}
+        else:
+            raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
+        #: the faces of the whole output and their labels
+        self.boundary: dict[str, int] = faces
+        #: the window problems built so far, by shape and faces touched
+        self.built: dict[tuple[Any, ...], Problem] = {}
+        small = self.miniature()
+        self.K = small.K
+        #: the arcs' reach (a window's ring of fixed cells is this wide)
+        self.reach = arc_reach(small)
+
+    @property
+    def n(self) -> int:
+        """The cells of the whole output."""
+        return math.prod(self.shape)
+
+    @property
+    def ndim(self) -> int:
+        """Its axes."""
+        return len(self.shape)
+
+    def _build(self, shape: tuple[int, ...], faces: dict[str, int]) -> Problem:
+        key = (shape, tuple(sorted(faces.items())))
+        P = self.built.get(key)
+        if P is None:
+            P = from_example(self.example, shape, boundary=faces or "none")
+            if self.rule is not None:
+                P.meta["boundary_rule"] = self.rule
+            self.built[key] = P
+        return P
+
+    def window(self, lo: Sequence[int], hi: Sequence[int]) -> Problem:
+        """The whole problem restricted to the cells ``lo <= (x, y, ...) < hi``.
+
+        Parameters
+        ----------
+        lo, hi : sequence of int
+            The box's corners, one per axis (``hi`` excluded).
+
+        Returns
+        -------
+        Problem
+            The box's problem (cell ``(x, y, ...)`` of the whole is its cell ``(x, y, ...)
+            - lo``); the same object for every box of the same shape touching the same
+            faces.
+
+        Raises
+        ------
+        InputError
+            When the box is empty or leaves the output.
+        """
+        lo_, hi_ = tuple(int(v) for v in lo), tuple(int(v) for v in hi)
+        if len(lo_) != self.ndim or len(hi_) != self.ndim or any(
+            not 0 <= a < b <= s for a, b, s in zip(lo_, hi_, self.shape, strict=True)
+        ):
+            raise InputError(f"window {lo_}..{hi_} is not a box of the output {self.shape}")
+        faces = {}
+        for f, b in self.boundary.items():
+            d = AXIS_NAMES.index(f[0])
+            if (f[1] == "-" and lo_[d] == 0) or (f[1] == "+" and hi_[d] == self.shape[d]):
+                faces[f] = b
+        return self._build(tuple(b - a for a, b in zip(lo_, hi_, strict=True)), faces)
+
+    def miniature(self, keep: int | None = None) -> Problem:
+        """The model with every face of the whole but at most ``2 * reach + 1`` cells per
+        axis (all of axis ``keep``): every kind of cell of the whole (which faces it is
+        on), every relation between neighbours and, along ``keep``, every layer.
+
+        Parameters
+        ----------
+        keep : int, optional
+            An axis kept at its full length.
+
+        Returns
+        -------
+        Problem
+            The small problem.
+        """
+        side = 2 * getattr(self, "reach", 1) + 1
+        shp = tuple(s if a == keep else min(s, side) for a, s in enumerate(self.shape))
+        return self._build(shp, dict(self.boundary))
+
+    def violations(self, grid: NDArray[np.integer[Any]], *, cells: int = CHECK_CELLS) -> int:
+        """The number of violations of ``grid`` (the whole output's labels, e.g. a memory
+        map) counted by :meth:`Problem.violations` of windows: slabs of the output along
+        ``x`` of about ``cells`` cells, each widened by the reach so that every arc lies
+        inside one; an arc is counted in the slab of its lower ``x`` end, a cell in its own.
+
+        Parameters
+        ----------
+        grid : int array of the output's shape
+            The labels.
+        cells : int
+            About the cells per window.
+
+        Returns
+        -------
+        int
+            Violated arcs plus cells whose label is not in their domain (0 for a solution).
+
+        Raises
+        ------
+        InputError
+            When ``grid`` does not have the output's shape.
+        """
+        if tuple(grid.shape) != self.shape:
+            raise InputError(f"grid has shape {grid.shape}, the output {self.shape}")
+        nx, rest = self.shape[0], math.prod(self.shape[1:])
+        width = max(1, min(nx, cells // max(1, rest)))
+        total = 0
+        for a in range(0, nx, width):
+            own = min(nx, a + width)
+            hi = min(nx, own + self.reach)
+            P = self.window((a, *(0,) * (self.ndim - 1)), (hi, *self.shape[1:]))
+            v = P.violations(np.asarray(grid[a:hi]))
+            ends = P.arcs[v.arcs, :2]
+            low = np.minimum(ends[:, 0], ends[:, 1]) // rest  # the arc's lower x, local
+            total += int((low < own - a).sum()) + int((v.cells // rest < own - a).sum())
+        return total

@@ -124,7 +124,7 @@ from csplab.engine import waves as wv
 from csplab.engine.alg31 import scan_order
 from csplab.errors import InputError, NoTrivialSolutionError
 from csplab.example import ExampleModel
-from csplab.grids import from_example
+from csplab.grids import arc_reach, from_example
 from csplab.problem import Problem
 from csplab.solvers.blocks import ExactCompletion, trivial_solution
 
@@ -473,7 +473,7 @@ class World:
         self.dropped: list[str] = []  # the model's global constraints (cannot hold)
         # the template: a block with its ring; the arcs' reach from it
         probe = self.problem(tuple(max(4, 2 * b) for b in self.block))
-        self.reach = _reach(probe)
+        self.reach = arc_reach(probe, axes=(0, 1))  # along x and y: z is the chunk's own
         if self.reach >= min(self.block):
             raise InputError(
                 f"the model's arcs reach {self.reach} cells, as far as the blocks "
@@ -1201,12 +1201,3 @@ def _name_of(f: Callable[..., Any] | None) -> str | None:
         return None
     return f"{getattr(f, '__module__', '')}.{getattr(f, '__qualname__', type(f).__name__)}"
 
-
-def _reach(P: Problem) -> int:
-    """The largest ``x``/``y`` offset of an arc of a non-periodic problem."""
-    if not len(P.arcs):
-        return 1
-    c = np.stack(np.unravel_index(P.arcs[:, :2].reshape(-1), P.shape), axis=1).reshape(
-        len(P.arcs), 2, P.ndim
-    )
-    return max(1, int(np.abs(c[:, 0, :2] - c[:, 1, :2]).max()))

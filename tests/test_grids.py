@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from csplab.errors import InputError
 from csplab.example import ExampleModel
 from csplab.examples import load_example
 from csplab.grids import auto_boundary, from_example, merrell_boundary
@@ -110,3 +111,62 @@ def test_auto_never_makes_the_problem_unsat() -> None:
     P1 = from_example(E, (3, 3, 1), boundary="auto")
     assert P1.meta["boundary_rule"].startswith("auto: ground z-=1")
     assert solve(P1, "backtrack", rng=0).status == "solved"
+
+
+# ----------------------------------------------------------------------------- GridWindows
+@pytest.mark.parametrize(
+    "name,shape,boundary",
+    [
+        ("castle", (9, 7, 6), "auto"),
+        ("fig3_4a", (11, 5), {"x-": 0, "y+": 1}),
+        ("line", (8, 6), None),
+    ],
+)
+def test_a_window_is_the_whole_problem_restricted(name, shape, boundary):
+    """Every box's domains and arcs are the whole problem's, renumbered."""
+    from csplab.grids import GridWindows
+
+    E = load_example(name)
+    P = from_example(E, shape, boundary=boundary)
+    W = GridWindows(E, shape, boundary=boundary)
+    assert (W.K, W.reach, W.n) == (P.K, 1, P.n)
+    idx = np.arange(P.n).reshape(P.shape)
+    rng = np.random.default_rng(0)
+    for _ in range(12):
+        lo = [int(rng.integers(0, s)) for s in shape]
+        hi = [int(rng.integers(a + 1, s + 1)) for a, s in zip(lo, shape, strict=True)]
+        Q = W.window(lo, hi)
+        cells = idx[tuple(slice(a, b) for a, b in zip(lo, hi, strict=True))].reshape(-1)
+        assert np.array_equal(Q.domains, P.domains[cells])
+        inside = np.zeros(P.n, dtype=np.int64) - 1
+        inside[cells] = np.arange(cells.size)
+        keep = (inside[P.arcs[:, 0]] >= 0) & (inside[P.arcs[:, 1]] >= 0)
+        mine = {(int(inside[s]), int(inside[d]), int(r)) for s, d, r in P.arcs[keep]}
+        assert mine == {tuple(map(int, a)) for a in Q.arcs}
+        assert W.window(lo, hi) is Q  # built once per shape and faces
+    with pytest.raises(InputError, match="not a box"):
+        W.window((0,) * len(shape), [s + 1 for s in shape])
+
+
+def test_windowed_check_counts_what_the_whole_check_counts():
+    """Planted defects: violated arcs across slab seams, out-of-domain face cells, an
+    unassigned cell; the slab check (small slabs) counts each once."""
+    from csplab.grids import GridWindows
+
+    E = load_example("castle")
+    shape = (13, 6, 5)
+    P = from_example(E, shape, boundary="auto")
+    W = GridWindows(E, shape, boundary="auto")
+    g = solve(P, "blocks", rng=2, block=5).grid.copy()
+    assert W.violations(g, cells=30) == 0
+    rng = np.random.default_rng(3)
+    for k in range(1, 6):
+        x, y, z = (int(rng.integers(0, s)) for s in shape)
+        g[x, y, z] = int(rng.integers(-1, P.K))
+        g[k, 0, 0] = (g[k, 0, 0] + 1) % P.K  # a face cell, often on a seam
+        want = len(P.violations(g))
+        for cells in (1, 30, 60, 10**6):
+            assert W.violations(g, cells=cells) == want
+    assert want > 0
+    with pytest.raises(InputError, match="shape"):
+        W.violations(g[:3])

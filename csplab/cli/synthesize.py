@@ -7,6 +7,11 @@ gives up after its ``--restarts`` is followed by an exact one (``--fallback``), 
 default run ends solved, or 'unsat' with the exact solver's proof, or 'not solved' when the
 time ran out.
 
+``--solver blocks`` on an example whose whole problem would need more than
+:data:`csplab.solvers.blocks.STREAM_BYTES` streams the thesis' sweep slab by slab
+(:func:`csplab.solvers.blocks.stream_blocks`, the same output for a seed): the settings line
+says ``streamed=yes``.
+
 Exit codes: 0 solved, 1 not solved or unsat (the message and ``--json`` say which), 2 bad
 input.
 """
@@ -35,7 +40,8 @@ from csplab.cli.common import (
     problem_from_args,
 )
 from csplab.errors import InputError
-from csplab.grids import parse_shape
+from csplab.grids import GridWindows, parse_shape
+from csplab.problem import Problem
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -229,6 +235,54 @@ def _check_grid_memory(args: argparse.Namespace, example: Any) -> None:
     )
 
 
+def _windows(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> GridWindows | None:
+    """The problem built window by window (:class:`csplab.grids.GridWindows`) when
+    ``--solver blocks`` on an example at ``--size`` would hold a whole problem over
+    :data:`csplab.solvers.blocks.STREAM_BYTES` and the sweep can be streamed
+    (:func:`csplab.solvers.blocks.streams`: the same grid either way); else ``None``."""
+    import math
+
+    from csplab.example import ExampleModel
+    from csplab.problem import memory_estimate
+    from csplab.solvers.blocks import STREAM_BYTES, BlocksSolver, streams
+
+    if (args.solver != "blocks" or not isinstance(example, ExampleModel) or not args.size
+            or args.periodic or getattr(args, "constraints", None)
+            or getattr(args, "topology", None)):  # fmt: skip
+        return None
+    shape = parse_shape(args.size, what="--size")
+    n = math.prod(shape)
+    if memory_estimate(n, example.K, len(shape) * n) <= STREAM_BYTES:
+        return None
+    from csplab.grids import parse_boundary
+
+    try:
+        windows = GridWindows(example, shape, boundary=parse_boundary(args.boundary) or "none")
+    except InputError:
+        return None  # not a square grid, a size that does not fit: the whole path says why
+    filled = dict(opts)
+    _settings(args, example, filled)  # the order and choice the model's format suits
+    if streams(windows, **BlocksSolver.validate(filled)) is not None:
+        return None
+    return windows
+
+
+def _check_stream_memory(args: argparse.Namespace, windows: GridWindows) -> None:
+    """Refuse a streamed run whose output (int32 cells) and the rest (interpreter, kernels,
+    slab problems, the check's and the file's slabs: 0.65-0.72 GB measured at 10^7 and
+    10^8 cells of castle) are over ``--memory-limit``."""
+    from csplab.limits import check_memory, memory_budget
+
+    need = 4 * windows.n + (768 << 20)
+    check_memory(
+        need,
+        f"{windows.example.name or args.model} --size {'x'.join(map(str, windows.shape))} "
+        f"(K={windows.K}) streamed",
+        "use a smaller --size",
+        budget=memory_budget(args.memory_limit),
+    )
+
+
 def run(args: argparse.Namespace) -> int:
     from csplab.io import write_labels
     from csplab.io.registry import output_format
@@ -245,9 +299,13 @@ def run(args: argparse.Namespace) -> int:
         return _continuous.synthesize(args, example, _options(args))
     if args.spacing is not None or args.snap or args.lines != "auto":
         raise InputError("--spacing, --snap and --lines apply to continuous (polygon) models only")
-    _check_grid_memory(args, example)
-    problem = problem_from_args(args, example)
     opts = _options(args)
+    windows = _windows(args, example, opts)
+    if windows is None:
+        _check_grid_memory(args, example)
+        problem: Problem | None = problem_from_args(args, example)
+    else:
+        problem = None
     settings = _settings(args, example, opts)
     if args.out:  # an input, a folder, an unwritable place: refused before the work
         check_output_path(args.out, "--out", inputs=input_files(args))
@@ -261,15 +319,30 @@ def run(args: argparse.Namespace) -> int:
     compiling = _jit.compile_seconds()
     free_at_exit()  # the command ends after this solve: the OS frees a large SAT solver
     try:
-        result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
-                       fallback=fallback, **opts)  # fmt: skip
+        if problem is not None:
+            result = solve(problem, args.solver, rng=args.seed, restarts=settings["restarts"],
+                           fallback=fallback, **opts)  # fmt: skip
+        else:  # the same sweep and grid, the problem built slab by slab
+            assert windows is not None
+            _check_stream_memory(args, windows)
+            settings["streamed"] = "yes (the problem built slab by slab)"
+            from csplab.rng import make_rng
+            from csplab.solvers.blocks import BlocksSolver
+
+            gen, seed = make_rng(args.seed)
+            result = BlocksSolver().stream(windows, rng=gen, seed=seed, **opts)
     finally:
         free_at_exit(False)
+    if problem is not None:
+        shape, K, meta = problem.shape, problem.K, problem.meta
+    else:
+        assert windows is not None
+        shape, K, meta = windows.shape, windows.K, windows.miniature().meta
     compiling = _jit.compile_seconds() - compiling  # numba's one-time cost, not the solve's
     wrote = None
     if out_format is not None and (result.ok or args.out_partial):
-        per = problem.meta.get("periodic", False)
-        topo = problem.meta.get("topology")
+        per = meta.get("periodic", False)
+        topo = meta.get("topology")
         write_labels(
             result.grid, args.out, name=example.name, model=example, periodic=bool(all(per)),
             meta={"topology": topo} if topo else None,
@@ -285,24 +358,25 @@ def run(args: argparse.Namespace) -> int:
         d["proof"] = result.stats.get("proof") if result.status == "unsat" else None
         print(json.dumps(d))
     else:
-        size = "x".join(map(str, problem.shape))
+        size = "x".join(map(str, shape))
         took = f"{max(0.0, result.time_s - compiling):.3f} s"
         if compiling >= 0.05:
             took += f" (+ {compiling:.1f} s compiling csplab's kernels, once)"
         msg = (
-            f"{outcome(result.status)}: {example.name or args.model} {size} (K={problem.K}) "
+            f"{outcome(result.status)}: {example.name or args.model} {size} (K={K}) "
             f"with {result.solver} in {took}, seed {result.seed}"
         )
         print(msg)
         print("  settings: " + ", ".join(f"{k}={v}" for k, v in settings.items()))
         for line in explain(result):
             print(line)
-        if problem.meta.get("boundary_rule"):
-            print(f"  boundary {problem.meta['boundary_rule']}")
+        if meta.get("boundary_rule"):
+            print(f"  boundary {meta['boundary_rule']}")
         keys = [k for k in result.stats if k not in ("order", "choice", *EXPLAINED_STATS)]
         if keys:
             print("  " + ", ".join(f"{k}={result.stats[k]}" for k in keys))
-        if result.status == "failed" and problem.constraints and fallback is None:
+        if (result.status == "failed" and problem is not None and problem.constraints
+                and fallback is None):  # fmt: skip
             from csplab.solvers import solver_class
 
             if solver_class(result.solver.partition(":")[0]).constraints != "exact":

@@ -22,7 +22,7 @@ import re
 import stat
 import tempfile
 import warnings
-from collections.abc import Container, Iterator, Mapping, Sequence
+from collections.abc import Container, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -147,7 +147,7 @@ def read_text(path: str | Path) -> str:
 
 
 # ---------------------------------------------------------------------------- writing
-def write_atomic(path: str | Path, data: bytes | str) -> None:
+def write_atomic(path: str | Path, data: bytes | str | Iterable[bytes]) -> None:
     """Write a file atomically: a temporary file beside ``path``, renamed over it.
 
     A reader never sees half a file, and a failed write leaves the old one as it was (the
@@ -157,8 +157,9 @@ def write_atomic(path: str | Path, data: bytes | str) -> None:
     ----------
     path : str or Path
         The file to write.
-    data : bytes or str
-        Its contents (text is written as UTF-8).
+    data : bytes, str or iterable of bytes
+        Its contents (text is written as UTF-8; an iterable, piece by piece: a large
+        file is never held whole).
 
     Raises
     ------
@@ -182,7 +183,8 @@ def write_atomic(path: str | Path, data: bytes | str) -> None:
         raise InputError(f"{path}: cannot write: {e.strerror}") from None
     try:
         with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+            for piece in [data] if isinstance(data, bytes) else data:
+                fh.write(piece)
             fh.flush()
             os.fsync(fh.fileno())
         mask = os.umask(0)

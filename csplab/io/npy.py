@@ -14,6 +14,9 @@ Examples
 
 from __future__ import annotations
 
+import itertools
+import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -77,7 +80,8 @@ def read_npy(path: str | Path) -> ExampleModel:
 def write_output(out: Output, path: Path) -> None:
     """The grid as an int32 array (int64 when the file's label ids need it).
 
-    Unassigned cells are written as ``-1``.
+    Unassigned cells are written as ``-1``. The file is written in slabs along the first
+    axis (about :data:`SLAB_CELLS` cells each): no copy of a large grid is held.
 
     Parameters
     ----------
@@ -89,9 +93,29 @@ def write_output(out: Output, path: Path) -> None:
 
     import io
 
+    from csplab.example import file_labels
     from csplab.io.common import write_atomic
 
-    g = out.file_grid()
-    buf = io.BytesIO()
-    np.save(buf, g.astype(np.int32) if g.size == 0 or g.max() <= 2**31 - 1 else g)
-    write_atomic(path, buf.getvalue())
+    g = out.grid
+    rows = max(1, SLAB_CELLS // max(1, math.prod(g.shape[1:]))) if g.ndim else 1
+
+    def slabs() -> Iterator[NDArray[np.int64]]:
+        if g.ndim == 0 or not g.shape[0]:
+            yield file_labels(g, out.meta)
+            return
+        for i in range(0, g.shape[0], rows):
+            yield file_labels(g[i : i + rows], out.meta)
+
+    big = any(s.size and s.max() > 2**31 - 1 for s in slabs())
+    dtype = np.dtype(np.int64 if big else np.int32)
+    head = io.BytesIO()
+    np.lib.format.write_array_header_1_0(
+        head, {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False,
+               "shape": g.shape},
+    )  # fmt: skip
+    write_atomic(path, itertools.chain([head.getvalue()],
+                                       (s.astype(dtype).tobytes() for s in slabs())))  # fmt: skip
+
+
+#: cells per slab written by :func:`write_output`
+SLAB_CELLS = 1 << 22

@@ -235,6 +235,7 @@ STATS: dict[str, str] = {
     "cooling": "factor applied to the temperature after each sweep",
     "window": "resemblance window half-width (2007 paper Eq. 2)",
     "blocks_tried": "blocks attempted (Alg. 3.4)",
+    "slab_problems": "slab problems the streamed sweep built (blocks.stream_blocks)",
     "blocks_accepted": "blocks whose new labels were kept (Alg. 3.4)",
     "acceptance_rate": "blocks_accepted / blocks_tried",
     "retries": "extra Alg. 3.1 runs after a failure",

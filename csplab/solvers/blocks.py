@@ -19,6 +19,15 @@ numbers in the same order as the Python sweep and gives the same grid and counts
 the ``random`` order, ``choice="resemblance"`` and ``energy=`` keep the Python sweep. The
 wave schedule below does the same per block (one kernel call each, in the workers too).
 
+Streamed (thesis Sec. 3.3.6: a block needs its neighbourhood, not the model).
+:func:`stream_blocks` runs the same compiled sweep on a problem built window by window
+(:class:`csplab.grids.GridWindows`): the blocks of one ``x`` origin in one kernel call on
+the slab of the grid they touch, its domains and arcs those of a slab problem (a handful
+serve the whole sweep), so the same grid and counts for a seed with the output as the only
+array of the model's size; ``csplab synthesize --solver blocks`` takes it when the whole
+problem would need more than :data:`STREAM_BYTES` and the settings allow it
+(:func:`streams`).
+
 Parallel blocks (``workers >= 1``). Blocks that neither overlap nor share an arc are
 independent; :mod:`csplab.engine.waves` colours the blocks by their block index modulo 3 on
 each axis and runs the ``3 ** d`` colour classes as waves, in order, the blocks of a wave in
@@ -63,7 +72,8 @@ from csplab import _interp
 from csplab.catalog import block_arrays, neighbourhood, sweep_blocks
 from csplab.engine import waves as wv
 from csplab.engine.alg31 import run_alg31, scan_order
-from csplab.errors import InputError, NoTrivialSolutionError
+from csplab.errors import CsplabError, InputError, NoTrivialSolutionError
+from csplab.grids import GridWindows
 from csplab.problem import Problem
 from csplab.progress import progress_bar
 from csplab.result import Result, Status
@@ -78,7 +88,14 @@ from csplab.solvers.base import (
     order_option,
 )
 
-__all__ = ["BlocksSolver", "ExactCompletion", "block_starts", "trivial_solution"]
+__all__ = [
+    "BlocksSolver",
+    "ExactCompletion",
+    "block_starts",
+    "stream_blocks",
+    "streams",
+    "trivial_solution",
+]
 
 
 def block_starts(n: int, m: int) -> list[int]:
@@ -121,24 +138,57 @@ def trivial_solution(problem: Problem, attempts: int = 5) -> NDArray[np.int32]:
     >>> trivial_solution(P).tolist()
     [[1, 0, 0], [1, 0, 0], [1, 0, 0]]
     """
-    K, n = problem.K, problem.n
-    rel, arcs = problem.relations, problem.arcs
-    w = np.asarray(problem.weights, dtype=np.float64)
+    plan = _trivial_plan(lambda axis: problem)
+    if plan is not None:
+        g = np.empty(problem.shape, dtype=np.int32)
+        _paint(plan, g)
+        return g
+    # 3. a few runs of Alg. 3.1 on a private generator
+    for seed in range(attempts):
+        r = run_alg31(problem, np.random.default_rng(seed))
+        if r.status == "solved" and problem.is_solution(r.grid):
+            return np.asarray(r.grid, dtype=np.int32)
+        if r.status == "unsat":
+            raise NoTrivialSolutionError(
+                "modify-in-blocks needs a consistent starting model, but the problem is "
+                "unsatisfiable (arc consistency empties a domain before any choice)"
+            )
+    raise NoTrivialSolutionError(
+        "modify-in-blocks needs a consistent starting model and none was found: no label "
+        f"tiles every axis within the domains, no stack of uniform layers (e.g. ground under "
+        f"empty space) fits, and Alg. 3.1 failed {attempts} times; pass init=<a consistent "
+        "grid> or use another solver"
+    )
+
+
+#: a trivial solution that is a function of one coordinate: ``(axis, labels)``, the label
+#: of every cell ``labels[its coordinate on axis]`` (one label everywhere: ``(-1, [label])``)
+_TrivialPlan = tuple[int, NDArray[np.int32]]
+
+
+def _trivial_plan(problem_for: Callable[[int | None], Problem]) -> _TrivialPlan | None:
+    """Steps 1 and 2 of :func:`trivial_solution`: one label everywhere, else uniform layers
+    along an axis, each tried on ``problem_for(None)`` / ``problem_for(axis)`` (the whole
+    problem, or a miniature with every kind of cell and, along ``axis``, every layer:
+    :meth:`csplab.grids.GridWindows.miniature`; the checks are translation invariant)."""
+    P = problem_for(None)
+    K = P.K
+    w = np.asarray(P.weights, dtype=np.float64)
     pref = np.argsort(-w, kind="stable")
     # 1. a single label everywhere
-    allowed_everywhere = np.asarray(problem.domains.all(axis=0), dtype=bool)
-    used_rel = np.unique(arcs[:, 2]) if arcs.size else np.zeros(0, dtype=np.int64)
+    allowed_everywhere = np.asarray(P.domains.all(axis=0), dtype=bool)
+    used_rel = np.unique(P.arcs[:, 2]) if P.arcs.size else np.zeros(0, dtype=np.int64)
     for a in pref:
-        if allowed_everywhere[a] and all(rel[r, a, a] for r in used_rel):
-            g = np.full(problem.shape, a, dtype=np.int32)
-            if problem.is_solution(g):
-                return g
+        if allowed_everywhere[a] and all(P.relations[r, a, a] for r in used_rel):
+            if P.is_solution(np.full(P.shape, a, dtype=np.int32)):
+                return -1, np.full(1, a, dtype=np.int32)
     # 2. uniform layers along one axis (last axis first)
-    coords = np.indices(problem.shape).reshape(problem.ndim, n)
     score = np.log(np.maximum(w, 1e-12))
-    for axis in reversed(range(problem.ndim)):
+    for axis in reversed(range(P.ndim)):
+        problem = problem_for(axis)
+        rel, arcs = problem.relations, problem.arcs
+        layer = np.indices(problem.shape)[axis].reshape(-1)
         L = problem.shape[axis]
-        layer = coords[axis]
         ls, ld = layer[arcs[:, 0]], layer[arcs[:, 1]]
         ok_label = np.ones((L, K), dtype=bool)
         for i in range(L):
@@ -166,25 +216,23 @@ def trivial_solution(problem: Problem, attempts: int = 5) -> NDArray[np.int32]:
         labels[-1] = int(best.argmax())
         for i in range(L - 1, 0, -1):
             labels[i - 1] = back[i, labels[i]]
-        lg: NDArray[np.int32] = labels[layer].astype(np.int32).reshape(problem.shape)
-        if problem.is_solution(lg):
-            return lg
-    # 3. a few runs of Alg. 3.1 on a private generator
-    for seed in range(attempts):
-        r = run_alg31(problem, np.random.default_rng(seed))
-        if r.status == "solved" and problem.is_solution(r.grid):
-            return np.asarray(r.grid, dtype=np.int32)
-        if r.status == "unsat":
-            raise NoTrivialSolutionError(
-                "modify-in-blocks needs a consistent starting model, but the problem is "
-                "unsatisfiable (arc consistency empties a domain before any choice)"
-            )
-    raise NoTrivialSolutionError(
-        "modify-in-blocks needs a consistent starting model and none was found: no label "
-        f"tiles every axis within the domains, no stack of uniform layers (e.g. ground under "
-        f"empty space) fits, and Alg. 3.1 failed {attempts} times; pass init=<a consistent "
-        "grid> or use another solver"
-    )
+        if problem.is_solution(labels[layer].astype(np.int32).reshape(problem.shape)):
+            return axis, labels
+    return None
+
+
+def _paint(plan: _TrivialPlan, out: NDArray[np.int32], start: int = 0) -> None:
+    """Write a trivial solution into ``out`` (the whole grid, or the slab of it from
+    ``x = start`` on), without a temporary of its size."""
+    axis, labels = plan
+    if axis < 0:
+        out[...] = labels[0]
+        return
+    if axis == 0:
+        labels = labels[start : start + out.shape[0]]
+    shape = [1] * out.ndim
+    shape[axis] = out.shape[axis]
+    out[...] = labels.reshape(shape)
 
 
 def _block_shape(block: int | Sequence[int], shape: tuple[int, ...]) -> tuple[int, ...]:
@@ -349,6 +397,157 @@ def run_blocks(
     if final and status == "solved":  # cannot happen: every accepted block is consistent
         status = "failed"
     return status, out, stats
+
+
+#: the whole problem's estimated peak memory from which ``csplab synthesize --solver
+#: blocks`` streams it (:func:`stream_blocks`) when it can
+STREAM_BYTES = 1 << 30
+
+
+def streams(
+    windows: GridWindows, *, workers: int = 0, init: Any = None, order: str = "scanline",
+    choice: str = "uniform", exact: str = "none", energy: Any = None, **_: Any,
+) -> str | None:  # fmt: skip
+    """Why the thesis' sweep on ``windows`` cannot be streamed (:func:`stream_blocks`),
+    or ``None`` when it can: the compiled sweep's settings, no starting grid, and a
+    trivial solution that is one label or uniform layers."""
+    if workers != 0:
+        return "the wave schedule (workers >= 1) visits blocks across the whole model"
+    if init is not None or exact != "none" or energy is not None:
+        return "init=, exact= and energy= need the whole model"
+    if choice not in ("uniform", "weighted") or order == "random":
+        return "the random order and resemblance choice run in the Python sweep"
+    _interp.kernels_for(windows.n, windows.K)  # a large job: its blocks run compiled
+    if not _interp.compiled_engine():
+        return "the compiled kernels are not loaded (CSPLAB_ENGINE=interp, or a small job)"
+    if windows.miniature().value_weights is not None:
+        return "per-class weights run in the Python sweep"
+    if _trivial_plan(windows.miniature) is None:
+        return "no trivial solution of one label or uniform layers"
+    return None
+
+
+def stream_blocks(
+    windows: GridWindows,
+    rng: np.random.Generator,
+    *,
+    block: int | Sequence[int] = 10,
+    retries: int = 20,
+    sweeps: int = 1,
+    order: str = "scanline",
+    choice: str = "uniform",
+    deadline: float | None = None,
+    out: NDArray[np.int32] | None = None,
+    progress: bool = False,
+) -> tuple[Status, NDArray[np.int32], dict[str, Any]]:
+    """The thesis' sweep (Alg. 3.4, ``workers=0``) on a problem built window by window.
+
+    The same blocks in the same order with the same random stream as :func:`run_blocks`,
+    so the same grid and counts for a seed (tested), without the whole problem: the blocks
+    at one ``x`` origin (all their ``y``, ``z``) are swept by one compiled kernel call
+    (:func:`csplab.catalog.sweep_blocks`) on the slab of the grid they touch, whose
+    domains and arcs are those of :meth:`GridWindows.window` (a handful of slab problems
+    serve the whole sweep, thesis Sec. 3.3.6: what a block needs is its neighbourhood).
+    The trivial solution is found on :meth:`GridWindows.miniature` problems and painted
+    slab by slab. The output (``out``, e.g. a memory map, or a new array) is the only
+    array of the model's size; the final check is :meth:`GridWindows.violations`.
+
+    Parameters
+    ----------
+    windows : GridWindows
+        The problem (square grid, no periodic axis, no global constraints).
+    rng : numpy.random.Generator
+        The randomness (one stream, as the thesis' sweep).
+    block, retries, sweeps, order, choice
+        As declared by :class:`BlocksSolver`.
+    deadline : float, optional
+        ``time.perf_counter()`` value at which the sweeps stop.
+    out : int32 array of the output's shape, optional
+        Where to write the labels.
+    progress : bool
+        A progress bar on stderr (after 2 s).
+
+    Returns
+    -------
+    status : {"solved", "timeout", "failed"}
+        ``failed`` only if the final check found a violation (never expected).
+    grid : int32 array of the output's shape
+    stats : dict
+        As :func:`run_blocks`'s, with ``slab_problems`` (the slab problems built).
+
+    Raises
+    ------
+    InputError
+        When :func:`streams` gives a reason, or ``out`` does not fit.
+    """
+    why = streams(windows, order=order, choice=choice)
+    if why is not None:
+        raise InputError(f"modify in blocks cannot be streamed: {why}")
+    if retries < 0 or sweeps < 1:
+        raise InputError("retries must be >= 0 and sweeps >= 1")
+    shape = windows.shape
+    plan = _trivial_plan(windows.miniature)
+    assert plan is not None
+    grid = np.empty(shape, dtype=np.int32) if out is None else out
+    if grid.shape != shape or grid.dtype != np.int32 or not grid.flags.c_contiguous:
+        raise InputError(f"out must be a C-ordered int32 array of shape {shape}")
+    m = _block_shape(block, shape)
+    starts = [block_starts(s, b) for s, b in zip(shape, m, strict=True)]
+    r, nx = windows.reach, shape[0]
+    scan = _block_scan(m, order)
+    counters = np.zeros(4, dtype=np.int64)  # tried, accepted, retries, revisions
+    painted = 0  # the trivial solution is painted ahead of the sweep, slab by slab
+    slabs: dict[tuple[tuple[int, ...], int], tuple[NDArray[np.int64], NDArray[np.int64]]] = {}
+    status: Status = "solved"
+    units = [a for _ in range(sweeps) for a in starts[0]]  # the x origins, sweep by sweep
+    for a in progress_bar(units, total=len(units), desc="blocks", enabled=progress,
+                          unit="slab"):  # fmt: skip
+        lo, hi = max(0, a - r), min(nx, a + m[0] + r)
+        if hi > painted:
+            _paint(plan, grid[painted:hi], painted)
+            painted = hi
+        P = windows.window((lo, *(0,) * (len(shape) - 1)), (hi, *shape[1:]))
+        key = (P.shape, a - lo)
+        if key not in slabs:  # the blocks of this x origin, in the slab's cell numbers
+            idx = np.arange(P.n, dtype=np.int64).reshape(P.shape)
+            cells = [
+                idx[(slice(a - lo, a - lo + m[0]),
+                     *(slice(q, q + b) for q, b in zip(rest, m[1:], strict=True)))].reshape(-1)
+                for rest in itertools.product(*starts[1:])
+            ]  # fmt: skip
+            bptr = np.arange(len(cells) + 1, dtype=np.int64) * int(np.prod(m))
+            slabs[key] = (bptr, np.concatenate(cells))
+        bptr, bcells = slabs[key]
+        view = grid.reshape(nx, -1)[lo:hi].reshape(-1)  # the slab's cells, in place
+        for b0 in range(0, len(bptr) - 1, _SWEEP_CHUNK):
+            if deadline is not None and time.perf_counter() > deadline:
+                status = "timeout"
+                break
+            sweep_blocks(P, view, bptr, bcells, (b0, min(b0 + _SWEEP_CHUNK, len(bptr) - 1)),
+                         scan, retries, order, choice, rng, counters)  # fmt: skip
+        if status == "timeout":
+            break
+    if painted < nx:
+        _paint(plan, grid[painted:], painted)
+    final = windows.violations(grid)
+    tried, accepted, retry_count, revisions = (int(x) for x in counters)
+    stats: dict[str, Any] = {
+        "block": list(m),
+        "blocks_tried": tried,
+        "blocks_accepted": accepted,
+        "retries": retry_count,
+        "acceptance_rate": accepted / tried if tried else 1.0,
+        "final_violations": final,
+        "init": "trivial",
+        "revisions": revisions,
+        "order": order,
+        "choice": choice,
+        "workers": 0,
+        "slab_problems": len(windows.built),
+    }
+    if final and status == "solved":  # cannot happen: every accepted block is consistent
+        status = "failed"
+    return status, grid, stats
 
 
 _Counts = tuple[Status, int, int, int, int]  # status, tried, accepted, retries, revisions
@@ -841,3 +1040,50 @@ class BlocksSolver(Solver):
         options = {k: v for k, v in call.options.items() if k != "time_limit"}
         status, grid, stats = run_blocks(problem, call.rng, deadline=call.deadline, **options)
         return self.result(status, grid, problem, stats, call)
+
+    def stream(
+        self, windows: GridWindows, *, rng: np.random.Generator, seed: int | None,
+        **options: Any,
+    ) -> Result:  # fmt: skip
+        """:func:`stream_blocks` with this solver's options: the thesis' sweep on a problem
+        built window by window, the same grid as :meth:`solve` on the whole problem.
+
+        Parameters
+        ----------
+        windows : GridWindows
+            The problem.
+        rng : numpy.random.Generator
+            The randomness.
+        seed : int or None
+            The seed ``rng`` was made from, recorded in the result.
+        **options
+            The solver's options (validated as :meth:`solve` does).
+
+        Returns
+        -------
+        Result
+            ``solved`` or ``timeout``; its ``problem`` is ``None`` (there is no whole one).
+
+        Raises
+        ------
+        InputError
+            When an option is invalid or :func:`streams` gives a reason.
+        CsplabError
+            When the windowed check finds a violation (a bug).
+        """
+        call = Call(rng, seed, None, self.validate(options))
+        o = call.options
+        why = streams(windows, **o)
+        if why is not None:
+            raise InputError(f"modify in blocks cannot be streamed: {why}")
+        status, grid, stats = stream_blocks(
+            windows, call.rng, block=o["block"], retries=o["retries"], sweeps=o["sweeps"],
+            order=o["order"], choice=o["choice"], deadline=call.deadline,
+            progress=o["progress"],
+        )  # fmt: skip
+        if stats["final_violations"]:  # every accepted block is consistent: a bug
+            raise CsplabError(f"the streamed sweep returned a grid with "
+                              f"{stats['final_violations']} violations (a bug in csplab)")
+        stats["violations"] = 0
+        return Result(status, grid, self.name, seed=seed, time_s=time.perf_counter() - call.t0,
+                      stats=stats)  # fmt: skip
