@@ -155,7 +155,7 @@ def nibble_supports(sup: NDArray[np.uint64]) -> NDArray[np.uint64]:
     Examples
     --------
     >>> sup = pack(np.eye(3, dtype=bool)[[1, 2, 0]]).reshape(1, 3, 1)  # a -> a + 1 mod 3
-    >>> nibble_supports(sup)[0, 0b011, 0] == pack(np.array([[0, 1, 1]], dtype=bool))[0, 0]
+    >>> bool(nibble_supports(sup)[0, 0b011, 0] == pack(np.array([[0, 1, 1]], dtype=bool))[0, 0])
     True
     """
     S, K, W = sup.shape
