@@ -388,10 +388,7 @@ def _check_closed(
             specs.append((key[0], key[1], [list(k) for k in c["keys"]]))
         fids.append(fid_of[key])
     frames = _frames(specs, region, back, axes)
-    plans = [
-        _check_config(frames[f], f, used, face_rules, a, b, memo)
-        for f, (_, _, a, b) in zip(fids, got, strict=True)
-    ]
+    plans = _plans(frames, fids, got, used, face_rules, memo)
     maps = None
     if classes:  # per set of open axes (a bit mask), label -> class; -1 (padding) kept
         maps = np.full((1 << ndim, len(fwd[0]) + 1), -1, dtype=np.int64)
@@ -419,8 +416,8 @@ class _Frame(NamedTuple):
     state, ``near_tab``: axis, or ``ndim`` for none), and where each label of the next
     state comes from (``nxt_at`` step and slot, ``nxt_from`` slot or -1: the label the
     step chooses, and ``nxt_open``: the axes, a bit mask, on which that label's cell
-    has a + neighbour in the frame not yet labelled). The small graph of a step is built only when a state needs arc
-    consistency (:func:`_step_graph`)."""
+    has a + neighbour in the frame not yet labelled). The small graph of a step is built
+    only when a state needs arc consistency (:func:`_step_graph`)."""
 
     ext: Cell
     n: int
@@ -610,72 +607,69 @@ class _Plan(NamedTuple):
     bases: tuple[int, ...]
 
 
-def _check_config(
-    frame: _Frame,
-    fid: int,
+def _plans(
+    frames: list[_Frame],
+    fids: list[int],
+    got: list[_Conf],
     used: int,
     face_rules: list[FaceRule],
-    at_lo: tuple[bool, ...],
-    at_hi: tuple[bool, ...],
     memo: _Memo,
-) -> _Plan:
-    """A configuration's frame and the domain of each of its cells: the labels in use,
+) -> list[_Plan]:
+    """Each configuration's frame and the domain of each of its cells: the labels in use,
     edited by the face rules of the faces it lies on, minus those dead wherever in an
-    output it may lie (its distances to the frame's edges, exact on a face)."""
+    output it may lie (its distances to the frame's edges, exact on a face). The cells of
+    every configuration are coded at once by their capped distances and face flags."""
+    coords = frames[0].coords  # every frame's cells sit in one box
+    P, ndim = coords.shape
     if not face_rules and not memo.dead:
-        return _Plan(frame, fid, (used,) * len(frame.coords))
-    ndim, cap = len(at_lo), max(memo.cap, 1)
-    # per cell: its distances to the frame's lower and upper edges, capped (the frame's
-    # own cells: those outside it count as on its upper edges), as digits of a signature
-    lo = np.minimum(frame.coords, cap)
-    hi = np.clip(np.array(frame.ext) - 1 - frame.coords, 0, cap)
-    sig = np.zeros(len(frame.coords), dtype=np.int64)
-    for d in range(ndim):
-        sig = (sig * (cap + 1) + lo[:, d]) * (cap + 1) + hi[:, d]
-    kinds, inv = np.unique(sig, return_inverse=True)
-    doms = []
-    for code in kinds.tolist():
-        key = (at_lo, at_hi, code)
-        dom = memo.domains.get(key)
-        if dom is None:
-            dist = []
-            for _ in range(ndim):
-                code, b = divmod(code, cap + 1)
-                code, a = divmod(code, cap + 1)
-                dist.append((a, b))
-            dom = memo.domains[key] = _cell_domain(dist[::-1], at_lo, at_hi, used, face_rules,
-                                                   memo.dead, cap)  # fmt: skip
-        doms.append(dom)
-    return _Plan(frame, fid, tuple(np.array(doms, dtype=object)[inv.ravel()].tolist()))
+        return [_Plan(frames[f], f, (used,) * P) for f in fids]
+    cap = max(memo.cap, 1)
+    radix = 4 * (cap + 1) ** 2  # per axis: distances to the lower and upper edge, flags
+    lo = np.minimum(coords, cap)[None]
+    out: list[_Plan] = []
+    per = max(1, (1 << 20) // (P * ndim))
+    for s in range(0, len(fids), per):
+        part = range(s, min(s + per, len(fids)))
+        ext = np.array([frames[fids[c]].ext for c in part])
+        on = np.array([[got[c][2], got[c][3]] for c in part], dtype=np.int64)
+        hi = np.clip(ext[:, None, :] - 1 - coords[None], 0, cap)  # outside: as on the edge
+        digit = ((lo * (cap + 1) + hi) * 2 + on[:, None, 0]) * 2 + on[:, None, 1]
+        inside = (coords[None] < ext[:, None, :]).all(-1)
+        code = np.where(inside, digit @ radix ** np.arange(ndim), -1)
+        kinds, inv = np.unique(code, return_inverse=True)
+        doms = []
+        for code in kinds.tolist():  # -1: a cell outside the frame
+            dom = memo.domains.get(code) if code >= 0 else used
+            if dom is None:
+                dom = memo.domains[code] = _cell_domain(code, ndim, cap, used, face_rules, memo)
+            doms.append(dom)
+        table = np.array(doms, dtype=object)[inv.reshape(len(part), P)].tolist()
+        out += [
+            _Plan(frames[fids[c]], fids[c], tuple(row))
+            for c, row in zip(part, table, strict=True)
+        ]
+    return out
 
 
 def _cell_domain(
-    dist: list[tuple[int, int]],
-    at_lo: tuple[bool, ...],
-    at_hi: tuple[bool, ...],
-    used: int,
-    face_rules: list[FaceRule],
-    dead: Mapping[Where, int],
-    cap: int,
+    code: int, ndim: int, cap: int, used: int, face_rules: list[FaceRule], memo: _Memo
 ) -> int:
-    """The domain of a frame cell at capped distances ``dist`` (per axis, to the frame's
-    lower and upper edge; a cell at 0 lies on the face when the edge is ``at_lo`` /
-    ``at_hi``), minus the labels dead at every place in an output it may have."""
-    ndim = len(dist)
-    on = {_AXES[d] + "-" for d in range(ndim) if at_lo[d] and dist[d][0] == 0}
-    on |= {_AXES[d] + "+" for d in range(ndim) if at_hi[d] and dist[d][1] == 0}
+    """The domain of a frame cell of ``code`` (per axis, little end first: its capped
+    distances to the frame's lower and upper edge, and whether each edge is on the face)."""
+    on, key = set(), []
+    for d in range(ndim):
+        code, digit = divmod(code, 4 * (cap + 1) ** 2)
+        rest, at_hi = divmod(digit, 2)
+        (lo, hi), at_lo = divmod(rest // 2, cap + 1), rest % 2
+        if at_lo and lo == 0:
+            on.add(_AXES[d] + "-")
+        if at_hi and hi == 0:
+            on.add(_AXES[d] + "+")
+        # exact on a face edge, else at least one more (a suffix lo .. cap: lo + cap + 1)
+        key += [lo if at_lo else min(lo + 1, cap) + cap + 1,
+                hi if at_hi else min(hi + 1, cap) + cap + 1]  # fmt: skip
     dom = _domain(face_rules, on, used)
-    if dead:
-        per_axis = []
-        for d, (lo_d, hi_d) in enumerate(dist):  # exact on a face edge, else at least
-            los = [lo_d] if at_lo[d] else range(min(lo_d + 1, cap), cap + 1)
-            his = [hi_d] if at_hi[d] else range(min(hi_d + 1, cap), cap + 1)
-            per_axis.append([(a, b) for a in los for b in his])
-        alive = 0
-        for k in itertools.product(*per_axis):
-            alive |= ~dead[k]
-        dom &= alive
-    return dom
+    return dom & ~memo.dead_in(tuple(key)) if memo.dead else dom
 
 
 class _Memo:
@@ -685,8 +679,19 @@ class _Memo:
         self.dead = dead
         self.cap = max((v for k in dead for a in k for v in a), default=0)
         self.union: dict[tuple[int, int, int], int] = {}
-        self.domains: dict[tuple[tuple[bool, ...], tuple[bool, ...], int], int] = {}
+        self.domains: dict[int, int] = {}
         self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+
+    def dead_in(self, key: tuple[int, ...]) -> int:
+        """The labels dead at every place of a box of places: per axis the distance to
+        the lower and to the upper face, each ``a`` (exactly) or ``a + cap + 1`` (``a``
+        to ``cap``)."""
+        c, got = self.cap, -1
+        spans = [[v] if v <= c else range(v - c - 1, c + 1) for v in key]
+        per_axis = [list(itertools.product(*spans[t : t + 2])) for t in range(0, len(key), 2)]
+        for k in itertools.product(*per_axis):
+            got &= self.dead[k]
+        return got
 
 
 # bytes per state and label the array check holds at once, above which it refuses
@@ -1051,11 +1056,17 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
     if not 1 <= cap <= 8:
         raise _Invalid("dead labels: cap must be 1 to 8")
     span = list(itertools.product(range(cap + 1), repeat=2))
-    known: dict[Where, int] = {}
-    for k in itertools.product(span, repeat=ndim):
-        on = {_AXES[d] + "-" for d in range(ndim) if k[d][0] == 0}
-        on |= {_AXES[d] + "+" for d in range(ndim) if k[d][1] == 0}
-        known[k] = used & ~_domain(face_rules, on, used)
+    # the labels the face rules exclude, by the faces a place lies on (bits 2d, 2d + 1)
+    excluded = [
+        used & ~_domain(face_rules, {_AXES[t // 2] + "-+"[t % 2] for t in _bits(f)}, used)
+        for f in range(1 << 2 * ndim)
+    ]
+    per_axis = [[(p, (p[0] == 0) << 2 * d | (p[1] == 0) << 2 * d + 1) for p in span]
+                for d in range(ndim)]  # fmt: skip
+    known: dict[Where, int] = {
+        tuple(p for p, _ in k): excluded[sum(f for _, f in k)]
+        for k in itertools.product(*per_axis)
+    }
     every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
     for face, got in dead["stages"]:
         if face not in every:
@@ -1063,7 +1074,7 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         d, minus = _AXES.index(face[0]), face[1] == "-"
         stage: dict[Where, int] = {}
         for where, labels in got:
-            k = tuple((int(a), int(b)) for a, b in where)
+            k: Where = tuple((int(a), int(b)) for a, b in where)
             if k not in known or k[d][0 if minus else 1] == 0:
                 raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
             for b in labels:
