@@ -55,7 +55,7 @@ Then Alg. 3.6 with these regions cannot fail in any configuration, so Alg. 3.1 n
 state records each label by its class -- the least label in use with the same forward
 supports along the axes on which the cell's + neighbour is in the frame and not yet
 labelled at that step -- and arc consistency leaves out arcs between labelled cells
-(:func:`_check_classes` says why that is sound). ``dead`` (optional, with
+(:func:`_check_closed` says why that is sound). ``dead`` (optional, with
 ``label_classes``): ``cap`` and ``stages`` ``[face, [[where, labels], ...]]`` of labels no
 catalog of Alg. 3.1 holds at cells whose capped distances to the faces are ``where``
 (each one's supports toward the face are dead at this stage or before:
@@ -203,10 +203,8 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
             for bits in dead.values():
                 everywhere &= bits
             model = _without(model, everywhere)
-        if claim == "infallible" and cert.get("label_classes"):
-            msg = _check_classes(cert, model, dead)
-        elif claim == "infallible":
-            msg = _check_closed(cert, model)
+        if claim == "infallible":
+            msg = _check_closed(cert, model, dead, bool(cert.get("label_classes")))
         elif claim == "fallible":
             msg = _check_run(cert, model)
         else:
@@ -350,13 +348,36 @@ def _positions(
     return region, back, axes, got
 
 
-def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
+def _check_closed(
+    cert: Mapping[str, Any],
+    rules: _Rules,
+    dead: Mapping[Where, int] | None = None,
+    classes: bool = False,
+) -> str:
+    """An *infallible* certificate: its configurations, frames and states (the module's
+    docstring lists the checks), with each frame cell's ``dead`` labels out of its domain.
+
+    With ``classes`` (``label_classes``), a state records each label by its class -- the
+    least label in use with the same forward supports (``fwd[d]``) along the axes on which
+    the cell's + neighbour lies in the frame box and is not yet labelled at that step --
+    and arc consistency leaves out the arcs between two labelled cells.
+
+    Why this suffices: inside the frame a labelled cell's - neighbours are labelled
+    (scan order), so it meets unlabelled cells only along those axes; there its label
+    acts only through ``fwd[d][label]`` (narrowing the neighbour, and keeping the label
+    iff the neighbour's domain meets it). Arcs between labelled cells hold in every real
+    run (each label agreed with its - neighbours, which its region holds). So arc
+    consistency with the classes gives the catalogs of the real labels, and a real run's
+    labels, mapped to their classes, stay in a closed set that holds the start state.
+    The step's cell meets its labelled - neighbours along axes on which it is open, so
+    their classes narrow it as their labels do.
+    """
     fwd, bwd, used, ndim, face_rules = rules
     region, back, axes, got = _positions(cert, ndim, bool(face_rules))
     configs = cert["configs"]
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and region graphs
-    memo = _Memo()
+    memo = _Memo(dead or {})
     specs: list[tuple[Cell, Cell, list[list[int]]]] = []
     fid_of: dict[Any, int] = {}
     fids = []
@@ -367,16 +388,19 @@ def _check_closed(cert: Mapping[str, Any], rules: _Rules) -> str:
             specs.append((key[0], key[1], [list(k) for k in c["keys"]]))
         fids.append(fid_of[key])
     frames = _frames(specs, region, back, axes)
-    plans = [
-        _check_config(frames[f], f, used, face_rules, a, b, memo)
-        for f, (_, _, a, b) in zip(fids, got, strict=True)
-    ]
-    nstates = _check_states(configs, plans, fwd, bwd, used, memo)
+    plans = _plans(frames, fids, got, used, face_rules, memo)
+    maps = None
+    if classes:  # per set of open axes (a bit mask), label -> class; -1 (padding) kept
+        maps = np.full((1 << ndim, len(fwd[0]) + 1), -1, dtype=np.int64)
+        for m in range(1 << ndim):
+            maps[m, :-1] = _class_of(fwd, used, frozenset(d for d in range(ndim) if m >> d & 1))
+    nstates = _check_states(configs, plans, fwd, bwd, used, memo, maps)
     rtxt = "x".join(map(str, region)) + (
         "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
     )
     return (
-        f"valid: {nstates} states in {len(configs)} configurations are closed under Alg. 3.6 "
+        f"valid: {nstates} states{' (labels by class)' if classes else ''} in {len(configs)} "
+        "configurations are closed under Alg. 3.6 "
         f"with {rtxt} regions ({cert['order']}) and no catalog of a point is empty: "
         "Alg. 3.1 never fails (Theorem 3.3.6)"
     )
@@ -391,8 +415,9 @@ class _Frame(NamedTuple):
     step's cell (``cell``), its labelled backward neighbours (``near_pos``: slot in the
     state, ``near_tab``: axis, or ``ndim`` for none), and where each label of the next
     state comes from (``nxt_at`` step and slot, ``nxt_from`` slot or -1: the label the
-    step chooses). The small graph of a step is built only when a state needs arc
-    consistency (:func:`_step_graph`)."""
+    step chooses, and ``nxt_open``: the axes, a bit mask, on which that label's cell
+    has a + neighbour in the frame not yet labelled). The small graph of a step is built
+    only when a state needs arc consistency (:func:`_step_graph`)."""
 
     ext: Cell
     n: int
@@ -406,6 +431,7 @@ class _Frame(NamedTuple):
     near_tab: Any
     nxt_at: tuple[Any, Any]
     nxt_from: Any
+    nxt_open: Any
     cells: list[Cell]
     graphs: dict[int, tuple[list[int], list[int], list[bool], bytes]]
 
@@ -487,6 +513,14 @@ def _frame_chunk(
         raise _Invalid(
             f"{_where(lo_f, hi_f)}: keys[{ii[t] + 1}] records a label step {ii[t]} forgot"
         )
+    # the axes on which each label of the next state has an open + neighbour (its class)
+    strides = np.cumprod((1, *E[:0:-1]))[::-1]
+    xj = cell[fi, ji]
+    nxt_open = np.zeros(len(xj), dtype=np.int64)
+    for d in range(ndim):
+        inside = coords[xj, d] + 1 < ext[fi, d]
+        plus = rank[fi, np.minimum(xj + strides[d], P - 1)]
+        nxt_open |= (inside & (plus > ii)).astype(np.int64) << d
     # the region of each step's cell, clipped to the frame
     at = coords[cell]  # (F, nmax, ndim)
     blo = np.maximum(at - np.array(back), 0)
@@ -511,7 +545,6 @@ def _frame_chunk(
         )
     # the labelled backward neighbours of each step's cell in its region (a forward
     # neighbour comes later in any scan order)
-    strides = np.cumprod((1, *E[:0:-1]))[::-1]
     y = np.maximum(cell[:, :, None] - strides, 0)  # (F, nmax, ndim)
     ok = (at > 0) & np.take_along_axis(box & done, y, axis=2)
     near_pos = np.where(ok, np.take_along_axis(keypos, y, axis=2), 0)
@@ -526,7 +559,7 @@ def _frame_chunk(
         out.append(_Frame(
             tuple(int(e) for e in ext[f]), m, coords, keys, cell[f, :m], box[f, :m],
             done[f, :m], keypos[f, :m], near_pos[f, :m], near_tab[f, :m],
-            (ii[a:b], nxt_slot[a:b]), nxt_from[a:b], cells, {},
+            (ii[a:b], nxt_slot[a:b]), nxt_from[a:b], nxt_open[a:b], cells, {},
         ))  # fmt: skip
     return out
 
@@ -535,12 +568,15 @@ def _where(lo: Sequence[int], hi: Sequence[int]) -> str:
     return f"configuration lower={list(lo)} upper={list(hi)}"
 
 
-def _nxt(frame: _Frame, width: int) -> Any:
+def _nxt(frame: _Frame, width: int) -> tuple[Any, Any]:
     """Per step, where each label of the next state comes from: a slot of the state,
-    ``width`` (the label just chosen) or ``width + 1`` (padding)."""
+    ``width`` (the label just chosen) or ``width + 1`` (padding); and the axes on which
+    its cell is open there (``nxt_open``)."""
     out = np.full((frame.n, width), width + 1, dtype=np.int64)
     out[frame.nxt_at] = np.where(frame.nxt_from < 0, width, frame.nxt_from)
-    return out
+    opens = np.zeros((frame.n, width), dtype=np.int64)
+    opens[frame.nxt_at] = frame.nxt_open
+    return out, opens
 
 
 def _step_graph(frame: _Frame, i: int) -> tuple[list[int], list[int], list[bool], bytes]:
@@ -571,42 +607,91 @@ class _Plan(NamedTuple):
     bases: tuple[int, ...]
 
 
-def _check_config(
-    frame: _Frame,
-    fid: int,
+def _plans(
+    frames: list[_Frame],
+    fids: list[int],
+    got: list[_Conf],
     used: int,
     face_rules: list[FaceRule],
-    at_lo: tuple[bool, ...],
-    at_hi: tuple[bool, ...],
     memo: _Memo,
-) -> _Plan:
-    """A configuration's frame and the domain of each of its cells."""
-    if not face_rules:
-        return _Plan(frame, fid, (used,) * len(frame.coords))
-    # the faces each cell lies on, as bits 2d (lower) and 2d + 1 (upper)
-    on = np.zeros(len(frame.coords), dtype=np.int64)
-    for d in range(len(at_lo)):
-        if at_lo[d]:
-            on |= (frame.coords[:, d] == 0) << (2 * d)
-        if at_hi[d]:
-            on |= (frame.coords[:, d] == frame.ext[d] - 1) << (2 * d + 1)
-    doms = []
-    for sig in on.tolist():
-        dom = memo.domains.get(sig)
-        if dom is None:
-            faces = {_AXES[b // 2] + "-+"[b % 2] for b in range(2 * len(at_lo)) if sig >> b & 1}
-            dom = memo.domains[sig] = _domain(face_rules, faces, used)
-        doms.append(dom)
-    return _Plan(frame, fid, tuple(doms))
+) -> list[_Plan]:
+    """Each configuration's frame and the domain of each of its cells: the labels in use,
+    edited by the face rules of the faces it lies on, minus those dead wherever in an
+    output it may lie (its distances to the frame's edges, exact on a face). The cells of
+    every configuration are coded at once by their capped distances and face flags."""
+    coords = frames[0].coords  # every frame's cells sit in one box
+    P, ndim = coords.shape
+    if not face_rules and not memo.dead:
+        return [_Plan(frames[f], f, (used,) * P) for f in fids]
+    cap = max(memo.cap, 1)
+    radix = 4 * (cap + 1) ** 2  # per axis: distances to the lower and upper edge, flags
+    lo = np.minimum(coords, cap)[None]
+    out: list[_Plan] = []
+    per = max(1, (1 << 20) // (P * ndim))
+    for s in range(0, len(fids), per):
+        part = range(s, min(s + per, len(fids)))
+        ext = np.array([frames[fids[c]].ext for c in part])
+        on = np.array([[got[c][2], got[c][3]] for c in part], dtype=np.int64)
+        hi = np.clip(ext[:, None, :] - 1 - coords[None], 0, cap)  # outside: as on the edge
+        digit = ((lo * (cap + 1) + hi) * 2 + on[:, None, 0]) * 2 + on[:, None, 1]
+        inside = (coords[None] < ext[:, None, :]).all(-1)
+        code = np.where(inside, digit @ radix ** np.arange(ndim), -1)
+        kinds, inv = np.unique(code, return_inverse=True)
+        doms = []
+        for code in kinds.tolist():  # -1: a cell outside the frame
+            dom = memo.domains.get(code) if code >= 0 else used
+            if dom is None:
+                dom = memo.domains[code] = _cell_domain(code, ndim, cap, used, face_rules, memo)
+            doms.append(dom)
+        table = np.array(doms, dtype=object)[inv.reshape(len(part), P)].tolist()
+        out += [
+            _Plan(frames[fids[c]], fids[c], tuple(row))
+            for c, row in zip(part, table, strict=True)
+        ]
+    return out
+
+
+def _cell_domain(
+    code: int, ndim: int, cap: int, used: int, face_rules: list[FaceRule], memo: _Memo
+) -> int:
+    """The domain of a frame cell of ``code`` (per axis, little end first: its capped
+    distances to the frame's lower and upper edge, and whether each edge is on the face)."""
+    on, key = set(), []
+    for d in range(ndim):
+        code, digit = divmod(code, 4 * (cap + 1) ** 2)
+        rest, at_hi = divmod(digit, 2)
+        (lo, hi), at_lo = divmod(rest // 2, cap + 1), rest % 2
+        if at_lo and lo == 0:
+            on.add(_AXES[d] + "-")
+        if at_hi and hi == 0:
+            on.add(_AXES[d] + "+")
+        # exact on a face edge, else at least one more (a suffix lo .. cap: lo + cap + 1)
+        key += [lo if at_lo else min(lo + 1, cap) + cap + 1,
+                hi if at_hi else min(hi + 1, cap) + cap + 1]  # fmt: skip
+    dom = _domain(face_rules, on, used)
+    return dom & ~memo.dead_in(tuple(key)) if memo.dead else dom
 
 
 class _Memo:
     """What the configurations of one certificate share."""
 
-    def __init__(self) -> None:
+    def __init__(self, dead: Mapping[Where, int]) -> None:
+        self.dead = dead
+        self.cap = max((v for k in dead for a in k for v in a), default=0)
         self.union: dict[tuple[int, int, int], int] = {}
         self.domains: dict[int, int] = {}
         self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+
+    def dead_in(self, key: tuple[int, ...]) -> int:
+        """The labels dead at every place of a box of places: per axis the distance to
+        the lower and to the upper face, each ``a`` (exactly) or ``a + cap + 1`` (``a``
+        to ``cap``)."""
+        c, got = self.cap, -1
+        spans = [[v] if v <= c else range(v - c - 1, c + 1) for v in key]
+        per_axis = [list(itertools.product(*spans[t : t + 2])) for t in range(0, len(key), 2)]
+        for k in itertools.product(*per_axis):
+            got &= self.dead[k]
+        return got
 
 
 # bytes per state and label the array check holds at once, above which it refuses
@@ -620,10 +705,13 @@ def _check_states(
     bwd: list[list[int]],
     used: int,
     memo: _Memo,
+    maps: Any = None,
 ) -> int:
     """The states of every configuration, at once: present at the start, closed, never an
     empty point. A *group* is a step of a configuration; each state is a row of labels
-    (padded with -1 to the widest state) in its group."""
+    (padded with -1 to the widest state) in its group. ``maps`` (labels by class): per
+    bit mask of open axes, label -> class, which the next state records; arcs between
+    labelled cells are then left out of arc consistency."""
     K = len(fwd[0])
     ndim = len(fwd)
     width = max(len(k) for p in plans for k in p.frame.keys)
@@ -634,8 +722,8 @@ def _check_states(
     widths: list[int] = []
     base: list[int] = []
     acid: list[int] = []
-    npos, ntab, nxt = [], [], []
-    nxt_of: dict[int, Any] = {}
+    npos, ntab, nxt, opens = [], [], [], []
+    nxt_of: dict[int, tuple[Any, Any]] = {}
     ac_ids: dict[tuple[int, int, int], int] = {}
     base_ids: dict[tuple[int, ...], int] = {}
     ac_of: list[tuple[_Plan, int]] = []
@@ -650,7 +738,8 @@ def _check_states(
         ntab.append(f.near_tab)
         if p.fid not in nxt_of:
             nxt_of[p.fid] = _nxt(f, width)
-        nxt.append(nxt_of[p.fid])
+        nxt.append(nxt_of[p.fid][0])
+        opens.append(nxt_of[p.fid][1])
         base.extend(p.bases[x] for x in f.cell.tolist())
         bid = base_ids.setdefault(p.bases, len(base_ids))
         for i in range(f.n):
@@ -661,7 +750,7 @@ def _check_states(
             acid.append(ac_ids[k])
         G += f.n
     g_next, g_width, g_acid = (np.array(v, dtype=np.int64) for v in (nexts, widths, acid))
-    g_npos, g_ntab, g_nxt = (np.concatenate(v) for v in (npos, ntab, nxt))
+    g_npos, g_ntab, g_nxt, g_open = (np.concatenate(v) for v in (npos, ntab, nxt, opens))
     bits = sorted(set(base))
     g_base = np.searchsorted(bits, base)
     base_rows = _unpack(bits, K)
@@ -724,7 +813,7 @@ def _check_states(
         fc &= tables[g_ntab[grp, j], labs[rows, g_npos[grp, j]]]
     last = g_next[grp] < 0
     st, lab = np.nonzero(fc & ~last[:, None])
-    codes, next_codes = _state_codes(grp, labs, st, lab, g_next, g_nxt, K)
+    codes, next_codes = _state_codes(grp, labs, st, lab, g_next, g_nxt, K, maps, g_open)
     known = np.sort(codes)
     at = np.minimum(np.searchsorted(known, next_codes), max(N - 1, 0))
     present = known[at] == next_codes
@@ -759,7 +848,11 @@ def _check_states(
             if graph is None:
                 there = [p.frame.cells[x] for x in nodes]
                 here = p.frame.cells[int(p.frame.cell[i])]
-                graph = memo.graphs[shape] = (_arcs(there), there.index(here))
+                arcs = _arcs(there)
+                if maps is not None:  # no arcs between labelled cells
+                    arcs = [[a for a in row if not (fu and fixed[a[0]])]
+                            for fu, row in zip(fixed, arcs, strict=True)]  # fmt: skip
+                graph = memo.graphs[shape] = (arcs, there.index(here))
             arcs, target = graph
             it = iter(mk[r, : len(slots)].tolist())
             dom = [1 << next(it) if f else p.bases[x]
@@ -779,6 +872,8 @@ def _check_states(
             r = int(need[row])
             g = int(grp[r])
             nx = [b if s == width else labs[r, s] for s in g_nxt[g, : g_width[g + 1]].tolist()]
+            if maps is not None:
+                nx = [maps[m, t] for m, t in zip(g_open[g].tolist(), nx, strict=False)]
             raise _Invalid(
                 f"{where(int(cfg[r]))}: not closed: state {state(r)} with label {b} leads to "
                 f"{[int(steps[r]) + 1, [int(t) for t in nx]]}, which is missing"
@@ -806,12 +901,21 @@ _CODE_LIMIT = 1 << 62
 
 
 def _state_codes(
-    grp: Any, labs: Any, st: Any, lab: Any, g_next: Any, g_nxt: Any, K: int
+    grp: Any,
+    labs: Any,
+    st: Any,
+    lab: Any,
+    g_next: Any,
+    g_nxt: Any,
+    K: int,
+    maps: Any = None,
+    g_open: Any = None,
 ) -> tuple[Any, Any]:
     """Exact codes of the states (``grp``, ``labs``) and of the states ``(g_next[grp[st]],
     labs[st] rearranged by g_nxt with lab chosen)`` that they lead to: equal codes for equal
-    states. A polynomial in the labels (the padding -1 adds nothing) when it stays below
-    ``_CODE_LIMIT``; else the rows are built and ranked (:func:`_row_codes`)."""
+    states. With ``maps``, each label of a next state is mapped by ``maps[g_open[group,
+    slot]]`` (to its class). A polynomial in the labels (the padding -1 adds nothing) when
+    it stays below ``_CODE_LIMIT``; else the rows are built and ranked (:func:`_row_codes`)."""
     N, width = labs.shape
     G = len(g_next)
     ext = np.concatenate([labs, np.full((N, 2), -1, dtype=np.int64)], axis=1)
@@ -820,12 +924,18 @@ def _state_codes(
         gw = (K + 1) ** width
         codes = grp * gw + (labs + 1) @ w
         # the next state: its labels kept from this one, plus the chosen label's term
-        kept = g_next[grp] * gw + (np.take_along_axis(ext, g_nxt[grp], axis=1) + 1) @ w
+        nxt = np.take_along_axis(ext, g_nxt[grp], axis=1)
+        if maps is not None:
+            nxt = maps[g_open[grp], nxt]
+            lab = maps[(g_open * (g_nxt == width)).sum(1)[grp[st]], lab]
+        kept = g_next[grp] * gw + (nxt + 1) @ w
         chosen = ((g_nxt == width) * w).sum(1)
         return codes, kept[st] + (lab + 1) * chosen[grp[st]]
     e = ext[st]
     e[:, width] = lab
     cand = np.take_along_axis(e, g_nxt[grp[st]], axis=1)
+    if maps is not None:
+        cand = maps[g_open[grp[st]], cand]
     both = _row_codes(np.concatenate([grp, g_next[grp[st]]]), np.concatenate([labs, cand]), K)
     return both[:N], both[N:]
 
@@ -907,39 +1017,7 @@ def _small_ac(
     return dom
 
 
-# ----------------------------------------------------------------------------- infallible,
-# labels recorded by their class
-
-
-def _check_classes(
-    cert: Mapping[str, Any], rules: _Rules, dead: Mapping[Where, int] | None = None
-) -> str:
-    """An *infallible* certificate with ``label_classes``: as above, except that a state
-    records each label by its class -- the least label in use with the same forward
-    supports (``fwd[d]``) along the axes on which the cell's + neighbour lies in the frame
-    box and is not yet labelled at that step -- and arc consistency leaves out the arcs
-    between two labelled cells.
-
-    Why this suffices: inside the frame a labelled cell's - neighbours are labelled
-    (scan order), so it meets unlabelled cells only along those axes; there its label
-    acts only through ``fwd[d][label]`` (narrowing the neighbour, and keeping the label
-    iff the neighbour's domain meets it). Arcs between labelled cells hold in every real
-    run (each label agreed with its - neighbours, which its region holds). So arc
-    consistency with the classes gives the catalogs of the real labels, and a real run's
-    labels, mapped to their classes, stay in a closed set that holds the start state.
-    """
-    region, back, axes, got = _positions(cert, rules.ndim, bool(rules.faces))
-    canon: dict[frozenset[int], list[int]] = {}
-    nstates = 0
-    for conf, (lo, hi, on_lo, on_hi) in zip(cert["configs"], got, strict=True):
-        nstates += _check_class_config(
-            conf, lo, hi, on_lo, on_hi, region, back, axes, rules, canon, dead or {}
-        )
-    return (
-        f"valid: {nstates} states (labels by class) in {len(got)} configurations are closed "
-        f"under Alg. 3.6 with {'x'.join(map(str, region))} regions ({cert['order']}) and no "
-        "catalog of a point is empty: Alg. 3.1 never fails (Theorem 3.3.6)"
-    )
+# ----------------------------------------------------------------------------- label classes
 
 
 def _class_of(fwd: list[list[int]], used: int, ax: frozenset[int]) -> list[int]:
@@ -949,131 +1027,6 @@ def _class_of(fwd: list[list[int]], used: int, ax: frozenset[int]) -> list[int]:
         first.setdefault(tuple(fwd[d][a] for d in sorted(ax)), a) if used >> a & 1 else a
         for a in range(len(fwd[0]))
     ]
-
-
-def _check_class_config(
-    conf: Mapping[str, Any],
-    lo: Cell,
-    hi: Cell,
-    at_lo: tuple[bool, ...],
-    at_hi: tuple[bool, ...],
-    region: list[int],
-    back: list[int],
-    axes: tuple[int, ...],
-    rules: _Rules,
-    canon: dict[frozenset[int], list[int]],
-    dead: Mapping[Where, int],
-) -> int:
-    fwd, bwd, used, ndim, face_rules = rules
-    where = f"configuration lower={list(lo)} upper={list(hi)}"
-    ext = tuple(a + 1 + b for a, b in zip(lo, hi, strict=True))
-
-    def okey(c: Cell) -> Cell:
-        return tuple(c[a] for a in axes)
-
-    cells = [c for c in itertools.product(*[range(e) for e in ext]) if okey(c) < okey(lo)]
-    cells = [*sorted(cells, key=okey), lo]
-    index = {c: i for i, c in enumerate(cells)}
-    n = len(cells)
-    keys = [[int(j) for j in k] for k in conf["keys"]]
-    if len(keys) != n or keys[0]:
-        raise _Invalid(f"{where}: keys must list {n} steps, the first empty")
-
-    cap = max((v for k in dead for a in k for v in a), default=0)
-    doms: dict[Cell, int] = {}
-
-    def face_dom(x: Cell) -> int:
-        if x in doms:
-            return doms[x]
-        on = {_AXES[d] + "-" for d in range(ndim) if at_lo[d] and x[d] == 0}
-        on |= {_AXES[d] + "+" for d in range(ndim) if at_hi[d] and x[d] == ext[d] - 1}
-        dom = _domain(face_rules, on, used)
-        if dead:  # minus the labels dead wherever in an output this cell may lie
-            per_axis = []
-            for d in range(ndim):
-                lo_d, hi_d = x[d], ext[d] - 1 - x[d]  # distances, exact on a face edge
-                los = [min(lo_d, cap)] if at_lo[d] else range(min(lo_d + 1, cap), cap + 1)
-                his = [min(hi_d, cap)] if at_hi[d] else range(min(hi_d + 1, cap), cap + 1)
-                per_axis.append([(a, b) for a in los for b in his])
-            alive = 0
-            for k in itertools.product(*per_axis):
-                alive |= ~dead[k]
-            dom &= alive
-        doms[x] = dom
-        return dom
-
-    def classes(j: int, i: int) -> list[int]:
-        """Label of step j -> its class at step i (axes whose + neighbour is open)."""
-        x = cells[j]
-        ax = frozenset(
-            d for d in range(ndim)
-            if x[d] + 1 < ext[d] and index.get((*x[:d], x[d] + 1, *x[d + 1 :]), n) >= i
-        )  # fmt: skip
-        if ax not in canon:
-            canon[ax] = _class_of(fwd, used, ax)
-        return canon[ax]
-
-    steps = []
-    for i, c in enumerate(cells):
-        if keys[i] != sorted(set(keys[i])) or any(not 0 <= j < i for j in keys[i]):
-            raise _Invalid(f"{where}: keys[{i}] must be sorted earlier steps")
-        if i + 1 < n and not set(keys[i + 1]) <= set(keys[i]) | {i}:
-            raise _Invalid(f"{where}: keys[{i + 1}] records a label step {i} forgot")
-        box = list(itertools.product(*[
-            range(max(0, c[d] - back[d]), min(ext[d] - 1, c[d] + region[d] - 2) + 1)
-            for d in range(ndim)
-        ]))  # fmt: skip
-        labelled = {x for x in box if index.get(x, n) < i}
-        nodes = [x for x in box if x not in labelled or index[x] in keys[i]]
-        inbox = set(box)
-        for x in labelled:
-            near = ((*x[:d], x[d] + s, *x[d + 1 :]) for d in range(ndim) for s in (-1, 1))
-            if any(y in inbox and y not in labelled for y in near) and index[x] not in keys[i]:
-                raise _Invalid(f"{where}: step {i} depends on cell {list(x)}, not in keys[{i}]")
-        arcs = [
-            [(v, d, plus) for v, d, plus in row if not (x in labelled and nodes[v] in labelled)]
-            for x, row in zip(nodes, _arcs(nodes), strict=True)
-        ]
-        pos = {j: k for k, j in enumerate(keys[i])}
-        src = [pos[index[x]] if x in labelled else -1 for x in nodes]
-        base = [face_dom(x) for x in nodes]
-        nxt = (
-            [(-1 if j == i else pos[j], classes(j, i + 1)) for j in keys[i + 1]]
-            if i + 1 < n else []
-        )  # fmt: skip
-        steps.append((src, arcs, nodes.index(c), base, nxt))
-    by_step: list[set[tuple[int, ...]]] = [set() for _ in range(n)]
-    for i, labs in conf["states"]:
-        if not 0 <= i < n or len(labs) != len(keys[i]):
-            raise _Invalid(f"{where}: state {[i, labs]} does not fit keys[{i}]")
-        if any(not (0 <= b < len(fwd[0]) and used >> b & 1) for b in labs):
-            raise _Invalid(f"{where}: state {[i, labs]} has a label not in use")
-        by_step[i].add(tuple(labs))
-    if () not in by_step[0]:
-        raise _Invalid(f"{where}: no start state")
-    union: dict[tuple[int, int, int], int] = {}
-    for i, (src, arcs, target, base, nxt) in enumerate(steps):
-        later = by_step[i + 1] if i + 1 < n else set()
-        cats: dict[tuple[int, ...], int] = {}
-        for labs in by_step[i]:
-            mk = tuple([labs[k] for k in src if k >= 0])
-            cat = cats.get(mk)
-            if cat is None:
-                dom = [b0 if k < 0 else 1 << labs[k] for k, b0 in zip(src, base, strict=True)]
-                out = _small_ac(dom, arcs, fwd, bwd, union)
-                cat = cats[mk] = 0 if out is None else out[target]
-            if i == n - 1:
-                if not cat:
-                    raise _Invalid(f"{where}: the point's catalog is empty in {[i, list(labs)]}")
-                continue
-            for b in _bits(cat):
-                new = tuple([m[b if k < 0 else labs[k]] for k, m in nxt])
-                if new not in later:
-                    raise _Invalid(
-                        f"{where}: not closed: state {[i, list(labs)]} with label {b} leads to "
-                        f"{[i + 1, list(new)]}, which is missing"
-                    )
-    return sum(len(s) for s in by_step)
 
 
 # ----------------------------------------------------------------------------- dead labels
@@ -1103,11 +1056,17 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
     if not 1 <= cap <= 8:
         raise _Invalid("dead labels: cap must be 1 to 8")
     span = list(itertools.product(range(cap + 1), repeat=2))
-    known: dict[Where, int] = {}
-    for k in itertools.product(span, repeat=ndim):
-        on = {_AXES[d] + "-" for d in range(ndim) if k[d][0] == 0}
-        on |= {_AXES[d] + "+" for d in range(ndim) if k[d][1] == 0}
-        known[k] = used & ~_domain(face_rules, on, used)
+    # the labels the face rules exclude, by the faces a place lies on (bits 2d, 2d + 1)
+    excluded = [
+        used & ~_domain(face_rules, {_AXES[t // 2] + "-+"[t % 2] for t in _bits(f)}, used)
+        for f in range(1 << 2 * ndim)
+    ]
+    per_axis = [[(p, (p[0] == 0) << 2 * d | (p[1] == 0) << 2 * d + 1) for p in span]
+                for d in range(ndim)]  # fmt: skip
+    known: dict[Where, int] = {
+        tuple(p for p, _ in k): excluded[sum(f for _, f in k)]
+        for k in itertools.product(*per_axis)
+    }
     every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
     for face, got in dead["stages"]:
         if face not in every:
@@ -1115,7 +1074,7 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         d, minus = _AXES.index(face[0]), face[1] == "-"
         stage: dict[Where, int] = {}
         for where, labels in got:
-            k = tuple((int(a), int(b)) for a, b in where)
+            k: Where = tuple((int(a), int(b)) for a, b in where)
             if k not in known or k[d][0 if minus else 1] == 0:
                 raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
             for b in labels:

@@ -174,3 +174,18 @@ def test_dead_labels_prove_fig3_5a_with_its_boundary():
         assert v.holds is True
         cert = json.loads(json.dumps(v.witness["certificate"]))
         assert cert["rules"]["used"] == [1] * 9 and check_certificate(cert)[0]
+
+
+def test_class_states_checked_with_row_codes_as_with_polynomial_codes(pipes3d_cert, monkeypatch):
+    # states too wide for one polynomial code are ranked row by row: the classes of the
+    # next states must be taken there too, and a missing state still found
+    import csplab.certcheck as cc
+
+    monkeypatch.setattr(cc, "_CODE_LIMIT", 0)
+    ok, msg = check_certificate(pipes3d_cert)
+    assert ok, msg
+    cert = copy.deepcopy(pipes3d_cert)
+    conf = max(cert["configs"], key=lambda c: len(c["states"]))
+    conf["states"] = [s for s in conf["states"] if s[0] != len(conf["keys"]) - 1]
+    ok, msg = check_certificate(cert)
+    assert not ok and "not closed" in msg
