@@ -32,7 +32,7 @@ from csplab.experiments.base import Experiment, Report, group_rows
 from csplab.experiments.figures import new_figure, save_figure
 from csplab.experiments.measures import dead_ends, pattern_distance
 from csplab.experiments.stats import median_iqr
-from csplab.experiments.trial import Trial
+from csplab.experiments.trial import Trial, record
 from csplab.grids import parse_shape
 
 __all__ = ["Baselines", "measure_baseline"]
@@ -70,7 +70,7 @@ def measure_baseline(trial: Trial, example: ExampleModel, problem: Any) -> dict[
         "pattern_tv": pattern_distance(g, np.asarray(example.labels)),
         "dead_ends": dead_ends(g, example.names) if g.ndim == 2 else None,
     }
-    return {"status": "solved", "time_s": dt, "stats": stats}
+    return record("solved", dt, stats)
 
 
 class Baselines(Experiment):

@@ -51,7 +51,7 @@ from csplab.experiments.measures import (
     unpack_hashes,
 )
 from csplab.experiments.stats import median_iqr, wilson
-from csplab.experiments.trial import Trial, grid_digest
+from csplab.experiments.trial import Trial, grid_digest, record
 from csplab.grids import parse_shape
 from csplab.problem import Problem
 
@@ -91,7 +91,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
         stats["patterns"] = int(h.size)
         stats["_patterns"] = pack_hashes(h)
     stats["_grid"] = pack_grid(r.grid)
-    return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
+    return record(r.status, r.time_s, stats)
 
 
 class BlockSize(Experiment):

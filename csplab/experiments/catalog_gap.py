@@ -54,7 +54,7 @@ from csplab.experiments.base import (
 )
 from csplab.experiments.figures import new_figure, outside_legend, save_figure
 from csplab.experiments.stats import median_iqr, wilson
-from csplab.experiments.trial import Trial
+from csplab.experiments.trial import Trial, record
 from csplab.problem import Problem
 
 __all__ = ["CatalogGap", "measure", "oracle_methods"]
@@ -83,7 +83,7 @@ def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict
     stats: dict[str, Any] = {"steps": T, "cells": problem.n, "oracle": "sat (csplab.exact)",
                              "oracle_calls": int(st.get("sat_calls", 0))}  # fmt: skip
     if status == "unsat":
-        return {"status": status, "time_s": float(st.get("time_s", 0.0)), "stats": stats}
+        return record(status, st.get("time_s", 0.0), stats)
     first_bad: int | None = None
     if status == "failed":
         stats["fail_step"] = T
@@ -106,7 +106,7 @@ def measure_exact(trial: Trial, example: ExampleModel, problem: Problem) -> dict
                 total += 1 - cs / c
         stats.update(gap_steps=len(gaps), expected_bad=total, checked_steps=upto, _gaps=gaps)
     stats["oracle_s"] = float(st.get("time_s", 0.0))
-    return {"status": status, "time_s": float(st.get("time_s", 0.0)), "stats": stats}
+    return record(status, st.get("time_s", 0.0), stats)
 
 
 def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
@@ -123,7 +123,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     T = int(trace.shape[0])
     stats: dict[str, Any] = {"steps": T, "cells": problem.n}
     if r.status == "unsat":
-        return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
+        return record(r.status, r.time_s, stats)
     t0 = time.perf_counter()
     oracle = SearchCompletability(problem)
     first_bad: int | None = None
@@ -160,7 +160,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     stats["oracle"] = "brute"  # the experiment's name for the search oracle, as stored
     stats["oracle_calls"] = oracle.calls
     stats["oracle_s"] = time.perf_counter() - t0
-    return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
+    return record(r.status, r.time_s, stats)
 
 
 class CatalogGap(Experiment):

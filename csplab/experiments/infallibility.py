@@ -53,7 +53,7 @@ from typing import Any, ClassVar
 from csplab.errors import CsplabError, InputError
 from csplab.example import ExampleModel
 from csplab.experiments.base import Experiment, Report, load_examples, sweep_defaults
-from csplab.experiments.trial import Trial
+from csplab.experiments.trial import Trial, record
 from csplab.problem import Problem
 
 __all__ = ["Infallibility", "anchor_rule_sets", "measure"]
@@ -316,7 +316,7 @@ def measure(trial: Trial, example: Any, problem: Problem | None) -> dict[str, An
         decide_s, decide_cpu = time.perf_counter() - t0, time.process_time() - c0
     except InputError as e:
         stats.update(verdict="n/a", method=str(e).split(": ", 1)[-1])
-        return {"status": "n/a", "time_s": 0.0, "stats": stats}
+        return record("n/a", 0.0, stats)
     verdict = {True: "proved", False: "refuted", None: "undecided"}[v.holds]
     stats.update(verdict=verdict, method=v.stats.get("method", ""), decide_s=decide_s,
                  decide_cpu_s=decide_cpu)  # fmt: skip
@@ -353,7 +353,7 @@ def measure(trial: Trial, example: Any, problem: Problem | None) -> dict[str, An
         if not rp.holds:
             stats["contradiction"] = f"the witness does not replay: {rp.message}"
     _any_order(example, boundary, trial, stats)
-    return {"status": "ok", "time_s": decide_s, "stats": stats}
+    return record("ok", decide_s, stats)
 
 
 def _sizes(ndim: int) -> list[tuple[int, ...]]:

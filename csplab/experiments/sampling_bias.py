@@ -40,7 +40,7 @@ from csplab.experiments.base import (
 from csplab.experiments.figures import new_figure, save_figure
 from csplab.experiments.measures import label_counts
 from csplab.experiments.stats import jensen_shannon, total_variation
-from csplab.experiments.trial import Trial
+from csplab.experiments.trial import Trial, record
 from csplab.experiments.uniform import StripSampler
 from csplab.grids import from_example, parse_shape
 from csplab.problem import Problem
@@ -88,7 +88,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     if trial.solver == "exact":
         S = _sampler(trial, problem)
         if not S.satisfiable:
-            return {"status": "unsat", "time_s": time.perf_counter() - t0, "stats": {}}
+            return record("unsat", time.perf_counter() - t0, {})
         pf = S.pattern_frequencies(2)
         exact = {
             "log_count": S.log_count,
@@ -96,7 +96,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
             "labels": S.label_frequencies().tolist(),
             "_patterns": [[c, pf[c]] for c in sorted(pf)],
         }
-        return {"status": "solved", "time_s": time.perf_counter() - t0, "stats": exact}
+        return record("solved", time.perf_counter() - t0, exact)
     if trial.solver == "uniform":
         grid = _sampler(trial, problem).sample(rng=trial.seed)
         status, elapsed = "solved", time.perf_counter() - t0
@@ -109,7 +109,7 @@ def measure(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, 
     if status == "solved":
         stats["labels"] = label_counts(grid, K).tolist()
         stats["_patterns"] = _sparse_patterns(grid, K)
-    return {"status": status, "time_s": elapsed, "stats": stats}
+    return record(status, elapsed, stats)
 
 
 class SamplingBias(Experiment):

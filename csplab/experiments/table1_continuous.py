@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from csplab.errors import InputError
 from csplab.experiments.base import Experiment, Report, sweep_defaults
 from csplab.experiments.stats import median_iqr
-from csplab.experiments.trial import Trial
+from csplab.experiments.trial import Trial, record
 from csplab.grids import parse_shape
 
 if TYPE_CHECKING:
@@ -148,7 +148,7 @@ def measure_synthesis3(trial: Trial, example: Any, problem: Any) -> dict[str, An
         stats.update(resemblance3(s.csp.example, s.model, ground=floor).to_dict())
         stats["resemblance_s"] = __import__("time").perf_counter() - t0
     status = "solved" if s.ok else s.result.status
-    return {"status": status, "time_s": float(sum(s.times.values())), "stats": stats}
+    return record(status, sum(s.times.values()), stats)
 
 
 class Table1Continuous(Experiment):

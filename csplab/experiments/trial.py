@@ -225,6 +225,18 @@ def kept_stats(stats: dict[str, Any]) -> dict[str, Any]:
     return {k: v for k, v in stats.items() if k in STATS and small(v)}
 
 
+def record(status: str, time_s: float, stats: dict[str, Any]) -> dict[str, Any]:
+    """What a measure returns, as the store keeps it: the trial's status, its time in
+    seconds and its stats.
+
+    Examples
+    --------
+    >>> record("solved", 1, {"nodes": 3})
+    {'status': 'solved', 'time_s': 1.0, 'stats': {'nodes': 3}}
+    """
+    return {"status": str(status), "time_s": float(time_s), "stats": stats}
+
+
 def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict[str, Any]:
     """The default measure: solve once with ``rng=trial.seed``; status, time, main stats and
     a digest of the output grid."""
@@ -236,4 +248,4 @@ def measure_solve(trial: Trial, example: ExampleModel, problem: Problem) -> dict
               **trial.options)  # fmt: skip
     stats = kept_stats(r.stats)
     stats["grid"] = grid_digest(r.grid)
-    return {"status": r.status, "time_s": float(r.time_s), "stats": stats}
+    return record(r.status, r.time_s, stats)
