@@ -3,7 +3,7 @@
 For each built-in polyhedral example it synthesizes one output with csplab's defaults
 (weighted choice, the example's own infinite ground) and, as the reference in the same
 process, one with the thesis' setting (uniform choice, no ground), and prints the
-resemblance figures of :func:`~csplab.continuous.resemblance.resemblance3` (computed from
+resemblance figures of :func:`~csplab.continuous.resemblance.resemblance` (computed from
 the solids alone): solids, median solid volume over the example's, share of the example's
 edge kinds and face orientations present, floating solids. The targets
 (:data:`~csplab.experiments.table1_continuous.TARGETS`: 0 floating solids with a ground,
@@ -12,7 +12,7 @@ the shortfall (:func:`~csplab.experiments.table1_continuous.targets_met`), never
 Sizes are Table 1's (the paper's output polygons), or 20x20x8 with ``--quick``.
 
 ``--polygons`` does the same for the built-in polygon (2D) examples with
-:func:`~csplab.continuous.resemblance.resemblance2`: for each example, size and choice
+:func:`~csplab.continuous.resemblance.resemblance`: for each example, size and choice
 (weighted, csplab's default, and uniform, the thesis', in the same process) over
 ``--seeds`` seeds, the share solved on the first attempt (no restarts), the mean solve
 time, and the medians of the figures over the solved seeds.
@@ -50,7 +50,7 @@ def main() -> None:
         polygons(a.sizes.split(","), a.seeds)
         return
 
-    from csplab.continuous.resemblance import resemblance3
+    from csplab.continuous.resemblance import resemblance
     from csplab.continuous.synthesis import synthesize
     from csplab.examples.continuous3d import load_polyhedral_example
     from csplab.grids import parse_shape
@@ -70,7 +70,7 @@ def main() -> None:
                       f"{s.result.status}")  # fmt: skip
                 continue
             floor = s.csp.region()[2] if "z-" in s.csp.ground else None
-            r = resemblance3(s.csp.example, s.model, ground=floor)
+            r = resemblance(s.csp.example, s.model, ground=floor)
             verdict = targets_met(r.to_dict(), bool(s.csp.ground))
             print(f"{name:<12} {'x'.join(map(str, size)):<9} {setting:<29} {r.solids:>6} "
                   f"{r.median_volume_ratio:>8.3f} {r.edge_kinds:>6.2f} "
@@ -82,7 +82,7 @@ def polygons(sizes: list[str], seeds: int) -> None:
     """The 2D comparison of ``--polygons`` (module docstring)."""
     import statistics
 
-    from csplab.continuous.resemblance import resemblance2
+    from csplab.continuous.resemblance import resemblance
     from csplab.continuous.synthesis import synthesize
     from csplab.examples.continuous import CONTINUOUS_EXAMPLES, load_polygon_example
     from csplab.grids import parse_shape
@@ -101,7 +101,7 @@ def polygons(sizes: list[str], seeds: int) -> None:
                     times.append(time.perf_counter() - t)
                     if s.ok and s.model is not None:
                         floor = s.csp.region()[1] if "y-" in s.csp.ground else None
-                        got.append(resemblance2(s.csp.example, s.model, ground=floor))
+                        got.append(resemblance(s.csp.example, s.model, ground=floor))
 
                 def med(key: str, rs: list = got) -> float:  # type: ignore[type-arg]
                     return statistics.median(getattr(r, key) for r in rs) if rs else float("nan")

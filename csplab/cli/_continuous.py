@@ -255,18 +255,18 @@ def synthesize(
         )  # fmt: skip
         snapped = csp.example  # (as synthesized: its vertices on the lattice)
         if isinstance(snapped, PolyhedralModel) and isinstance(s.model, PolyhedralModel):
-            from csplab.continuous.resemblance import resemblance3  # from the geometry alone
+            from csplab.continuous.resemblance import resemblance  # from the geometry alone
 
             floor = csp.region()[2] if "z-" in opened else None  # the ground's height
             # through bounding volumes: the original example against the output with its
             # curved geometry back (the proxy is what was synthesized, not what it resembles)
             like = s.bounded.example if s.bounded is not None else snapped
-            d["resemblance"] = resemblance3(like, s.model, ground=floor).to_dict()
+            d["resemblance"] = resemblance(like, s.model, ground=floor).to_dict()
         elif isinstance(snapped, PolygonModel) and isinstance(s.model, PolygonModel):
-            from csplab.continuous.resemblance import resemblance2
+            from csplab.continuous.resemblance import resemblance
 
             floor = csp.region()[1] if "y-" in opened else None  # the ground's height
-            d["resemblance"] = resemblance2(snapped, s.model, ground=floor).to_dict()
+            d["resemblance"] = resemblance(snapped, s.model, ground=floor).to_dict()
         if s.bounded is not None:
             d["bounding_volumes"] = s.bounded.describe()
         print(json.dumps(d))

@@ -2,7 +2,7 @@
 figures computed from the geometry alone (no planes, lattice or CSP), to read beside Eq.
 4.1's violations.
 
-:func:`resemblance3` gives, for an example and an output
+:func:`resemblance` gives, for an example and an output
 (:class:`~csplab.continuous.polyhedra.PolyhedralModel`):
 
 * ``solids`` and ``example_solids``: the numbers of solids;
@@ -21,7 +21,7 @@ figures computed from the geometry alone (no planes, lattice or CSP), to read be
   of another solid that faces upwards. Floating solids in an output of an example without
   any are a defect a human sees at once.
 
-:func:`resemblance2` gives the same figures for polygon models
+:func:`resemblance` gives the same figures for polygon models
 (:class:`~csplab.continuous.model.PolygonModel`), one dimension down: polygons for
 solids, areas for volumes, corners for edges (the pair of edge directions meeting at a
 corner of each label's union, shapely, and whether the corner is convex or reflex),
@@ -40,7 +40,7 @@ Examples
 >>> ex = PolyhedralModel([box((0, 0, 0), (2, 2, 1))])
 >>> out = PolyhedralModel([box((0, 0, 0), (2, 2, 1)), box((0, 0, 1), (1, 1, 2)),
 ...                        box((5, 5, 3), (6, 6, 4))])
->>> r = resemblance3(ex, out)
+>>> r = resemblance(ex, out)
 >>> r.solids, r.floating, r.example_floating, r.face_orientations, r.edge_kinds
 (3, 1, 0, 1.0, 1.0)
 >>> r.median_volume_ratio
@@ -51,7 +51,7 @@ Examples
 >>> out2 = PolygonModel.from_json({"polygons": [
 ...     {"label": 1, "points": [[0, 0], [4, 0], [4, 2], [0, 2]]},
 ...     {"label": 1, "points": [[6, 3], [7, 3], [6, 4]]}]})
->>> r2 = resemblance2(ex2, out2)
+>>> r2 = resemblance(ex2, out2)
 >>> r2.solids, r2.floating, r2.face_orientations, r2.edge_kinds, r2.median_volume_ratio
 (2, 1, 1.0, 1.0, 0.53125)
 """
@@ -68,6 +68,7 @@ from numpy.typing import NDArray
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.deps import require
+from csplab.errors import InputError
 
 __all__ = [
     "Resemblance",
@@ -75,8 +76,7 @@ __all__ = [
     "edge_kinds",
     "floating_polygons",
     "floating_solids",
-    "resemblance2",
-    "resemblance3",
+    "resemblance",
 ]
 
 #: normals closer than this (radians) are one face orientation
@@ -85,7 +85,7 @@ ANGLE_TOL = 1e-3
 
 @dataclass(frozen=True)
 class Resemblance:
-    """The figures of :func:`resemblance3` and :func:`resemblance2` (see the module
+    """The figures of :func:`resemblance` and :func:`resemblance` (see the module
     docstring; for polygons ``solids`` counts polygons, volumes are areas, edge kinds are
     corner kinds and face orientations are edge directions)."""
 
@@ -233,35 +233,58 @@ def floating_solids(model: PolyhedralModel, ground: float | None = None) -> list
 
 
 # ---------------------------------------------------------------------------- figures
-def resemblance3(
-    example: PolyhedralModel, output: PolyhedralModel, *, angle_tol: float = ANGLE_TOL,
+def resemblance(
+    example: PolygonModel | PolyhedralModel,
+    output: PolygonModel | PolyhedralModel,
+    *,
+    angle_tol: float = ANGLE_TOL,
     ground: float | None = None,
 ) -> Resemblance:
-    """The resemblance figures of ``output`` against ``example`` (module docstring).
+    """The resemblance figures of ``output`` against ``example`` (module docstring), for
+    polyhedral models or, one dimension down, polygon models.
 
     Parameters
     ----------
-    example, output : PolyhedralModel
-        The example and a synthesized model (any polyhedral models).
+    example, output : PolyhedralModel or PolygonModel
+        The example and a synthesized model (any two models of the same dimension).
     angle_tol : float
-        Normals closer than this many radians are one face orientation.
+        Normals closer than this many radians are one face orientation (3D) or one edge
+        direction (2D).
     ground : float, optional
-        The height of the output's ground (a solid whose lowest point is there rests on
-        it; a synthesis with a ground: the region's bottom); default the output's lowest
-        ``z``. The example's ground is its own lowest ``z``.
+        The height (``z`` in 3D, ``y`` in 2D) of the output's ground: a part whose lowest
+        point is there rests on it (a synthesis with a ground: the region's bottom);
+        default the output's lowest point. The example's ground is its own lowest point.
 
     Returns
     -------
     Resemblance
-        The figures.
+        The figures (in 2D: polygons, areas, corner kinds and edge directions).
+
+    Raises
+    ------
+    InputError
+        When the two models are not of the same dimension.
     """
     normals = _Normals(angle_tol)
-    return _figures(
-        edge_kinds(example, normals, grow=True),
-        edge_kinds(output, normals, grow=False) if output.solids else (set(), set()),
-        [s.volume for s in example.solids],
-        [s.volume for s in output.solids],
-        (len(floating_solids(example)), len(floating_solids(output, ground))),
+    if isinstance(example, PolyhedralModel) and isinstance(output, PolyhedralModel):
+        return _figures(
+            edge_kinds(example, normals, grow=True),
+            edge_kinds(output, normals, grow=False) if output.solids else (set(), set()),
+            [s.volume for s in example.solids],
+            [s.volume for s in output.solids],
+            (len(floating_solids(example)), len(floating_solids(output, ground))),
+        )
+    if isinstance(example, PolygonModel) and isinstance(output, PolygonModel):
+        return _figures(
+            corner_kinds(example, normals, grow=True),
+            corner_kinds(output, normals, grow=False) if output.polygons else (set(), set()),
+            [p.shape.area for p in example.polygons],
+            [p.shape.area for p in output.polygons],
+            (len(floating_polygons(example)), len(floating_polygons(output, ground))),
+        )
+    raise InputError(
+        f"resemblance compares two models of one dimension, not a {type(example).__name__} "
+        f"with a {type(output).__name__}"
     )
 
 
@@ -392,36 +415,3 @@ def floating_polygons(model: PolygonModel, ground: float | None = None) -> list[
         if not touch:
             out.append(i)
     return out
-
-
-def resemblance2(
-    example: PolygonModel, output: PolygonModel, *, angle_tol: float = ANGLE_TOL,
-    ground: float | None = None,
-) -> Resemblance:
-    """The resemblance figures of polygon model ``output`` against ``example`` (module
-    docstring: :func:`resemblance3` one dimension down).
-
-    Parameters
-    ----------
-    example, output : PolygonModel
-        The example and a synthesized model (any polygon models).
-    angle_tol : float
-        Edge normals closer than this many radians are one edge direction.
-    ground : float, optional
-        The ``y`` of the output's ground (a synthesis with a ground below: the region's
-        bottom); default the output's lowest ``y``. The example's ground is its own lowest
-        ``y``.
-
-    Returns
-    -------
-    Resemblance
-        The figures (polygons, areas, corner kinds, edge directions).
-    """
-    normals = _Normals(angle_tol)
-    return _figures(
-        corner_kinds(example, normals, grow=True),
-        corner_kinds(output, normals, grow=False) if output.polygons else (set(), set()),
-        [p.shape.area for p in example.polygons],
-        [p.shape.area for p in output.polygons],
-        (len(floating_polygons(example)), len(floating_polygons(output, ground))),
-    )

@@ -11,7 +11,7 @@ default for continuous inputs, and the thesis' ``uniform``) and each ground (``-
 ``auto``, the example's own infinite ground, and ``none``), and records the output's
 polygons and solids, the independent checker's violations, the time of each phase
 (building the CSP, solving, the output geometry, the check) and the resemblance figures of
-:func:`~csplab.continuous.resemblance.resemblance3` (solids, median solid volume over the
+:func:`~csplab.continuous.resemblance.resemblance` (solids, median solid volume over the
 example's, edge kinds and face orientations of the example present, floating solids).
 
 The report gives the paper's Table 1 beside the median over the seeds (first choice and
@@ -127,7 +127,7 @@ def _synthesis(example: Any, size: Any, solver: str, seed: int, p: dict[str, Any
 def measure_synthesis3(trial: Trial, example: Any, problem: Any) -> dict[str, Any]:
     """Synthesize once (``rng=trial.seed``): status, end-to-end time, phases, polygons,
     solids, violations and the resemblance figures."""
-    from csplab.continuous.resemblance import resemblance3
+    from csplab.continuous.resemblance import resemblance
 
     del problem
     p = trial.params
@@ -145,7 +145,7 @@ def measure_synthesis3(trial: Trial, example: Any, problem: Any) -> dict[str, An
     if s.model is not None:
         t0 = __import__("time").perf_counter()
         floor = s.csp.region()[2] if "z-" in s.csp.ground else None
-        stats.update(resemblance3(s.csp.example, s.model, ground=floor).to_dict())
+        stats.update(resemblance(s.csp.example, s.model, ground=floor).to_dict())
         stats["resemblance_s"] = __import__("time").perf_counter() - t0
     status = "solved" if s.ok else s.result.status
     return record(status, sum(s.times.values()), stats)
@@ -283,7 +283,7 @@ class Table1Continuous(Experiment):
             "polygons)."
         )
         rep.notes.append(
-            "Resemblance: median over the solved seeds of resemblance3 (computed from the "
+            "Resemblance: median over the solved seeds of resemblance (computed from the "
             "output's and the example's solids alone): solids; median solid volume / the "
             "example's; share of the example's edge kinds (two face orientations, convex or "
             "reflex) present; share of its face orientations used; floating solids (resting "

@@ -20,7 +20,7 @@ import pytest
 from csplab import _interp
 from csplab.continuous.check import violations
 from csplab.continuous.csp3d import WINDOW, ContinuousCSP3, ground_faces
-from csplab.continuous.resemblance import floating_solids, resemblance3
+from csplab.continuous.resemblance import floating_solids, resemblance
 from csplab.continuous.synthesis import auto_ground, synthesize
 from csplab.engine.alg31 import run_alg31
 from csplab.errors import InputError
@@ -140,7 +140,7 @@ def test_weighted_arches_keep_their_size() -> None:
     for seed in range(8):
         s = synthesize(E, (12, 12, 6), rng=seed, restarts=5, check=False)
         assert s.model is not None and "z-" in s.csp.ground
-        ratios.append(resemblance3(s.csp.example, s.model, ground=s.csp.region()[2])
+        ratios.append(resemblance(s.csp.example, s.model, ground=s.csp.region()[2])
                       .median_volume_ratio)  # fmt: skip
     assert float(np.median(ratios)) >= 0.32, ratios
 
