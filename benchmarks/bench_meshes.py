@@ -205,11 +205,15 @@ def main(argv: list[str] | None = None) -> int:
         ref = measure(houses, args.size, work)
         print(f"machine load (1/5/15 min): {os.getloadavg()}")
         report("houses (reference, built-in, exact coordinates)", 0, ref, None)
+        drawn: list[Path] = []
         for name in args.parts:
             path = cad.export(cad.build(name), work / f"{name}.stl")
             report(name, orientations(path), measure(path, args.size, work), ref)
-            if args.pictures is not None:
-                picture(path, work / f"{path.stem}-out.obj", args.size, args.pictures)
+            drawn.append(path)
+        # after every measurement: the pictures' models would otherwise swell this process,
+        # whose resident size a forked child's ru_maxrss starts from
+        for path in drawn if args.pictures is not None else []:
+            picture(path, work / f"{path.stem}-out.obj", args.size, args.pictures)
     return 0
 
 
