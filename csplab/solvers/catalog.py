@@ -36,7 +36,8 @@ class CatalogSolver(Solver):
     notes = (
         "orders `scanline` (thesis loop order, default), `random`, `min-entropy` (WFC-style), "
         "`scan:AXES`; label choice `uniform` (thesis) or `weighted`; `failed` = gave up, "
-        "`unsat` only when arc consistency wipes out before any choice"
+        "`unsat` only when arc consistency wipes out before any choice; with global "
+        "constraints a refuted choice is withdrawn and the cell chooses again"
     )
     options = (order_option(), CHOICE, WINDOW, TIME_LIMIT)
 
