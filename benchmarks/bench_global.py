@@ -45,26 +45,15 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 TARGET = {"catalog": 10.0, "sat": 10.0, "asp": 10.0, "cpsat": 30.0}
 
 
 def city(size: tuple[int, ...] = (40, 40, 10)) -> tuple[Any, Any]:
-    import csplab
-    from csplab.constraints import parse_constraints
-    from csplab.experiments.base import background_labels
+    from csplab.testing.synthetic import connected_city
 
-    ex = csplab.load_example("city")
-    P = csplab.from_example(ex, size, boundary="auto")
-    bg = set(background_labels(ex))
-    fg = [b for b in range(ex.K) if b not in bg]
-    cons = [
-        {"type": "connected", "labels": fg},
-        {"type": "count", "labels": fg, "min": int(np.ceil(0.05 * P.n)), "max": int(0.3 * P.n)},
-    ]
-    return P, P.with_constraints(parse_constraints(cons, P))
+    return connected_city(size)
 
 
 def pipes(size: tuple[int, ...] = (128, 128)) -> tuple[Any, Any]:

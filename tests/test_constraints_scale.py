@@ -11,22 +11,14 @@ import pytest
 import csplab
 from csplab import ExampleModel
 from csplab.cnf import encode
-from csplab.constraints import ClauseContext, Connected, Count, parse_constraints
+from csplab.constraints import ClauseContext, Connected, Count
 from csplab.engine.alg31 import run_alg31
-from csplab.experiments.base import background_labels
 from csplab.grids import from_example
+from csplab.testing.synthetic import connected_city
 
 
 def _city(size, lo_frac=0.05):
-    ex = csplab.load_example("city")
-    P = csplab.from_example(ex, size, boundary="auto")
-    bg = set(background_labels(ex))
-    fg = [b for b in range(ex.K) if b not in bg]
-    cons = [
-        {"type": "connected", "labels": fg},
-        {"type": "count", "labels": fg, "min": int(np.ceil(lo_frac * P.n)), "max": int(0.3 * P.n)},
-    ]
-    return P.with_constraints(parse_constraints(cons, P))
+    return connected_city(size, lo_frac)[1]
 
 
 @pytest.mark.parametrize("order", ["scanline", "min-entropy"])

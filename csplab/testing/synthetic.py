@@ -23,9 +23,10 @@ from __future__ import annotations
 import numpy as np
 
 from csplab.example import ExampleModel
+from csplab.problem import Problem
 from csplab.rng import RngLike, make_rng
 
-__all__ = ["box_town"]
+__all__ = ["box_town", "connected_city"]
 
 
 def box_town(
@@ -74,3 +75,43 @@ def box_town(
 
 def _pos(i: int, extent: int) -> int:
     return 0 if i == 0 else (2 if i == extent - 1 else 1)
+
+
+def connected_city(
+    size: tuple[int, ...] = (40, 40, 10), lo_frac: float = 0.05
+) -> tuple[Problem, Problem]:
+    """Merrell's City at Night of ``size`` with its boundary (``auto``), and the same with the
+    global constraints of the performance issue: every non-background cell in one connected
+    set, and between ``lo_frac`` and 30 % of the cells of it.
+
+    Parameters
+    ----------
+    size : tuple of int
+        The output size.
+    lo_frac : float
+        The count's lower bound as a share of the cells.
+
+    Returns
+    -------
+    tuple of Problem
+        The problem without and with the constraints.
+
+    Examples
+    --------
+    >>> P, Q = connected_city((6, 6, 4))
+    >>> len(P.constraints), [c.kind for c in Q.constraints]
+    (0, ['connected', 'count'])
+    """
+    import csplab
+    from csplab.constraints import parse_constraints
+    from csplab.experiments.base import background_labels
+
+    ex = csplab.load_example("city")
+    P = csplab.from_example(ex, size, boundary="auto")
+    bg = set(background_labels(ex))
+    fg = [b for b in range(ex.K) if b not in bg]
+    cons = [
+        {"type": "connected", "labels": fg},
+        {"type": "count", "labels": fg, "min": int(np.ceil(lo_frac * P.n)), "max": int(0.3 * P.n)},
+    ]
+    return P, P.with_constraints(parse_constraints(cons, P))
