@@ -227,19 +227,18 @@ class _Grow:
             S = c.set_labels(problem) if isinstance(c, Connected) else None
             if S is not None:
                 self.sets.append(pack(S[None, :])[0])
-        self.problem = problem
+        self.ptr, self.nbr = grid_csr(problem)
         self.started: set[bytes] = set()
 
     def steer(self, bits: NDArray[np.uint64], p: int) -> None:
         """Restrict cell ``p``'s catalog to the labels outside a set it cannot join yet."""
-        ptr, nbr = grid_csr(self.problem)
+        ptr, nbr = self.ptr, self.nbr
         row = bits[p]
         for sp in self.sets:
             out = row & ~sp
             if not (row & sp).any() or not out.any():
                 continue
-            nb = bits[nbr[ptr[p] : ptr[p + 1]]]
-            if ((nb & sp).any(axis=1) & ~(nb & ~sp).any(axis=1)).any():
+            if kern.set_status(bits[nbr[ptr[p] : ptr[p + 1]]], sp)[1].any():
                 continue  # p touches the component
             if not self._started(bits, sp):
                 continue
@@ -251,7 +250,7 @@ class _Grow:
         key = sp.tobytes()
         if key in self.started:
             return True
-        if ((bits & sp).any(axis=1) & ~(bits & ~sp).any(axis=1)).any():
+        if kern.set_status(bits, sp)[1].any():
             self.started.add(key)
             return True
         return False
@@ -296,10 +295,9 @@ def _withdraw(
     for c, a in withdrawn:
         bits[c, a // 64] &= ~np.uint64(1 << (a % 64))
     changed = np.flatnonzero((bits != root).any(axis=1))
-    eng.bits[...] = bits
-    eng.prev[...] = 0  # unknown: the next revisions are full ones
-    eng.ok, eng.wiped = True, -1
-    eng._last = []  # the constraints' remembered fixpoints belong to the withdrawn step
+    # previous domains unknown (the next revisions are full ones); load also forgets the
+    # constraints' remembered fixpoints, which belong to the withdrawn step
+    eng.load((bits, np.zeros_like(bits), True, -1))
     if not eng.propagate(changed) or eng.constrain() != -1:
         run.state[2] = p if eng.wiped < 0 else eng.wiped
         return False
