@@ -241,8 +241,9 @@ class ClauseContext:
 
     ``lit(cell, label)`` gives a solver literal (``int``) or a constant (``True``/
     ``False``); :meth:`in_set` adds one auxiliary variable per cell and label set ("the
-    label is in the set"); cardinalities use :mod:`pysat.card` unless a subclass overrides
-    :meth:`card`. ``clauses`` collects the output; ``top`` is the largest variable used.
+    label is in the set"); cardinalities are sequential counters or adders (:meth:`card`)
+    unless a subclass overrides it. ``clauses`` collects the output; ``top`` is the largest
+    variable used.
     """
 
     def __init__(self, problem: Problem, lit: Callable[[int, int], Lit], top: int) -> None:

@@ -85,7 +85,7 @@ ANGLE_TOL = 1e-3
 
 @dataclass(frozen=True)
 class Resemblance:
-    """The figures of :func:`resemblance` and :func:`resemblance` (see the module
+    """The figures of :func:`resemblance` (see the module
     docstring; for polygons ``solids`` counts polygons, volumes are areas, edge kinds are
     corner kinds and face orientations are edge directions)."""
 

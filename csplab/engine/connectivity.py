@@ -59,7 +59,7 @@ class _State:
         self.y: list[Any] = [con.in_set(ctx, c) for c in range(problem.n)]
         #: lower bounds of counts over labels of the set: (cells of the count's region, min)
         self.need: list[tuple[NDArray[np.int64] | None, int]] = []
-        if con.members is None:
+        if self.grid:
             S = {int(b) for b in con.labels}
             for cnt in problem.constraints:
                 if isinstance(cnt, Count) and cnt.min > 0 and {int(b) for b in cnt.labels} <= S:

@@ -423,13 +423,6 @@ class Output:
             example=example,
         )
 
-    def file_grid(self) -> NDArray[np.int64]:
-        """The grid with the label ids of the model's file (see
-        :func:`csplab.example.file_labels`)."""
-        from csplab.example import file_labels
-
-        return file_labels(self.grid, self.meta)
-
     def to_example(self) -> ExampleModel:
         """The grid as an :class:`ExampleModel` (``example`` when set)."""
         from csplab.example import ExampleModel

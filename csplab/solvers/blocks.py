@@ -187,7 +187,8 @@ def _trivial_plan(problem_for: Callable[[int | None], Problem]) -> _TrivialPlan 
     for axis in reversed(range(P.ndim)):
         problem = problem_for(axis)
         rel, arcs = problem.relations, problem.arcs
-        layer = np.indices(problem.shape)[axis].reshape(-1)
+        stride = math.prod(problem.shape[axis + 1 :])  # C order: the axis's index per cell
+        layer = (np.arange(problem.n) // stride) % problem.shape[axis]
         L = problem.shape[axis]
         ls, ld = layer[arcs[:, 0]], layer[arcs[:, 1]]
         ok_label = np.ones((L, K), dtype=bool)
