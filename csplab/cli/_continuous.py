@@ -207,6 +207,9 @@ def synthesize(
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
     if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
+        # what check needs to compare the example as it was synthesized (kept by .obj,
+        # .glb and .json outputs)
+        s.model.meta["synthesis"] = recorded_settings(args, example, ground)
         fmt.write(s.model, args.out)
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
@@ -385,6 +388,46 @@ def onto_planes(model: PolyhedralModel, lat: Any) -> tuple[PolyhedralModel, int]
     return PolyhedralModel(solids, name=model.name, meta=model.meta, source=model.source), moved
 
 
+def recorded_settings(
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel, ground: str
+) -> dict[str, Any]:
+    """The settings of ``csplab synthesize`` that ``csplab check`` needs, as given (``None``
+    spacing: derived, as check derives it too)."""
+    d: dict[str, Any] = {"example": example.name or str(args.model), "ground": ground}
+    if example.ndim == 3:
+        d.update(spacing=args.spacing, snap=bool(args.snap), lines=args.lines)
+    return d
+
+
+def apply_recorded(args: argparse.Namespace, out: PolygonModel | PolyhedralModel) -> str:
+    """Take the output's recorded synthesis settings for the options the user left at
+    their defaults (given options win); a note saying which were read, or ``""``."""
+    rec = out.meta.get("synthesis")
+    if not isinstance(rec, dict):
+        return ""
+    defaults = {"spacing": None, "snap": False, "lines": "auto", "ground": "auto"}
+    taken, differ = [], []
+    for key, default in defaults.items():
+        given = getattr(args, key, default)
+        if key in rec and given != default and given != rec[key]:
+            differ.append(f"--{key} {given} given, synthesize used {rec[key]}")
+        if key in rec and given == default and rec[key] != default:
+            value = rec[key]
+            bad = (key == "spacing" and not (isinstance(value, int | float) and value > 0)) or (
+                key == "lines" and value not in ("auto", "lattice", "equal")
+            )
+            if bad:
+                raise InputError(f"{args.grid}: the recorded {key} {value!r} is not valid")
+            if key == "spacing":
+                value = float(value)
+                taken.append(f"--spacing {value:g}")
+            else:
+                taken.append(f"--{key}" if value is True else f"--{key} {value}")
+            setattr(args, key, value)
+    note = f" (settings of synthesize read from {args.grid}: {' '.join(taken)})" if taken else ""
+    return note + (f" ({'; '.join(differ)})" if differ else "")
+
+
 def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> int:
     """``csplab check EXAMPLE.json OUT.json`` (or ``EXAMPLE.obj OUT.obj``): violations of
     Eq. 4.1 (and of the user constraints of thesis Sec. 4.6 on solids)."""
@@ -402,6 +445,7 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
     out = load_model(args.grid)
     if not isinstance(out, PolygonModel | PolyhedralModel) or out.ndim != example.ndim:
         raise InputError(f"{args.grid} is not a {example.kind} model (the example {args.model} is)")
+    recorded = apply_recorded(args, out)
     bounded = None
     if isinstance(example, PolyhedralModel) and isinstance(out, PolyhedralModel):
         from csplab.continuous.bounding import bounding_volumes
@@ -454,7 +498,8 @@ def check(args: argparse.Namespace, example: PolygonModel | PolyhedralModel) -> 
         print(json.dumps({"violations": len(v), **v.counts(), out.parts: len(out)}))
     else:
         print(f"{len(v)} violations in {args.grid} ({len(out)} {out.parts}, labels "
-              f"{list(out.labels)}) against {example.name or args.model}{snapped}")  # fmt: skip
+              f"{list(out.labels)}) against {example.name or args.model}{snapped}"
+              f"{recorded}")  # fmt: skip
         if bounded is not None:
             print(f"  {bounded.describe()}; checked: curved parts are moved and scaled "
                   "originals, each box holds the mapped original, Eq. 4.1 on the proxy")

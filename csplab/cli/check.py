@@ -46,7 +46,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--spacing",
         type=float,
         help="polyhedral examples: the plane spacing the output was synthesized with (the "
-        "example is compared as synthesize snaps it; default: derived, as synthesize)",
+        "example is compared as synthesize snaps it; default: what synthesize recorded in "
+        "the output (.obj, .glb), else derived, as synthesize). --snap, --lines and "
+        "--ground also default to the recorded settings; given options win",
     )
     p.add_argument("--snap", action="store_true", help="polyhedral examples: as synthesize --snap")
     p.add_argument(

@@ -58,6 +58,7 @@ Examples
 from __future__ import annotations
 
 import io
+import json
 import re
 import struct
 import warnings
@@ -107,6 +108,30 @@ __all__ = [
 
 _LABEL_NAME = re.compile(r"label[_\s-]?(\d+)", re.IGNORECASE)
 _LABEL_COMMENT = re.compile(r"#\s*csplab\s+label\s+(\S+)", re.IGNORECASE)
+_SYNTHESIS_COMMENT = re.compile(r"#\s*csplab\s+synthesis\s+(.*\S)")
+
+
+def _synthesis(model: PolyhedralModel) -> dict[str, Any] | None:
+    """The settings ``csplab synthesize`` made the model with (``meta["synthesis"]``: spacing,
+    snap, lines, ground), which ``.obj``, ``.glb`` and ``.json`` outputs keep so that
+    ``csplab check`` compares the example as it was synthesized."""
+    d = model.meta.get("synthesis")
+    return dict(d) if isinstance(d, dict) else None
+
+
+_EMPTY_GLB_GENERATOR = "csplab (empty scene)"
+
+
+def _read_synthesis(text: str | Any, p: Path, where: str) -> dict[str, Any]:
+    """``{"synthesis": settings}`` from the JSON text (or the decoded object) a writer
+    stored; one line naming the file on error."""
+    try:
+        d = json.loads(text) if isinstance(text, str) else text
+    except ValueError:
+        raise FormatError(f"{where}: the csplab synthesis settings are not JSON", path=p) from None
+    if not isinstance(d, dict):
+        raise FormatError(f"{where}: the csplab synthesis settings are not an object", path=p)
+    return {"synthesis": d}
 _OBJ_FACE = re.compile(r"^[ \t]*f[ \t]", re.MULTILINE)
 
 
@@ -217,6 +242,7 @@ def _solids(
     fmt: str,
     by_component: bool,
     vertex_name: Callable[[int], str] | None = None,
+    extra: dict[str, Any] | None = None,
 ) -> PolyhedralModel:
     """Solids (edge-connected shells of one label and group) and the model, after the
     repairs of :mod:`csplab.io.mesh_repair` (one warning line says what was repaired;
@@ -267,7 +293,7 @@ def _solids(
             s["label"] = k
     if not solids:
         raise InputError(f"{path}: no faces: a polyhedral example needs closed solids")
-    meta: dict[str, Any] = {"format": fmt}
+    meta: dict[str, Any] = {"format": fmt, **(extra or {})}
     if names and not by_component:
         meta["label_names"] = {str(b): n for b, n in sorted(names.items())}
     if repairs:
@@ -355,6 +381,7 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
     explicit: list[int | None] = []
     group, mat, label = "", None, None
     any_group = False
+    extra: dict[str, Any] = {}
     text = _text(p)
     check_face_count(sum(1 for _ in _OBJ_FACE.finditer(text)), p)
     vlines: list[int] = []
@@ -363,6 +390,10 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
         if not line:
             continue
         if line.startswith("#"):
+            sm = _SYNTHESIS_COMMENT.match(line)
+            if sm is not None:
+                extra = _read_synthesis(sm.group(1), p, f"line {n}")
+                continue
             m = _LABEL_COMMENT.match(line)
             if m is not None:
                 try:
@@ -429,7 +460,7 @@ def read_obj_model(path: str | Path, labels: str = "auto") -> PolyhedralModel:
         for j, b in zip(free, got, strict=True):
             labs[j] = b
     return _solids(v, polys, labs, groups, names, p, "mesh-obj", mode == "components",
-                   lambda k: f"line {vlines[k]}")  # fmt: skip
+                   lambda k: f"line {vlines[k]}", extra)  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OFF in
@@ -687,6 +718,18 @@ def read_glb(path: str | Path, labels: str = "auto") -> PolyhedralModel:
     data = read_bytes(p)
     doc = _glb_json(data, p)
     check_face_count(_glb_face_count(doc, p), p)
+    extra: dict[str, Any] = {}
+    scenes, k = doc.get("scenes"), doc.get("scene", 0)
+    if isinstance(scenes, list) and isinstance(k, int) and 0 <= k < len(scenes):
+        mine = scenes[k].get("extras") if isinstance(scenes[k], dict) else None
+        ours = mine.get("csplab") if isinstance(mine, dict) else None
+        if isinstance(ours, dict) and "synthesis" in ours:
+            extra = _read_synthesis(ours["synthesis"], p, "the scene's extras")
+    asset = doc.get("asset")
+    if not doc.get("meshes") and isinstance(asset, dict) and (
+        asset.get("generator") == _EMPTY_GLB_GENERATOR
+    ):  # what write_glb writes for an output that is all empty space
+        return PolyhedralModel([], name=p.stem, meta={"format": "glb", **extra}, source=str(p))
     nodes = doc.get("nodes", [])
     rank = {n.get("name"): i for i, n in enumerate(nodes) if isinstance(n, dict)}
     tm = require("trimesh", "mesh", "reading glTF")
@@ -725,7 +768,7 @@ def read_glb(path: str | Path, labels: str = "auto") -> PolyhedralModel:
     else:
         labs = [1] * len(polys)
     return _solids(v, polys, labs, [""] * len(polys), names_, p, "glb",
-                   labels == "components", lambda k: f"vertex {k}")  # fmt: skip
+                   labels == "components", lambda k: f"vertex {k}", extra)  # fmt: skip
 
 
 # ---------------------------------------------------------------------------- OBJ out
@@ -766,6 +809,9 @@ def write_obj_model(model: PolyhedralModel, path: str | Path) -> None:
         + f": {len(model)} solids, labels {list(model.labels)}",
         f"mtllib {mtl.name}",
     ]
+    settings = _synthesis(model)
+    if settings is not None:
+        lines.insert(1, "# csplab synthesis " + json.dumps(settings, sort_keys=True))
     base = 1
     for i, s in enumerate(model.solids):
         lines += [f"o solid_{i}", f"usemtl label_{s.label}"]
@@ -1055,16 +1101,20 @@ def write_glb(model: PolyhedralModel, path: str | Path) -> None:
         mesh = tm.Trimesh(vertices=np.concatenate(vs), faces=np.concatenate(fs), process=False)
         mesh.visual = tm.visual.TextureVisuals(material=mat)
         scene.add_geometry(mesh, node_name=f"label_{b}", geom_name=f"label_{b}")
-    data = scene.export(file_type="glb") if model.solids else _empty_glb()
+    settings = _synthesis(model)
+    if settings is not None:  # the scene's extras (glTF's place for application data)
+        scene.metadata["csplab"] = {"synthesis": settings}
+    data = scene.export(file_type="glb") if model.solids else _empty_glb(settings)
     write_atomic(Path(path), bytes(data))
 
 
-def _empty_glb() -> bytes:
-    """A valid ``.glb`` with an empty scene (an output that is all empty space)."""
-    import json
-
-    doc = json.dumps({"asset": {"version": "2.0", "generator": "csplab"}, "scenes": [{}],
-                      "scene": 0}).encode()  # fmt: skip
+def _empty_glb(settings: dict[str, Any] | None = None) -> bytes:
+    """A valid ``.glb`` with an empty scene (an output that is all empty space), which
+    :func:`read_glb` reads back as a model of no solids."""
+    scene: dict[str, Any] = {} if settings is None else {
+        "extras": {"csplab": {"synthesis": settings}}}
+    doc = json.dumps({"asset": {"version": "2.0", "generator": _EMPTY_GLB_GENERATOR},
+                      "scenes": [scene], "scene": 0}).encode()  # fmt: skip
     doc += b" " * (-len(doc) % 4)
     return (
         b"glTF"

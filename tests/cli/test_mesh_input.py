@@ -237,3 +237,47 @@ def test_check_agrees_on_float32_outputs_at_40x40x20(tmp_path, capsys, part, ext
     assert code == 0 and "Eq. 4.1 violations=0" in text, (text, err)
     code, text, err = run(capsys, "check", str(src), str(out))
     assert code == 0 and text.startswith("0 violations"), (text, err)
+
+
+def test_check_reads_the_settings_synthesize_recorded(tmp_path, capsys):
+    """``synthesize --spacing 1 --snap`` records its settings in the output (glTF scene
+    extras, an OBJ comment); ``check`` without options compares the example as it was
+    synthesized and says so, and an option given to ``check`` wins (with a note)."""
+    src = str(cad.export(cad.build("tetra"), tmp_path / "tetra.stl"))
+    for ext in (".glb", ".obj"):
+        out = str(tmp_path / f"out{ext}")
+        code, _, err = run(capsys, "synthesize", src, "--size", "8x8x4", "--seed", "1",
+                           "--spacing", "1", "--snap", "--out", out)  # fmt: skip
+        assert code == 0, err
+        code, text, err = run(capsys, "check", src, out)
+        assert code == 0 and text.startswith("0 violations"), (text, err)
+        assert "planes of spacing 1," in text
+        assert f"settings of synthesize read from {out}: --spacing 1 --snap" in text
+        code, text, err = run(capsys, "check", src, out, "--spacing", "0.5")
+        assert "planes of spacing 0.5," in text and "read from" in text
+        assert "--spacing 0.5 given, synthesize used 1.0" in text
+
+
+def test_mesh_writers_keep_the_synthesis_settings_and_empty_outputs(tmp_path):
+    from csplab.continuous.polyhedra import PolyhedralModel
+    from csplab.errors import FormatError
+    from csplab.io.meshes import read_glb, read_obj_model, write_glb, write_obj_model
+
+    settings = {"example": "t", "ground": "z-", "lines": "auto", "snap": True, "spacing": 0.5}
+    box = {"label": 2, "vertices": [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1],
+                                    [1, 0, 1], [1, 1, 1], [0, 1, 1]],
+           "faces": [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6],
+                     [3, 0, 4, 7]]}  # fmt: skip
+    for model in (PolyhedralModel([box], meta={"synthesis": settings}),
+                  PolyhedralModel([], meta={"synthesis": settings})):  # fmt: skip
+        write_glb(model, tmp_path / "m.glb")
+        back = read_glb(tmp_path / "m.glb")
+        assert len(back) == len(model) and back.meta["synthesis"] == settings
+    write_obj_model(PolyhedralModel([box], meta={"synthesis": settings}), tmp_path / "m.obj")
+    assert read_obj_model(tmp_path / "m.obj").meta["synthesis"] == settings
+    write_obj_model(PolyhedralModel([box]), tmp_path / "n.obj")  # nothing recorded: none read
+    assert "synthesis" not in read_obj_model(tmp_path / "n.obj").meta
+    text = (tmp_path / "m.obj").read_text().replace('"spacing": 0.5}', '"spacing": 0.5')
+    (tmp_path / "bad.obj").write_text(text)
+    with pytest.raises(FormatError, match=r"bad\.obj.*line 2.*not JSON"):
+        read_obj_model(tmp_path / "bad.obj")
