@@ -209,7 +209,9 @@ def synthesize(
     if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
         # what check needs to compare the example as it was synthesized (kept by .obj,
         # .glb and .json outputs)
-        s.model.meta["synthesis"] = recorded_settings(args, example, ground)
+        recorded = recorded_settings(args, example, ground)
+        if recorded:  # defaults record nothing (check derives the same)
+            s.model.meta["synthesis"] = recorded
         fmt.write(s.model, args.out)
         wrote = args.out
     A: PlaneArrangement = csp.arrangement
@@ -388,15 +390,19 @@ def onto_planes(model: PolyhedralModel, lat: Any) -> tuple[PolyhedralModel, int]
     return PolyhedralModel(solids, name=model.name, meta=model.meta, source=model.source), moved
 
 
+#: the options of synthesize an output records (with their defaults, which record nothing)
+RECORDED: dict[str, Any] = {"spacing": None, "snap": False, "lines": "auto", "ground": "auto"}
+
+
 def recorded_settings(
     args: argparse.Namespace, example: PolygonModel | PolyhedralModel, ground: str
 ) -> dict[str, Any]:
-    """The settings of ``csplab synthesize`` that ``csplab check`` needs, as given (``None``
-    spacing: derived, as check derives it too)."""
-    d: dict[str, Any] = {"example": example.name or str(args.model), "ground": ground}
+    """The settings of ``csplab synthesize`` that ``csplab check`` needs and that differ
+    from the defaults (which check derives as synthesize does), as given."""
+    d: dict[str, Any] = {"ground": ground}
     if example.ndim == 3:
         d.update(spacing=args.spacing, snap=bool(args.snap), lines=args.lines)
-    return d
+    return {k: v for k, v in d.items() if v != RECORDED[k]}
 
 
 def apply_recorded(args: argparse.Namespace, out: PolygonModel | PolyhedralModel) -> str:
@@ -405,9 +411,8 @@ def apply_recorded(args: argparse.Namespace, out: PolygonModel | PolyhedralModel
     rec = out.meta.get("synthesis")
     if not isinstance(rec, dict):
         return ""
-    defaults = {"spacing": None, "snap": False, "lines": "auto", "ground": "auto"}
     taken, differ = [], []
-    for key, default in defaults.items():
+    for key, default in RECORDED.items():
         given = getattr(args, key, default)
         if key in rec and given != default and given != rec[key]:
             differ.append(f"--{key} {given} given, synthesize used {rec[key]}")
