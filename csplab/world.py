@@ -137,6 +137,8 @@ __all__ = [
     "UNHONOURED",
     "World",
     "network_per_chunk",
+    "world_problem",
+    "world_zfaces",
 ]
 
 #: largest period of the start model ``M0`` tried before a model is refused
@@ -332,6 +334,129 @@ class _LRU(OrderedDict[Any, Any]):
         self.move_to_end(key)
         while len(self) > self.size:
             self.popitem(last=False)
+
+
+def world_zfaces(
+    model: Any, chunk: Sequence[int], boundary: Any
+) -> dict[str, int] | None:
+    """The ``z`` faces of a world of ``chunk``-sized chunks (``None``: no faces).
+
+    Parameters
+    ----------
+    model : ExampleModel or rule set
+        The world's model.
+    chunk : sequence of int
+        The chunk's shape; a 3D world's third number is its height.
+    boundary : {"auto", "none"}, mapping or None
+        As :class:`World` takes it: only ``z-`` and ``z+`` exist in an infinite world.
+
+    Returns
+    -------
+    dict of str to int or None
+        The label of each bounded ``z`` face.
+
+    Raises
+    ------
+    InputError
+        For faces other than ``z-``/``z+`` or a boundary that is not ``auto``, ``none`` or a
+        mapping.
+
+    Examples
+    --------
+    >>> import csplab.examples
+    >>> world_zfaces(csplab.examples.load_example("city"), (16, 16, 10), "auto")
+    {'z+': 0, 'z-': 1}
+    >>> world_zfaces(csplab.examples.load_example("line"), (16, 16), "auto") is None
+    True
+    """
+    ndim = len(chunk)
+    if boundary in (None, "none"):
+        return None
+    if isinstance(boundary, Mapping):
+        bad = [f for f in boundary if f not in ("z-", "z+")]
+        if bad or ndim == 2:
+            raise InputError(
+                f"boundary faces {bad or list(boundary)} do not exist in an infinite "
+                "world (only z- and z+ of a 3D world)"
+            )
+        return {str(f): int(v) for f, v in boundary.items()}
+    if boundary != "auto":
+        raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
+    if ndim == 2:
+        return None
+    if isinstance(model, ExampleModel):
+        P = from_example(model, (6, 6, int(chunk[2])), boundary="auto")
+        faces = P.meta.get("boundary") or {}
+    else:
+        faces = dict(getattr(model, "boundary", None) or {})
+    z = {f: int(v) for f, v in faces.items() if f in ("z-", "z+")}
+    return z or None
+
+
+def world_problem(
+    model: Any,
+    shape: Sequence[int],
+    height: int | None,
+    zfaces: Mapping[str, int] | None,
+    *,
+    periodic: bool = False,
+) -> tuple[Problem, list[str]]:
+    """The grid problem of a world's rectangle, and the global constraints it drops.
+
+    No faces on ``x``/``y``; ``zfaces`` (:func:`world_zfaces`) on ``z``. What
+    :meth:`World.problem` gives, without building a world (``csplab world`` reads its
+    ``--constraints`` against it).
+
+    Parameters
+    ----------
+    model : ExampleModel or rule set
+        The world's model.
+    shape : sequence of int
+        ``(X, Y)``.
+    height : int or None
+        A 3D world's height (``None``: 2D).
+    zfaces : mapping of str to int or None
+        The ``z`` faces' labels.
+    periodic : bool
+        Wrap ``x`` and ``y``.
+
+    Returns
+    -------
+    Problem
+        The problem, without the model's global constraints.
+    list of str
+        The names of the global constraints dropped (a world cannot honour them).
+
+    Raises
+    ------
+    InputError
+        When the model is not a grid model (an example or a rule set).
+
+    Examples
+    --------
+    >>> import csplab.examples
+    >>> P, dropped = world_problem(csplab.examples.load_example("line"), (8, 6), None, None)
+    >>> P.shape, dropped
+    ((8, 6), [])
+    """
+    shp = tuple(int(s) for s in shape[:2])
+    per: bool | tuple[bool, ...] = periodic
+    if height is not None:
+        shp = (*shp, int(height))
+        per = (periodic, periodic, False)
+    bound: Any = dict(zfaces) if zfaces else "none"
+    if isinstance(model, ExampleModel):
+        P = from_example(model, shp, periodic=per, boundary=bound)
+    elif hasattr(model, "problem"):
+        P = model.problem(shp, periodic=per, boundary=bound)
+    else:
+        raise InputError(
+            f"{getattr(model, 'name', None) or type(model).__name__} is not a grid model: a "
+            "world takes grid examples, tilesets and overlapping samples"
+        )
+    if not P.constraints:
+        return P, []
+    return P.without_constraints(), [type(c).__name__ for c in P.constraints]
 
 
 class World:
@@ -643,28 +768,7 @@ class World:
         )
 
     def _zfaces(self, boundary: Any) -> dict[str, int] | None:
-        if boundary in (None, "none"):
-            return None
-        if isinstance(boundary, Mapping):
-            bad = [f for f in boundary if f not in ("z-", "z+")]
-            if bad or self.ndim == 2:
-                raise InputError(
-                    f"boundary faces {bad or list(boundary)} do not exist in an infinite "
-                    "world (only z- and z+ of a 3D world)"
-                )
-            return {str(f): int(v) for f, v in boundary.items()}
-        if boundary != "auto":
-            raise InputError(f"boundary must be 'auto', 'none' or a mapping, not {boundary!r}")
-        if self.ndim == 2:
-            return None
-        assert self.height is not None
-        if isinstance(self.model, ExampleModel):
-            P = from_example(self.model, (6, 6, self.height), boundary="auto")
-            faces = P.meta.get("boundary") or {}
-        else:
-            faces = dict(getattr(self.model, "boundary", None) or {})
-        z = {f: int(v) for f, v in faces.items() if f in ("z-", "z+")}
-        return z or None
+        return world_zfaces(self.model, self.chunk_shape, boundary)
 
     def problem(self, shape: Sequence[int], *, periodic: bool = False) -> Problem:
         """The model's problem on a rectangle of ``shape``.
@@ -689,30 +793,14 @@ class World:
         InputError
             When the model is not a grid model (an example or a rule set).
         """
-        shp = tuple(int(s) for s in shape[:2])
-        per: bool | tuple[bool, ...] = periodic
-        if self.height is not None:
-            shp = (*shp, self.height)
-            per = (periodic, periodic, False)
-        m = self.model
-        if isinstance(m, ExampleModel):
-            P = from_example(m, shp, periodic=per, boundary=self.zfaces or "none")
-        elif hasattr(m, "problem"):
-            P = m.problem(shp, periodic=per, boundary=self.zfaces or "none")
-        else:
-            raise InputError(
-                f"{getattr(m, 'name', None) or type(m).__name__} is not a grid model: a world "
-                "takes grid examples, tilesets and overlapping samples"
+        P, dropped = world_problem(self.model, shape, self.height, self.zfaces, periodic=periodic)
+        if dropped and not self.dropped:  # global constraints of the file cannot hold
+            self.dropped = dropped
+            warnings.warn(
+                f"a world cannot honour the model's global constraints "
+                f"({', '.join(self.dropped)}): dropped",
+                stacklevel=3,
             )
-        if P.constraints:  # global constraints of the file: they cannot hold (module doc)
-            if not self.dropped:
-                self.dropped = [type(c).__name__ for c in P.constraints]
-                warnings.warn(
-                    f"a world cannot honour the model's global constraints "
-                    f"({', '.join(self.dropped)}): dropped",
-                    stacklevel=3,
-                )
-            P = P.without_constraints()
         return P
 
     def _start(self) -> NDArray[np.int32]:

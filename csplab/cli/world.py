@@ -126,10 +126,13 @@ def run(args: argparse.Namespace) -> int:
     constraints, per_chunk = [], []
     if args.constraints:  # read against the chunk's grid; the world refuses global ones
         from csplab.io.constraints import read_world_constraints
+        from csplab.world import world_problem, world_zfaces
 
-        probe = World(model, chunk=chunk, boundary=parse_boundary(args.boundary) or "none")
+        zfaces = world_zfaces(model, chunk, parse_boundary(args.boundary) or "none")
+        height = chunk[2] if len(chunk) == 3 else None
+        on, _ = world_problem(model, chunk[:2], height, zfaces)
         for path in args.constraints:
-            whole, per = read_world_constraints(path, probe.problem(chunk[:2]))
+            whole, per = read_world_constraints(path, on)
             constraints += whole
             per_chunk += per
     t0 = time.perf_counter()
