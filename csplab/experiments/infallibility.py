@@ -19,9 +19,12 @@ checks what the verdict rests on, with code that shares nothing with the prover:
   (one thread each, in the same process): on a loaded machine a check of a few
   milliseconds that loses the processor for a time slice would otherwise count the wait;
   the wall-clock times are in the table beside;
-* a **proved** model gets ``runs`` seeded runs of Alg. 3.1 (the ``catalog`` solver, the same
-  order) spread over outputs from 2x2 to 40x40 (2D) or 2x2x2 to 40x40x10 (3D): one failure
-  is a contradiction (a bug), reported with its size and seed;
+* a **proved** model gets ``runs`` (default 100000, the issue's target) seeded runs of
+  Alg. 3.1 (:func:`random_runs`: the ``catalog`` solver's engine, the same order, each
+  output problem built once) over a fixed mix of outputs from 2x2 to 40x40 (2D) or 2x2x2
+  to 40x40x10 (3D) (:data:`RUN_MIX`); every solved output is checked by
+  :meth:`Problem.violations`. One failure or invalid output is a contradiction (a bug),
+  reported with its size and seed and replayed;
 * a **refuted** model's witness is replayed by :func:`~csplab.analysis.witness.replay`
   (Alg. 3.1's engine): a witness that does not replay is a contradiction;
 * *any order*: seeded min-entropy runs (WFC's order) look for a failure
@@ -50,13 +53,15 @@ import time
 from pathlib import Path
 from typing import Any, ClassVar
 
+import numpy as np
+
 from csplab.errors import CsplabError, InputError
 from csplab.example import ExampleModel
 from csplab.experiments.base import Experiment, Report, load_examples, sweep_defaults
 from csplab.experiments.trial import Trial, record
 from csplab.problem import Problem
 
-__all__ = ["Infallibility", "anchor_rule_sets", "measure"]
+__all__ = ["RUN_MIX", "Infallibility", "anchor_rule_sets", "measure", "random_runs", "run_schedule"]
 
 # the 2D figures the thesis decides by hand (Sec. 3.3.4, 3.3.7, 3.3.8), in its scan order
 HAND_DECIDED = ("fig3_5a", "fig3_6a", "fig3_15", "fig3_16")
@@ -107,13 +112,13 @@ class Infallibility(Experiment):
     defaults = sweep_defaults(
         omit=("sizes", "size", "solvers", "seeds", "choice", "options", "periodic", "order",
               "constraints"),
-        examples=[], boundary="none,auto", time_limit=600.0, runs=2000, runs_limit=120.0,
+        examples=[], boundary="none,auto", time_limit=600.0, runs=100_000, runs_limit=600.0,
         any_order_s=20.0,
     )  # fmt: skip
     quick: ClassVar[dict[str, Any]] = {
         "examples": ["fig3_4a"],
         "time_limit": 20.0,
-        "runs": 20,
+        "runs": 200,
         "runs_limit": 10.0,
         "any_order_s": 2.0,
     }
@@ -122,10 +127,11 @@ class Infallibility(Experiment):
     default_out = str(Path("papers") / "merrell-2009-thesis")
 
     def add_arguments(self, p: Any) -> None:
-        p.add_argument("--runs", type=int, help="random Alg. 3.1 runs per proved model "
-                       "(the issue's cross-check target is 100000)")  # fmt: skip
+        p.add_argument("--runs", type=int, help="random Alg. 3.1 runs per proved model, "
+                       f"over a fixed mix of sizes (default and target {RUNS_TARGET})")  # fmt: skip
         p.add_argument("--runs-limit", type=float, dest="runs_limit",
-                       help="seconds for a model's random runs")  # fmt: skip
+                       help="CPU seconds for a model's random runs, a safety; "
+                       "runs cut short are reported short of the target")  # fmt: skip
         p.add_argument("--any-order-s", type=float, dest="any_order_s",
                        help="seconds of min-entropy runs per model (0: skip)")  # fmt: skip
 
@@ -288,11 +294,21 @@ def _targets(rows: list[dict[str, Any]]) -> list[str]:
             f"{'all decided' if done else 'not all decided'}, slowest {worst:.2f} s: "
             + ("meets" if done and worst < 10 else "shortfall")
         )  # fmt: skip
-    runs = sum(int(r["stats"].get("runs_done") or 0) for r in rows)
-    out.append(
-        f"Random Alg. 3.1 runs on proved models: {runs} in all (target ≥ 100000 per model "
-        "with `--runs 100000`; this table's count per model is in `cross-check`)."
-    )
+    proved = [r for r in rows if r["stats"].get("verdict") == "proved"]
+    if proved:
+        counts = [int(r["stats"].get("runs_done") or 0) for r in proved]
+        met = [r for r in proved if r["stats"].get("runs_target") == "meets"]
+        cpu = sum(float(r["stats"].get("runs_cpu_s") or 0) for r in proved)
+        slowest = max(float(r["stats"].get("runs_cpu_s") or 0) for r in proved)
+        out.append(
+            f"Target ≥ {RUNS_TARGET} random Alg. 3.1 runs per proved model with 0 failures "
+            "(outputs 2x2 to 40x40, 2x2x2 to 40x40x10, in the fixed mix of `RUN_MIX`; every "
+            f"solved output checked by `Problem.violations`): {len(met)} of {len(proved)} "
+            f"proved settings meet; fewest runs {min(counts)}, {sum(counts)} runs in all, "
+            f"{cpu:.1f} s CPU (slowest setting {slowest:.1f} s): "
+            + ("meets" if len(met) == len(proved) else
+               f"shortfall on {len(proved) - len(met)} (see `cross-check`)")
+        )  # fmt: skip
     return out
 
 
@@ -356,52 +372,195 @@ def measure(trial: Trial, example: Any, problem: Problem | None) -> dict[str, An
     return record("ok", decide_s, stats)
 
 
-def _sizes(ndim: int) -> list[tuple[int, ...]]:
-    if ndim == 1:
-        return [(2,), (5,), (10,), (40,)]
-    if ndim == 2:
-        return [(2, 2), (3, 3), (5, 5), (8, 8), (16, 16), (40, 40)]
-    return [(2, 2, 2), (3, 3, 3), (5, 5, 5), (8, 8, 10), (16, 16, 10), (40, 40, 10)]
+# The fixed mix of output sizes of the random runs (per 100 runs, for 1D, 2D and 3D): many
+# small outputs, where every cell is near a border, and a share of large ones, where a run
+# makes the most choices; a few flat shapes so that each axis is scanned both long and short.
+# Run ``i`` of a trial has the size ``run_schedule(ndim)[i % 100]`` and the seed
+# ``trial.seed * 1_000_003 + i``; any prefix of the schedule holds every size about in
+# proportion, so runs cut short by ``runs_limit`` (CPU seconds) still cover them all.
+RUN_MIX: dict[int, tuple[tuple[tuple[int, ...], int], ...]] = {
+    1: (((2,), 8), ((3,), 8), ((4,), 8), ((5,), 8), ((6,), 8), ((8,), 10), ((12,), 10),
+        ((16,), 10), ((24,), 15), ((40,), 15)),
+    2: (((2, 2), 8), ((3, 3), 8), ((2, 5), 4), ((5, 2), 4), ((4, 4), 8), ((5, 5), 8),
+        ((3, 8), 4), ((8, 3), 4), ((6, 6), 8), ((8, 8), 10), ((12, 12), 10), ((16, 16), 10),
+        ((24, 24), 7), ((40, 40), 7)),
+    3: (((2, 2, 2), 8), ((3, 3, 3), 8), ((2, 3, 5), 4), ((5, 3, 2), 4), ((4, 4, 4), 8),
+        ((5, 5, 5), 8), ((3, 7, 4), 4), ((7, 3, 4), 4), ((6, 6, 6), 8), ((8, 8, 10), 10),
+        ((12, 12, 10), 10), ((16, 16, 10), 10), ((24, 24, 10), 9), ((40, 40, 10), 5)),
+}  # fmt: skip
+RUNS_TARGET = 100_000  # the issue's cross-check: random runs per proved model, 0 failures
+
+
+def run_schedule(ndim: int) -> list[tuple[int, ...]]:
+    """The 100 output sizes of one cycle of the random runs (:data:`RUN_MIX`), interleaved:
+    size ``s`` of weight ``w`` takes the slots at ``(j + 1/2) / w``, ``j < w``.
+
+    Parameters
+    ----------
+    ndim : int
+        1, 2 or 3.
+
+    Returns
+    -------
+    list of tuple of int
+
+    Raises
+    ------
+    InputError
+        For another number of dimensions.
+
+    Examples
+    --------
+    >>> sch = run_schedule(2)
+    >>> len(sch), sch.count((40, 40)), sch[:3]
+    (100, 7, [(8, 8), (12, 12), (16, 16)])
+    """
+    mix = RUN_MIX.get(ndim)
+    if mix is None:
+        raise InputError(f"random runs: outputs of 1, 2 or 3 dimensions, not {ndim}")
+    slots = [((j + 0.5) / w, i, s) for i, (s, w) in enumerate(mix) for j in range(w)]
+    return [s for _, _, s in sorted(slots)]
+
+
+def random_runs(
+    example: Any, order: str, boundary: str | None, *, runs: int, seed: int,
+    time_limit: float, keep: int = 3,
+) -> dict[str, Any]:  # fmt: skip
+    """Seeded runs of Alg. 3.1 (:func:`~csplab.engine.alg31.run_alg31`, the ``catalog``
+    solver's engine) over the sizes of :func:`run_schedule`, each output problem built once.
+
+    Run ``i`` has the seed ``seed + i`` and the size ``run_schedule(ndim)[i % 100]``; it
+    repeats alone with ``solve(P, "catalog", rng=seed + i, order=order)``. A run that does
+    not solve is a failure: the first ``keep`` are kept as witnesses (size, seed, choices)
+    and replayed by :func:`~csplab.analysis.witness.replay`. A solved output is checked by
+    :meth:`Problem.violations`, which shares no code with the engine: a violation is
+    ``invalid``. Stops after ``runs`` runs or ``time_limit`` CPU seconds of the calling
+    thread (a wall-clock limit would cut a run short on a loaded machine, or with more
+    workers than cores, that fits on one core).
+
+    Parameters
+    ----------
+    example : ExampleModel or RuleSet
+    order : str
+        A scan order of Alg. 3.1 (``scanline``, ``scan:yx`` ...).
+    boundary : {None, "none", "auto"}
+        ``"auto"``: ground and empty space (a tileset always has its file's own).
+    runs : int
+        How many runs.
+    seed : int
+        The seed of run 0.
+    time_limit : float
+        CPU seconds (this thread, building the problems included) after which no run
+        starts.
+    keep : int
+        Failures kept as witnesses.
+
+    Returns
+    -------
+    dict
+        ``runs_done``, ``runs_per_size`` (``"2x2": count``, in the order of
+        :data:`RUN_MIX`), ``failed``,
+        ``invalid``, ``failures`` (the kept witnesses with ``replays``), ``runs_s`` (wall
+        clock) and ``runs_cpu_s`` (CPU of this thread), building the problems included, and
+        ``cut`` (whether the time limit stopped the runs).
+
+    Examples
+    --------
+    >>> from csplab.examples import load_example
+    >>> out = random_runs(load_example("line"), "scanline", None, runs=30, seed=0,
+    ...                   time_limit=60)
+    >>> out["runs_done"], out["failed"], out["invalid"], out["runs_per_size"]["2x2"]
+    (30, 0, 0, 3)
+    """
+    from csplab.analysis.witness import model_problem, replay
+    from csplab.engine.alg31 import run_alg31
+    from csplab.grids import parse_boundary
+
+    t0, c0 = time.perf_counter(), time.thread_time()
+    deadline = c0 + float(time_limit)
+    bnd = "auto" if (boundary == "auto" or not isinstance(example, ExampleModel)) else None
+    schedule = run_schedule(example.ndim)
+    problems = {s: model_problem(example, s, None if bnd is None else parse_boundary(bnd))
+                for s, _ in RUN_MIX[example.ndim]}  # fmt: skip
+    per = dict.fromkeys(problems, 0)
+    failures: list[dict[str, Any]] = []
+    failed = invalid = done = 0
+    cut = False
+    while done < runs:
+        if time.thread_time() >= deadline:
+            cut = True
+            break
+        s = schedule[done % len(schedule)]
+        P, sd = problems[s], seed + done
+        r = run_alg31(P, np.random.default_rng(sd), order=order)
+        done += 1
+        per[s] += 1
+        if r.status == "solved":
+            if len(P.violations(r.grid)):
+                invalid += 1
+                if len(failures) < keep:
+                    failures.append({"shape": list(s), "seed": sd, "kind": "invalid"})
+            continue
+        failed += 1
+        if len(failures) < keep:
+            tr = r.trace if r.trace is not None else np.zeros((0, 2), dtype=np.int64)
+            w: dict[str, Any] = {"shape": list(s), "order": order, "seed": sd}
+            if bnd is not None:
+                w["boundary"] = bnd
+            w["kind"] = r.status
+            w["choices"] = [[list(P.coords(int(c))), int(b)] for c, b in tr.tolist()]
+            w["replays"] = bool(replay(example, w).holds)
+            failures.append(w)
+    return {
+        "runs_done": done,
+        "runs_per_size": {_fmt(s): k for s, k in per.items() if k},
+        "failed": failed, "invalid": invalid, "failures": failures, "cut": cut,
+        "runs_s": time.perf_counter() - t0, "runs_cpu_s": time.thread_time() - c0,
+    }  # fmt: skip
+
+
+def _fmt(shape: tuple[int, ...] | list[int]) -> str:
+    return "x".join(map(str, shape))
 
 
 def _runs(example: Any, order: str, boundary: str | None, trial: Trial,
           stats: dict[str, Any]) -> None:  # fmt: skip
-    """Seeded runs of Alg. 3.1 on a proved model: every failure is a contradiction. Sizes
-    from the smallest up, round-robin, until ``runs`` runs or ``runs_limit`` seconds."""
-    from csplab.analysis.witness import model_problem
-    from csplab.grids import parse_boundary
-    from csplab.solvers import solve
-
+    """The random-run cross-check of a proved model (:func:`random_runs`, seeds from
+    ``trial.seed``): every failure, and every invalid output, is a contradiction."""
     want = int(trial.params["runs"])
-    deadline = time.perf_counter() + float(trial.params["runs_limit"])
-    bnd = parse_boundary("auto") if (boundary == "auto" or not isinstance(example, ExampleModel)) \
-        else None  # fmt: skip
-    problems = [(s, model_problem(example, s, bnd)) for s in _sizes(example.ndim)]
-    done, fails, per = 0, [], dict.fromkeys((s for s, _ in problems), 0)
-    seed = trial.seed * 1_000_003
-    active = list(problems)
-    while done < want and active and time.perf_counter() < deadline:
-        for s, P in list(active):
-            if done >= want or time.perf_counter() >= deadline:
-                break
-            t1 = time.perf_counter()
-            r = solve(P, "catalog", rng=seed + done, order=order)
-            done += 1
-            per[s] += 1
-            if r.status != "solved":
-                fails.append((s, seed + done - 1, r.status))
-            # the largest sizes get fewer runs when one run eats much of the budget
-            if time.perf_counter() - t1 > 0.05 * float(trial.params["runs_limit"]):
-                active.remove((s, P))
-    stats["runs_done"] = done
-    big = "x".join(map(str, max(per, key=lambda s: (math.prod(s), s)))) if per else ""
-    stats["crosscheck"] = f"{done} runs (2x2.. {big}), {len(fails)} failed"
-    if fails:
-        s, sd, st = fails[0]
+    out = random_runs(example, order, boundary, runs=want, seed=trial.seed * 1_000_003,
+                      time_limit=float(trial.params["runs_limit"]))  # fmt: skip
+    done, per = out["runs_done"], out["runs_per_size"]
+    failures = [{k: v for k, v in f.items() if k != "choices"} for f in out["failures"]]
+    stats.update(runs_done=done, runs_per_size=per, runs_failed=out["failed"],
+                 runs_invalid=out["invalid"], runs_failures=failures, runs_s=out["runs_s"],
+                 runs_cpu_s=out["runs_cpu_s"])  # fmt: skip
+    bad = out["failed"] + out["invalid"]
+    sizes = list(per)
+    span = f"{len(sizes)} sizes {sizes[0]}..{max(sizes, key=_cells)}" if sizes else "no sizes"
+    met = done >= RUNS_TARGET and not bad
+    verdict = "meets" if met else (
+        f"short: {done} of {RUNS_TARGET}" + (" (runs_limit)" if out["cut"] else "")
+        if not bad else "FAILS")  # fmt: skip
+    stats["runs_target"] = "meets" if met else "short" if not bad else "fails"
+    stats["crosscheck"] = (
+        f"{done} runs ({span}), {out['failed']} failed, {out['invalid']} invalid, "
+        f"{out['runs_cpu_s']:.1f} s CPU: {verdict}"
+    )
+    if bad:
+        f = out["failures"][0]
+        how = "an invalid grid" if f["kind"] == "invalid" else f["kind"]
+        rp = "" if f["kind"] == "invalid" else (
+            ", replays" if f["replays"] else ", does NOT replay")  # fmt: skip
         stats["contradiction"] = (
-            f"Alg. 3.1 {st} on {'x'.join(map(str, s))} (seed {sd}, order {order}) although "
-            "proved infallible"
+            f"Alg. 3.1 {how} on {_fmt(f['shape'])} (seed {f['seed']}, order {order}{rp}) "
+            f"although proved infallible; {out['failed']} failed, {out['invalid']} invalid "
+            f"of {done} runs"
         )
+
+
+def _cells(size: str) -> tuple[int, str]:
+    return math.prod(int(t) for t in size.split("x")), size
 
 
 def _any_order(example: Any, boundary: str | None, trial: Trial,
