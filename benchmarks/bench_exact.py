@@ -75,42 +75,48 @@ sys.path.insert(0, str(ROOT))
 SAT_TARGET_S = 1.0
 CPSAT_TARGET_X = 2.0
 REFERENCE = "s = 0\nfor i in range(6_000_000):\n    s += i\n"
-#: the command's steps in a fresh process, CPU seconds after each printed as JSON
+#: the command's steps in a fresh process; prints each step's CPU seconds and the CPU
+#: at its end as JSON (the two warm encodings, for the load's figure, are in no step)
 PHASES = """
 import json, sys, time
 cpu = time.process_time
-marks = [("start", cpu())]
+marks, last = [("start", cpu())], [cpu()]
+def mark(name, less=0.0):
+    t = cpu()
+    marks.append((name, t - last[0] - less))
+    last[0] = t
 import numpy as np
 import pysat.solvers
 import csplab
 import csplab.cli.synthesize
 from csplab.engine.sat import SatOracle, free_at_exit, preferred_labels
-marks.append(("imports", cpu()))
+mark("imports")
 import numba
-marks.append(("numba import", cpu()))
+mark("numba import")
 from csplab.cnf import encode
 encode(csplab.from_example(csplab.load_example("castle"), (4, 4, 3)))
-marks.append(("numba first kernels", cpu()))
+mark("numba first kernels")
 P = csplab.from_example(csplab.load_example("castle"), sys.argv[1])
-marks.append(("problem", cpu()))
+mark("problem")
 encode(P)
-marks.append(("encode", cpu()))
+mark("encode")
+c = cpu()
+encode(P)  # warm: what the oracle's own encoding costs, subtracted from its time
+warm = cpu() - c
+last[0] = cpu()
 rng = np.random.default_rng(1)  # as `--seed 1` through csplab.solve
 free_at_exit()  # as the command: the native solver is left to the process exit
 o = SatOracle(P, seed=int(rng.integers(2**31 - 1)))
-c = cpu()
-encode(P)
-warm = cpu() - c
-marks.append(("load (oracle - encode)", cpu() - warm))
+mark("load (oracle - encode)", warm)
 o.set_phases(preferred_labels(o.enc.catalog, None, rng))
 status = o.solve()
 o.close()
-marks.append(("search", cpu()))
+mark("search")
 from csplab.io import write_labels
 write_labels(o.grid, sys.argv[2])
-marks.append(("write", cpu()))
+mark("write")
 assert status == "sat" and len(P.violations(o.grid)) == 0
-print(json.dumps(marks), flush=True)
+print(json.dumps({"marks": marks, "end": cpu()}), flush=True)
 """
 
 
@@ -142,15 +148,13 @@ def phases(runs: int, size: str, env: dict[str, str], out: str) -> None:
                            capture_output=True, text=True)  # fmt: skip
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         total = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-        marks = json.loads(p.stdout.strip().splitlines()[-1])
-        last = 0.0
-        for name, t in marks:
-            rows.setdefault(name, []).append(t - last)
-            last = t
-        rows.setdefault("exit (teardown)", []).append(total - last)
+        got = json.loads(p.stdout.strip().splitlines()[-1])
+        for name, t in got["marks"]:
+            rows.setdefault(name, []).append(t)
+        rows.setdefault("exit (teardown)", []).append(total - got["end"])
     med = {k: statistics.median(v) for k, v in rows.items()}
     print(f"  where the CPU goes (the same steps in a fresh process, median of {runs}; "
-          f"sum {sum(med.values()):.2f} s):")  # fmt: skip
+          f"CPU seconds, sum {sum(med.values()):.2f} s):")  # fmt: skip
     print("    " + ", ".join(f"{k} {v:.2f}" for k, v in med.items()))
 
 
