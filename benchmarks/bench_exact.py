@@ -11,6 +11,17 @@ as every phase runs on one thread). The reference in the same run is a fixed pur
 loop in a fresh process: its wall over CPU ratio says how much the load stretches wall
 times. The verdict uses the CPU time, both are printed.
 
+Where that CPU time goes is printed below it (``--skip-phases`` leaves it out): a fresh
+process (:data:`PHASES`, median of ``--runs``) repeats the command's steps with
+``time.process_time`` between them: the interpreter's start, imports (numpy, csplab's CLI
+and ``sat`` solver, pysat), numba's import, numba's first kernels (its target registries,
+scipy's BLAS check, csplab's cached machine code; measured on a 4x4x3 castle), the problem,
+the encoding (arc consistency, clauses), CaDiCaL taking the clauses (the oracle's CPU minus
+a second, warm encoding), the search, writing the ``.npy``, and the process's exit after
+that (the parent's count of the child's CPU minus the child's last reading: an ordinary
+interpreter exit, the native solver left unfreed as the command leaves it; the command
+itself skips this teardown, ``EXIT_AT_ONCE`` in :mod:`csplab.cli`).
+
 Item 3, CP-SAT <= 2x ``sat``: in this process, on the same problem, the ``sat`` solver (the
 reference) and CP-SAT models, each timed by its wall time and its CPU time (CP-SAT runs one
 worker, so its CPU time is what the wall time would be on an idle core; the verdict uses the
@@ -39,7 +50,7 @@ and linearization off); each output is checked with ``Problem.violations``.
 Usage::
 
     python benchmarks/bench_exact.py [--runs 3] [--size 40x40x10] [--time-limit 60]
-        [--skip-process] [--skip-cpsat] [--models catalog-forward random-both ...]
+        [--skip-process] [--skip-cpsat] [--skip-phases] [--models catalog-forward random-both ...]
 """
 
 from __future__ import annotations
@@ -64,6 +75,49 @@ sys.path.insert(0, str(ROOT))
 SAT_TARGET_S = 1.0
 CPSAT_TARGET_X = 2.0
 REFERENCE = "s = 0\nfor i in range(6_000_000):\n    s += i\n"
+#: the command's steps in a fresh process; prints each step's CPU seconds and the CPU
+#: at its end as JSON (the two warm encodings, for the load's figure, are in no step)
+PHASES = """
+import json, sys, time
+cpu = time.process_time
+marks, last = [("start", cpu())], [cpu()]
+def mark(name, less=0.0):
+    t = cpu()
+    marks.append((name, t - last[0] - less))
+    last[0] = t
+import numpy as np
+import pysat.solvers
+import csplab
+import csplab.cli.synthesize
+from csplab.engine.sat import SatOracle, free_at_exit, preferred_labels
+mark("imports")
+import numba
+mark("numba import")
+from csplab.cnf import encode
+encode(csplab.from_example(csplab.load_example("castle"), (4, 4, 3)))
+mark("numba first kernels")
+P = csplab.from_example(csplab.load_example("castle"), sys.argv[1])
+mark("problem")
+encode(P)
+mark("encode")
+c = cpu()
+encode(P)  # warm: what the oracle's own encoding costs, subtracted from its time
+warm = cpu() - c
+last[0] = cpu()
+rng = np.random.default_rng(1)  # as `--seed 1` through csplab.solve
+free_at_exit()  # as the command: the native solver is left to the process exit
+o = SatOracle(P, seed=int(rng.integers(2**31 - 1)))
+mark("load (oracle - encode)", warm)
+o.set_phases(preferred_labels(o.enc.catalog, None, rng))
+status = o.solve()
+o.close()
+mark("search")
+from csplab.io import write_labels
+write_labels(o.grid, sys.argv[2])
+mark("write")
+assert status == "sat" and len(P.violations(o.grid)) == 0
+print(json.dumps({"marks": marks, "end": cpu()}), flush=True)
+"""
 
 
 def load() -> str:
@@ -83,7 +137,28 @@ def timed(cmd: list[str], env: dict[str, str]) -> tuple[float, float]:
     return wall, cpu
 
 
-def process_target(runs: int, size: str) -> None:
+def phases(runs: int, size: str, env: dict[str, str], out: str) -> None:
+    """Where the CPU time of the command goes (see the module docstring)."""
+    import json
+
+    rows: dict[str, list[float]] = {}
+    for _ in range(runs):
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        p = subprocess.run([sys.executable, "-c", PHASES, size, out], env=env, check=True,
+                           capture_output=True, text=True)  # fmt: skip
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        total = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+        got = json.loads(p.stdout.strip().splitlines()[-1])
+        for name, t in got["marks"]:
+            rows.setdefault(name, []).append(t)
+        rows.setdefault("exit (teardown)", []).append(total - got["end"])
+    med = {k: statistics.median(v) for k, v in rows.items()}
+    print(f"  where the CPU goes (the same steps in a fresh process, median of {runs}; "
+          f"CPU seconds, sum {sum(med.values()):.2f} s):")  # fmt: skip
+    print("    " + ", ".join(f"{k} {v:.2f}" for k, v in med.items()))
+
+
+def process_target(runs: int, size: str, breakdown: bool = True) -> None:
     env = dict(os.environ)
     env.pop("CSPLAB_ENGINE", None)
     env["PYTHONPATH"] = str(ROOT) + os.pathsep + env.get("PYTHONPATH", "")
@@ -106,6 +181,9 @@ def process_target(runs: int, size: str) -> None:
     verdict = "meets" if cpu <= SAT_TARGET_S else f"SHORT by {cpu - SAT_TARGET_S:.2f} s"
     print(f"  target sat end to end <= {SAT_TARGET_S:.0f} s: CPU {cpu:.2f} s (wall {wall:.2f} s "
           f"under this load): {verdict}")  # fmt: skip
+    if breakdown:
+        with tempfile.TemporaryDirectory() as tmp:
+            phases(runs, size, env, str(Path(tmp) / "castle.npy"))
 
 
 # ----------------------------------------------------------------------------- CP-SAT models
@@ -250,12 +328,13 @@ def main() -> None:
     ap.add_argument("--time-limit", type=float, default=60.0)
     ap.add_argument("--skip-process", action="store_true")
     ap.add_argument("--skip-cpsat", action="store_true")
+    ap.add_argument("--skip-phases", action="store_true")
     ap.add_argument("--models", nargs="+", default=DEFAULT_MODELS,
                     choices=[*OPTIONS, *MODELS])  # fmt: skip
     args = ap.parse_args()
     print(load())
     if not args.skip_process:
-        process_target(args.runs, args.size)
+        process_target(args.runs, args.size, not args.skip_phases)
     if not args.skip_cpsat:
         cpsat_target(args.size, args.time_limit, args.models)
     print(load())

@@ -6,6 +6,9 @@ name in double backquotes, a colon, what it does) is the one-line help of ``cspl
 the whole docstring (what it does, its exit codes) the description of ``csplab NAME --help``.
 A ``HELP`` string, a ``DESCRIPTION`` string (``RAW_DESCRIPTION = True`` keeps its layout) or
 a ``description()`` function (a text computed when the parser is built) replaces them.
+``EXIT_AT_ONCE = True`` declares a command that leaves nothing to clean up once ``run``
+returns (its output written atomically, its worker pools closed): the console script then
+ends the process at once, without the interpreter's teardown (:func:`main`).
 :data:`COMMANDS` maps names to modules, and :func:`build_parser` builds every subparser the
 same way. Exit codes: 0 success, 1 the algorithm failed / the problem is unsatisfiable / a
 check found problems, 2 bad input (one line on stderr, no traceback).
@@ -15,12 +18,13 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import re
 import sys
 import warnings
 from collections.abc import Sequence
 from types import ModuleType
-from typing import Any
+from typing import Any, NoReturn
 
 from csplab.cli.common import readable
 from csplab.errors import CsplabError
@@ -151,7 +155,7 @@ def build_parser(only: str | None = None) -> argparse.ArgumentParser:
             formatter_class=argparse.RawDescriptionHelpFormatter if raw else argparse.HelpFormatter,
         )
         mod.add_arguments(p)
-        p.set_defaults(_run=mod.run)
+        p.set_defaults(_run=mod.run, _exit_at_once=bool(getattr(mod, "EXIT_AT_ONCE", False)))
     return parser
 
 
@@ -214,12 +218,28 @@ def _announce_compiling() -> None:
         _jit.on_load(_compiling_notice)
 
 
+def _exit_at_once(code: int) -> NoReturn:
+    """Flush stdout and stderr, then end the process with ``code`` (no teardown)."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (BrokenPipeError, ValueError):  # a closed pipe or stream: nothing to write
+            pass
+    os._exit(code)
+
+
 def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> int:
     """Entry point of the ``csplab`` console script.
 
     ``announce`` (default: only for the console script itself, ``argv is None``) prints one
     line on stderr before numba's one-time compilation of a kernel (numba compiles one
     only when its cache lacks it).
+
+    The console script (``argv is None``) of a command declaring ``EXIT_AT_ONCE`` ends the
+    process with the command's exit code as soon as it returns, skipping the interpreter's
+    teardown (freeing every object and module, a native SAT solver's destructor): 0.2 s of
+    CPU after ``synthesize castle --size 40x40x10 --solver sat``. Callers passing ``argv``
+    (tests, scripts) get the code returned as always.
     """
     words = _attach_negative_values(list(sys.argv[1:] if argv is None else argv))
     first = next((w for w in words if not w.startswith("-")), None)
@@ -237,6 +257,8 @@ def main(argv: Sequence[str] | None = None, *, announce: bool | None = None) -> 
             # ones a command passes it to)
             with memory_limit(getattr(args, "memory_limit", None)):
                 code: int = args._run(args)
+        if argv is None and getattr(args, "_exit_at_once", False):
+            _exit_at_once(code)
         return code
     except CsplabError as e:
         msg = readable(str(e)).strip().splitlines()

@@ -43,6 +43,10 @@ from csplab.errors import InputError
 from csplab.grids import GridWindows, parse_shape
 from csplab.problem import Problem
 
+#: the output is written atomically and worker pools are closed before ``run`` returns: the
+#: console script skips the interpreter's teardown (a large SAT solver's among it)
+EXIT_AT_ONCE = True
+
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     add_problem_args(p)

@@ -108,3 +108,34 @@ def test_every_command_help(capsys, name):
     out = capsys.readouterr().out
     assert out.startswith(f"usage: csplab {name}")
     assert "``" not in out and ":mod:" not in out
+
+
+def test_console_script_exit_at_once_keeps_codes_and_output(tmp_path, capsys):
+    """`python -m csplab synthesize` ends without the interpreter's teardown
+    (``EXIT_AT_ONCE``): the exit codes, the flushed stdout and the written file stay."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    env = dict(os.environ)
+    env["PYTHONPATH"] = str(Path(__file__).resolve().parents[2])
+    out = tmp_path / "o.npy"
+
+    def cli(*argv):
+        return subprocess.run([sys.executable, "-m", "csplab", *argv], env=env,
+                              capture_output=True, text=True, timeout=120)  # fmt: skip
+
+    p = cli("synthesize", "castle", "--size", "6x6x3", "--solver", "sat", "--seed", "1",
+            "--out", str(out), "--json")  # fmt: skip
+    assert p.returncode == 0, p.stderr
+    d = json.loads(p.stdout)  # the whole line arrived: stdout was flushed before the exit
+    assert d["status"] == "solved" and d["out"] == str(out)
+    assert cli("check", "castle", str(out)).returncode == 0
+    same = tmp_path / "same.npy"  # in-process (main(argv) returns): the same bytes
+    assert main(["synthesize", "castle", "--size", "6x6x3", "--solver", "sat", "--seed", "1",
+                 "--out", str(same)]) == 0  # fmt: skip
+    assert same.read_bytes() == out.read_bytes()
+    assert cli("synthesize", "fig3_1d", "--size", "5x5", "--seed", "0").returncode == 1
+    bad = cli("synthesize", "line", "--size", "5xq")
+    assert bad.returncode == 2 and bad.stderr.startswith("csplab: error:")
