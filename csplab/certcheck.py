@@ -6,13 +6,17 @@ no code with the prover (:mod:`csplab.analysis.infallible`; an import-linter con
 forbids importing it, or anything of csplab but :mod:`csplab.errors`): the frames, regions,
 arc consistency and grid replay below are written again, plainly.
 
-How the closure is checked: every frame of the certificate is verified in one batch of
-boolean arrays (regions, labelled cells, recorded keys); every state of every
-configuration is a row of one label array, and its successors are looked up among the
-states by exact integer codes. A state needs arc consistency only when some label that
+How the closure is checked: a state needs arc consistency only when some label that
 its cell's labelled neighbours allow (a superset of the catalog) leads to no recorded
 state, and at the point; the catalog is computed once per region shape (the region's
-cells relative to the step's cell, which are labelled, their domains) and labels.
+cells relative to the step's cell, which are labelled, their domains) and labels. A
+certificate of up to ``_LEAN_STATES`` states is checked one frame and one state at a time
+with Python integers (sets of cells as bit masks: :func:`_check_lean`), where arrays
+would cost more in fixed overhead than in work. A larger one is checked in arrays: every
+frame is verified in one batch of boolean arrays (regions, labelled cells, recorded
+keys); every state of every configuration is a row of one label array, and its
+successors are looked up among the states by exact integer codes. Both make the same
+checks (the tests run each planted defect through both).
 
 Format ``csplab-certificate``, version 1 (JSON)
 -----------------------------------------------
@@ -88,7 +92,7 @@ import json
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, cast
 
 import numpy as np
 
@@ -325,26 +329,29 @@ def _positions(
     if _axes_of(str(cert["order"]), ndim) != axes:
         raise _Invalid("axes do not match the order")
     both = (False, True) if face_rules else (False,)
-    want = set()
-    for lo in itertools.product(*[range(1 + b + h) for b, h in zip(back, history, strict=True)]):
-        for hi in itertools.product(*[range(r - 1) for r in region]):
-            at_lo = [(True,) if lo[d] < back[d] + history[d] else both for d in range(ndim)]
-            at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
-            for a in itertools.product(*at_lo):
-                for b in itertools.product(*at_hi):
-                    want.add((lo, hi, a, b))
-    got: list[_Conf] = [
-        (
-            tuple(c["lower"]), tuple(c["upper"]),
-            tuple(bool(t) for t in c.get("at_lower", [])) or tuple(
-                lo < b + h for lo, b, h in zip(c["lower"], back, history, strict=True)),
-            tuple(bool(t) for t in c.get("at_upper", [])) or tuple(
-                hi < r - 2 for hi, r in zip(c["upper"], region, strict=True)),
-        )
-        for c in cert["configs"]
-    ]  # fmt: skip
-    if len(got) != len(set(got)) or set(got) != want:
-        raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
+
+    def sides(extent: list[int], exact: list[int]) -> set[tuple[Any, ...]]:
+        # per axis the pairs (distance, edge on the face): on the face when the region is
+        # clipped there (distance below ``exact``), either way otherwise
+        per = [[(v, a) for v in range(e) for a in ((True,) if v < x else both)]
+               for e, x in zip(extent, exact, strict=True)]  # fmt: skip
+        return {(*zip(*p, strict=True),) for p in itertools.product(*per)}
+
+    lows = sides([1 + b + h for b, h in zip(back, history, strict=True)],
+                 [b + h for b, h in zip(back, history, strict=True)])  # fmt: skip
+    highs = sides([r - 1 for r in region], [r - 2 for r in region])
+    got: list[_Conf] = []
+    for c in cert["configs"]:
+        lo, hi = tuple(c["lower"]), tuple(c["upper"])
+        a = tuple(map(bool, c.get("at_lower", ()))) or tuple(
+            v < b + h for v, b, h in zip(lo, back, history, strict=True))
+        b = tuple(map(bool, c.get("at_upper", ()))) or tuple(
+            v < r - 2 for v, r in zip(hi, region, strict=True))
+        got.append((lo, hi, a, b))
+    want = len(lows) * len(highs)
+    if (len(got) != want or len(set(got)) != want
+            or any((lo, a) not in lows or (hi, b) not in highs for lo, hi, a, b in got)):
+        raise _Invalid(f"the configurations are not the {want} positions of a point")
     return region, back, axes, got
 
 
@@ -377,7 +384,10 @@ def _check_closed(
     configs = cert["configs"]
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and region graphs
-    memo = _Memo(dead or {})
+    memo = _Memo(dead or {}, int(cert["dead"]["cap"]) if dead else 0)
+    if sum(len(c["states"]) for c in configs) <= _LEAN_STATES:
+        nstates = _check_lean(cert, rules, region, back, axes, got, memo, classes)
+        return _closed_message(cert, nstates, len(configs), region, back, classes)
     specs: list[tuple[Cell, Cell, list[list[int]]]] = []
     fid_of: dict[Any, int] = {}
     fids = []
@@ -395,11 +405,18 @@ def _check_closed(
         for m in range(1 << ndim):
             maps[m, :-1] = _class_of(fwd, used, frozenset(d for d in range(ndim) if m >> d & 1))
     nstates = _check_states(configs, plans, fwd, bwd, used, memo, maps)
+    return _closed_message(cert, nstates, len(configs), region, back, classes)
+
+
+def _closed_message(
+    cert: Mapping[str, Any], nstates: int, nconf: int, region: list[int], back: list[int],
+    classes: bool,
+) -> str:  # fmt: skip
     rtxt = "x".join(map(str, region)) + (
         "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
     )
     return (
-        f"valid: {nstates} states{' (labels by class)' if classes else ''} in {len(configs)} "
+        f"valid: {nstates} states{' (labels by class)' if classes else ''} in {nconf} "
         "configurations are closed under Alg. 3.6 "
         f"with {rtxt} regions ({cert['order']}) and no catalog of a point is empty: "
         "Alg. 3.1 never fails (Theorem 3.3.6)"
@@ -656,41 +673,58 @@ def _cell_domain(
 ) -> int:
     """The domain of a frame cell of ``code`` (per axis, little end first: its capped
     distances to the frame's lower and upper edge, and whether each edge is on the face)."""
-    on, key = set(), []
+    on, key = 0, []
     for d in range(ndim):
         code, digit = divmod(code, 4 * (cap + 1) ** 2)
         rest, at_hi = divmod(digit, 2)
         (lo, hi), at_lo = divmod(rest // 2, cap + 1), rest % 2
-        if at_lo and lo == 0:
-            on.add(_AXES[d] + "-")
-        if at_hi and hi == 0:
-            on.add(_AXES[d] + "+")
+        on |= (at_lo and lo == 0) << 2 * d | (at_hi and hi == 0) << 2 * d + 1
         # exact on a face edge, else at least one more (a suffix lo .. cap: lo + cap + 1)
         key += [lo if at_lo else min(lo + 1, cap) + cap + 1,
                 hi if at_hi else min(hi + 1, cap) + cap + 1]  # fmt: skip
-    dom = _domain(face_rules, on, used)
-    return dom & ~memo.dead_in(tuple(key)) if memo.dead else dom
+    return memo.domain(on, tuple(key), used, face_rules)
 
 
 class _Memo:
     """What the configurations of one certificate share."""
 
-    def __init__(self, dead: Mapping[Where, int]) -> None:
+    def __init__(self, dead: Mapping[Where, int], cap: int = 0) -> None:
         self.dead = dead
-        self.cap = max((v for k in dead for a in k for v in a), default=0)
+        self.cap = cap
         self.union: dict[tuple[int, int, int], int] = {}
         self.domains: dict[int, int] = {}
         self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+        self.faces: dict[int, int] = {}
+        self.boxes: dict[tuple[int, ...], int] = {}
+
+    def domain(self, on: int, key: tuple[int, ...], used: int, face_rules: list[FaceRule]) -> int:
+        """The domain of a cell on the faces ``on`` (bits ``2d``: the lower face of axis
+        ``d``, ``2d + 1``: the upper) and in the box of places ``key``
+        (:meth:`dead_in`): the labels in use, edited by the face rules, minus the dead."""
+        dom = self.faces.get(on)
+        if dom is None:
+            faces = {_AXES[t // 2] + "-+"[t % 2] for t in _bits(on)}
+            dom = self.faces[on] = _domain(face_rules, faces, used)
+        if not self.dead:
+            return dom
+        return dom & ~self.dead_in(key)
 
     def dead_in(self, key: tuple[int, ...]) -> int:
         """The labels dead at every place of a box of places: per axis the distance to
         the lower and to the upper face, each ``a`` (exactly) or ``a + cap + 1`` (``a``
         to ``cap``)."""
-        c, got = self.cap, -1
-        spans = [[v] if v <= c else range(v - c - 1, c + 1) for v in key]
-        per_axis = [list(itertools.product(*spans[t : t + 2])) for t in range(0, len(key), 2)]
-        for k in itertools.product(*per_axis):
-            got &= self.dead[k]
+        got = self.boxes.get(key)
+        if got is None:
+            c, got = self.cap, -1
+            # the farthest places first: inside, few labels are dead, and none ends the AND
+            spans = [[v] if v <= c else range(c, v - c - 2, -1) for v in key]
+            per_axis = [list(itertools.product(*spans[t : t + 2]))
+                        for t in range(0, len(key), 2)]  # fmt: skip
+            for k in itertools.product(*per_axis):
+                got &= self.dead[k]
+                if not got:
+                    break
+            self.boxes[key] = got
         return got
 
 
@@ -1017,6 +1051,339 @@ def _small_ac(
     return dom
 
 
+# ----------------------------------------------------------------------------- small certificates
+#
+# The same checks as _frames / _check_states, one frame and one state at a time with
+# Python integers: a certificate of a few hundred states is checked faster so than
+# with arrays, whose every operation costs microseconds however small.
+
+# states up to which an infallible certificate is checked one state at a time (measured:
+# below it, this is the faster; 1000 states of pillar with its boundary take about as long
+# either way)
+_LEAN_STATES = 4000
+
+
+class _Step(NamedTuple):
+    """Step ``i`` of a frame, as :func:`_check_lean` uses it: the slot and axis of each
+    labelled backward neighbour of the step's cell in its region (``near``); the slot in
+    this step's state and the axes on which the cell is open at the next step (a bit mask)
+    of each label the next state keeps (``kept``, in the next state's order), whether the
+    next state records the label chosen here (last, ``chosen``) and that label's open axes
+    (``chosen_open``); the step's region (``box``) and the cells not yet labelled in it
+    (``free``), as bit masks over the scan ranks."""
+
+    near: list[tuple[int, int]]
+    kept: list[tuple[int, int]]
+    chosen: bool
+    chosen_open: int
+    box: int
+    free: int
+
+
+class _LeanFrame(NamedTuple):
+    """A frame's cells in scan order (``coords``, every cell of the box) and its steps."""
+
+    n: int
+    coords: list[Cell]
+    keys: list[list[int]]
+    steps: list[_Step]
+
+
+def _lean_frame(
+    lo: Cell, hi: Cell, keys: list[list[int]], region: list[int], back: list[int],
+    axes: tuple[int, ...],
+) -> _LeanFrame:  # fmt: skip
+    """The frame of ``(lower, upper)`` with its ``keys`` verified (the checks of
+    :func:`_frame_chunk`, with sets of cells as bit masks over the scan ranks)."""
+    ndim = len(lo)
+    rd = range(ndim)
+    ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
+    sc = [0] * ndim
+    s = 1
+    for d in reversed(axes):
+        sc[d] = s
+        s *= ext[d]
+    n = sum(v * sc[d] for d, v in enumerate(lo)) + 1
+    if len(keys) != n or keys[0]:
+        raise _Invalid(f"{_where(lo, hi)}: keys must list {n} steps, the first empty")
+    scan = itertools.product(*[range(ext[d]) for d in axes])
+    if list(axes) == sorted(axes):
+        coords = list(scan)
+    else:
+        at = [axes.index(d) for d in rd]
+        coords = [tuple(c[k] for k in at) for c in scan]
+    # per axis: the cells of each layer; the region's layers about each layer (clipped)
+    layer = [[0] * e for e in ext]
+    for r, c in enumerate(coords):
+        for d in rd:
+            layer[d][c[d]] |= 1 << r
+    win = [[sum(layer[d][max(v - back[d], 0) : v + region[d] - 1]) for v in range(ext[d])]
+           for d in rd]  # fmt: skip
+    inner = [(d, sc[d], ~layer[d][-1], ~layer[d][0]) for d in rd]
+    masks = []
+    for i, ks in enumerate(keys):
+        m = 0
+        for j in ks:
+            if not (_is_int(j) and 0 <= j < i and not m >> j):
+                raise _Invalid(f"{_where(lo, hi)}: keys[{i}] must be sorted earlier steps")
+            m |= 1 << j
+        masks.append(m)
+    for i in range(n - 1):
+        if masks[i + 1] & ~(masks[i] | 1 << i):
+            raise _Invalid(f"{_where(lo, hi)}: keys[{i + 1}] records a label step {i} forgot")
+    # each cell's + neighbours in the frame: (axis, rank)
+    plus = [[(d, r + sc[d]) for d in rd if c[d] + 1 < ext[d]] for r, c in enumerate(coords)]
+    steps = []
+    for i in range(n):
+        c = coords[i]
+        box = -1
+        for d in rd:
+            box &= win[d][c[d]]
+        done = (1 << i) - 1
+        free = box & ~done
+        near_free = 0
+        for _, s, not_last, not_first in inner:
+            near_free |= (free & not_last) << s | (free & not_first) >> s
+        miss = box & done & near_free & ~masks[i]
+        if miss:
+            x = coords[(miss & -miss).bit_length() - 1]
+            raise _Invalid(
+                f"{_where(lo, hi)}: step {i} depends on cell {list(x)}, not in keys[{i}]"
+            )
+        ks = keys[i]
+        near = [(ks.index(i - s), d) for d, s, _, _ in inner if c[d] and box >> (i - s) & 1]
+        kept: list[tuple[int, int]] = []
+        chosen, chosen_open = False, 0
+        if i + 1 < n:
+            for j in keys[i + 1]:
+                op = 0
+                for d, r in plus[j]:
+                    if r > i:
+                        op |= 1 << d
+                if j == i:
+                    chosen, chosen_open = True, op
+                else:
+                    kept.append((ks.index(j), op))
+        steps.append(_Step(near, kept, chosen, chosen_open, box, free))
+    return _LeanFrame(n, coords, keys, steps)
+
+
+def _check_lean(
+    cert: Mapping[str, Any],
+    rules: _Rules,
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+    got: list[_Conf],
+    memo: _Memo,
+    classes: bool,
+) -> int:
+    """The checks of :func:`_check_states` on a small certificate, a state at a time.
+
+    A state at a step that is not the point is closed when each label of its cell that
+    agrees with the labelled backward neighbours (a superset of the catalog ``C_R``)
+    leads to a recorded state; only otherwise is arc consistency run on the region. At
+    the point arc consistency runs unless the cell is the region's only one not yet
+    labelled and labels are recorded by class: arcs between labelled cells are then left
+    out, and the catalog is that superset itself (each neighbour's label supports every
+    label of it, and nothing else narrows it).
+    """
+    fwd, _, used, ndim, face_rules = rules
+    K = len(fwd[0])
+    configs = cert["configs"]
+    class_maps: dict[int, list[int]] = {}
+    ident = list(range(K))
+
+    def cls(m: int) -> list[int]:
+        if not classes:
+            return ident
+        got_m = class_maps.get(m)
+        if got_m is None:
+            got_m = class_maps[m] = _class_of(fwd, used, frozenset(_bits(m)))
+        return got_m
+
+    ac = _LeanAC(rules, memo, classes)
+    cap = max(memo.cap, 1)
+    plain = not face_rules and not memo.dead
+    # the labels in use, and a state's labels as they are checked: every one in use
+    in_use = {b for b in range(K) if used >> b & 1}
+    pair = (list, tuple)
+    # configurations by frame (the same frame: the same steps and keys)
+    by_frame: dict[Any, list[tuple[Mapping[str, Any], _Conf]]] = {}
+    for conf, g in zip(configs, got, strict=True):
+        by_frame.setdefault((g[0], g[1], tuple(map(tuple, conf["keys"]))), []).append((conf, g))
+    axis_places: dict[tuple[int, int, bool, bool, int], list[tuple[int, tuple[int, int]]]] = {}
+    total = 0
+    for (lo, hi, _), members in by_frame.items():
+        fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes)
+        n, coords, keys, steps = fr.n, fr.coords, fr.keys, fr.steps
+        ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
+        widths = [len(k) for k in keys]
+        plans = [([(k, cls(m)) for k, m in st.kept], cls(st.chosen_open)) for st in steps]
+        for conf, (_, _, at_lo, at_hi) in members:
+            # the domain of each cell of the frame (labels in use, face rules, dead labels)
+            if plain:
+                base = [used] * len(coords)
+            else:
+                per = []
+                for d in range(ndim):
+                    sig = (d, ext[d], at_lo[d], at_hi[d], cap)
+                    p = axis_places.get(sig)
+                    if p is None:
+                        p = axis_places[sig] = _axis_places(*sig)
+                    per.append(p)
+                base = []
+                for c in coords:
+                    on, where = 0, cast(tuple[int, ...], ())
+                    for d, v in enumerate(c):
+                        f, w = per[d][v]
+                        on |= f
+                        where += w
+                    base.append(memo.domain(on, where, used, face_rules))
+            # the states by step, checked for their form
+            states = conf["states"]
+            by_step: list[list[tuple[int, ...]]] = [[] for _ in range(n)]
+            for s in states:
+                if not isinstance(s, pair) or len(s) != 2:
+                    raise _Invalid("a state is not a pair [step, labels]")
+                i, labs = s
+                if not (type(i) is int or _is_int(i)) or not isinstance(labs, pair):
+                    raise _Invalid("a state's step or labels are not integers")
+                if not 0 <= i < n:
+                    raise _Invalid(f"{_where(lo, hi)}: a state's step is not one of its {n} steps")
+                if len(labs) != widths[i]:
+                    raise _Invalid(f"{_where(lo, hi)}: a state at step {i} does not fit keys[{i}]")
+                by_step[i].append(tuple(labs))
+            flat = set(itertools.chain.from_iterable(s[1] for s in states))
+            if not in_use.issuperset(flat) or set(map(type, flat)) - {int}:
+                _labels_in_use(states, flat, in_use, _where(lo, hi))
+            if not by_step[0]:
+                raise _Invalid(f"{_where(lo, hi)}: no start state")
+            total += len(states)
+            # closed: each state's labels lead to recorded states; the point's catalog
+            nxt: Any = None  # the next step's states (by their labels but the last: its bits)
+            for i in range(n - 1, -1, -1):
+                st = steps[i]
+                b0 = base[i]
+                near = st.near
+                here = by_step[i]
+                if i == n - 1:
+                    exact = classes and st.free == 1 << i
+                    for labs in here:
+                        fc = b0
+                        for k, d in near:
+                            fc &= fwd[d][labs[k]]
+                        if fc and not exact:
+                            fc = ac.catalog(fr, i, labs, base)
+                        if not fc:
+                            raise _Invalid(f"{_where(lo, hi)}: the point's catalog is empty "
+                                           f"in state {[i, list(labs)]}")  # fmt: skip
+                else:
+                    maps, pick = plans[i]
+                    chosen = st.chosen
+                    for labs in here:
+                        fc = b0
+                        for k, d in near:
+                            fc &= fwd[d][labs[k]]
+                        if not fc:
+                            continue
+                        kept = tuple([m[labs[k]] for k, m in maps])
+                        if chosen:
+                            avail = nxt.get(kept, 0)
+                            miss = 0
+                            for b in _bits(fc):
+                                if not avail >> pick[b] & 1:
+                                    miss |= 1 << b
+                        else:
+                            miss = 0 if kept in nxt else fc
+                        if miss:
+                            miss &= ac.catalog(fr, i, labs, base)
+                        if miss:
+                            b = (miss & -miss).bit_length() - 1
+                            nx = [*kept, pick[b]] if chosen else list(kept)
+                            raise _Invalid(
+                                f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} with "
+                                f"label {b} leads to {[i + 1, nx]}, which is missing"
+                            )
+                if i and steps[i - 1].chosen:
+                    nxt = {}
+                    for labs in here:
+                        nxt[labs[:-1]] = nxt.get(labs[:-1], 0) | 1 << labs[-1]
+                else:
+                    nxt = set(here)
+    return total
+
+
+def _axis_places(
+    d: int, e: int, at_lo: bool, at_hi: bool, cap: int
+) -> list[tuple[int, tuple[int, int]]]:
+    """Per coordinate of a frame of extent ``e`` along axis ``d``: the faces a cell there
+    lies on (bits ``2d``, ``2d + 1``) and its capped distances to the faces (exact where
+    the frame's edge is on the face, else ``a + cap + 1``: ``a`` or more)."""
+    return [
+        ((at_lo and v == 0) << 2 * d | (at_hi and v == e - 1) << 2 * d + 1,
+         (min(v, cap) if at_lo else min(v + 1, cap) + cap + 1,
+          min(e - 1 - v, cap) if at_hi else min(e - v, cap) + cap + 1))
+        for v in range(e)
+    ]  # fmt: skip
+
+
+def _labels_in_use(states: list[Any], flat: set[Any], in_use: set[int], where: str) -> None:
+    """Raise for the first label of ``states`` that is not an integer or not in use."""
+    if any(not issubclass(t, np.integer) for t in set(map(type, flat)) - {int}):
+        raise _Invalid("a state's step or labels are not integers")
+    for s in states:
+        if not in_use.issuperset(int(x) for x in s[1]):
+            raise _Invalid(f"{where}: a state at step {s[0]} has a label not in use")
+
+
+class _LeanAC:
+    """``C_R`` of a step of a frame in a state: arc consistency on the step's region (its
+    cells not yet labelled, with their domains, and its recorded ones); with ``classes``
+    no arcs between labelled cells. Graphs are shared by steps of one shape (the cells
+    relative to the step's cell, and which are labelled), catalogs by shape, domains and
+    labels."""
+
+    def __init__(self, rules: _Rules, memo: _Memo, classes: bool) -> None:
+        self.rules, self.memo, self.classes = rules, memo, classes
+        self.graphs: dict[Any, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+        self.catalogs: dict[Any, int] = {}
+
+    def catalog(self, fr: _LeanFrame, i: int, labs: tuple[int, ...], base: list[int]) -> int:
+        st = fr.steps[i]
+        c = fr.coords[i]
+        keys = fr.keys[i]
+        fixed = [(fr.coords[j], k) for k, j in enumerate(keys) if st.box >> j & 1]
+        free = list(_bits(st.free))
+        rel = [tuple(a - b for a, b in zip(x, c, strict=True)) for x, _ in fixed]
+        rel.append(())  # the labelled cells, then those not yet labelled
+        rel += [tuple(a - b for a, b in zip(fr.coords[j], c, strict=True)) for j in free]
+        shape = tuple(rel)
+        doms = tuple(base[j] for j in free)
+        key = (shape, doms, tuple(labs[k] for _, k in fixed))
+        cat = self.catalogs.get(key)
+        if cat is not None:
+            return cat
+        graph = self.graphs.get(shape)
+        if graph is None:
+            nf = len(fixed)
+            arcs = _arcs([x for x, _ in fixed] + [fr.coords[j] for j in free])
+            if self.classes:
+                arcs = [[a for a in row if not (u < nf and a[0] < nf)]
+                        for u, row in enumerate(arcs)]  # fmt: skip
+            graph = self.graphs[shape] = (arcs, nf + free.index(i))
+        arcs, target = graph
+        dom = [1 << labs[k] for _, k in fixed] + list(doms)
+        fwd, bwd = self.rules.fwd, self.rules.bwd
+        out = _small_ac(dom, arcs, fwd, bwd, self.memo.union)
+        cat = self.catalogs[key] = 0 if out is None else out[target]
+        return cat
+
+
+def _is_int(x: Any) -> bool:
+    return type(x) is int or isinstance(x, np.integer)
+
+
 # ----------------------------------------------------------------------------- label classes
 
 
@@ -1061,28 +1428,43 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         used & ~_domain(face_rules, {_AXES[t // 2] + "-+"[t % 2] for t in _bits(f)}, used)
         for f in range(1 << 2 * ndim)
     ]
-    per_axis = [[(p, (p[0] == 0) << 2 * d | (p[1] == 0) << 2 * d + 1) for p in span]
-                for d in range(ndim)]  # fmt: skip
-    known: dict[Where, int] = {
-        tuple(p for p, _ in k): excluded[sum(f for _, f in k)]
-        for k in itertools.product(*per_axis)
-    }
+    # every place, and the faces it lies on, in the same order (iterated in C)
+    flags = [[(a == 0) << 2 * d | (b == 0) << 2 * d + 1 for a, b in span] for d in range(ndim)]
+    known: dict[Where, int] = dict(zip(
+        itertools.product(span, repeat=ndim),
+        map(excluded.__getitem__, map(sum, itertools.product(*flags))),
+        strict=True,
+    ))  # fmt: skip
     every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
+    label_bits: dict[tuple[Any, ...], int] = {}
     for face, got in dead["stages"]:
         if face not in every:
             raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
         d, minus = _AXES.index(face[0]), face[1] == "-"
         stage: dict[Where, int] = {}
         for where, labels in got:
-            k: Where = tuple((int(a), int(b)) for a, b in where)
+            k: Where = tuple(map(tuple, where))
             if k not in known or k[d][0 if minus else 1] == 0:
                 raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
-            for b in labels:
-                if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
-                    raise _Invalid(f"dead labels: {b!r} is not a label in use")
-                stage[k] = stage.get(k, 0) | 1 << b
+            t = tuple(labels)
+            m = label_bits.get(t)
+            if m is None:
+                m = 0
+                for b in t:
+                    if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
+                        raise _Invalid(f"dead labels: {b!r} is not a label in use")
+                    m |= 1 << b
+                label_bits[t] = m
+            stage[k] = stage.get(k, 0) | m
         table = bwd[d] if minus else fwd[d]
+        sup_of: dict[int, int] = {}  # labels -> their supports toward the face
         for k, bits in stage.items():
+            sup = sup_of.get(bits)
+            if sup is None:
+                sup = 0
+                for b in _bits(bits):
+                    sup |= table[b]
+                sup_of[bits] = sup
             lo, hi = k[d]
             if minus:
                 los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
@@ -1091,6 +1473,8 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
             for a, c in itertools.product(los, his):
                 n = (*k[:d], (a, c), *k[d + 1 :])
                 gone = known[n] | stage.get(n, 0)
+                if not sup & ~gone:
+                    continue
                 for b in _bits(bits):
                     if table[b] & ~gone:
                         raise _Invalid(
