@@ -92,7 +92,7 @@ import json
 import math
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
-from typing import Any, NamedTuple, cast
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -384,7 +384,7 @@ def _check_closed(
     configs = cert["configs"]
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and region graphs
-    memo = _Memo(dead or {}, int(cert["dead"]["cap"]) if dead else 0)
+    memo = _Memo(rules, dead or {}, int(cert["dead"]["cap"]) if dead else 0)
     if sum(len(c["states"]) for c in configs) <= _LEAN_STATES:
         nstates = _check_lean(cert, rules, region, back, axes, got, memo, classes)
         return _closed_message(cert, nstates, len(configs), region, back, classes)
@@ -688,14 +688,19 @@ def _cell_domain(
 class _Memo:
     """What the configurations of one certificate share."""
 
-    def __init__(self, dead: Mapping[Where, int], cap: int = 0) -> None:
+    def __init__(self, rules: _Rules, dead: Mapping[Where, int], cap: int = 0) -> None:
         self.dead = dead
         self.cap = cap
-        self.union: dict[tuple[int, int, int], int] = {}
+        self.used = rules.used
+        self.tables = [*rules.fwd, *rules.bwd]
+        self.unions: list[dict[int, int]] = [{} for _ in self.tables]
         self.domains: dict[int, int] = {}
-        self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+        self.graphs: dict[bytes, tuple[Arcs, int]] = {}
         self.faces: dict[int, int] = {}
         self.boxes: dict[tuple[int, ...], int] = {}
+        # a distance or a range of distances (``a + cap + 1``: ``a`` to ``cap``) -> the
+        # farthest distance in it
+        self.far = [*range(cap + 1), *[cap] * (cap + 1)]
 
     def domain(self, on: int, key: tuple[int, ...], used: int, face_rules: list[FaceRule]) -> int:
         """The domain of a cell on the faces ``on`` (bits ``2d``: the lower face of axis
@@ -712,11 +717,17 @@ class _Memo:
     def dead_in(self, key: tuple[int, ...]) -> int:
         """The labels dead at every place of a box of places: per axis the distance to
         the lower and to the upper face, each ``a`` (exactly) or ``a + cap + 1`` (``a``
-        to ``cap``)."""
+        to ``cap``); only labels in use."""
         got = self.boxes.get(key)
         if got is None:
-            c, got = self.cap, -1
-            # the farthest places first: inside, few labels are dead, and none ends the AND
+            c = self.cap
+            # the farthest place first: inside, few labels are dead, and none ends the AND
+            far = tuple(zip(map(self.far.__getitem__, key[::2]),
+                            map(self.far.__getitem__, key[1::2]), strict=True))  # fmt: skip
+            got = self.dead[far] & self.used  # (labels dead everywhere are out of use)
+            if not got:
+                self.boxes[key] = 0
+                return 0
             spans = [[v] if v <= c else range(c, v - c - 2, -1) for v in key]
             per_axis = [list(itertools.product(*spans[t : t + 2]))
                         for t in range(0, len(key), 2)]  # fmt: skip
@@ -891,7 +902,7 @@ def _check_states(
             it = iter(mk[r, : len(slots)].tolist())
             dom = [1 << next(it) if f else p.bases[x]
                    for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
-            ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
+            ac = _small_ac(dom, arcs, memo.tables, memo.unions)
             cats.append(0 if ac is None else ac[target])
         cat_rows = _unpack(cats, K)[inv]
         empty = last[need] & ~cat_rows.any(1)
@@ -998,55 +1009,59 @@ def _row_codes(group: Any, rows: Any, K: int) -> Any:
     return code
 
 
-def _arcs(nodes: Sequence[Cell]) -> list[list[tuple[int, int, bool]]]:
-    """The arcs between grid-adjacent ``nodes``: per node, ``(other node, axis, other is the
-    + neighbour)``."""
+Arcs = list[list[tuple[int, int]]]
+
+
+def _arcs(nodes: Sequence[Cell]) -> Arcs:
+    """The arcs between grid-adjacent ``nodes``: per node, ``(other node, t)`` with ``t``
+    the axis ``d`` when the other is the + neighbour along ``d``, else ``ndim + d`` (the
+    index of the support table in ``[*fwd, *bwd]``)."""
     pos = {x: k for k, x in enumerate(nodes)}
-    arcs: list[list[tuple[int, int, bool]]] = [[] for _ in nodes]
+    arcs: Arcs = [[] for _ in nodes]
     for x, k in pos.items():
-        for d in range(len(x)):
+        ndim = len(x)
+        for d in range(ndim):
             m = pos.get((*x[:d], x[d] + 1, *x[d + 1 :]))
             if m is not None:
-                arcs[k].append((m, d, True))
-                arcs[m].append((k, d, False))
+                arcs[k].append((m, d))
+                arcs[m].append((k, ndim + d))
     return arcs
 
 
 def _small_ac(
     dom: list[int],
-    arcs: list[list[tuple[int, int, bool]]],
-    fwd: list[list[int]],
-    bwd: list[list[int]],
-    union: dict[tuple[int, int, int], int],
+    arcs: Arcs,
+    tables: list[list[int]],
+    unions: list[dict[int, int]],
     start: Sequence[int] | None = None,
 ) -> list[int] | None:
     """Arc consistency (a work list of nodes) on a small graph; ``None`` on a wipe-out.
-    ``start``: the nodes whose domains changed since the domains were last arc consistent
-    (default: all)."""
+    ``tables``: ``[*fwd, *bwd]``; ``unions``: per table, the supports of a set of labels
+    found so far. ``start``: the nodes whose domains changed since the domains were last
+    arc consistent (default: all). ``dom`` is narrowed in place."""
     queue = list(range(len(dom))) if start is None else list(start)
-    waiting = [False] * len(dom)
-    for u in queue:
-        waiting[u] = True
+    waiting = set(queue)
     while queue:
         u = queue.pop()
-        waiting[u] = False
+        waiting.discard(u)
         du = dom[u]
-        for v, d, plus in arcs[u]:
-            ukey = (d if plus else -1 - d, du, 0)
-            sup = union.get(ukey)
+        for v, t in arcs[u]:
+            known = unions[t]
+            sup = known.get(du)
             if sup is None:
-                table = fwd[d] if plus else bwd[d]
+                table = tables[t]
                 sup = 0
                 for b in _bits(du):
                     sup |= table[b]
-                union[ukey] = sup
-            new = dom[v] & sup
-            if new != dom[v]:
-                if new == 0:
+                known[du] = sup
+            dv = dom[v]
+            new = dv & sup
+            if new != dv:
+                if not new:
                     return None
                 dom[v] = new
-                if not waiting[v]:
-                    waiting[v] = True
+                if v not in waiting:
+                    waiting.add(v)
                     queue.append(v)
     return dom
 
@@ -1058,9 +1073,9 @@ def _small_ac(
 # with arrays, whose every operation costs microseconds however small.
 
 # states up to which an infallible certificate is checked one state at a time (measured:
-# below it, this is the faster; 1000 states of pillar with its boundary take about as long
-# either way)
-_LEAN_STATES = 4000
+# below it, this is the faster; from about 400 to 1200 states both take about as long,
+# beyond, arrays win)
+_LEAN_STATES = 1000
 
 
 class _Step(NamedTuple):
@@ -1213,6 +1228,20 @@ def _check_lean(
     for conf, g in zip(configs, got, strict=True):
         by_frame.setdefault((g[0], g[1], tuple(map(tuple, conf["keys"]))), []).append((conf, g))
     axis_places: dict[tuple[int, int, bool, bool, int], list[tuple[int, tuple[int, int]]]] = {}
+    # a cell's domain by its faces and places along each axis (in scan order)
+    cell_doms: dict[tuple[tuple[int, tuple[int, int]], ...], int] = {}
+    scan_at = [axes.index(d) for d in range(ndim)]
+
+    def cell_dom(it: tuple[tuple[int, tuple[int, int]], ...]) -> int:
+        on = 0
+        where: tuple[int, ...] = ()
+        for k in scan_at:
+            f, w = it[k]
+            on |= f
+            where += w
+        dom = cell_doms[it] = memo.domain(on, where, used, face_rules)
+        return dom
+
     total = 0
     for (lo, hi, _), members in by_frame.items():
         fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes)
@@ -1226,20 +1255,16 @@ def _check_lean(
                 base = [used] * len(coords)
             else:
                 per = []
-                for d in range(ndim):
+                for d in axes:  # in scan order: the product below runs as the cells do
                     sig = (d, ext[d], at_lo[d], at_hi[d], cap)
                     p = axis_places.get(sig)
                     if p is None:
                         p = axis_places[sig] = _axis_places(*sig)
                     per.append(p)
-                base = []
-                for c in coords:
-                    on, where = 0, cast(tuple[int, ...], ())
-                    for d, v in enumerate(c):
-                        f, w = per[d][v]
-                        on |= f
-                        where += w
-                    base.append(memo.domain(on, where, used, face_rules))
+                base = [
+                    cell_doms[it] if it in cell_doms else cell_dom(it)
+                    for it in itertools.product(*per)
+                ]
             # the states by step, checked for their form
             states = conf["states"]
             by_step: list[list[tuple[int, ...]]] = [[] for _ in range(n)]
@@ -1346,7 +1371,7 @@ class _LeanAC:
 
     def __init__(self, rules: _Rules, memo: _Memo, classes: bool) -> None:
         self.rules, self.memo, self.classes = rules, memo, classes
-        self.graphs: dict[Any, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+        self.graphs: dict[Any, tuple[Arcs, int]] = {}
         self.catalogs: dict[Any, int] = {}
 
     def catalog(self, fr: _LeanFrame, i: int, labs: tuple[int, ...], base: list[int]) -> int:
@@ -1374,8 +1399,7 @@ class _LeanAC:
             graph = self.graphs[shape] = (arcs, nf + free.index(i))
         arcs, target = graph
         dom = [1 << labs[k] for _, k in fixed] + list(doms)
-        fwd, bwd = self.rules.fwd, self.rules.bwd
-        out = _small_ac(dom, arcs, fwd, bwd, self.memo.union)
+        out = _small_ac(dom, arcs, self.memo.tables, self.memo.unions)
         cat = self.catalogs[key] = 0 if out is None else out[target]
         return cat
 
@@ -1442,9 +1466,10 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
             raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
         d, minus = _AXES.index(face[0]), face[1] == "-"
         stage: dict[Where, int] = {}
+        side = 0 if minus else 1
         for where, labels in got:
             k: Where = tuple(map(tuple, where))
-            if k not in known or k[d][0 if minus else 1] == 0:
+            if k not in known or k[d][side] == 0:
                 raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
             t = tuple(labels)
             m = label_bits.get(t)
@@ -1458,6 +1483,14 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
             stage[k] = stage.get(k, 0) | m
         table = bwd[d] if minus else fwd[d]
         sup_of: dict[int, int] = {}  # labels -> their supports toward the face
+        # per distances along d, those the neighbour one cell nearer the face may have
+        toward: dict[tuple[int, int], list[tuple[int, int]]] = {}
+        for (lo, hi) in span:
+            if minus:
+                los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+            else:
+                los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+            toward[lo, hi] = list(itertools.product(los, his))
         for k, bits in stage.items():
             sup = sup_of.get(bits)
             if sup is None:
@@ -1465,13 +1498,9 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
                 for b in _bits(bits):
                     sup |= table[b]
                 sup_of[bits] = sup
-            lo, hi = k[d]
-            if minus:
-                los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
-            else:
-                los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
-            for a, c in itertools.product(los, his):
-                n = (*k[:d], (a, c), *k[d + 1 :])
+            head, tail = k[:d], k[d + 1 :]
+            for p in toward[k[d]]:
+                n = (*head, p, *tail)
                 gone = known[n] | stage.get(n, 0)
                 if not sup & ~gone:
                     continue
@@ -1530,8 +1559,9 @@ def _check_run(cert: Mapping[str, Any], rules: _Rules) -> str:
     if any(v == 0 for v in first):
         return "valid: Alg. 3.1 fails before its first choice (a boundary cell has no label)"
     arcs = _arcs(cells)
-    union: dict[tuple[int, int, int], int] = {}
-    dom = _small_ac(first, arcs, fwd, bwd, union)
+    tables = [*fwd, *bwd]
+    unions: list[dict[int, int]] = [{} for _ in tables]
+    dom = _small_ac(first, arcs, tables, unions)
     if dom is None:
         return "valid: Alg. 3.1 fails before its first choice (the grid has no solution)"
     choices = list(run["choices"])
@@ -1545,7 +1575,7 @@ def _check_run(cert: Mapping[str, Any], rules: _Rules) -> str:
             raise _Invalid(f"run: choice {k + 1} ({label} at {list(c)}) is not in its catalog")
         dom[k] = 1 << int(label)
         # the domains were arc consistent before: revising from the changed cell suffices
-        dom = _small_ac(dom, arcs, fwd, bwd, union, start=[k])
+        dom = _small_ac(dom, arcs, tables, unions, start=[k])
         if dom is None:
             rest = choices[k + 1 :]  # at most the cell found empty, marked [cell, None]
             if rest and (len(rest) > 1 or rest[0][1] is not None):
