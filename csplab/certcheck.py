@@ -10,9 +10,10 @@ How the closure is checked: a state needs arc consistency only when some label t
 its cell's labelled neighbours allow (a superset of the catalog) leads to no recorded
 state, and at the point; the catalog is computed once per region shape (the region's
 cells relative to the step's cell, which are labelled, their domains) and labels. A
-certificate of up to ``_LEAN_STATES`` states is checked one frame and one state at a time
-with Python integers (sets of cells as bit masks: :func:`_check_lean`), where arrays
-would cost more in fixed overhead than in work. A larger one is checked in arrays: every
+certificate of up to ``_LEAN_STATES`` states (or two per step) is checked one frame and
+one state at a time with Python integers (sets of cells as bit masks:
+:func:`_check_lean`), where arrays would cost more in fixed overhead than in work. A
+larger one is checked in arrays: every
 frame is verified in one batch of boolean arrays (regions, labelled cells, recorded
 keys); every state of every configuration is a row of one label array, and its
 successors are looked up among the states by exact integer codes. Both make the same
@@ -86,10 +87,12 @@ True
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import json
 import math
+import operator
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -203,10 +206,7 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
             if not cert.get("label_classes"):
                 raise _Invalid("dead labels are checked with label classes only")
             dead = _check_dead(cert["dead"], model)
-            everywhere = -1
-            for bits in dead.values():
-                everywhere &= bits
-            model = _without(model, everywhere)
+            model = _without(model, functools.reduce(operator.and_, dead.values(), -1))
         if claim == "infallible":
             msg = _check_closed(cert, model, dead, bool(cert.get("label_classes")))
         elif claim == "fallible":
@@ -385,7 +385,9 @@ def _check_closed(
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and region graphs
     memo = _Memo(rules, dead or {}, int(cert["dead"]["cap"]) if dead else 0)
-    if sum(len(c["states"]) for c in configs) <= _LEAN_STATES:
+    nstates = sum(len(c["states"]) for c in configs)
+    nsteps = sum(len(c["keys"]) for c in configs)
+    if _LEAN_STATES >= 0 and nstates <= max(_LEAN_STATES, 2 * nsteps):
         nstates = _check_lean(cert, rules, region, back, axes, got, memo, classes)
         return _closed_message(cert, nstates, len(configs), region, back, classes)
     specs: list[tuple[Cell, Cell, list[list[int]]]] = []
@@ -1072,9 +1074,11 @@ def _small_ac(
 # Python integers: a certificate of a few hundred states is checked faster so than
 # with arrays, whose every operation costs microseconds however small.
 
-# states up to which an infallible certificate is checked one state at a time (measured:
-# below it, this is the faster; from about 400 to 1200 states both take about as long,
-# beyond, arrays win)
+# states up to which an infallible certificate is checked one state at a time, or up to
+# twice its steps (measured: below 400 states this is the faster, from 400 to 1200 both
+# take about as long, beyond, arrays win -- unless the states are spread thin over many
+# configurations, about one per step, as with a 3D boundary: the arrays' per-step work
+# then costs as much as the states'); negative: never
 _LEAN_STATES = 1000
 
 
@@ -1484,7 +1488,7 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         table = bwd[d] if minus else fwd[d]
         sup_of: dict[int, int] = {}  # labels -> their supports toward the face
         # per distances along d, those the neighbour one cell nearer the face may have
-        toward: dict[tuple[int, int], list[tuple[int, int]]] = {}
+        toward: dict[tuple[int, ...], list[tuple[int, int]]] = {}
         for (lo, hi) in span:
             if minus:
                 los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
