@@ -1246,13 +1246,31 @@ def _check_lean(
         dom = cell_doms[it] = memo.domain(on, where, used, face_rules)
         return dom
 
-    total = 0
+    # every state a pair, every label an integer in use (all states at once)
+    every = [s for c in configs for s in c["states"]]
+    if not all(isinstance(s, pair) and len(s) == 2 for s in every):
+        raise _Invalid("a state is not a pair [step, labels]")
+    flat = set(itertools.chain.from_iterable(s[1] for s in every))
+    if not in_use.issuperset(flat) or set(map(type, flat)) - {int}:
+        for c in configs:
+            lo, hi = c["lower"], c["upper"]
+            _labels_in_use(c["states"], set(itertools.chain.from_iterable(
+                s[1] for s in c["states"])), in_use, _where(lo, hi))  # fmt: skip
+    total = len(every)
     for (lo, hi, _), members in by_frame.items():
         fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes)
         n, coords, keys, steps = fr.n, fr.coords, fr.keys, fr.steps
         ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
         widths = [len(k) for k in keys]
-        plans = [([(k, cls(m)) for k, m in st.kept], cls(st.chosen_open)) for st in steps]
+        # per step: the neighbours' slots and axes, the kept labels' slots and class maps,
+        # the chosen label's class map, whether the next state records it, whether the
+        # states here are looked up by all labels but the last (the step before chose it)
+        plans = [
+            (st.near, [(k, cls(m)) for k, m in st.kept], cls(st.chosen_open), st.chosen,
+             i > 0 and steps[i - 1].chosen)
+            for i, st in enumerate(steps)
+        ]  # fmt: skip
+        exact = classes and steps[-1].free == 1 << (n - 1)
         for conf, (_, _, at_lo, at_hi) in members:
             # the domain of each cell of the frame (labels in use, face rules, dead labels)
             if plain:
@@ -1272,10 +1290,7 @@ def _check_lean(
             # the states by step, checked for their form
             states = conf["states"]
             by_step: list[list[tuple[int, ...]]] = [[] for _ in range(n)]
-            for s in states:
-                if not isinstance(s, pair) or len(s) != 2:
-                    raise _Invalid("a state is not a pair [step, labels]")
-                i, labs = s
+            for i, labs in states:
                 if not (type(i) is int or _is_int(i)) or not isinstance(labs, pair):
                     raise _Invalid("a state's step or labels are not integers")
                 if not 0 <= i < n:
@@ -1283,63 +1298,55 @@ def _check_lean(
                 if len(labs) != widths[i]:
                     raise _Invalid(f"{_where(lo, hi)}: a state at step {i} does not fit keys[{i}]")
                 by_step[i].append(tuple(labs))
-            flat = set(itertools.chain.from_iterable(s[1] for s in states))
-            if not in_use.issuperset(flat) or set(map(type, flat)) - {int}:
-                _labels_in_use(states, flat, in_use, _where(lo, hi))
             if not by_step[0]:
                 raise _Invalid(f"{_where(lo, hi)}: no start state")
-            total += len(states)
             # closed: each state's labels lead to recorded states; the point's catalog
-            nxt: Any = None  # the next step's states (by their labels but the last: its bits)
-            for i in range(n - 1, -1, -1):
-                st = steps[i]
-                b0 = base[i]
-                near = st.near
-                here = by_step[i]
-                if i == n - 1:
-                    exact = classes and st.free == 1 << i
-                    for labs in here:
-                        fc = b0
-                        for k, d in near:
-                            fc &= fwd[d][labs[k]]
-                        if fc and not exact:
-                            fc = ac.catalog(fr, i, labs, base)
-                        if not fc:
-                            raise _Invalid(f"{_where(lo, hi)}: the point's catalog is empty "
-                                           f"in state {[i, list(labs)]}")  # fmt: skip
-                else:
-                    maps, pick = plans[i]
-                    chosen = st.chosen
-                    for labs in here:
-                        fc = b0
-                        for k, d in near:
-                            fc &= fwd[d][labs[k]]
-                        if not fc:
-                            continue
-                        kept = tuple([m[labs[k]] for k, m in maps])
-                        if chosen:
-                            avail = nxt.get(kept, 0)
-                            miss = 0
-                            for b in _bits(fc):
-                                if not avail >> pick[b] & 1:
-                                    miss |= 1 << b
-                        else:
-                            miss = 0 if kept in nxt else fc
-                        if miss:
-                            miss &= ac.catalog(fr, i, labs, base)
-                        if miss:
-                            b = (miss & -miss).bit_length() - 1
-                            nx = [*kept, pick[b]] if chosen else list(kept)
-                            raise _Invalid(
-                                f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} with "
-                                f"label {b} leads to {[i + 1, nx]}, which is missing"
-                            )
-                if i and steps[i - 1].chosen:
-                    nxt = {}
-                    for labs in here:
+            near, _, _, _, keyed = plans[n - 1]
+            for labs in by_step[n - 1]:
+                fc = base[n - 1]
+                for k, d in near:
+                    fc &= fwd[d][labs[k]]
+                if fc and not exact:
+                    fc = ac.catalog(fr, n - 1, labs, base)
+                if not fc:
+                    raise _Invalid(f"{_where(lo, hi)}: the point's catalog is empty in state "
+                                   f"{[n - 1, list(labs)]}")  # fmt: skip
+            later = by_step[n - 1]
+            for i in range(n - 2, -1, -1):
+                # the next step's states (by their labels but the last: its bits, if chosen)
+                if keyed:
+                    nxt: Any = {}
+                    for labs in later:
                         nxt[labs[:-1]] = nxt.get(labs[:-1], 0) | 1 << labs[-1]
                 else:
-                    nxt = set(here)
+                    nxt = set(later)
+                later = here = by_step[i]
+                near, maps, pick, chosen, keyed = plans[i]
+                b0 = base[i]
+                for labs in here:
+                    fc = b0
+                    for k, d in near:
+                        fc &= fwd[d][labs[k]]
+                    if not fc:
+                        continue
+                    kept = tuple([m[labs[k]] for k, m in maps])
+                    if chosen:
+                        avail = nxt.get(kept, 0)
+                        miss = 0
+                        for b in _bits(fc):
+                            if not avail >> pick[b] & 1:
+                                miss |= 1 << b
+                    else:
+                        miss = 0 if kept in nxt else fc
+                    if miss:
+                        miss &= ac.catalog(fr, i, labs, base)
+                    if miss:
+                        b = (miss & -miss).bit_length() - 1
+                        nx = [*kept, pick[b]] if chosen else list(kept)
+                        raise _Invalid(
+                            f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} with "
+                            f"label {b} leads to {[i + 1, nx]}, which is missing"
+                        )
     return total
 
 
