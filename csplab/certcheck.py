@@ -708,13 +708,18 @@ class _Memo:
         """The domain of a cell on the faces ``on`` (bits ``2d``: the lower face of axis
         ``d``, ``2d + 1``: the upper) and in the box of places ``key``
         (:meth:`dead_in`): the labels in use, edited by the face rules, minus the dead."""
+        dom = self.face_domain(on, used, face_rules)
+        if not self.dead:
+            return dom
+        return dom & ~self.dead_in(key)
+
+    def face_domain(self, on: int, used: int, face_rules: list[FaceRule]) -> int:
+        """The labels in use, edited by the face rules of the faces ``on``."""
         dom = self.faces.get(on)
         if dom is None:
             faces = {_AXES[t // 2] + "-+"[t % 2] for t in _bits(on)}
             dom = self.faces[on] = _domain(face_rules, faces, used)
-        if not self.dead:
-            return dom
-        return dom & ~self.dead_in(key)
+        return dom
 
     def dead_in(self, key: tuple[int, ...]) -> int:
         """The labels dead at every place of a box of places: per axis the distance to
@@ -1231,19 +1236,26 @@ def _check_lean(
     by_frame: dict[Any, list[tuple[Mapping[str, Any], _Conf]]] = {}
     for conf, g in zip(configs, got, strict=True):
         by_frame.setdefault((g[0], g[1], tuple(map(tuple, conf["keys"]))), []).append((conf, g))
-    axis_places: dict[tuple[int, int, bool, bool, int], list[tuple[int, tuple[int, int]]]] = {}
+    axis_places: dict[tuple[int, int, bool, bool, int], list[AxisPlace]] = {}
     # a cell's domain by its faces and places along each axis (in scan order)
-    cell_doms: dict[tuple[tuple[int, tuple[int, int]], ...], int] = {}
+    cell_doms: dict[tuple[AxisPlace, ...], int] = {}
     scan_at = [axes.index(d) for d in range(ndim)]
+    dead_at = memo.dead
 
-    def cell_dom(it: tuple[tuple[int, tuple[int, int]], ...]) -> int:
+    def cell_dom(it: tuple[AxisPlace, ...]) -> int:
         on = 0
-        where: tuple[int, ...] = ()
+        far: Where = ()
         for k in scan_at:
-            f, w = it[k]
-            on |= f
-            where += w
-        dom = cell_doms[it] = memo.domain(on, where, used, face_rules)
+            on |= it[k][0]
+            far += (it[k][2],)
+        if dead_at and dead_at[far] & used:  # (else no label in use is dead in the box)
+            where: tuple[int, ...] = ()
+            for k in scan_at:
+                where += it[k][1]
+            dom = memo.domain(on, where, used, face_rules)
+        else:
+            dom = memo.face_domain(on, used, face_rules)
+        cell_doms[it] = dom
         return dom
 
     # every state a pair, every label an integer in use (all states at once)
@@ -1350,18 +1362,24 @@ def _check_lean(
     return total
 
 
-def _axis_places(
-    d: int, e: int, at_lo: bool, at_hi: bool, cap: int
-) -> list[tuple[int, tuple[int, int]]]:
+AxisPlace = tuple[int, tuple[int, int], tuple[int, int]]
+
+
+def _axis_places(d: int, e: int, at_lo: bool, at_hi: bool, cap: int) -> list[AxisPlace]:
     """Per coordinate of a frame of extent ``e`` along axis ``d``: the faces a cell there
-    lies on (bits ``2d``, ``2d + 1``) and its capped distances to the faces (exact where
-    the frame's edge is on the face, else ``a + cap + 1``: ``a`` or more)."""
-    return [
-        ((at_lo and v == 0) << 2 * d | (at_hi and v == e - 1) << 2 * d + 1,
-         (min(v, cap) if at_lo else min(v + 1, cap) + cap + 1,
-          min(e - 1 - v, cap) if at_hi else min(e - v, cap) + cap + 1))
-        for v in range(e)
-    ]  # fmt: skip
+    lies on (bits ``2d``, ``2d + 1``), its capped distances to the faces (exact where the
+    frame's edge is on the face, else ``a + cap + 1``: ``a`` or more) and the farthest
+    distances among those."""
+    out = []
+    for v in range(e):
+        lo = min(v, cap) if at_lo else min(v + 1, cap) + cap + 1
+        hi = min(e - 1 - v, cap) if at_hi else min(e - v, cap) + cap + 1
+        out.append((
+            (at_lo and v == 0) << 2 * d | (at_hi and v == e - 1) << 2 * d + 1,
+            (lo, hi),
+            (lo if lo <= cap else cap, hi if hi <= cap else cap),
+        ))  # fmt: skip
+    return out
 
 
 def _labels_in_use(states: list[Any], flat: set[Any], in_use: set[int], where: str) -> None:
