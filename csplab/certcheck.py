@@ -1482,14 +1482,15 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         for f in range(1 << 2 * ndim)
     ]
     # every place, and the faces it lies on, in the same order (iterated in C)
-    flags = [[(a == 0) << 2 * d | (b == 0) << 2 * d + 1 for a, b in span] for d in range(ndim)]
+    on = [0]
+    for d in range(ndim):
+        on = [f | (a == 0) << 2 * d | (b == 0) << 2 * d + 1 for f in on for a, b in span]
     known: dict[Where, int] = dict(zip(
-        itertools.product(span, repeat=ndim),
-        map(excluded.__getitem__, map(sum, itertools.product(*flags))),
-        strict=True,
+        itertools.product(span, repeat=ndim), map(excluded.__getitem__, on), strict=True
     ))  # fmt: skip
     every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
     label_bits: dict[tuple[Any, ...], int] = {}
+    towards: dict[bool, dict[tuple[int, ...], list[tuple[int, int]]]] = {}
     for face, got in dead["stages"]:
         if face not in every:
             raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
@@ -1513,13 +1514,15 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         table = bwd[d] if minus else fwd[d]
         sup_of: dict[int, int] = {}  # labels -> their supports toward the face
         # per distances along d, those the neighbour one cell nearer the face may have
-        toward: dict[tuple[int, ...], list[tuple[int, int]]] = {}
-        for (lo, hi) in span:
-            if minus:
-                los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
-            else:
-                los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
-            toward[lo, hi] = list(itertools.product(los, his))
+        toward = towards.get(minus)
+        if toward is None:
+            toward = towards[minus] = {}
+            for lo, hi in span:
+                if minus:
+                    los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+                else:
+                    los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+                toward[lo, hi] = list(itertools.product(los, his))
         for k, bits in stage.items():
             sup = sup_of.get(bits)
             if sup is None:
@@ -1539,8 +1542,7 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
                             f"dead labels: {b} at {[list(t) for t in k]} has a support toward "
                             f"{face} that is not dead: {sorted(_bits(table[b] & ~gone))}"
                         )
-        for k, bits in stage.items():
-            known[k] |= bits
+        known.update({k: known[k] | bits for k, bits in stage.items()})
     return known
 
 
