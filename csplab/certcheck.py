@@ -1136,14 +1136,19 @@ def _lean_frame(
     else:
         at = [axes.index(d) for d in rd]
         coords = [tuple(c[k] for k in at) for c in scan]
-    # per axis: the cells of each layer; the region's layers about each layer (clipped)
-    layer = [[0] * e for e in ext]
-    for r, c in enumerate(coords):
-        for d in rd:
-            layer[d][c[d]] |= 1 << r
-    win = [[sum(layer[d][max(v - back[d], 0) : v + region[d] - 1]) for v in range(ext[d])]
-           for d in rd]  # fmt: skip
-    inner = [(d, sc[d], ~layer[d][-1], ~layer[d][0]) for d in rd]
+    # per axis, the cells whose coordinate lies in a range: a block of sc[d] ranks per
+    # coordinate, repeated every sc[d] * ext[d] ranks
+    full = (1 << s) - 1
+
+    def layers(d: int, a: int, b: int) -> int:
+        period = sc[d] * ext[d]
+        return ((1 << (b - a + 1) * sc[d]) - 1 << a * sc[d]) * (full // ((1 << period) - 1))
+
+    # the region's layers about each layer (clipped); per axis, all but the last / first
+    win = [[layers(d, max(v - back[d], 0), min(v + region[d] - 2, ext[d] - 1))
+            for v in range(ext[d])] for d in rd]  # fmt: skip
+    inner = [(d, sc[d], full & ~layers(d, ext[d] - 1, ext[d] - 1), full & ~layers(d, 0, 0))
+             for d in rd]  # fmt: skip
     masks = []
     for i, ks in enumerate(keys):
         m = 0
@@ -1155,8 +1160,6 @@ def _lean_frame(
     for i in range(n - 1):
         if masks[i + 1] & ~(masks[i] | 1 << i):
             raise _Invalid(f"{_where(lo, hi)}: keys[{i + 1}] records a label step {i} forgot")
-    # each cell's + neighbours in the frame: (axis, rank)
-    plus = [[(d, r + sc[d]) for d in rd if c[d] + 1 < ext[d]] for r, c in enumerate(coords)]
     steps = []
     for i in range(n):
         c = coords[i]
@@ -1180,9 +1183,11 @@ def _lean_frame(
         chosen, chosen_open = False, 0
         if i + 1 < n:
             for j in keys[i + 1]:
+                # the axes on which j's + neighbour is in the frame, not yet labelled
                 op = 0
-                for d, r in plus[j]:
-                    if r > i:
+                cj = coords[j]
+                for d, sd, _, _ in inner:
+                    if j + sd > i and cj[d] + 1 < ext[d]:
                         op |= 1 << d
                 if j == i:
                     chosen, chosen_open = True, op
