@@ -18,6 +18,14 @@ a process pays warm-ups on both sides). The ratio judged is of CPU seconds (both
 run on one thread in this process): on a loaded machine a check of a few milliseconds
 that loses the processor for a time slice would otherwise count the wait. The wall-clock
 times and their ratio are printed beside.
+
+Measured on the shared 2-core machine (loaded: load average 4.6-7.6), the default models:
+9 of 11 within, check/find CPU 0.044 (fig3_1a), 0.055 (fig3_15), 0.062 (pipes.xml), 0.067
+(tiny_poms), 0.104 (pillar with its boundary; wall clock 9 ms for 1,000 states against a
+0.10 s decision) and 0.222 (pillar without: in CPU seconds 0.38 ms for 92 states in
+8 configurations against a 1.8 ms decision, 0.17 ms of it rebuilding the 8 frames).
+Before this branch (every certificate checked on arrays; loaded the same): 5 of 11,
+worst 0.497 (pillar), fig3_1a 0.230, fig3_15 0.213, pipes.xml 0.219.
 """
 
 from __future__ import annotations

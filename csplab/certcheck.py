@@ -6,13 +6,18 @@ no code with the prover (:mod:`csplab.analysis.infallible`; an import-linter con
 forbids importing it, or anything of csplab but :mod:`csplab.errors`): the frames, regions,
 arc consistency and grid replay below are written again, plainly.
 
-How the closure is checked: every frame of the certificate is verified in one batch of
-boolean arrays (regions, labelled cells, recorded keys); every state of every
-configuration is a row of one label array, and its successors are looked up among the
-states by exact integer codes. A state needs arc consistency only when some label that
+How the closure is checked: a state needs arc consistency only when some label that
 its cell's labelled neighbours allow (a superset of the catalog) leads to no recorded
 state, and at the point; the catalog is computed once per region shape (the region's
-cells relative to the step's cell, which are labelled, their domains) and labels.
+cells relative to the step's cell, which are labelled, their domains) and labels. A
+certificate of up to ``_LEAN_STATES`` states (or two per step) is checked one frame and
+one state at a time with Python integers (sets of cells as bit masks:
+:func:`_check_lean`), where arrays would cost more in fixed overhead than in work. A
+larger one is checked in arrays: every
+frame is verified in one batch of boolean arrays (regions, labelled cells, recorded
+keys); every state of every configuration is a row of one label array, and its
+successors are looked up among the states by exact integer codes. Both make the same
+checks (the tests run each planted defect through both).
 
 Format ``csplab-certificate``, version 1 (JSON)
 -----------------------------------------------
@@ -82,10 +87,12 @@ True
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import itertools
 import json
 import math
+import operator
 from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -199,10 +206,7 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
             if not cert.get("label_classes"):
                 raise _Invalid("dead labels are checked with label classes only")
             dead = _check_dead(cert["dead"], model)
-            everywhere = -1
-            for bits in dead.values():
-                everywhere &= bits
-            model = _without(model, everywhere)
+            model = _without(model, functools.reduce(operator.and_, dead.values(), -1))
         if claim == "infallible":
             msg = _check_closed(cert, model, dead, bool(cert.get("label_classes")))
         elif claim == "fallible":
@@ -325,26 +329,29 @@ def _positions(
     if _axes_of(str(cert["order"]), ndim) != axes:
         raise _Invalid("axes do not match the order")
     both = (False, True) if face_rules else (False,)
-    want = set()
-    for lo in itertools.product(*[range(1 + b + h) for b, h in zip(back, history, strict=True)]):
-        for hi in itertools.product(*[range(r - 1) for r in region]):
-            at_lo = [(True,) if lo[d] < back[d] + history[d] else both for d in range(ndim)]
-            at_hi = [(True,) if hi[d] < region[d] - 2 else both for d in range(ndim)]
-            for a in itertools.product(*at_lo):
-                for b in itertools.product(*at_hi):
-                    want.add((lo, hi, a, b))
-    got: list[_Conf] = [
-        (
-            tuple(c["lower"]), tuple(c["upper"]),
-            tuple(bool(t) for t in c.get("at_lower", [])) or tuple(
-                lo < b + h for lo, b, h in zip(c["lower"], back, history, strict=True)),
-            tuple(bool(t) for t in c.get("at_upper", [])) or tuple(
-                hi < r - 2 for hi, r in zip(c["upper"], region, strict=True)),
-        )
-        for c in cert["configs"]
-    ]  # fmt: skip
-    if len(got) != len(set(got)) or set(got) != want:
-        raise _Invalid(f"the configurations are not the {len(want)} positions of a point")
+
+    def sides(extent: list[int], exact: list[int]) -> set[tuple[Any, ...]]:
+        # per axis the pairs (distance, edge on the face): on the face when the region is
+        # clipped there (distance below ``exact``), either way otherwise
+        per = [[(v, a) for v in range(e) for a in ((True,) if v < x else both)]
+               for e, x in zip(extent, exact, strict=True)]  # fmt: skip
+        return {(*zip(*p, strict=True),) for p in itertools.product(*per)}
+
+    lows = sides([1 + b + h for b, h in zip(back, history, strict=True)],
+                 [b + h for b, h in zip(back, history, strict=True)])  # fmt: skip
+    highs = sides([r - 1 for r in region], [r - 2 for r in region])
+    got: list[_Conf] = []
+    for c in cert["configs"]:
+        lo, hi = tuple(c["lower"]), tuple(c["upper"])
+        a = tuple(map(bool, c.get("at_lower", ()))) or tuple(
+            v < b + h for v, b, h in zip(lo, back, history, strict=True))
+        b = tuple(map(bool, c.get("at_upper", ()))) or tuple(
+            v < r - 2 for v, r in zip(hi, region, strict=True))
+        got.append((lo, hi, a, b))
+    want = len(lows) * len(highs)
+    if (len(got) != want or len(set(got)) != want
+            or any((lo, a) not in lows or (hi, b) not in highs for lo, hi, a, b in got)):
+        raise _Invalid(f"the configurations are not the {want} positions of a point")
     return region, back, axes, got
 
 
@@ -377,7 +384,12 @@ def _check_closed(
     configs = cert["configs"]
     # shared by every configuration: frames (configurations that differ only in which
     # frame edges lie on a face have the same frame), domains and region graphs
-    memo = _Memo(dead or {})
+    memo = _Memo(rules, dead or {}, int(cert["dead"]["cap"]) if dead else 0)
+    nstates = sum(len(c["states"]) for c in configs)
+    nsteps = sum(len(c["keys"]) for c in configs)
+    if _LEAN_STATES >= 0 and nstates <= max(_LEAN_STATES, 2 * nsteps):
+        nstates = _check_lean(cert, rules, region, back, axes, got, memo, classes)
+        return _closed_message(cert, nstates, len(configs), region, back, classes)
     specs: list[tuple[Cell, Cell, list[list[int]]]] = []
     fid_of: dict[Any, int] = {}
     fids = []
@@ -395,11 +407,18 @@ def _check_closed(
         for m in range(1 << ndim):
             maps[m, :-1] = _class_of(fwd, used, frozenset(d for d in range(ndim) if m >> d & 1))
     nstates = _check_states(configs, plans, fwd, bwd, used, memo, maps)
+    return _closed_message(cert, nstates, len(configs), region, back, classes)
+
+
+def _closed_message(
+    cert: Mapping[str, Any], nstates: int, nconf: int, region: list[int], back: list[int],
+    classes: bool,
+) -> str:  # fmt: skip
     rtxt = "x".join(map(str, region)) + (
         "" if set(back) == {1} else " (reaching back " + "x".join(map(str, back)) + ")"
     )
     return (
-        f"valid: {nstates} states{' (labels by class)' if classes else ''} in {len(configs)} "
+        f"valid: {nstates} states{' (labels by class)' if classes else ''} in {nconf} "
         "configurations are closed under Alg. 3.6 "
         f"with {rtxt} regions ({cert['order']}) and no catalog of a point is empty: "
         "Alg. 3.1 never fails (Theorem 3.3.6)"
@@ -656,41 +675,74 @@ def _cell_domain(
 ) -> int:
     """The domain of a frame cell of ``code`` (per axis, little end first: its capped
     distances to the frame's lower and upper edge, and whether each edge is on the face)."""
-    on, key = set(), []
+    on, key = 0, []
     for d in range(ndim):
         code, digit = divmod(code, 4 * (cap + 1) ** 2)
         rest, at_hi = divmod(digit, 2)
         (lo, hi), at_lo = divmod(rest // 2, cap + 1), rest % 2
-        if at_lo and lo == 0:
-            on.add(_AXES[d] + "-")
-        if at_hi and hi == 0:
-            on.add(_AXES[d] + "+")
+        on |= (at_lo and lo == 0) << 2 * d | (at_hi and hi == 0) << 2 * d + 1
         # exact on a face edge, else at least one more (a suffix lo .. cap: lo + cap + 1)
         key += [lo if at_lo else min(lo + 1, cap) + cap + 1,
                 hi if at_hi else min(hi + 1, cap) + cap + 1]  # fmt: skip
-    dom = _domain(face_rules, on, used)
-    return dom & ~memo.dead_in(tuple(key)) if memo.dead else dom
+    return memo.domain(on, tuple(key), used, face_rules)
 
 
 class _Memo:
     """What the configurations of one certificate share."""
 
-    def __init__(self, dead: Mapping[Where, int]) -> None:
+    def __init__(self, rules: _Rules, dead: Mapping[Where, int], cap: int = 0) -> None:
         self.dead = dead
-        self.cap = max((v for k in dead for a in k for v in a), default=0)
-        self.union: dict[tuple[int, int, int], int] = {}
+        self.cap = cap
+        self.used = rules.used
+        self.tables = [*rules.fwd, *rules.bwd]
+        self.unions: list[dict[int, int]] = [{} for _ in self.tables]
         self.domains: dict[int, int] = {}
-        self.graphs: dict[bytes, tuple[list[list[tuple[int, int, bool]]], int]] = {}
+        self.graphs: dict[bytes, tuple[Arcs, int]] = {}
+        self.faces: dict[int, int] = {}
+        self.boxes: dict[tuple[int, ...], int] = {}
+        # a distance or a range of distances (``a + cap + 1``: ``a`` to ``cap``) -> the
+        # farthest distance in it
+        self.far = [*range(cap + 1), *[cap] * (cap + 1)]
+
+    def domain(self, on: int, key: tuple[int, ...], used: int, face_rules: list[FaceRule]) -> int:
+        """The domain of a cell on the faces ``on`` (bits ``2d``: the lower face of axis
+        ``d``, ``2d + 1``: the upper) and in the box of places ``key``
+        (:meth:`dead_in`): the labels in use, edited by the face rules, minus the dead."""
+        dom = self.face_domain(on, used, face_rules)
+        if not self.dead:
+            return dom
+        return dom & ~self.dead_in(key)
+
+    def face_domain(self, on: int, used: int, face_rules: list[FaceRule]) -> int:
+        """The labels in use, edited by the face rules of the faces ``on``."""
+        dom = self.faces.get(on)
+        if dom is None:
+            faces = {_AXES[t // 2] + "-+"[t % 2] for t in _bits(on)}
+            dom = self.faces[on] = _domain(face_rules, faces, used)
+        return dom
 
     def dead_in(self, key: tuple[int, ...]) -> int:
         """The labels dead at every place of a box of places: per axis the distance to
         the lower and to the upper face, each ``a`` (exactly) or ``a + cap + 1`` (``a``
-        to ``cap``)."""
-        c, got = self.cap, -1
-        spans = [[v] if v <= c else range(v - c - 1, c + 1) for v in key]
-        per_axis = [list(itertools.product(*spans[t : t + 2])) for t in range(0, len(key), 2)]
-        for k in itertools.product(*per_axis):
-            got &= self.dead[k]
+        to ``cap``); only labels in use."""
+        got = self.boxes.get(key)
+        if got is None:
+            c = self.cap
+            # the farthest place first: inside, few labels are dead, and none ends the AND
+            far = tuple(zip(map(self.far.__getitem__, key[::2]),
+                            map(self.far.__getitem__, key[1::2]), strict=True))  # fmt: skip
+            got = self.dead[far] & self.used  # (labels dead everywhere are out of use)
+            if not got:
+                self.boxes[key] = 0
+                return 0
+            spans = [[v] if v <= c else range(c, v - c - 2, -1) for v in key]
+            per_axis = [list(itertools.product(*spans[t : t + 2]))
+                        for t in range(0, len(key), 2)]  # fmt: skip
+            for k in itertools.product(*per_axis):
+                got &= self.dead[k]
+                if not got:
+                    break
+            self.boxes[key] = got
         return got
 
 
@@ -857,7 +909,7 @@ def _check_states(
             it = iter(mk[r, : len(slots)].tolist())
             dom = [1 << next(it) if f else p.bases[x]
                    for f, x in zip(fixed, nodes, strict=True)]  # fmt: skip
-            ac = _small_ac(dom, arcs, fwd, bwd, memo.union)
+            ac = _small_ac(dom, arcs, memo.tables, memo.unions)
             cats.append(0 if ac is None else ac[target])
         cat_rows = _unpack(cats, K)[inv]
         empty = last[need] & ~cat_rows.any(1)
@@ -964,57 +1016,430 @@ def _row_codes(group: Any, rows: Any, K: int) -> Any:
     return code
 
 
-def _arcs(nodes: Sequence[Cell]) -> list[list[tuple[int, int, bool]]]:
-    """The arcs between grid-adjacent ``nodes``: per node, ``(other node, axis, other is the
-    + neighbour)``."""
+Arcs = list[list[tuple[int, int]]]
+
+
+def _arcs(nodes: Sequence[Cell]) -> Arcs:
+    """The arcs between grid-adjacent ``nodes``: per node, ``(other node, t)`` with ``t``
+    the axis ``d`` when the other is the + neighbour along ``d``, else ``ndim + d`` (the
+    index of the support table in ``[*fwd, *bwd]``)."""
     pos = {x: k for k, x in enumerate(nodes)}
-    arcs: list[list[tuple[int, int, bool]]] = [[] for _ in nodes]
+    arcs: Arcs = [[] for _ in nodes]
     for x, k in pos.items():
-        for d in range(len(x)):
+        ndim = len(x)
+        for d in range(ndim):
             m = pos.get((*x[:d], x[d] + 1, *x[d + 1 :]))
             if m is not None:
-                arcs[k].append((m, d, True))
-                arcs[m].append((k, d, False))
+                arcs[k].append((m, d))
+                arcs[m].append((k, ndim + d))
     return arcs
 
 
 def _small_ac(
     dom: list[int],
-    arcs: list[list[tuple[int, int, bool]]],
-    fwd: list[list[int]],
-    bwd: list[list[int]],
-    union: dict[tuple[int, int, int], int],
+    arcs: Arcs,
+    tables: list[list[int]],
+    unions: list[dict[int, int]],
     start: Sequence[int] | None = None,
 ) -> list[int] | None:
     """Arc consistency (a work list of nodes) on a small graph; ``None`` on a wipe-out.
-    ``start``: the nodes whose domains changed since the domains were last arc consistent
-    (default: all)."""
+    ``tables``: ``[*fwd, *bwd]``; ``unions``: per table, the supports of a set of labels
+    found so far. ``start``: the nodes whose domains changed since the domains were last
+    arc consistent (default: all). ``dom`` is narrowed in place."""
     queue = list(range(len(dom))) if start is None else list(start)
-    waiting = [False] * len(dom)
-    for u in queue:
-        waiting[u] = True
+    waiting = set(queue)
     while queue:
         u = queue.pop()
-        waiting[u] = False
+        waiting.discard(u)
         du = dom[u]
-        for v, d, plus in arcs[u]:
-            ukey = (d if plus else -1 - d, du, 0)
-            sup = union.get(ukey)
+        for v, t in arcs[u]:
+            known = unions[t]
+            sup = known.get(du)
             if sup is None:
-                table = fwd[d] if plus else bwd[d]
+                table = tables[t]
                 sup = 0
                 for b in _bits(du):
                     sup |= table[b]
-                union[ukey] = sup
-            new = dom[v] & sup
-            if new != dom[v]:
-                if new == 0:
+                known[du] = sup
+            dv = dom[v]
+            new = dv & sup
+            if new != dv:
+                if not new:
                     return None
                 dom[v] = new
-                if not waiting[v]:
-                    waiting[v] = True
+                if v not in waiting:
+                    waiting.add(v)
                     queue.append(v)
     return dom
+
+
+# ----------------------------------------------------------------------------- small certificates
+#
+# The same checks as _frames / _check_states, one frame and one state at a time with
+# Python integers: a certificate of a few hundred states is checked faster so than
+# with arrays, whose every operation costs microseconds however small.
+
+# states up to which an infallible certificate is checked one state at a time, or up to
+# twice its steps (measured: below 400 states this is the faster, from 400 to 1200 both
+# take about as long, beyond, arrays win -- unless the states are spread thin over many
+# configurations, about one per step, as with a 3D boundary: the arrays' per-step work
+# then costs as much as the states'); negative: never
+_LEAN_STATES = 1000
+
+
+class _Step(NamedTuple):
+    """Step ``i`` of a frame, as :func:`_check_lean` uses it: the slot and axis of each
+    labelled backward neighbour of the step's cell in its region (``near``); the slot in
+    this step's state and the axes on which the cell is open at the next step (a bit mask)
+    of each label the next state keeps (``kept``, in the next state's order), whether the
+    next state records the label chosen here (last, ``chosen``) and that label's open axes
+    (``chosen_open``); the step's region (``box``) and the cells not yet labelled in it
+    (``free``), as bit masks over the scan ranks."""
+
+    near: list[tuple[int, int]]
+    kept: list[tuple[int, int]]
+    chosen: bool
+    chosen_open: int
+    box: int
+    free: int
+
+
+class _LeanFrame(NamedTuple):
+    """A frame's cells in scan order (``coords``, every cell of the box) and its steps."""
+
+    n: int
+    coords: list[Cell]
+    keys: list[list[int]]
+    steps: list[_Step]
+
+
+def _lean_frame(
+    lo: Cell, hi: Cell, keys: list[list[int]], region: list[int], back: list[int],
+    axes: tuple[int, ...],
+) -> _LeanFrame:  # fmt: skip
+    """The frame of ``(lower, upper)`` with its ``keys`` verified (the checks of
+    :func:`_frame_chunk`, with sets of cells as bit masks over the scan ranks)."""
+    ndim = len(lo)
+    rd = range(ndim)
+    ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
+    sc = [0] * ndim
+    s = 1
+    for d in reversed(axes):
+        sc[d] = s
+        s *= ext[d]
+    n = sum(v * sc[d] for d, v in enumerate(lo)) + 1
+    if len(keys) != n or keys[0]:
+        raise _Invalid(f"{_where(lo, hi)}: keys must list {n} steps, the first empty")
+    scan = itertools.product(*[range(ext[d]) for d in axes])
+    if list(axes) == sorted(axes):
+        coords = list(scan)
+    else:
+        at = [axes.index(d) for d in rd]
+        coords = [tuple(c[k] for k in at) for c in scan]
+    # per axis, the cells whose coordinate lies in a range: a block of sc[d] ranks per
+    # coordinate, repeated every sc[d] * ext[d] ranks
+    full = (1 << s) - 1
+
+    def layers(d: int, a: int, b: int) -> int:
+        period = sc[d] * ext[d]
+        return ((1 << (b - a + 1) * sc[d]) - 1 << a * sc[d]) * (full // ((1 << period) - 1))
+
+    # the region's layers about each layer (clipped); per axis, all but the last / first
+    win = [[layers(d, max(v - back[d], 0), min(v + region[d] - 2, ext[d] - 1))
+            for v in range(ext[d])] for d in rd]  # fmt: skip
+    inner = [(d, sc[d], full & ~layers(d, ext[d] - 1, ext[d] - 1), full & ~layers(d, 0, 0))
+             for d in rd]  # fmt: skip
+    masks = []
+    for i, ks in enumerate(keys):
+        m = 0
+        for j in ks:
+            if not (_is_int(j) and 0 <= j < i and not m >> j):
+                raise _Invalid(f"{_where(lo, hi)}: keys[{i}] must be sorted earlier steps")
+            m |= 1 << j
+        masks.append(m)
+    for i in range(n - 1):
+        if masks[i + 1] & ~(masks[i] | 1 << i):
+            raise _Invalid(f"{_where(lo, hi)}: keys[{i + 1}] records a label step {i} forgot")
+    steps = []
+    for i in range(n):
+        c = coords[i]
+        box = -1
+        for d in rd:
+            box &= win[d][c[d]]
+        done = (1 << i) - 1
+        free = box & ~done
+        near_free = 0
+        for _, s, not_last, not_first in inner:
+            near_free |= (free & not_last) << s | (free & not_first) >> s
+        miss = box & done & near_free & ~masks[i]
+        if miss:
+            x = coords[(miss & -miss).bit_length() - 1]
+            raise _Invalid(
+                f"{_where(lo, hi)}: step {i} depends on cell {list(x)}, not in keys[{i}]"
+            )
+        ks = keys[i]
+        near = [(ks.index(i - s), d) for d, s, _, _ in inner if c[d] and box >> (i - s) & 1]
+        kept: list[tuple[int, int]] = []
+        chosen, chosen_open = False, 0
+        if i + 1 < n:
+            for j in keys[i + 1]:
+                # the axes on which j's + neighbour is in the frame, not yet labelled
+                op = 0
+                cj = coords[j]
+                for d, sd, _, _ in inner:
+                    if j + sd > i and cj[d] + 1 < ext[d]:
+                        op |= 1 << d
+                if j == i:
+                    chosen, chosen_open = True, op
+                else:
+                    kept.append((ks.index(j), op))
+        steps.append(_Step(near, kept, chosen, chosen_open, box, free))
+    return _LeanFrame(n, coords, keys, steps)
+
+
+def _check_lean(
+    cert: Mapping[str, Any],
+    rules: _Rules,
+    region: list[int],
+    back: list[int],
+    axes: tuple[int, ...],
+    got: list[_Conf],
+    memo: _Memo,
+    classes: bool,
+) -> int:
+    """The checks of :func:`_check_states` on a small certificate, a state at a time.
+
+    A state at a step that is not the point is closed when each label of its cell that
+    agrees with the labelled backward neighbours (a superset of the catalog ``C_R``)
+    leads to a recorded state; only otherwise is arc consistency run on the region. At
+    the point arc consistency runs unless the cell is the region's only one not yet
+    labelled and labels are recorded by class: arcs between labelled cells are then left
+    out, and the catalog is that superset itself (each neighbour's label supports every
+    label of it, and nothing else narrows it).
+    """
+    fwd, _, used, ndim, face_rules = rules
+    K = len(fwd[0])
+    configs = cert["configs"]
+    class_maps: dict[int, list[int]] = {}
+    ident = list(range(K))
+
+    def cls(m: int) -> list[int]:
+        if not classes:
+            return ident
+        got_m = class_maps.get(m)
+        if got_m is None:
+            got_m = class_maps[m] = _class_of(fwd, used, frozenset(_bits(m)))
+        return got_m
+
+    ac = _LeanAC(rules, memo, classes)
+    cap = max(memo.cap, 1)
+    plain = not face_rules and not memo.dead
+    # the labels in use, and a state's labels as they are checked: every one in use
+    in_use = {b for b in range(K) if used >> b & 1}
+    pair = (list, tuple)
+    # configurations by frame (the same frame: the same steps and keys)
+    by_frame: dict[Any, list[tuple[Mapping[str, Any], _Conf]]] = {}
+    for conf, g in zip(configs, got, strict=True):
+        by_frame.setdefault((g[0], g[1], tuple(map(tuple, conf["keys"]))), []).append((conf, g))
+    axis_places: dict[tuple[int, int, bool, bool, int], list[AxisPlace]] = {}
+    # a cell's domain by its faces and places along each axis (in scan order)
+    cell_doms: dict[tuple[AxisPlace, ...], int] = {}
+    scan_at = [axes.index(d) for d in range(ndim)]
+    dead_at = memo.dead
+
+    def cell_dom(it: tuple[AxisPlace, ...]) -> int:
+        on = 0
+        far: Where = ()
+        for k in scan_at:
+            on |= it[k][0]
+            far += (it[k][2],)
+        if dead_at and dead_at[far] & used:  # (else no label in use is dead in the box)
+            where: tuple[int, ...] = ()
+            for k in scan_at:
+                where += it[k][1]
+            dom = memo.domain(on, where, used, face_rules)
+        else:
+            dom = memo.face_domain(on, used, face_rules)
+        cell_doms[it] = dom
+        return dom
+
+    # every state a pair, every label an integer in use (all states at once)
+    every = [s for c in configs for s in c["states"]]
+    if not all(isinstance(s, pair) and len(s) == 2 for s in every):
+        raise _Invalid("a state is not a pair [step, labels]")
+    flat = set(itertools.chain.from_iterable(s[1] for s in every))
+    if not in_use.issuperset(flat) or set(map(type, flat)) - {int}:
+        for c in configs:
+            lo, hi = c["lower"], c["upper"]
+            _labels_in_use(c["states"], set(itertools.chain.from_iterable(
+                s[1] for s in c["states"])), in_use, _where(lo, hi))  # fmt: skip
+    total = len(every)
+    for (lo, hi, _), members in by_frame.items():
+        fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes)
+        n, coords, keys, steps = fr.n, fr.coords, fr.keys, fr.steps
+        ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
+        widths = [len(k) for k in keys]
+        # per step: the neighbours' slots and axes, the kept labels' slots and class maps,
+        # the chosen label's class map, whether the next state records it, whether the
+        # states here are looked up by all labels but the last (the step before chose it)
+        plans = [
+            (st.near, [(k, cls(m)) for k, m in st.kept], cls(st.chosen_open), st.chosen,
+             i > 0 and steps[i - 1].chosen)
+            for i, st in enumerate(steps)
+        ]  # fmt: skip
+        exact = classes and steps[-1].free == 1 << (n - 1)
+        for conf, (_, _, at_lo, at_hi) in members:
+            # the domain of each cell of the frame (labels in use, face rules, dead labels)
+            if plain:
+                base = [used] * len(coords)
+            else:
+                per = []
+                for d in axes:  # in scan order: the product below runs as the cells do
+                    sig = (d, ext[d], at_lo[d], at_hi[d], cap)
+                    p = axis_places.get(sig)
+                    if p is None:
+                        p = axis_places[sig] = _axis_places(*sig)
+                    per.append(p)
+                base = [
+                    cell_doms[it] if it in cell_doms else cell_dom(it)
+                    for it in itertools.product(*per)
+                ]
+            # the states by step, checked for their form
+            states = conf["states"]
+            by_step: list[list[tuple[int, ...]]] = [[] for _ in range(n)]
+            for i, labs in states:
+                if not (type(i) is int or _is_int(i)) or not isinstance(labs, pair):
+                    raise _Invalid("a state's step or labels are not integers")
+                if not 0 <= i < n:
+                    raise _Invalid(f"{_where(lo, hi)}: a state's step is not one of its {n} steps")
+                if len(labs) != widths[i]:
+                    raise _Invalid(f"{_where(lo, hi)}: a state at step {i} does not fit keys[{i}]")
+                by_step[i].append(tuple(labs))
+            if not by_step[0]:
+                raise _Invalid(f"{_where(lo, hi)}: no start state")
+            # closed: each state's labels lead to recorded states; the point's catalog
+            near, _, _, _, keyed = plans[n - 1]
+            for labs in by_step[n - 1]:
+                fc = base[n - 1]
+                for k, d in near:
+                    fc &= fwd[d][labs[k]]
+                if fc and not exact:
+                    fc = ac.catalog(fr, n - 1, labs, base)
+                if not fc:
+                    raise _Invalid(f"{_where(lo, hi)}: the point's catalog is empty in state "
+                                   f"{[n - 1, list(labs)]}")  # fmt: skip
+            later = by_step[n - 1]
+            for i in range(n - 2, -1, -1):
+                # the next step's states (by their labels but the last: its bits, if chosen)
+                if keyed:
+                    nxt: Any = {}
+                    for labs in later:
+                        nxt[labs[:-1]] = nxt.get(labs[:-1], 0) | 1 << labs[-1]
+                else:
+                    nxt = set(later)
+                later = here = by_step[i]
+                near, maps, pick, chosen, keyed = plans[i]
+                b0 = base[i]
+                for labs in here:
+                    fc = b0
+                    for k, d in near:
+                        fc &= fwd[d][labs[k]]
+                    if not fc:
+                        continue
+                    kept = tuple([m[labs[k]] for k, m in maps])
+                    if chosen:
+                        avail = nxt.get(kept, 0)
+                        miss = 0
+                        for b in _bits(fc):
+                            if not avail >> pick[b] & 1:
+                                miss |= 1 << b
+                    else:
+                        miss = 0 if kept in nxt else fc
+                    if miss:
+                        miss &= ac.catalog(fr, i, labs, base)
+                    if miss:
+                        b = (miss & -miss).bit_length() - 1
+                        nx = [*kept, pick[b]] if chosen else list(kept)
+                        raise _Invalid(
+                            f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} with "
+                            f"label {b} leads to {[i + 1, nx]}, which is missing"
+                        )
+    return total
+
+
+AxisPlace = tuple[int, tuple[int, int], tuple[int, int]]
+
+
+def _axis_places(d: int, e: int, at_lo: bool, at_hi: bool, cap: int) -> list[AxisPlace]:
+    """Per coordinate of a frame of extent ``e`` along axis ``d``: the faces a cell there
+    lies on (bits ``2d``, ``2d + 1``), its capped distances to the faces (exact where the
+    frame's edge is on the face, else ``a + cap + 1``: ``a`` or more) and the farthest
+    distances among those."""
+    out = []
+    for v in range(e):
+        lo = min(v, cap) if at_lo else min(v + 1, cap) + cap + 1
+        hi = min(e - 1 - v, cap) if at_hi else min(e - v, cap) + cap + 1
+        out.append((
+            (at_lo and v == 0) << 2 * d | (at_hi and v == e - 1) << 2 * d + 1,
+            (lo, hi),
+            (lo if lo <= cap else cap, hi if hi <= cap else cap),
+        ))  # fmt: skip
+    return out
+
+
+def _labels_in_use(states: list[Any], flat: set[Any], in_use: set[int], where: str) -> None:
+    """Raise for the first label of ``states`` that is not an integer or not in use."""
+    if any(not issubclass(t, np.integer) for t in set(map(type, flat)) - {int}):
+        raise _Invalid("a state's step or labels are not integers")
+    for s in states:
+        if not in_use.issuperset(int(x) for x in s[1]):
+            raise _Invalid(f"{where}: a state at step {s[0]} has a label not in use")
+
+
+class _LeanAC:
+    """``C_R`` of a step of a frame in a state: arc consistency on the step's region (its
+    cells not yet labelled, with their domains, and its recorded ones); with ``classes``
+    no arcs between labelled cells. Graphs are shared by steps of one shape (the cells
+    relative to the step's cell, and which are labelled), catalogs by shape, domains and
+    labels."""
+
+    def __init__(self, rules: _Rules, memo: _Memo, classes: bool) -> None:
+        self.rules, self.memo, self.classes = rules, memo, classes
+        self.graphs: dict[Any, tuple[Arcs, int]] = {}
+        self.catalogs: dict[Any, int] = {}
+
+    def catalog(self, fr: _LeanFrame, i: int, labs: tuple[int, ...], base: list[int]) -> int:
+        st = fr.steps[i]
+        c = fr.coords[i]
+        keys = fr.keys[i]
+        fixed = [(fr.coords[j], k) for k, j in enumerate(keys) if st.box >> j & 1]
+        free = list(_bits(st.free))
+        rel = [tuple(a - b for a, b in zip(x, c, strict=True)) for x, _ in fixed]
+        rel.append(())  # the labelled cells, then those not yet labelled
+        rel += [tuple(a - b for a, b in zip(fr.coords[j], c, strict=True)) for j in free]
+        shape = tuple(rel)
+        doms = tuple(base[j] for j in free)
+        key = (shape, doms, tuple(labs[k] for _, k in fixed))
+        cat = self.catalogs.get(key)
+        if cat is not None:
+            return cat
+        graph = self.graphs.get(shape)
+        if graph is None:
+            nf = len(fixed)
+            arcs = _arcs([x for x, _ in fixed] + [fr.coords[j] for j in free])
+            if self.classes:
+                arcs = [[a for a in row if not (u < nf and a[0] < nf)]
+                        for u, row in enumerate(arcs)]  # fmt: skip
+            graph = self.graphs[shape] = (arcs, nf + free.index(i))
+        arcs, target = graph
+        dom = [1 << labs[k] for _, k in fixed] + list(doms)
+        out = _small_ac(dom, arcs, self.memo.tables, self.memo.unions)
+        cat = self.catalogs[key] = 0 if out is None else out[target]
+        return cat
+
+
+def _is_int(x: Any) -> bool:
+    return type(x) is int or isinstance(x, np.integer)
 
 
 # ----------------------------------------------------------------------------- label classes
@@ -1061,44 +1486,68 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         used & ~_domain(face_rules, {_AXES[t // 2] + "-+"[t % 2] for t in _bits(f)}, used)
         for f in range(1 << 2 * ndim)
     ]
-    per_axis = [[(p, (p[0] == 0) << 2 * d | (p[1] == 0) << 2 * d + 1) for p in span]
-                for d in range(ndim)]  # fmt: skip
-    known: dict[Where, int] = {
-        tuple(p for p, _ in k): excluded[sum(f for _, f in k)]
-        for k in itertools.product(*per_axis)
-    }
+    # every place, and the faces it lies on, in the same order (iterated in C)
+    on = [0]
+    for d in range(ndim):
+        on = [f | (a == 0) << 2 * d | (b == 0) << 2 * d + 1 for f in on for a, b in span]
+    known: dict[Where, int] = dict(zip(
+        itertools.product(span, repeat=ndim), map(excluded.__getitem__, on), strict=True
+    ))  # fmt: skip
     every = [_AXES[d] + s for d in range(ndim) for s in "-+"]
+    label_bits: dict[tuple[Any, ...], int] = {}
+    towards: dict[bool, dict[tuple[int, ...], list[tuple[int, int]]]] = {}
     for face, got in dead["stages"]:
         if face not in every:
             raise _Invalid(f"dead labels: {face!r} is not a face of a {ndim}D grid")
         d, minus = _AXES.index(face[0]), face[1] == "-"
         stage: dict[Where, int] = {}
+        side = 0 if minus else 1
         for where, labels in got:
-            k: Where = tuple((int(a), int(b)) for a, b in where)
-            if k not in known or k[d][0 if minus else 1] == 0:
+            k: Where = tuple(map(tuple, where))
+            if k not in known or k[d][side] == 0:
                 raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
-            for b in labels:
-                if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
-                    raise _Invalid(f"dead labels: {b!r} is not a label in use")
-                stage[k] = stage.get(k, 0) | 1 << b
+            t = tuple(labels)
+            m = label_bits.get(t)
+            if m is None:
+                m = 0
+                for b in t:
+                    if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
+                        raise _Invalid(f"dead labels: {b!r} is not a label in use")
+                    m |= 1 << b
+                label_bits[t] = m
+            stage[k] = stage.get(k, 0) | m
         table = bwd[d] if minus else fwd[d]
+        sup_of: dict[int, int] = {}  # labels -> their supports toward the face
+        # per distances along d, those the neighbour one cell nearer the face may have
+        toward = towards.get(minus)
+        if toward is None:
+            toward = towards[minus] = {}
+            for lo, hi in span:
+                if minus:
+                    los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
+                else:
+                    los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
+                toward[lo, hi] = list(itertools.product(los, his))
         for k, bits in stage.items():
-            lo, hi = k[d]
-            if minus:
-                los, his = ([lo - 1] if lo < cap else [cap - 1, cap]), [min(hi + 1, cap)]
-            else:
-                los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
-            for a, c in itertools.product(los, his):
-                n = (*k[:d], (a, c), *k[d + 1 :])
+            sup = sup_of.get(bits)
+            if sup is None:
+                sup = 0
+                for b in _bits(bits):
+                    sup |= table[b]
+                sup_of[bits] = sup
+            head, tail = k[:d], k[d + 1 :]
+            for p in toward[k[d]]:
+                n = (*head, p, *tail)
                 gone = known[n] | stage.get(n, 0)
+                if not sup & ~gone:
+                    continue
                 for b in _bits(bits):
                     if table[b] & ~gone:
                         raise _Invalid(
                             f"dead labels: {b} at {[list(t) for t in k]} has a support toward "
                             f"{face} that is not dead: {sorted(_bits(table[b] & ~gone))}"
                         )
-        for k, bits in stage.items():
-            known[k] |= bits
+        known.update({k: known[k] | bits for k, bits in stage.items()})
     return known
 
 
@@ -1146,8 +1595,9 @@ def _check_run(cert: Mapping[str, Any], rules: _Rules) -> str:
     if any(v == 0 for v in first):
         return "valid: Alg. 3.1 fails before its first choice (a boundary cell has no label)"
     arcs = _arcs(cells)
-    union: dict[tuple[int, int, int], int] = {}
-    dom = _small_ac(first, arcs, fwd, bwd, union)
+    tables = [*fwd, *bwd]
+    unions: list[dict[int, int]] = [{} for _ in tables]
+    dom = _small_ac(first, arcs, tables, unions)
     if dom is None:
         return "valid: Alg. 3.1 fails before its first choice (the grid has no solution)"
     choices = list(run["choices"])
@@ -1161,7 +1611,7 @@ def _check_run(cert: Mapping[str, Any], rules: _Rules) -> str:
             raise _Invalid(f"run: choice {k + 1} ({label} at {list(c)}) is not in its catalog")
         dom[k] = 1 << int(label)
         # the domains were arc consistent before: revising from the changed cell suffices
-        dom = _small_ac(dom, arcs, fwd, bwd, union, start=[k])
+        dom = _small_ac(dom, arcs, tables, unions, start=[k])
         if dom is None:
             rest = choices[k + 1 :]  # at most the cell found empty, marked [cell, None]
             if rest and (len(rest) > 1 or rest[0][1] is not None):

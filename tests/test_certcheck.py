@@ -122,12 +122,15 @@ def _altered(cert: dict) -> dict:
 
 
 @pytest.mark.parametrize(("spec", "region", "order"), [PROVED[0], PROVED[2], PROVED[3]])
-def test_planted_defects_rejected(spec, region, order):
+def test_planted_defects_rejected(spec, region, order, monkeypatch):
     cert = _cert(spec, region, order)
     for what, bad in _defects(cert).items():
-        ok, msg = check_certificate(bad)
-        assert not ok, what
-        assert msg.startswith("invalid:"), (what, msg)
+        for path in ("one state at a time", "polynomial codes"):
+            with monkeypatch.context() as m:
+                _use_path(m, path)
+                ok, msg = check_certificate(bad)
+            assert not ok, (what, path)
+            assert msg.startswith("invalid:"), (what, path, msg)
 
 
 def test_removing_a_transition_that_matters_is_rejected():
@@ -289,16 +292,47 @@ def face_cert():
     return json.loads(json.dumps(v.witness["certificate"]))
 
 
-@pytest.fixture(params=["polynomial codes", "ranked codes", "one frame per chunk"])
-def checker_path(request, monkeypatch):
-    """The checker's alternative paths: state codes as a polynomial in the labels or ranked
-    column by column (past _CODE_LIMIT), frames verified together or one at a time."""
+@pytest.fixture(scope="module")
+def class_cert():
+    """fig3_15 with 2x2 regions, scan:yx, labels recorded by class (as decide proves)."""
+    v = prove_infallible(load_model("fig3_15"), "2x2", order="scan:yx", refute=False,
+                         classes=True, certificate=True)  # fmt: skip
+    cert = json.loads(json.dumps(v.witness["certificate"]))
+    assert cert.get("label_classes") and check_certificate(cert)[0]
+    return cert
+
+
+@pytest.fixture(scope="module")
+def dead_cert():
+    """fig3_15 with its ground and empty space: label classes and dead labels by place."""
+    v = prove_infallible(load_model("fig3_15"), "2x2", order="scan:yx", boundary="auto",
+                         refute=False, classes=True, certificate=True)  # fmt: skip
+    cert = json.loads(json.dumps(v.witness["certificate"]))
+    assert cert.get("dead") and check_certificate(cert)[0]
+    return cert
+
+
+CHECKER_PATHS = ["one state at a time", "polynomial codes", "ranked codes", "one frame per chunk"]
+
+
+def _use_path(monkeypatch, path: str) -> None:
+    """Make the checker take ``path``: small certificates one state at a time (the
+    default below _LEAN_STATES), or the array check (polynomial or ranked state codes,
+    frames verified together or one at a time)."""
     import csplab.certcheck as cc
 
-    if request.param == "ranked codes":
+    if path != "one state at a time":
+        monkeypatch.setattr(cc, "_LEAN_STATES", -1)
+    if path == "ranked codes":
         monkeypatch.setattr(cc, "_CODE_LIMIT", 0)
-    elif request.param == "one frame per chunk":
+    elif path == "one frame per chunk":
         monkeypatch.setattr(cc, "_FRAME_CHUNK", 1)
+
+
+@pytest.fixture(params=CHECKER_PATHS)
+def checker_path(request, monkeypatch):
+    """The checker's alternative paths (:func:`_use_path`)."""
+    _use_path(monkeypatch, request.param)
     return request.param
 
 
@@ -315,7 +349,7 @@ def _without_state(cert: dict, k: int) -> tuple[dict, list]:
     raise IndexError(k)
 
 
-@pytest.mark.parametrize("which", ["small_cert", "face_cert"])
+@pytest.mark.parametrize("which", ["small_cert", "face_cert", "class_cert", "dead_cert"])
 def test_removing_any_state_breaks_the_closure(which, checker_path, request):
     cert = request.getfixturevalue(which)
     assert check_certificate(cert)[0]
@@ -328,9 +362,10 @@ def test_removing_any_state_breaks_the_closure(which, checker_path, request):
         assert f"leads to {gone}" in msg or "which is missing" in msg
 
 
-def test_a_state_with_a_wrong_label_is_rejected(small_cert, checker_path):
-    bad = copy.deepcopy(small_cert)
-    K = small_cert["rules"]["labels"]
+@pytest.mark.parametrize("which", ["small_cert", "class_cert"])
+def test_a_state_with_a_wrong_label_is_rejected(which, checker_path, request):
+    bad = copy.deepcopy(request.getfixturevalue(which))
+    K = bad["rules"]["labels"]
 
     def other() -> tuple[list, int, int]:  # a state changed into one the set lacks
         for conf in bad["configs"]:
@@ -354,9 +389,12 @@ def test_no_start_state(small_cert, checker_path):
     assert not ok and "no start state" in msg, msg
 
 
-def test_a_point_with_an_empty_catalog(small_cert, checker_path):
+@pytest.mark.parametrize("which", ["small_cert", "class_cert"])
+def test_a_point_with_an_empty_catalog(which, checker_path, request):
     # the catalog of every point of some state is empty once a label loses its successors
-    bad = copy.deepcopy(small_cert)
+    # (with label classes, a point whose region has no other open cell is checked without
+    # arc consistency: this must still see it)
+    bad = copy.deepcopy(request.getfixturevalue(which))
     a0 = bad["rules"]["pairs"][0][0][0]
     bad["rules"]["pairs"][0] = [p for p in bad["rules"]["pairs"][0] if p[0] != a0]
     bad["rules_sha256"] = rules_hash(bad["rules"])
@@ -370,7 +408,7 @@ def _conf_with_keys(cert: dict) -> tuple[dict, int]:
     return bad, next(k for k, c in enumerate(bad["configs"]) if len(c["keys"]) >= 4)
 
 
-def test_keys_defects(small_cert):
+def test_keys_defects(small_cert, checker_path):
     def rejected(bad: dict, what: str) -> None:
         ok, msg = check_certificate(bad)
         assert not ok and what in msg, (what, msg)
@@ -448,7 +486,7 @@ def test_state_shape_defects(small_cert, checker_path):
     rejected(triple, "not a pair")
 
 
-def test_configuration_defects(small_cert):
+def test_configuration_defects(small_cert, checker_path):
     bad = copy.deepcopy(small_cert)
     bad["configs"].append(copy.deepcopy(bad["configs"][0]))
     ok, msg = check_certificate(bad)
@@ -464,5 +502,29 @@ def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
     from csplab.errors import MemoryLimitError
 
     monkeypatch.setattr(cc, "_MAX_BYTES", 1000)
+    monkeypatch.setattr(cc, "_LEAN_STATES", -1)  # one state at a time needs no arrays
     with pytest.raises(MemoryLimitError, match="GB"):
         check_certificate(small_cert)
+
+
+def test_both_paths_agree_on_every_rule_removed(monkeypatch):
+    # fig3_16 with 4x2 regions: points with cells after them in their region, where the
+    # catalog needs arc consistency; each pair of the rules removed in turn (the hash
+    # updated), the one-state-at-a-time check and the array check give the same verdict
+    v = prove_infallible(load_model("fig3_16"), "4x2", order="scan:yx", refute=False,
+                         classes=True, certificate=True)  # fmt: skip
+    cert = json.loads(json.dumps(v.witness["certificate"]))
+    verdicts = []
+    for d, pairs in enumerate(cert["rules"]["pairs"]):
+        for k in range(len(pairs)):
+            bad = copy.deepcopy(cert)
+            del bad["rules"]["pairs"][d][k]
+            bad["rules_sha256"] = rules_hash(bad["rules"])
+            got = []
+            for path in ("one state at a time", "polynomial codes"):
+                with monkeypatch.context() as m:
+                    _use_path(m, path)
+                    got.append(check_certificate(bad))
+            assert got[0][0] == got[1][0], (d, pairs[k], got)
+            verdicts.append(got[0][0])
+    assert False in verdicts and True in verdicts  # both kinds occur
