@@ -500,7 +500,52 @@ def _propagate(
                     x &= x - np.uint64(1)
                     for q in range(SW):
                         accs[q] |= nib[a >> sh, 1 << (a & (lb - 1)), q]
-        if tabled:
+        if tabled and SW <= 8:
+            # the row in registers (unused ones stay 0): Alg. 3.1 3% faster on the sample's
+            # overlapping model (SW = 8), 12% on castle 24x24x8 (SW = 6) than the loop below
+            a0 = np.uint64(0)
+            a1 = np.uint64(0)
+            a2 = np.uint64(0)
+            a3 = np.uint64(0)
+            a4 = np.uint64(0)
+            a5 = np.uint64(0)
+            a6 = np.uint64(0)
+            a7 = np.uint64(0)
+            for j in range(J):
+                b0 = j * lb  # no slice straddles two words
+                x = (dom[u, b0 >> 6] >> np.uint64(b0 & 63)) & np.uint64(B - 1)
+                if x:
+                    a0 |= nib[j, x, 0]
+                    if SW > 1:
+                        a1 |= nib[j, x, 1]
+                    if SW > 2:
+                        a2 |= nib[j, x, 2]
+                    if SW > 3:
+                        a3 |= nib[j, x, 3]
+                    if SW > 4:
+                        a4 |= nib[j, x, 4]
+                    if SW > 5:
+                        a5 |= nib[j, x, 5]
+                    if SW > 6:
+                        a6 |= nib[j, x, 6]
+                    if SW > 7:
+                        a7 |= nib[j, x, 7]
+            accs[0] = a0
+            if SW > 1:
+                accs[1] = a1
+            if SW > 2:
+                accs[2] = a2
+            if SW > 3:
+                accs[3] = a3
+            if SW > 4:
+                accs[4] = a4
+            if SW > 5:
+                accs[5] = a5
+            if SW > 6:
+                accs[6] = a6
+            if SW > 7:
+                accs[7] = a7
+        elif tabled:
             for q in range(SW):
                 accs[q] = 0
             for j in range(J):
