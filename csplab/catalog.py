@@ -165,7 +165,7 @@ def nibble_supports(sup: NDArray[np.uint64], bits: int = 4) -> NDArray[np.uint64
 
     Raises
     ------
-    ValueError
+    InputError
         When ``bits`` is not 4 or 8.
 
     Examples
@@ -177,7 +177,7 @@ def nibble_supports(sup: NDArray[np.uint64], bits: int = 4) -> NDArray[np.uint64
     (1, 256, 1)
     """
     if bits not in (4, 8):
-        raise ValueError(f"bits must be 4 or 8, not {bits}")
+        raise InputError(f"bits must be 4 or 8, not {bits}")
     S, K, W = sup.shape
     J = -(-K // bits)
     padded = np.zeros((S, bits * J, W), dtype=np.uint64)
