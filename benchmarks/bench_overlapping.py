@@ -26,6 +26,12 @@ the first solve (loading the compiled kernels), and per output the compiled Alg.
 against everything around it (``solve``'s Python: rng, arrays, result), from a profile of
 ``--split-runs`` seeded runs at 48x48. The machine's load average is printed with it.
 
+Measured (``results/overlapping.md``, a shared 2-core machine at load average 6, CPU time
+per valid output): 48x48 3.66 ms after the kernel changes of issue 29 round three (4.57 ms
+before, in the run just before), so Rooms 4.10x and Knot 3.80x meet while City (<= 2.80 ms)
+is missed by 0.86 ms (1.53x fast-wfc); 200x200 87.1 ms (112.6 before), 10.3x. An idle run
+before those changes gave 4.33 ms at 48x48.
+
 Usage::
 
     python benchmarks/bench_overlapping.py [--seconds 5] [--sample tests/io/data/sample.png]

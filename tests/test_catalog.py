@@ -186,23 +186,25 @@ def test_arc_rows_by_counting_sort_equal_the_numpy_rows(monkeypatch, name, shape
         assert x.dtype == y.dtype == np.int64 and np.array_equal(x, y)
 
 
+@pytest.mark.parametrize("b", [4, 8])
 @pytest.mark.parametrize("K", [1, 3, 4, 5, 64, 69, 130])
-def test_nibble_table_ors_to_the_union_of_the_supports_of_a_domain(K):
-    """OR of the table's rows for the nibbles of D = the labels some label of D supports
-    (computed on the unpacked relation), in every direction."""
+def test_nibble_table_ors_to_the_union_of_the_supports_of_a_domain(K, b):
+    """OR of the table's rows for the b-label slices of D = the labels some label of D
+    supports (computed on the unpacked relation), in every direction."""
     rng = np.random.default_rng(K)
     S = 4
     rel = rng.random((S, K, K)) < 0.08  # rel[s, a, b]: b supported by a across direction s
     W = (K + 63) // 64
     sup = pack(rel.reshape(S * K, K)).reshape(S, K, W)
-    nib = nibble_supports(sup)
-    assert nib.shape == ((K + 3) // 4, 16, S * W)
+    nib = nibble_supports(sup, b)
+    assert nib.shape == ((K + b - 1) // b, 1 << b, S * W)
+    per = 64 // b  # slices per word
     for _ in range(20):
         D = rng.random(K) < rng.uniform(0.0, 1.0)
         bits = pack(D.reshape(1, K))[0]
         got = np.zeros(S * W, dtype=np.uint64)
         for j in range(nib.shape[0]):
-            got |= nib[j, (int(bits[j // 16]) >> (4 * (j % 16))) & 15]
+            got |= nib[j, (int(bits[j // per]) >> (b * (j % per))) & ((1 << b) - 1)]
         for s in range(S):
             want = rel[s][D].any(axis=0)
             assert np.array_equal(unpack(got[s * W : (s + 1) * W].reshape(1, W), K)[0], want)

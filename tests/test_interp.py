@@ -68,24 +68,28 @@ def test_alg31_same_as_kernels_on_random_examples(engine, order, choice):
 
 @pytest.mark.parametrize("order", ["scanline", "min-entropy"])
 def test_alg31_same_with_and_without_the_nibble_table(engine, monkeypatch, order):
-    """The kernels' revision by nibble table (K <= NIBBLE_MAX_K) and label by label (larger
-    K) give the interpreted twin's run: grid, trace, pops and removals."""
+    """The kernels' revision by slice table (K <= NIBBLE_MAX_K: 8-label slices while the
+    table fits in BYTE_TABLE_MAX, else 4-label ones) and label by label (larger K) give the
+    interpreted twin's run: grid, trace, pops and removals."""
     rng = np.random.default_rng(11)
     cases = [(load_example("city"), (6, 6, 4), {"boundary": "auto"})]  # K = 119: two words
     for _ in range(4):
         cases.append((_random_example(rng, int(rng.integers(3, 12)), (6, 5)), (11, 9), {}))
+    settings = [(catalog.NIBBLE_MAX_K, catalog.BYTE_TABLE_MAX, 256),
+                (catalog.NIBBLE_MAX_K, 0, 16), (0, catalog.BYTE_TABLE_MAX, 0)]  # fmt: skip
     for E, shape, kw in cases:
         for seed in range(2):
             runs = []
-            for limit in (catalog.NIBBLE_MAX_K, 0):
+            for limit, table, rows in settings:
                 monkeypatch.setattr(catalog, "NIBBLE_MAX_K", limit)
+                monkeypatch.setattr(catalog, "BYTE_TABLE_MAX", table)
                 P = from_example(E, shape, **kw)
-                assert (Propagator(P).c.nib.shape[0] > 0) == (limit > 0)
+                nib = Propagator(P).c.nib
+                assert (nib.shape[0] > 0) == (limit > 0) and (rows == 0 or nib.shape[1] == rows)
                 runs.append(_both(engine, lambda P=P: P, seed, order=order, choice="weighted"))
-            (a, b), (c, d) = runs
-            _same(a, b)
-            _same(c, d)
-            _same(a, c)
+            for a, b in runs:
+                _same(a, b)
+                _same(a, runs[0][0])
 
 
 def test_propagate_stops_at_a_wipe_out_of_cell_0(engine):
