@@ -346,6 +346,16 @@ class AspContext(ClauseContext):
         self.rules: list[str] = []
         self.defined: list[int] = []
 
+    @classmethod
+    def of(cls, problem: Problem, enc: Encoding) -> AspContext:
+        """The clauses and rules of every global constraint of ``problem`` over the atoms
+        of its encoding ``enc``."""
+        ctx = cls(problem, enc.literal, enc.nvars)
+        for con in problem.constraints:
+            con.clauses(ctx)
+        ctx.reach()
+        return ctx
+
     def _atom(self) -> int:
         x = self.new_var()
         self.defined.append(x)
@@ -732,10 +742,7 @@ class AspSolver(Solver):
         if problem.constraints:  # global constraints: choice atoms and integrity constraints
             if grounding != "csplab":
                 raise InputError("solver 'asp': global constraints need grounding='csplab'")
-            ctx = AspContext(problem, enc.literal, enc.nvars)
-            for con in problem.constraints:
-                con.clauses(ctx)
-            ctx.reach()
+            ctx = AspContext.of(problem, enc)
             stats["constraint_clauses"] = len(ctx.clauses)
             stats["constraint_rules"] = len(ctx.rules)
             stats["cuts"] = 0
