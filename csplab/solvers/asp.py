@@ -411,7 +411,7 @@ class AspContext(ClauseContext):
             self.rules.append(f"1 0 1 {g} 1 {lo} {body}")  # g :- lo {free}.
             self.rules.append(f"1 0 0 0 1 -{g}")  # :- not g.
 
-    def reach(self, order: NDArray[np.int64] | None = None) -> None:
+    def reach(self) -> None:
         """Connectivity the ASP way, for every :class:`~csplab.constraints.Connected` of
         the problem: a root ``h(r)``, reachability ``h(v) :- h(u), link(u, v)`` along the
         axis neighbours (through open ports for ``edgedPath``) and ``:- y(c), not h(c)``.
@@ -428,8 +428,7 @@ class AspContext(ClauseContext):
             S = con.mask(P)
             y = [con.in_set(self, c) for c in range(P.n)]
             h = np.zeros(P.n, dtype=np.int64)
-            seq = range(P.n) if order is None else order.tolist()
-            cand = [c for c in seq if y[c] is not False]
+            cand = [c for c in range(P.n) if y[c] is not False]
             for c in cand:
                 h[c] = self._atom()
             must = [c for c in cand if y[c] is True]
