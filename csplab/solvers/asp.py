@@ -79,6 +79,38 @@ clingo's first answer set. ``--rand-freq=0.05`` on top of random signs added not
 (0.27--0.38), so it is not offered. For comparison, Alg. 3.1 0.19--0.21 (0.12), ``sat``
 0.49--0.51 (0.44). At 40×40×10 ``"sign"`` gives 0.23--0.50 (0.19--0.37).
 
+Global constraints
+------------------
+:class:`AspContext` adds the problem's global constraints to the ground program: label
+sets and other clauses as integrity constraints, a count as clasp's cardinality rules
+(``:- hi+1 {y}.``, ``:- not lo {y}.``), a connected set as reachability from a fixed root
+(:meth:`AspContext.reach`), so answer sets and constrained solutions still correspond one
+to one (tested against brute force). The label atoms are decided first (domain heuristic
+level 1, ``--heuristic=Domain``): with random signs on every atom clasp also guessed
+reachability atoms and rule bodies, cutting networks apart. Measured on the pipes
+(knot) tileset at 128×128 (16,384 cells, 12 labels; one network through open ports, at
+most 2 crossings; clingo on the written program, ``--sign-def=rnd``, a shared 2-core
+machine at load 6--7, wall seconds with clasp's CPU seconds in brackets):
+
+============================================  ======================================
+program                                       clingo
+============================================  ======================================
+connectivity, a chosen root                   no answer in 40 s (2,265 conflicts)
+count, sequential counter of clauses          solved, 7 conflicts (8.6 s with csplab)
+connectivity, fixed root, random signs        no answer in 40 s (2,061 conflicts)
+connectivity, fixed root, label atoms first   8.2 s (2.8 s), 0 conflicts
+count, cardinality rule                       6.8 s (2.2 s), 0 conflicts
+both, fixed root, label atoms first           7.4 s (2.8 s), 0 conflicts
+============================================  ======================================
+
+City 40×40×10 (boundary auto) with its non-background labels connected and 5--30 % of the
+cells is not solved in 60 s: with the label atoms first clasp made 1,994 conflicts in 40 s
+of search (each one closes a loop of reachability atoms over thousands of cells, against
+a count over 16,000 cells); ordering the decisions outward from a random seed cell, with
+the root first in that order and the cells next to the set preferred into it (domain
+heuristics), gave 339--559 conflicts in 30 s and no answer either. Connectivity alone
+is solved there (1,572 conflicts; a set of about 0.1 % of the cells).
+
 Status ``unsat`` comes with a proof: clingo's exhaustive search (no answer set), or an
 arc-consistency wipe-out before encoding (Theorem 3.3.2). When arc consistency leaves one
 label per cell, that is the solution and clingo is not started.
@@ -119,7 +151,7 @@ from numpy.typing import NDArray
 
 from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, Encoding, encode
-from csplab.constraints import ClauseContext, constraint_clauses
+from csplab.constraints import ClauseContext
 from csplab.deps import require
 from csplab.engine.sat import preferred_labels
 from csplab.errors import CsplabError, InputError
@@ -127,7 +159,7 @@ from csplab.problem import Problem
 from csplab.result import Result, Status
 from csplab.solvers.base import TIME_LIMIT, Call, Option, Solver
 
-__all__ = ["PROGRAM", "AspSolver", "facts", "ground_program"]
+__all__ = ["PROGRAM", "AspContext", "AspSolver", "facts", "ground_program"]
 
 PROGRAM = {
     "choice": "1 { a(C,L) : d(C,L) } 1 :- cell(C).",
@@ -234,29 +266,28 @@ def _constraints(lits: NDArray[np.int32], starts: NDArray[np.int64], a: int, b: 
     return _text(tok, line)
 
 
-def _heuristics(atoms: NDArray[np.int64], sign: int = 1) -> bytes:
-    """``#heuristic a. [sign, sign]`` for each atom (aspif ``7 1 a sign 0 0``)."""
+def _heuristics(atoms: NDArray[np.int64], sign: int = 1, modifier: int = 1) -> bytes:
+    """``#heuristic a. [sign, sign]`` for each atom (aspif ``7 1 a sign 0 0``); with
+    ``modifier=0`` ``#heuristic a. [sign, level]``."""
     m = atoms.size
     tok = np.zeros((m, 6), dtype=np.int64)
-    tok[:, 0], tok[:, 1], tok[:, 2], tok[:, 3] = 7, 1, atoms, sign
+    tok[:, 0], tok[:, 1], tok[:, 2], tok[:, 3] = 7, modifier, atoms, sign
     return _text(tok.ravel(), np.full(m, 6, dtype=np.int64))
 
 
 def ground_program(
     enc: Encoding,
     prefer: NDArray[np.int64] | None = None,
-    ctx: ClauseContext | None = None,
-    reach: tuple[bytes, NDArray[np.int64]] | None = None,
+    ctx: AspContext | None = None,
 ) -> Iterator[bytes]:
     """The ground ASP program of an encoding, in aspif, as a stream of pieces.
 
     Atom ``i`` is CNF variable ``i`` of ``enc`` (``(cell, label)`` of the catalog, numbered
     cell by cell); constant cells have no atoms. ``prefer`` (one label per cell, -1 for
     none) adds domain-heuristic sign preferences. ``ctx`` adds the clauses of the
-    problem's global constraints (:mod:`csplab.constraints`): their auxiliary variables
-    become free choice atoms and every clause an integrity constraint, so answer sets are
-    exactly the models of the clauses; ``reach`` (:func:`reach_rules`) adds the
-    reachability rules of connectivity constraints.
+    problem's global constraints (:class:`AspContext`): its rules (counts, reachability),
+    its auxiliary variables not defined by them as free choice atoms and every clause an
+    integrity constraint, so answer sets are exactly the models of the clauses and rules.
 
     Examples
     --------
@@ -287,14 +318,13 @@ def ground_program(
         yield _cell_rules(first[a : a + _CELL_CHUNK], k[a : a + _CELL_CHUNK])
     for a in range(0, enc.nclauses, _CLAUSE_CHUNK):
         yield _constraints(enc.lits, enc.starts, a, min(a + _CLAUSE_CHUNK, enc.nclauses))
-    if reach is not None:
-        yield reach[0]
-    if ctx is not None and (ctx.clauses or reach is not None):
+    if ctx is not None:
+        if ctx.rules:
+            yield ("\n".join(ctx.rules) + "\n").encode()
         aux = np.arange(enc.nvars + 1, ctx.top + 1, dtype=np.int64)
-        if reach is not None:
-            aux = aux[~np.isin(aux, reach[1])]  # reach atoms are defined by rules
-        if aux.size:
-            yield _cell_rules(aux, np.ones(aux.size, dtype=np.int64))  # {a}. (and :- 2 {a}.)
+        aux = aux[~np.isin(aux, np.asarray(ctx.defined, dtype=np.int64))]
+        if aux.size:  # {a1; ...; am}.
+            yield f"1 1 {aux.size} {' '.join(map(str, aux.tolist()))} 0 0\n".encode()
         lits = np.fromiter(itertools.chain.from_iterable(ctx.clauses), np.int32)
         lens = np.array([len(c) for c in ctx.clauses], dtype=np.int64)
         starts = np.zeros(lens.size + 1, dtype=np.int64)
@@ -305,64 +335,142 @@ def ground_program(
         c = cells[prefer[cells] >= 0]
         atoms = enc.var[c, prefer[c]].astype(np.int64)
         yield _heuristics(atoms[atoms > 0])
+    if ctx is not None:  # label atoms first: auxiliary atoms and bodies follow from them
+        yield _heuristics(np.arange(1, enc.nvars + 1, dtype=np.int64), 1, modifier=0)
     if ctx is not None and ctx.hints:  # after a cut: try the stray cells without the set
         yield _heuristics(-np.asarray(ctx.hints, dtype=np.int64), sign=-1)
     yield b"0\n"
 
 
-def reach_rules(ctx: ClauseContext) -> tuple[bytes, NDArray[np.int64]]:
-    """Connectivity the ASP way, for every :class:`~csplab.constraints.Connected` of the
-    problem: a chosen root ``r(c)`` (at most one, on a cell of the set), reachability
-    ``h(v) :- h(u), link(u, v)`` along the axis neighbours (through open ports for
-    ``edgedPath``) and ``:- y(c), not h(c)``. Stable models make ``h`` the least fixpoint,
-    so the answer sets are exactly the connected grids: no cut loop. Returns the aspif
-    lines and the ``h`` atoms (defined by rules, not choices)."""
-    from csplab.constraints import Connected
+class AspContext(ClauseContext):
+    """The global constraints of a problem as ASP rules over the atoms of an encoding.
 
-    P = ctx.problem
-    lines: list[str] = []
-    defined: list[int] = []
-    for con in P.constraints:
-        if not isinstance(con, Connected):
-            continue
-        S = con.mask(P)
-        y = [con.in_set(ctx, c) for c in range(P.n)]
-        h = np.zeros(P.n, dtype=np.int64)
-        roots = []
-        for c in range(P.n):
-            if y[c] is False:
+    Clauses (label sets, links, cuts) become integrity constraints over free choice atoms
+    as in :class:`~csplab.constraints.ClauseContext`; a count becomes clasp's native
+    cardinality rules, ``:- hi+1 {y}.`` and ``:- not lo {y}.`` (:meth:`card`), and every
+    :class:`~csplab.constraints.Connected` reachability rules (:meth:`reach`). ``rules``
+    holds their aspif lines, ``defined`` the atoms they define (not free choices).
+
+    Parameters
+    ----------
+    problem : Problem
+        The problem whose constraints are encoded.
+    lit : callable
+        ``lit(cell, label)``: the atom of a label (or a constant ``True``/``False``).
+    top : int
+        The largest atom used so far.
+
+    Examples
+    --------
+    >>> from csplab import ExampleModel, from_example
+    >>> from csplab.cnf import encode
+    >>> from csplab.constraints import Count
+    >>> P = from_example(ExampleModel([[0, 1], [1, 0]]), (1, 3))
+    >>> enc = encode(P)
+    >>> ctx = AspContext(P, enc.literal, enc.nvars)
+    >>> ctx.card([1, 3, 5], 1, 2)
+    >>> ctx.rules
+    ['1 0 0 1 3 3 1 1 3 1 5 1', '1 0 1 7 1 1 3 1 1 3 1 5 1', '1 0 0 0 1 -7']
+    """
+
+    def __init__(self, problem: Problem, lit: Any, top: int) -> None:
+        super().__init__(problem, lit, top)
+        self.rules: list[str] = []
+        self.defined: list[int] = []
+
+    @classmethod
+    def of(cls, problem: Problem, enc: Encoding) -> AspContext:
+        """The clauses and rules of every global constraint of ``problem`` over the atoms
+        of its encoding ``enc``."""
+        ctx = cls(problem, enc.literal, enc.nvars)
+        for con in problem.constraints:
+            con.clauses(ctx)
+        ctx.reach()
+        return ctx
+
+    def _atom(self) -> int:
+        x = self.new_var()
+        self.defined.append(x)
+        return x
+
+    def card(self, lits: Any, lo: int, hi: int | None) -> None:
+        """``lo <= (number of true lits) <= hi`` as cardinality rules (clasp propagates
+        them as one constraint each, where a counter or adder of clauses propagates weakly
+        and loads O(n) or O(n k) rules)."""
+        fixed = sum(1 for x in lits if x is True)
+        free = [int(x) for x in lits if x is not True and x is not False]
+        lo, up = lo - fixed, None if hi is None else hi - fixed
+        if (up is not None and up < 0) or lo > len(free):
+            self.add([])
+            return
+        body = f"{len(free)} " + " ".join(f"{x} 1" for x in free)
+        if up is not None and up < len(free):
+            self.rules.append(f"1 0 0 1 {up + 1} {body}")  # :- up+1 {free}.
+        if lo > 0:
+            g = self._atom()
+            self.rules.append(f"1 0 1 {g} 1 {lo} {body}")  # g :- lo {free}.
+            self.rules.append(f"1 0 0 0 1 -{g}")  # :- not g.
+
+    def reach(self) -> None:
+        """Connectivity the ASP way, for every :class:`~csplab.constraints.Connected` of
+        the problem: a root ``h(r)``, reachability ``h(v) :- h(u), link(u, v)`` along the
+        axis neighbours (through open ports for ``edgedPath``) and ``:- y(c), not h(c)``.
+        Stable models make ``h`` the least fixpoint, so the answer sets are exactly the
+        connected grids: no cut loop. The root is fixed, not chosen (no symmetric answer
+        sets): a cell that must be in the set, else the first cell of the set in scan order,
+        ``h(c) :- y(c), not b(c)`` with ``b(c)`` "a cell before ``c`` is in the set"."""
+        from csplab.constraints import Connected
+
+        P = self.problem
+        for con in P.constraints:
+            if not isinstance(con, Connected):
                 continue
-            h[c] = ctx.new_var()
-            defined.append(int(h[c]))
-            r = ctx.new_var()
-            roots.append(r)
-            if y[c] is not True:
-                ctx.clauses.append([-r, int(y[c])])  # a root is in the set
-            lines.append(f"1 0 1 {h[c]} 0 1 {r}")  # h(c) :- r(c).
-            if y[c] is True:
-                lines.append(f"1 0 0 0 1 -{h[c]}")  # :- not h(c).
-            else:
-                lines.append(f"1 0 0 0 2 {int(y[c])} -{h[c]}")  # :- y(c), not h(c).
-        if len(roots) > 1:  # :- 2 {r(c)}.
-            lines.append(f"1 0 0 1 2 {len(roots)} " + " ".join(f"{r} 1" for r in roots))
-        lo, hi, ax = con.edges(P)
-        ports = None if con.ports is None else np.asarray(con.ports, dtype=bool)
-        for u, v, a in zip(lo.tolist(), hi.tolist(), ax.tolist(), strict=True):
-            if not (h[u] and h[v]):
-                continue
-            if ports is None:
-                p, q = y[u], y[v]
-            else:
-                p = ctx.in_set(u, S & ports[:, 2 * a + 1])
-                q = ctx.in_set(v, S & ports[:, 2 * a])
-            if p is False or q is False:
-                continue
-            body = [int(x) for x in (p, q) if x is not True]
-            for src, dst in ((u, v), (v, u)):
-                lits = [int(h[src]), *body]
-                lines.append(f"1 0 1 {h[dst]} 0 {len(lits)} " + " ".join(map(str, lits)))
-    text = ("\n".join(lines) + "\n").encode() if lines else b""
-    return text, np.asarray(defined, dtype=np.int64)
+            S = con.mask(P)
+            y = [con.in_set(self, c) for c in range(P.n)]
+            h = np.zeros(P.n, dtype=np.int64)
+            cand = [c for c in range(P.n) if y[c] is not False]
+            for c in cand:
+                h[c] = self._atom()
+            must = [c for c in cand if y[c] is True]
+            if must:
+                self.rules.append(f"1 0 1 {h[must[0]]} 0 0")  # h(root).
+            before = 0
+            for i, c in enumerate(cand if not must else ()):
+                yc = int(y[c])
+                if before:
+                    self.rules.append(f"1 0 1 {h[c]} 0 2 {yc} -{before}")  # h(c) :- y(c), not b(c).
+                else:
+                    self.rules.append(f"1 0 1 {h[c]} 0 1 {yc}")
+                if i + 1 < len(cand):  # b(next) :- y(c).  b(next) :- b(c).
+                    b = self._atom()
+                    self.rules.append(f"1 0 1 {b} 0 1 {yc}")
+                    if before:
+                        self.rules.append(f"1 0 1 {b} 0 1 {before}")
+                    before = b
+            for c in cand:
+                if y[c] is True:
+                    self.rules.append(f"1 0 0 0 1 -{h[c]}")  # :- not h(c).
+                else:
+                    self.rules.append(f"1 0 0 0 2 {int(y[c])} -{h[c]}")  # :- y(c), not h(c).
+            lo, hi, ax = con.edges(P)
+            ports = None if con.ports is None else np.asarray(con.ports, dtype=bool)
+            for u, v, a in zip(lo.tolist(), hi.tolist(), ax.tolist(), strict=True):
+                if not (h[u] and h[v]):
+                    continue
+                if ports is None:  # h(u) holds only on cells of the set
+                    for src, dst in ((u, v), (v, u)):
+                        body = [int(h[src])] + ([] if y[dst] is True else [int(y[dst])])
+                        self.rules.append(f"1 0 1 {h[dst]} 0 {len(body)} "
+                                          + " ".join(map(str, body)))  # fmt: skip
+                    continue
+                p = self.in_set(u, S & ports[:, 2 * a + 1])
+                q = self.in_set(v, S & ports[:, 2 * a])
+                if p is False or q is False:
+                    continue
+                ends = [int(x) for x in (p, q) if x is not True]
+                for src, dst in ((u, v), (v, u)):
+                    lits = [int(h[src]), *ends]
+                    self.rules.append(f"1 0 1 {h[dst]} 0 {len(lits)} " + " ".join(map(str, lits)))
 
 
 def _grid_of(enc: Encoding, report: dict[str, Any]) -> NDArray[np.int32]:
@@ -658,19 +766,19 @@ class AspSolver(Solver):
         prefer = None
         if diversity == "label":
             prefer = preferred_labels(enc.catalog, None, rng)
+        if prefer is not None or problem.constraints:  # preferred labels, label atoms first
             args.append("--heuristic=Domain")
         pieces: Iterator[bytes]
         ctx = None
-        reach = None
         if problem.constraints:  # global constraints: choice atoms and integrity constraints
             if grounding != "csplab":
                 raise InputError("solver 'asp': global constraints need grounding='csplab'")
-            ctx = constraint_clauses(problem, enc.literal, enc.nvars)
-            reach = reach_rules(ctx)
+            ctx = AspContext.of(problem, enc)
             stats["constraint_clauses"] = len(ctx.clauses)
+            stats["constraint_rules"] = len(ctx.rules)
             stats["cuts"] = 0
         if grounding == "csplab":
-            pieces = ground_program(enc, prefer, ctx, reach)
+            pieces = ground_program(enc, prefer, ctx)
             read = "atoms"
         else:
             text = facts(problem, enc.catalog, supports, encoding)
@@ -690,9 +798,7 @@ class AspSolver(Solver):
                 break
             stats["cuts"] += k
             stats["sat_calls"] = stats.get("sat_calls", 1) + 1
-            if "--heuristic=Domain" not in args:
-                args = [*args, "--heuristic=Domain"]
-            report, written = _run_child(args, ground_program(enc, prefer, ctx, reach), read=read,
+            report, written = _run_child(args, ground_program(enc, prefer, ctx), read=read,
                                          nx=enc.nx, deadline=deadline)  # fmt: skip
         stats["solver_stats"] = sub = {
             "clingo": str(clingo.__version__),
