@@ -9,7 +9,8 @@ and its boundary ``B`` (cells next to ``R``, all excluded). Every cell outside `
 be in the set, with the reason clause ``¬y_t ∨ ¬y_s ∨ ⋁_{w ∈ B} y_w`` -- the cut of the
 lazy loop, now learnt in the middle of the search (a cell outside ``R`` that is already
 in the set makes it a conflict); ``B`` is replaced by the excluded neighbours of ``t``'s own
-pocket when they are fewer (both separate ``t`` from ``s``: :func:`_separators`). Measured on ``city`` 16×16×6 with a connectivity and a
+pocket when they are fewer (both separate ``t`` from ``s``: :func:`_separators`).
+Measured on ``city`` 16×16×6 with a connectivity and a
 count constraint: the cut loop alone times out at 20 s, with the propagator 1.5 s.
 
 A :class:`~csplab.constraints.Count` with a lower bound whose labels all put a cell in the
