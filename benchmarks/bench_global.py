@@ -26,13 +26,44 @@ Usage::
                                       [--time-limit 60] [--seed 1] [--catalog-order ORDER]
 
 Measured (2-core machine shared by other jobs, load average 9-12; ``--time-limit 60``):
-catalog meets both targets (city 3.05 s, 10 choices withdrawn; pipes 7.45 s), sat and
-cpsat meet on pipes (5.15 s, 5.09 s); sat, asp and cpsat time out on city (their
-references without the constraints: 4.74, 30.4 and 9.80 s), asp on pipes (reference
-8.89 s; solved since, below). On city sat's CaDiCaL makes about 2,000 conflicts a
-minute inside its own search (the Python propagator took under 1 s of 56), so the
-encoding (an adder for the count over 16,000 cells) rather than the callbacks is what to
-change next.
+catalog meets both targets (city 3.05 s, 10 choices withdrawn; pipes 7.45 s); asp's
+figures are in the paragraph after the next.
+``sat`` and ``cpsat`` (``--cases city pipes --solvers sat cpsat --time-limit 60``, load
+average 4.6-5.2): they meet on pipes (2.63 s against 0.40 s without the constraints; 3.93 s
+against 0.73 s) and time out on city (8,901 conflicts; 103 cuts; references 3.23 and 2.47 s).
+
+Where ``sat`` is stuck on city (profiled with ``perf``; CPU seconds, the wall time was about
+three times as long on the loaded machine):
+
+- with the connectivity propagator attached (CaDiCaL 1.9.5's IPASIR-UP, not lazy), 78 % of
+  the time is CaDiCaL's ``explain_external_propagations``/``explain_reason``: before every
+  conflict analysis it walks the whole implication cone back to the decisions, which on
+  the support encoding (arc consistency chains across the grid) is most of the trail. A
+  no-op propagator observing nothing is as slow (2,000 conflicts in 23 CPU seconds, no
+  restart); without a propagator CaDiCaL made 5,100 conflicts in 9.4 s. CaDiCaL 3.0 has
+  the option ``exteagerreasons=0`` (reasons only when needed), but pysat's ``cadical300``
+  took 12 CPU seconds for a 0-conflict answer (connectivity alone) unless ``fastelim``,
+  ``inprocessing`` and the other preprocessing are switched off (then 0.2 s); so set, it
+  made 12,600 conflicts in 17 CPU seconds with the propagator, without an answer in 25 s;
+- without the propagator (the cut loop alone) the profile is dominated by inprocessing
+  (SCC decomposition, watch flushing, subsumption, probing, elimination over 2.6 M
+  clauses) and its allocations; with ``inprocessing=0`` 30,000 conflicts in 10 s and no
+  model meeting the count; on a quieter machine (CPU time = wall time) the cut loop with
+  uniform phases added 49 cuts in 30 s (16,900 conflicts) without an answer, the
+  propagator 5,172 exclusions (3,622 conflicts) without one either;
+- the count is hard by itself: CaDiCaL decides the set literals ``y`` true by default
+  (with background phases on the labels only, connectivity alone put all 11,552 possible
+  cells in the set), and with background phases on both the adder found no model of "at
+  least 800" in 20 s, nor with background outside a box of 1,183 cells (uniform phases:
+  1.0 s, with 2,052 cells in 34 components); pysat's ``kmtotalizer`` and ``cardnetwrk``
+  (3.5 M and 4.9 M constraint clauses) found none for [800, 4800] with background
+  phases in 20 s (uniform phases: 10.9 and 12.1 s, after 15-16 s of building);
+- reason clauses were the boundary of the whole region (1,289 literals); they are now the
+  walls of the stray pocket when fewer (median 50 literals): correct, but not what limits
+  the search.
+
+So a connected object of 800 cells (one building in City) is what CDCL does not find; the
+catalog solver finds it by growing one object under the count's propagation.
 
 ``asp`` (``--cases city pipes --solvers asp --time-limit 60``, load average 5.7--6.6):
 pipes solved in 5.72 s (reference 4.64 s), 0 conflicts, where it timed out before the

@@ -196,3 +196,98 @@ def test_unchanged_judgement_with_chains_of_new_must_cells_hides_no_stray():
                 again = con.prune_sets(Q, c2.copy(), m2.copy())
                 assert again is not None and again[0].size == 0
     assert judged > 20 and chains > 5
+
+
+def _separated(shape, walls, s, t):
+    """Whether every path of axis neighbours from cell ``s`` to cell ``t`` of a grid of
+    ``shape`` passes through a cell of ``walls`` (breadth-first search, flat indices)."""
+    seen = np.zeros(int(np.prod(shape)), dtype=bool)
+    seen[list(walls)] = True
+    if seen[s] or seen[t]:
+        return True
+    seen[s] = True
+    todo = [s]
+    while todo:
+        x = np.unravel_index(todo.pop(), shape)
+        for ax in range(len(shape)):
+            for d in (-1, 1):
+                y = list(x)
+                y[ax] += d
+                if 0 <= y[ax] < shape[ax]:
+                    w = int(np.ravel_multi_index(y, shape))
+                    if w == t:
+                        return False
+                    if not seen[w]:
+                        seen[w] = True
+                        todo.append(w)
+    return True
+
+
+def _reach(shape, walls, s):
+    """How many cells a path of axis neighbours reaches from ``s`` without entering
+    ``walls`` (``s`` included)."""
+    n = int(np.prod(shape))
+    return sum(1 for c in range(n) if c == s or not _separated(shape, walls, s, c))
+
+
+@pytest.mark.parametrize("shape,lo", [((7, 6), 0), ((7, 6), 14), ((5, 4, 3), 9)])
+def test_every_reason_of_the_connectivity_propagator_is_a_separator(shape, lo):
+    """Each reason the SAT search's connectivity propagator gives on a random partial
+    assignment, ``¬y_t ∨ ¬y_s ∨ y_w...`` or ``¬y_s ∨ y_w...``, is false but for its
+    propagated literal, and holds in every connected answer: the walls ``w`` cut every path
+    from ``s`` to ``t``, or leave ``s`` fewer cells than the count needs (checked by a
+    search of the grid, not by the propagator's components). The walls are those of the
+    stray pocket when they are fewer than those of the region of ``s``: both kinds occur,
+    and a wrong side would admit a path."""
+    pytest.importorskip("pysat")
+    from csplab.constraints import constraint_clauses
+    from csplab.engine import connectivity as CN
+
+    # every pair of labels is allowed along every axis
+    bits = [[0, 0, 1], [0, 1, 1], [1, 1, 0]]
+    E = ExampleModel(np.array(bits if len(shape) == 2 else [bits, bits[::-1], bits]))
+    cons = [Connected([1])] + ([Count([1], min=lo)] if lo else [])
+    Q = from_example(E, shape).with_constraints(cons)
+    enc = encode(Q)
+    ctx = constraint_clauses(Q, enc.literal, enc.nvars)
+    rng = np.random.default_rng(len(shape) + lo)
+    kinds, checked = set(), 0
+    real_sep = CN._separators
+
+    def spy_sep(st, comp, root, targets):
+        out = real_sep(st, comp, root, targets)
+        kinds.update("pocket" if v is not out[root] else "region" for v in out.values())
+        return out
+
+    CN._separators = spy_sep
+    try:
+        for _ in range(150):
+            prop = CN.ConnectivityPropagator(Q, ctx)
+            st = prop.states[0]
+            cell = {abs(y): c for c, y in enumerate(st.y) if not isinstance(y, bool)}
+            val = {}
+            for y in st.y:
+                u = rng.random()
+                if isinstance(y, bool) or u > 0.55:
+                    continue
+                lit = int(y) if u < 0.12 else -int(y)  # in the set, or out of it
+                val[abs(lit)] = lit
+                prop.on_assignment(lit)
+            for lit in prop.propagate():
+                clause = prop.reasons[lit]
+                assert clause[0] == lit
+                # a reason: every other literal is false under the assignment
+                assert all(val.get(abs(x)) == -x for x in clause[1:])
+                neg = [cell[-x] for x in clause if x < 0]
+                walls = [cell[x] for x in clause if x > 0]
+                s = neg[-1]
+                small = lo > 0 and _reach(Q.shape, walls, s) < lo
+                if len(neg) == 2 and not small:
+                    assert _separated(Q.shape, walls, neg[0], s)
+                else:
+                    assert len(neg) in (1, 2) and small
+                checked += 1
+    finally:
+        CN._separators = real_sep
+    assert checked > 20
+    assert kinds == {"pocket", "region"}
