@@ -27,7 +27,7 @@ Usage::
 
 Measured (2-core machine shared by other jobs, load average 9-12; ``--time-limit 60``):
 catalog meets both targets (city 3.05 s, 10 choices withdrawn; pipes 7.45 s); asp's
-figures are in the paragraph after the next.
+figures are in the last paragraph below.
 ``sat`` and ``cpsat`` (``--cases city pipes --solvers sat cpsat --time-limit 60``, load
 average 4.6-5.2): they meet on pipes (2.63 s against 0.40 s without the constraints; 3.93 s
 against 0.73 s) and time out on city (8,901 conflicts; 103 cuts; references 3.23 and 2.47 s).
