@@ -153,6 +153,7 @@ from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, Encoding, encode
 from csplab.constraints import ClauseContext
 from csplab.deps import require
+from csplab.engine.alg31 import solution_hint
 from csplab.engine.sat import preferred_labels
 from csplab.errors import CsplabError, InputError
 from csplab.problem import Problem
@@ -715,8 +716,9 @@ class AspSolver(Solver):
         Option("grounding", str, "csplab", "ground program written by csplab (aspif) or "
                "grounded by gringo from facts", values=("csplab", "gringo")),
         Option("diversity", str, "sign", "how seeds vary the output: random default signs, "
-               "a random preferred label per cell, or the seed alone",
-               values=("sign", "label", "none")),
+               "a random preferred label per cell, a seeded Alg. 3.1 solution as the "
+               "preferred labels (catalog; random labels when it fails), or the seed alone",
+               values=("sign", "label", "catalog", "none")),
         TIME_LIMIT,
     )  # fmt: skip
 
@@ -764,7 +766,10 @@ class AspSolver(Solver):
         if diversity == "sign":
             args.append("--sign-def=rnd")
         prefer = None
-        if diversity == "label":
+        if diversity == "catalog":  # a seeded Alg. 3.1 solution, as cpsat's hint
+            prefer = solution_hint(problem, rng, call.remaining())
+            stats["hint"] = "catalog solution" if prefer is not None else "random labels"
+        if diversity == "label" or (diversity == "catalog" and prefer is None):
             prefer = preferred_labels(enc.catalog, None, rng)
         if prefer is not None or problem.constraints:  # preferred labels, label atoms first
             args.append("--heuristic=Domain")

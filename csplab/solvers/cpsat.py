@@ -88,7 +88,7 @@ from csplab._jit import njit
 from csplab.cnf import DeadlineExceeded, encode
 from csplab.constraints import ClauseContext
 from csplab.deps import require
-from csplab.engine.alg31 import run_alg31
+from csplab.engine.alg31 import solution_hint
 from csplab.engine.sat import preferred_labels
 from csplab.errors import InputError
 from csplab.problem import Problem
@@ -203,7 +203,7 @@ class CpsatSolver(Solver):
 
         whole = None  # a solution to hint (diversity="catalog")
         if diversity == "catalog":
-            whole = _catalog_hint(problem, rng, call.remaining())
+            whole = solution_hint(problem, rng, call.remaining())
             stats["hint"] = "catalog solution" if whole is not None else "random labels"
         if supports == "auto":
             supports = "forward" if whole is not None else "both"
@@ -361,40 +361,6 @@ class CpsatSolver(Solver):
             return np.asarray(values[: P.n], dtype=np.int32)
 
         return read, "proto-api", units
-
-
-#: Alg. 3.1 runs tried for a ``diversity="catalog"`` hint before random labels are used
-_CATALOG_TRIES = 3
-
-
-def _catalog_hint(
-    problem: Problem, rng: np.random.Generator, left: float | None
-) -> NDArray[np.int64] | None:
-    """A solution of Alg. 3.1 (scanline, uniform choice; up to :data:`_CATALOG_TRIES` runs)
-    as one label per cell, or None when every run fails. CP-SAT then gets a complete hint
-    that it confirms without search; when Alg. 3.1 fails it searches as usual.
-
-    With global constraints (Alg. 3.1 then withdraws refuted choices and grows one
-    connected set), runs in ``min-entropy`` order follow when the scanline runs fail: a
-    large connected object (a City building under a count of at least 5 % of the cells)
-    grows from where it started in that order, and does not in scanline order. Problems
-    without global constraints get the scanline runs only (their hints, so their outputs,
-    are unchanged).
-    """
-    t0 = time.perf_counter()
-    orders = ["scanline"] * _CATALOG_TRIES
-    if problem.constraints:
-        orders += ["min-entropy"] * _CATALOG_TRIES
-    for order in orders:
-        budget = None if left is None else left / 4 - (time.perf_counter() - t0)
-        if budget is not None and budget <= 0:
-            return None
-        r = run_alg31(problem, rng, order=order, time_limit=budget)
-        if r.status == "solved":
-            return np.asarray(r.grid, dtype=np.int64).reshape(-1)
-        if r.status == "unsat":  # an arc-consistency wipe-out: the encoding reports it
-            return None
-    return None
 
 
 class _LinearContext(ClauseContext):

@@ -11,6 +11,11 @@ the rng (``choice="uniform"``, the default, like Alg. 3.1's uniform choice, or
 to it; CaDiCaL is also seeded. Two seeds' outputs differ in 30-46% of the cells at
 40×40×10 (``benchmarks/bench_solvers.py``; Alg. 3.1: 16-30%); ``"weighted"`` phases give
 mostly empty space and much less variety; ``choice="none"`` keeps the solver's own phases.
+``choice="catalog"`` sets the phases to a seeded Alg. 3.1 solution
+(:func:`~csplab.engine.alg31.solution_hint`, as ``cpsat``'s default hint; uniform labels when
+every run fails): with global constraints CDCL on its own does not find one connected object
+of hundreds of cells (City 40×40×10 with connectivity and a count: timeout at 60 s), and from
+that solution it does (7 s, ``benchmarks/bench_global.py``).
 
 Status ``unsat`` comes only with a proof: the SAT solver's refutation, or an arc-consistency
 wipe-out before any choice (what unit propagation on the support encoding also derives).
@@ -36,6 +41,7 @@ import time
 from numpy.typing import ArrayLike
 
 from csplab.cnf import AMO_ENCODINGS
+from csplab.engine.alg31 import solution_hint
 from csplab.engine.sat import SatOracle, backends, preferred_labels
 from csplab.problem import Problem
 from csplab.result import Result, Status
@@ -62,9 +68,9 @@ class SatSolver(Solver):
         'support encoding (unit propagation = arc consistency) or `encoding="direct"`; '
         '`supports="forward"` halves the clauses; at-most-one `amo="lazy"` (added only '
         "for cells a model labels twice) or any `pysat.card` encoding; diverse outputs from "
-        'random decision phases (`choice="uniform"`/`"weighted"`, `"none"` keeps the '
-        'solver\'s); clauses go to CaDiCaL through a compiled loader (`loader="api"` for '
-        "pysat's); `unsat` = the solver's refutation"
+        'random decision phases (`choice="uniform"`/`"weighted"`, `"catalog"`: a seeded '
+        'Alg. 3.1 solution, `"none"` keeps the solver\'s); clauses go to CaDiCaL through a '
+        'compiled loader (`loader="api"` for pysat\'s); `unsat` = the solver\'s refutation'
     )
     options = (
         Option("encoding", str, "support", "support clauses (= arc consistency) or direct "
@@ -74,8 +80,9 @@ class SatSolver(Solver):
         Option("amo", str, "lazy", "at-most-one per cell: lazy (added for cells a model "
                "labels twice) or a pysat.card encoding", values=AMO_ENCODINGS),
         Option("choice", str, "uniform", "decision phases: a label per cell drawn uniformly "
-               "or by weight from the catalog, or none (the solver's own)",
-               values=("uniform", "weighted", "none")),
+               "or by weight from the catalog, a seeded Alg. 3.1 solution (catalog; "
+               "uniform when it fails), or none (the solver's own)",
+               values=("uniform", "weighted", "catalog", "none")),
         Option("loader", str, "auto", "clause loading: auto (compiled CaDiCaL loader when "
                "available) or api (pysat's Python API)", values=("auto", "api")),
         TIME_LIMIT,
@@ -107,7 +114,13 @@ class SatSolver(Solver):
                 )
                 stats["fail_cell"] = list(problem.coords(o.enc.wiped))
             else:
-                if choice != "none":
+                hint = None
+                if choice == "catalog":  # a seeded Alg. 3.1 solution, as cpsat's hint
+                    hint = solution_hint(problem, rng, call.remaining())
+                    stats["hint"] = "catalog solution" if hint is not None else "uniform labels"
+                if hint is not None:
+                    o.set_phases(hint)
+                elif choice != "none":
                     w = None
                     if choice == "weighted":  # per cell when the weights are per class
                         tab, cls = problem.weight_classes()
