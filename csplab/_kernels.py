@@ -46,6 +46,9 @@ within 5-9%). Measured again with only the full revision (the covering loop that
 ``inline="always"`` helper: Alg. 3.1 at 40x40x10, three runs, median of shuffled A/B
 rounds in one process on a busy 2-core machine, helper / copies = 1.21 (castle) and 1.15
 (city) over 8 rounds, 1.00 and 1.21 over 16: still slower, so the copies stay.
+:func:`_propagate1` is a third copy, for domains of one word (``K <= 64``: castle, city),
+which :func:`_propagate` hands over to: with the words in registers, Alg. 3.4's blocks on
+castle (K = 62) took 25% less time (A/B in one process, 10 alternating rounds).
 """
 
 from __future__ import annotations
@@ -430,6 +433,12 @@ def _propagate(
     """
     n = dom.shape[0]
     W = dom.shape[1]
+    if W == 1:
+        return _propagate1(
+            dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, nstart, stats,
+            heap, hpos, hkey, hsize, noise, weights, wlogw, wclass, weighted, sw, swl, nib,
+            dirty, isdirty,
+        )  # fmt: skip
     head = 0
     tail = 0
     count = 0
@@ -596,6 +605,177 @@ def _propagate(
             head = 0
         count -= 1
     return wiped
+
+
+@njit(cache=True)
+def _propagate1(
+    dom: np.ndarray,
+    prev: np.ndarray,
+    full: np.ndarray,
+    ptr: np.ndarray,
+    nbr: np.ndarray,
+    sidx: np.ndarray,
+    sup: np.ndarray,
+    supall: np.ndarray,
+    queue: np.ndarray,
+    inq: np.ndarray,
+    start: np.ndarray,
+    nstart: int,
+    stats: np.ndarray,
+    heap: np.ndarray,
+    hpos: np.ndarray,
+    hkey: np.ndarray,
+    hsize: int,
+    noise: np.ndarray,
+    weights: np.ndarray,
+    wlogw: np.ndarray,
+    wclass: np.ndarray,
+    weighted: bool,
+    sw: np.ndarray,
+    swl: np.ndarray,
+    nib: np.ndarray,
+    dirty: np.ndarray,
+    isdirty: np.ndarray,
+) -> int:
+    """:func:`_propagate` for domains of one word (``K <= 64``): the same queue, revisions,
+    counts and heap updates, the words held in registers instead of arrays of ``W`` (a
+    copy on purpose, see the module docstring: 20-25% less time per block of Alg. 3.4 on
+    castle, K = 62)."""
+    n = dom.shape[0]
+    head = 0
+    tail = 0
+    count = 0
+    for i in range(nstart):
+        c = start[i]
+        if not inq[c]:
+            inq[c] = True
+            queue[tail] = c
+            tail += 1
+            if tail == n:
+                tail = 0
+            count += 1
+    J = nib.shape[0]
+    SW = nib.shape[2]
+    accs = np.empty(SW, dtype=np.uint64)
+    fullw = full[0]
+    zero = np.uint64(0)
+    wiped = -1
+    ndirty = 0
+    while count > 0:
+        u = queue[head]
+        head += 1
+        if head == n:
+            head = 0
+        count -= 1
+        inq[u] = False
+        stats[0] += 1
+        du = dom[u, 0]
+        pu = prev[u, 0]
+        isfull = du == fullw
+        known = pu != zero
+        nd = popcount64(du)
+        rem = pu & ~du
+        nr = popcount64(rem)
+        if known and nr == 0:
+            continue
+        use_delta = known and nr < nd and (J == 0 or 8 * nr <= J)
+        prev[u, 0] = du
+        tabled = J > 0 and not use_delta and not isfull
+        if tabled:
+            for q in range(SW):
+                accs[q] = 0
+            for j in range(J):
+                x = (du >> np.uint64(4 * j)) & np.uint64(15)
+                if x:
+                    for q in range(SW):
+                        accs[q] |= nib[j, x, q]
+        for e in range(ptr[u], ptr[u + 1]):
+            v = nbr[e]
+            s = sidx[e]
+            if use_delta:
+                acc = zero
+                x = rem
+                while x:
+                    a = ctz64(x)
+                    x &= x - np.uint64(1)
+                    acc |= sup[s, a, 0]
+                x = dom[v, 0] & acc
+                keep = ~x
+                while x:
+                    cbit = x & (~x + np.uint64(1))
+                    c = ctz64(x)
+                    x ^= cbit
+                    if du & sup[s ^ 1, c, 0]:
+                        keep |= cbit
+                acc = keep
+            elif isfull:
+                acc = supall[s, 0]
+            elif tabled:
+                acc = accs[s]
+            else:
+                acc = zero
+                dv = dom[v, 0]
+                covered = False
+                x = du
+                while x:
+                    a = ctz64(x)
+                    x &= x - np.uint64(1)
+                    acc |= sup[s, a, 0]
+                    if not (dv & ~acc):
+                        covered = True
+                        break
+                if covered:
+                    continue
+            old = dom[v, 0]
+            new = old & acc
+            if new != old:
+                stats[1] += popcount64(old ^ new)
+                dom[v, 0] = new
+                inheap = hsize > 0 and hpos[v] >= 0 and hpos[v] < hsize
+                if inheap and weighted and sw.shape[0] > 0:
+                    r = wrow(wclass, v)
+                    x = old & ~new
+                    while x:
+                        a = ctz64(x)
+                        x &= x - np.uint64(1)
+                        sw[v] -= weights[r, a]
+                        swl[v] -= wlogw[r, a]
+                if not new:
+                    wiped = v
+                    break
+                if inheap and not isdirty[v]:
+                    isdirty[v] = True
+                    dirty[ndirty] = v
+                    ndirty += 1
+                if not inq[v]:
+                    inq[v] = True
+                    queue[tail] = v
+                    tail += 1
+                    if tail == n:
+                        tail = 0
+                    count += 1
+        if wiped >= 0:
+            break
+    for i in range(ndirty):
+        v = dirty[i]
+        isdirty[v] = False
+        if wiped < 0:
+            if weighted and sw.shape[0] > 0 and sw[v] > 1e-12:
+                k = np.log(sw[v]) - swl[v] / sw[v] + 1e-6 * noise[v]
+            else:
+                r = wrow(wclass, v)
+                k = entropy_of(dom, v, weights[r], wlogw[r], weighted) + 1e-6 * noise[v]
+            heap_update(heap, hpos, hkey, hsize, v, k)
+    while count > 0:
+        q = queue[head]
+        inq[q] = False
+        prev[q, 0] = 0
+        head += 1
+        if head == n:
+            head = 0
+        count -= 1
+    return wiped
+
 
 
 @njit(cache=True)
@@ -1509,6 +1689,7 @@ def block_catalog(
     lptr: np.ndarray,
     lnbr: np.ndarray,
     lsidx: np.ndarray,
+    table: np.ndarray,
 ) -> int:
     """The catalog of one block of Alg. 3.4 before propagation, and its internal arcs.
 
@@ -1518,15 +1699,19 @@ def block_catalog(
     them) and the block's arcs as CSR rows in local cell numbers (``lptr``, ``nb + 1``;
     ``lnbr``/``lsidx``, as long as the block's arc ends in the problem), in the order of the
     problem's arcs, as in the subproblem. Returns the number of internal arc ends.
+
+    ``table`` (``int64``, the problem's cells, all -1) looks the block's cells up (it is
+    left all -1); an empty one: a table of the problem's cells is made when the block is
+    most of the problem (a world's template), else ``cells`` is bisected per arc (ten
+    times slower per block of 1000 cells than a table).
     """
     ptr, nbr, sidx, sup = arcs.ptr, arcs.nbr, arcs.sidx, arcs.sup
     W = doms.shape[1]
     nb = cells.shape[0]
-    # a block that is most of the problem (a world's template) looks its cells up in a
-    # table of the problem's cells; a small block of a large grid bisects ``cells``
     n = grid.shape[0]
-    dense = n <= 4 * nb
-    pos = np.full(n if dense else 0, -1, dtype=np.int64)
+    given = table.shape[0] == n
+    dense = given or n <= 4 * nb
+    pos = table if given else np.full(n if dense else 0, -1, dtype=np.int64)
     if dense:
         for i in range(nb):
             pos[cells[i]] = i
@@ -1550,6 +1735,9 @@ def block_catalog(
                     for w in range(W):
                         dom0[i, w] &= sup[s1, a, w]
     lptr[nb] = k
+    if given:
+        for i in range(nb):
+            pos[cells[i]] = -1
     return k
 
 
@@ -1702,6 +1890,7 @@ def blocks_sweep(
     as it was. ``counters += [blocks tried, accepted, retries, queue pops]``.
     """
     W = doms.shape[1]
+    table = np.full(grid.shape[0], -1, dtype=np.int64)  # the block's cells, looked up
     for b in range(first, last):
         lo = bptr[b]
         nb = bptr[b + 1] - lo
@@ -1716,7 +1905,7 @@ def blocks_sweep(
         lptr = np.zeros(nb + 1, dtype=np.int64)
         lnbr = np.empty(max(deg, 1), dtype=np.int64)
         lsidx = np.empty(max(deg, 1), dtype=np.int64)
-        k = block_catalog(arcs, doms, grid, cells, dom0, lptr, lnbr, lsidx)
+        k = block_catalog(arcs, doms, grid, cells, dom0, lptr, lnbr, lsidx, table)
         lclass = arcs.wclass[cells].copy() if arcs.wclass.shape[0] > 1 else arcs.wclass
         local = Arcs(arcs.full, lptr, lnbr[:k].copy(), lsidx[:k].copy(), arcs.sup,
                      arcs.supall, arcs.weights, arcs.wlogw, lclass, arcs.nib)  # fmt: skip
