@@ -559,12 +559,13 @@ def _propagate(
                     dom[v, w] = new
                     changed = True
                     if memo:
+                        r = wrow(wclass, v)
                         x = old & ~new
                         while x:
                             a = w * 64 + ctz64(x)
                             x &= x - np.uint64(1)
-                            sw[v] -= weights[wrow(wclass, v), a]
-                            swl[v] -= wlogw[wrow(wclass, v), a]
+                            sw[v] -= weights[r, a]
+                            swl[v] -= wlogw[r, a]
                 if new:
                     empty = False
             if changed:
