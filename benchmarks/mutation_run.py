@@ -126,9 +126,9 @@ TARGETS: tuple[Target, ...] = (
         "engine.kernels",
         "csplab/_kernels.py",
         (
-            "alg31", "_propagate", "propagate", "choose_label", "entropy_of", "domain_size",
-            "nth_label", "heap_update", "heap_build", "heap_pop", "_heap_up", "_heap_down",
-            "_heap_swap", "ctz64", "popcount64",
+            "alg31", "_propagate", "_propagate1", "propagate", "choose_label", "entropy_of",
+            "domain_size", "nth_label", "heap_update", "heap_build", "heap_pop", "_heap_up",
+            "_heap_down", "_heap_swap", "ctz64", "popcount64",
         ),
         (*_TWINS, "tests/test_kernels.py::test_alg31_in_chunks_equals_one_run"),
         _NOJIT,

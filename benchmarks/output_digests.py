@@ -7,7 +7,9 @@ must be equal line for line::
     python benchmarks/output_digests.py > after.txt    # on the new one
     diff before.txt after.txt
 
-Each line: example, size, the SHA-256 of the output file, and the command's exit code.
+Each line: example, size, the SHA-256 of the output file, and the command's exit code; the
+3D grid examples have a second line, ``blocks``: the same command with ``--solver blocks
+--block 6`` (modify in blocks, its compiled sweep).
 """
 
 from __future__ import annotations
@@ -58,9 +60,15 @@ def main() -> None:
                 cmd += ["--grid", "hex:odd-r"]
             if name == "trifan":
                 cmd += ["--grid", "tri"]
-            rc = subprocess.run(cmd, capture_output=True, text=True).returncode
-            digest = hashlib.sha256(out.read_bytes()).hexdigest()[:16] if out.exists() else "-"
-            print(f"{name:14s} {size:8s} {digest} exit={rc}", flush=True)
+            runs = [("", cmd)]
+            if kind == "grid3":  # modify in blocks too (its compiled sweep: many blocks)
+                runs.append(("blocks", [*cmd, "--solver", "blocks", "--block", "6"]))
+            for solver, argv in runs:
+                out.unlink(missing_ok=True)
+                rc = subprocess.run(argv, capture_output=True, text=True).returncode
+                digest = hashlib.sha256(out.read_bytes()).hexdigest()[:16] if out.exists() else "-"
+                print(f"{name:14s} {size:8s} {digest} exit={rc}{' ' + solver if solver else ''}",
+                      flush=True)  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -649,7 +649,7 @@ def block_arrays(
     lnbr = np.empty(max(deg, 1), dtype=np.int64)
     lsidx = np.empty(max(deg, 1), dtype=np.int64)
     k = kern.block_catalog(c.arcs, c.packed_domains(problem), grid, cells, dom0, lptr, lnbr,
-                           lsidx)  # fmt: skip
+                           lsidx, np.zeros(0, dtype=np.int64))  # fmt: skip
     return BlockArrays(dom0, lptr, lnbr[:k].copy(), lsidx[:k].copy())
 
 

@@ -626,8 +626,10 @@ def arc_reach(problem: Problem, axes: Sequence[int] | None = None) -> int:
     return max(1, int(np.abs(c[:, 0] - c[:, 1]).max()))
 
 
-#: cells of one window of :meth:`GridWindows.violations` (its slabs along ``x``)
-CHECK_CELLS = 1 << 19
+#: cells of one window of :meth:`GridWindows.violations` (its slabs along ``x``); small
+#: windows stay in the caches: a castle 1000x1000x10 output is checked in 0.52 s of CPU
+#: with 2**16, 0.68 s with 2**17, 1.1 s with 2**18 and 1.5 s with 2**19
+CHECK_CELLS = 1 << 16
 
 
 class GridWindows:

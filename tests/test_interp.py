@@ -150,10 +150,15 @@ def test_alg31_same_as_kernels_on_builtins(engine, name, shape, kw):
             _same(a, b)
 
 
-def test_propagate_same_as_kernels_on_random_catalogs(engine):
+@pytest.mark.parametrize(
+    "name,shape,kw",
+    [("fig3_10", (9, 11), {}),  # one word per domain: the kernels' _propagate1
+     ("city", (6, 6, 4), {"boundary": "auto"})],  # K = 119, two words: _propagate's loops
+)  # fmt: skip
+def test_propagate_same_as_kernels_on_random_catalogs(engine, name, shape, kw):
     rng = np.random.default_rng(3)
-    E = load_example("fig3_10")
-    P = from_example(E, (9, 11))
+    E = load_example(name)
+    P = from_example(E, shape, **kw)
     wipes = 0
     C0 = Propagator(P).catalog()
     for _ in range(40):

@@ -98,23 +98,32 @@ def write_output(out: Output, path: Path) -> None:
 
     g = out.grid
     rows = max(1, SLAB_CELLS // max(1, math.prod(g.shape[1:]))) if g.ndim else 1
+    ids = out.meta.get("label_ids")
 
-    def slabs() -> Iterator[NDArray[np.int64]]:
-        if g.ndim == 0 or not g.shape[0]:
-            yield file_labels(g, out.meta)
-            return
-        for i in range(0, g.shape[0], rows):
-            yield file_labels(g[i : i + rows], out.meta)
+    def slabs(dtype: type[np.integer[Any]]) -> Iterator[NDArray[np.integer[Any]]]:
+        """The file's labels slab by slab, as ``dtype`` (one conversion per slab)."""
+        parts = [g] if g.ndim == 0 or not g.shape[0] else (
+            g[i : i + rows] for i in range(0, g.shape[0], rows))  # fmt: skip
+        for part in parts:
+            yield np.asarray(part, dtype=dtype) if ids is None else file_labels(
+                part, out.meta).astype(dtype, copy=False)  # fmt: skip
 
-    big = any(s.size and s.max() > 2**31 - 1 for s in slabs())
-    dtype = np.dtype(np.int64 if big else np.int32)
+    # int64 only when a label id of the file needs it: read off the grid's type or the ids
+    # when they fit (no pass over the grid), else from the grid's slabs
+    fits = np.iinfo(np.int32).max
+    if ids is None and np.can_cast(g.dtype, np.int32):
+        big = False
+    elif ids is not None and (not len(ids) or max(int(i) for i in ids) <= fits):
+        big = False
+    else:
+        big = any(s.size and s.max() > fits for s in slabs(np.int64))
+    dtype = np.int64 if big else np.int32
     head = io.BytesIO()
     np.lib.format.write_array_header_1_0(
-        head, {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False,
-               "shape": g.shape},
+        head, {"descr": np.lib.format.dtype_to_descr(np.dtype(dtype)),
+               "fortran_order": False, "shape": g.shape},
     )  # fmt: skip
-    write_atomic(path, itertools.chain([head.getvalue()],
-                                       (s.astype(dtype).tobytes() for s in slabs())))  # fmt: skip
+    write_atomic(path, itertools.chain([head.getvalue()], (s.tobytes() for s in slabs(dtype))))
 
 
 #: cells per slab written by :func:`write_output`

@@ -32,3 +32,15 @@ def test_label_ids_beyond_int32_are_written_as_int64(monkeypatch, tmp_path):
     got = np.load(path)
     assert got.dtype == np.int64
     assert got.tolist() == [[5, 2**40], [2**40, -1], [5, 5]]
+
+
+@pytest.mark.parametrize("slab", [1, 1 << 22])
+def test_label_ids_within_int32_write_the_bytes_of_np_save(monkeypatch, tmp_path, slab):
+    monkeypatch.setattr(npy, "SLAB_CELLS", slab)
+    grid = np.array([[0, 1, -1], [1, 1, 0]], dtype=np.int32)
+    path = tmp_path / "g.npy"
+    npy.write_output(Output.of(grid, meta={"label_ids": (7, 2**31 - 1)}), path)
+    want = io.BytesIO()
+    np.save(want, np.array([[7, 2**31 - 1, -1], [2**31 - 1, 2**31 - 1, 7]], dtype=np.int32))
+    assert path.read_bytes() == want.getvalue()
+
