@@ -220,6 +220,8 @@ STATS: dict[str, str] = {
     "violations": "violated constraints of the returned grid (0 when solved)",
     "broken": "global constraints the grid of a failed run breaks (csplab.constraints)",
     "constraint_clauses": "clauses of the global constraints (csplab.constraints)",
+    "constraint_rules": "rules of the global constraints in the answer-set program "
+    "(asp: reachability, cardinality)",
     "cuts": "connectivity cuts added lazily (csplab.constraints.Connected)",
     "connectivity_propagations": "cells excluded by the SAT search's connectivity propagator",
     "constraint_prunings": "search steps where a global-constraint propagator removed labels",
@@ -286,7 +288,9 @@ STATS: dict[str, str] = {
     "free_s": "seconds spent freeing the solver",
     "model": "the model flavour (CP-SAT)",
     "diversity": "how outputs are diversified across seeds",
-    "hint": "the solution hint given (CP-SAT): a catalog solution or random labels",
+    "hint": "where the solver started: a seeded Alg. 3.1 solution (catalog solution; cpsat's "
+    "hint, sat's choice=catalog phases, asp's diversity=catalog labels) or, when it fails, "
+    "random or uniform labels",
     "sat": "figures of the SAT oracle used (a dict with these names)",
     "atoms": "ground atoms (ASP)",
     "rules": "ground rules (ASP)",
