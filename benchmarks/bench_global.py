@@ -20,8 +20,8 @@ chooses again (:func:`csplab.engine.alg31.run_alg31`).
 
 ``sat+catalog`` and ``asp+catalog`` are ``sat`` with ``choice="catalog"`` and ``asp`` with
 ``diversity="catalog"``: each starts from a seeded Alg. 3.1 solution
-(:func:`csplab.engine.alg31.solution_hint`: scanline runs, then min-entropy runs under
-global constraints) as its decision phases / preferred labels -- what ``cpsat`` does by
+(:func:`csplab.engine.alg31.solution_hint`: under global constraints min-entropy runs,
+then scanline runs) as its decision phases / preferred labels -- what ``cpsat`` does by
 default with its solution hint. The plain lines keep each solver's defaults.
 
 Targets: ``catalog``, ``sat``, ``asp`` <= 10 s each, ``cpsat`` <= 30 s, every output valid.

@@ -38,7 +38,7 @@ one-hot is the default: the table model solved only 1 of 6 40×40×10 settings w
 
 Diversity and the hint: CP-SAT returns the same solution for every ``random_seed`` by
 default. ``diversity="catalog"`` (default) runs Alg. 3.1 (scanline, uniform choice; up to
-three runs, and with global constraints three more in min-entropy order, where a large
+three runs; with global constraints three runs in min-entropy order first, where a large
 connected object grows from where it started) with the rng and gives its solution as a
 complete hint; CP-SAT confirms a
 complete feasible hint without search (0 branches), so the output is that solution, and the
