@@ -209,7 +209,7 @@ def synthesize(
     if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
         # what check needs to compare the example as it was synthesized (kept by .obj,
         # .glb and .json outputs)
-        recorded = recorded_settings(args, example, ground)
+        recorded = recorded_settings(args, example)
         if recorded:  # defaults record nothing (check derives the same)
             s.model.meta["synthesis"] = recorded
         fmt.write(s.model, args.out)
@@ -390,16 +390,18 @@ def onto_planes(model: PolyhedralModel, lat: Any) -> tuple[PolyhedralModel, int]
     return PolyhedralModel(solids, name=model.name, meta=model.meta, source=model.source), moved
 
 
-#: the options of synthesize an output records (with their defaults, which record nothing)
-RECORDED: dict[str, Any] = {"spacing": None, "snap": False, "lines": "auto", "ground": "auto"}
+#: the options of synthesize an output records (with their defaults, which record nothing):
+#: how the example was snapped for the output. Not ``--ground``: the example's own ground is
+#: part of what it means, so check judges an output against it unless told otherwise
+RECORDED: dict[str, Any] = {"spacing": None, "snap": False, "lines": "auto"}
 
 
 def recorded_settings(
-    args: argparse.Namespace, example: PolygonModel | PolyhedralModel, ground: str
+    args: argparse.Namespace, example: PolygonModel | PolyhedralModel
 ) -> dict[str, Any]:
     """The settings of ``csplab synthesize`` that ``csplab check`` needs and that differ
     from the defaults (which check derives as synthesize does), as given."""
-    d: dict[str, Any] = {"ground": ground}
+    d: dict[str, Any] = {}
     if example.ndim == 3:
         d.update(spacing=args.spacing, snap=bool(args.snap), lines=args.lines)
     return {k: v for k, v in d.items() if v != RECORDED[k]}

@@ -47,8 +47,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         type=float,
         help="polyhedral examples: the plane spacing the output was synthesized with (the "
         "example is compared as synthesize snaps it; default: what synthesize recorded in "
-        "the output (.obj, .glb), else derived, as synthesize). --snap, --lines and "
-        "--ground also default to the recorded settings; given options win",
+        "the output (.obj, .glb), else derived, as synthesize). --snap and --lines also "
+        "default to the recorded settings; given options win",
     )
     p.add_argument("--snap", action="store_true", help="polyhedral examples: as synthesize --snap")
     p.add_argument(
