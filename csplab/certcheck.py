@@ -1314,7 +1314,7 @@ def _check_lean(
                     raise _Invalid(f"{_where(lo, hi)}: a state's step is not one of its {n} steps")
                 if len(labs) != widths[i]:
                     raise _Invalid(f"{_where(lo, hi)}: a state at step {i} does not fit keys[{i}]")
-                by_step[i].append(tuple(labs))
+                by_step[i].append(tuple(map(int, labs)))  # numpy ints: shifts past 63
             if not by_step[0]:
                 raise _Invalid(f"{_where(lo, hi)}: no start state")
             # closed: each state's labels lead to recorded states; the point's catalog

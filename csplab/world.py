@@ -136,6 +136,7 @@ __all__ = [
     "THIN_MARGIN",
     "UNHONOURED",
     "World",
+    "chunk_shape",
     "network_per_chunk",
     "world_problem",
     "world_zfaces",
@@ -336,6 +337,34 @@ class _LRU(OrderedDict[Any, Any]):
             self.popitem(last=False)
 
 
+def chunk_shape(chunk: Sequence[int]) -> tuple[int, ...]:
+    """A world's chunk shape checked: 2 or 3 positive sizes.
+
+    Parameters
+    ----------
+    chunk : sequence of int
+        ``(X, Y)`` or ``(X, Y, height)``.
+
+    Returns
+    -------
+    tuple of int
+
+    Raises
+    ------
+    InputError
+        For another number of sizes or a size below 1.
+
+    Examples
+    --------
+    >>> chunk_shape([16, 16, 10])
+    (16, 16, 10)
+    """
+    shape = tuple(int(c) for c in chunk)
+    if len(shape) not in (2, 3) or min(shape) < 1:
+        raise InputError(f"chunk must be 2 or 3 positive sizes, not {tuple(chunk)!r}")
+    return shape
+
+
 def world_zfaces(
     model: Any, chunk: Sequence[int], boundary: Any
 ) -> dict[str, int] | None:
@@ -358,8 +387,8 @@ def world_zfaces(
     Raises
     ------
     InputError
-        For faces other than ``z-``/``z+`` or a boundary that is not ``auto``, ``none`` or a
-        mapping.
+        For a chunk that is not 2 or 3 positive sizes, faces other than ``z-``/``z+`` or a
+        boundary that is not ``auto``, ``none`` or a mapping.
 
     Examples
     --------
@@ -369,6 +398,7 @@ def world_zfaces(
     >>> world_zfaces(csplab.examples.load_example("line"), (16, 16), "auto") is None
     True
     """
+    chunk = chunk_shape(chunk)
     ndim = len(chunk)
     if boundary in (None, "none"):
         return None
@@ -572,9 +602,7 @@ class World:
         self.seed = int(seed)
         if self.seed < 0:
             raise InputError(f"seed must be >= 0, not {seed}")
-        self.chunk_shape = tuple(int(c) for c in chunk)
-        if len(self.chunk_shape) not in (2, 3) or min(self.chunk_shape) < 1:
-            raise InputError(f"chunk must be 2 or 3 positive sizes, not {chunk!r}")
+        self.chunk_shape = chunk_shape(chunk)
         if passes < 1 or retries < 0 or workers < 0:
             raise InputError("passes must be >= 1, retries >= 0 and workers >= 0")
         if exact not in ("sat", "backtrack", "none"):

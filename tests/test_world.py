@@ -293,6 +293,12 @@ def test_global_constraints_are_refused_in_one_line(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "cannot honour a connected constraint" in err and len(err.strip().splitlines()) == 1
+    for chunk in ("16", "16x16x10x2"):  # the chunk is checked before the file is read
+        argv = ["world", "castle", "--chunk", chunk, "--region", "0:16,0:16", "--boundary",
+                "auto", "--constraints", str(f)]  # fmt: skip
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert "chunk must be 2 or 3 positive sizes" in err and len(err.strip().splitlines()) == 1
 
 
 def test_blocks_of_another_size_than_the_chunk() -> None:

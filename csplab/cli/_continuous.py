@@ -207,13 +207,18 @@ def synthesize(
     r, csp, P = s.result, s.csp, s.csp.problem
     wrote = None
     if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
-        # what check needs to compare the example as it was synthesized (kept by .obj,
-        # .glb and .json outputs)
+        # what check needs to compare the example as it was synthesized (kept by .obj and
+        # .glb outputs)
         recorded = recorded_settings(args, example)
         if recorded:  # defaults record nothing (check derives the same)
             s.model.meta["synthesis"] = recorded
         fmt.write(s.model, args.out)
         wrote = args.out
+        if recorded and not args.out.lower().endswith(KEEPS_SETTINGS):
+            flags = " ".join(f"--{k}" if v is True else f"--{k} {v:g}" if k == "spacing"
+                             else f"--{k} {v}" for k, v in recorded.items())  # fmt: skip
+            print(f"csplab: note: {args.out} does not keep the settings it was made with; "
+                  f"check it with {flags}", file=sys.stderr)  # fmt: skip
     A: PlaneArrangement = csp.arrangement
     spacing = float(csp.lattice.spacing)
     opened: tuple[str, ...] = csp.ground
@@ -390,6 +395,8 @@ def onto_planes(model: PolyhedralModel, lat: Any) -> tuple[PolyhedralModel, int]
     return PolyhedralModel(solids, name=model.name, meta=model.meta, source=model.source), moved
 
 
+#: the output formats that keep the recorded settings (an OBJ comment, glTF scene extras)
+KEEPS_SETTINGS = (".obj", ".glb")
 #: the options of synthesize an output records (with their defaults, which record nothing):
 #: how the example was snapped for the output. Not ``--ground``: the example's own ground is
 #: part of what it means, so check judges an output against it unless told otherwise
@@ -407,30 +414,40 @@ def recorded_settings(
     return {k: v for k, v in d.items() if v != RECORDED[k]}
 
 
+def _valid_recorded(key: str, value: Any) -> bool:
+    if key == "spacing":
+        return type(value) in (int, float) and value > 0
+    if key == "snap":
+        return type(value) is bool
+    return value in ("auto", "lattice", "equal")
+
+
 def apply_recorded(args: argparse.Namespace, out: PolygonModel | PolyhedralModel) -> str:
-    """Take the output's recorded synthesis settings for the options the user left at
-    their defaults (given options win); a note saying which were read, or ``""``."""
+    """Take the output's recorded synthesis settings for the options the user did not
+    give (``None``; given options win), then the defaults for the rest; a note saying
+    which were read, or ``""``."""
     rec = out.meta.get("synthesis")
-    if not isinstance(rec, dict):
-        return ""
+    rec = rec if isinstance(rec, dict) else {}
     taken, differ = [], []
     for key, default in RECORDED.items():
-        given = getattr(args, key, default)
-        if key in rec and given != default and given != rec[key]:
-            differ.append(f"--{key} {given} given, synthesize used {rec[key]}")
-        if key in rec and given == default and rec[key] != default:
-            value = rec[key]
-            bad = (key == "spacing" and not (isinstance(value, int | float) and value > 0)) or (
-                key == "lines" and value not in ("auto", "lattice", "equal")
-            )
-            if bad:
-                raise InputError(f"{args.grid}: the recorded {key} {value!r} is not valid")
-            if key == "spacing":
-                value = float(value)
-                taken.append(f"--spacing {value:g}")
-            else:
-                taken.append(f"--{key}" if value is True else f"--{key} {value}")
-            setattr(args, key, value)
+        given = getattr(args, key, None)
+        if key not in rec:
+            setattr(args, key, default if given is None else given)
+            continue
+        value = rec[key]
+        if not _valid_recorded(key, value):
+            raise InputError(f"{args.grid}: the recorded {key} {value!r} is not valid")
+        if given is not None:
+            if given != value:
+                differ.append(f"--{key} {given} given, synthesize used {value}")
+            continue
+        if key == "spacing":
+            value = float(value)
+            taken.append(f"--spacing {value:g}")
+        else:
+            taken.append(f"--{key}" if value is True else "--no-snap" if value is False
+                         else f"--{key} {value}")  # fmt: skip
+        setattr(args, key, value)
     note = f" (settings of synthesize read from {args.grid}: {' '.join(taken)})" if taken else ""
     return note + (f" ({'; '.join(differ)})" if differ else "")
 

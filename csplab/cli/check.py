@@ -47,15 +47,21 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         type=float,
         help="polyhedral examples: the plane spacing the output was synthesized with (the "
         "example is compared as synthesize snaps it; default: what synthesize recorded in "
-        "the output (.obj, .glb), else derived, as synthesize). --snap and --lines also "
-        "default to the recorded settings; given options win",
+        "the output (.obj, .glb), else derived, as synthesize). --snap/--no-snap and --lines "
+        "also default to the recorded settings; given options win",
     )
-    p.add_argument("--snap", action="store_true", help="polyhedral examples: as synthesize --snap")
+    p.add_argument(
+        "--snap",
+        action=argparse.BooleanOptionalAction,
+        default=None,
+        help="polyhedral examples: as synthesize --snap (default: recorded, else no)",
+    )
     p.add_argument(
         "--lines",
         choices=("auto", "lattice", "equal"),
-        default="auto",
-        help="polyhedral examples: as synthesize --lines (how the example's faces were snapped)",
+        default=None,
+        help="polyhedral examples: as synthesize --lines (how the example's faces were "
+        "snapped; default: recorded, else auto)",
     )
     p.add_argument("--json", action="store_true")
     p.add_argument("--limit", type=int, default=10, help="violations to list")
@@ -69,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
         from csplab.cli import _continuous
 
         return _continuous.check(args, model)
-    if args.spacing is not None or args.snap or args.lines != "auto":
+    if args.spacing is not None or args.snap is not None or args.lines is not None:
         raise InputError("--spacing, --snap and --lines apply to continuous (polyhedral) models")
     grid = load_grid(args.grid, model.ndim, model)
     problem = problem_from_args(args, model, shape=tuple(grid.shape))

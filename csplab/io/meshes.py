@@ -112,9 +112,9 @@ _SYNTHESIS_COMMENT = re.compile(r"#\s*csplab\s+synthesis\s+(.*\S)")
 
 
 def _synthesis(model: PolyhedralModel) -> dict[str, Any] | None:
-    """The settings ``csplab synthesize`` made the model with (``meta["synthesis"]``: spacing,
-    snap, lines, ground), which ``.obj``, ``.glb`` and ``.json`` outputs keep so that
-    ``csplab check`` compares the example as it was synthesized."""
+    """The settings ``csplab synthesize`` made the model with (``meta["synthesis"]``: the
+    spacing, snap and lines that differ from the defaults), which ``.obj`` and ``.glb``
+    outputs keep so that ``csplab check`` compares the example as it was synthesized."""
     d = model.meta.get("synthesis")
     return dict(d) if isinstance(d, dict) else None
 

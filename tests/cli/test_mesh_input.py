@@ -256,6 +256,14 @@ def test_check_reads_the_settings_synthesize_recorded(tmp_path, capsys):
         code, text, err = run(capsys, "check", src, out, "--spacing", "0.5")
         assert "planes of spacing 0.5," in text and "read from" in text
         assert "--spacing 0.5 given, synthesize used 1.0" in text
+        # a default, given, wins too: without snapping the part is off the spacing-1 lattice
+        code, text, err = run(capsys, "check", src, out, "--no-snap")
+        assert code == 2 and "off the lattice of spacing 1" in err, (text, err)
+    bad = tmp_path / "bad.obj"  # a hand-edited record is refused in one line
+    bad.write_text((tmp_path / "out.obj").read_text().replace('"snap": true', '"snap": "no"'))
+    code, _, err = run(capsys, "check", src, str(bad))
+    assert code == 2 and "recorded snap 'no' is not valid" in err
+    assert len(err.strip().splitlines()) == 1
 
 
 def test_mesh_writers_keep_the_synthesis_settings_and_empty_outputs(tmp_path):
