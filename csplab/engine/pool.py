@@ -157,10 +157,14 @@ class Workers:
 
     def share(self, obj: Any) -> Any:
         """``obj`` as a task argument that reaches each worker once (Dask: scattered to
-        every worker; a local pool: ``obj`` itself)."""
+        every worker under a key of its own; a local pool: ``obj`` itself).
+
+        The key is not the object's hash: a second client of the same scheduler scattering
+        an equal object would get the key the first client's release is still dropping, and
+        its tasks would fail with "lost dependencies"."""
         if self.client is None:
             return obj
-        return self.client.scatter(obj, broadcast=True)
+        return self.client.scatter(obj, broadcast=True, hash=False)
 
     def submit(self, fn: Callable[..., Any], *args: Any, key: str | None = None) -> Any:
         """A future of ``fn(*args)``; ``key`` names the task on a Dask cluster."""
