@@ -331,14 +331,25 @@ class ClauseContext:
         self._links[key] = out
         return out
 
-    def card(self, lits: Sequence[Lit], lo: int, hi: int | None) -> None:
-        """``lo <= (number of true lits) <= hi`` (``hi=None``: no upper bound)."""
+    def card_bounds(
+        self, lits: Sequence[Lit], lo: int, hi: int | None
+    ) -> tuple[list[int], int, int | None] | None:
+        """A count's free literals and its bounds on them (the true constants taken off),
+        or None after adding the empty clause when no number of them meets the bounds."""
         fixed = sum(1 for x in lits if x is True)
         free = [int(x) for x in lits if x is not True and x is not False]
         lo, up = lo - fixed, None if hi is None else hi - fixed
         if (up is not None and up < 0) or lo > len(free):
             self.add([])
+            return None
+        return free, lo, up
+
+    def card(self, lits: Sequence[Lit], lo: int, hi: int | None) -> None:
+        """``lo <= (number of true lits) <= hi`` (``hi=None``: no upper bound)."""
+        got = self.card_bounds(lits, lo, hi)
+        if got is None:
             return
+        free, lo, up = got
         n = len(free)
         big_lo = big_hi = None  # the bounds too large for a counter: one adder for both
         for bound, atmost in ((up, True), (lo, False)):

@@ -398,12 +398,10 @@ class AspContext(ClauseContext):
         """``lo <= (number of true lits) <= hi`` as cardinality rules (clasp propagates
         them as one constraint each, where a counter or adder of clauses propagates weakly
         and loads O(n) or O(n k) rules)."""
-        fixed = sum(1 for x in lits if x is True)
-        free = [int(x) for x in lits if x is not True and x is not False]
-        lo, up = lo - fixed, None if hi is None else hi - fixed
-        if (up is not None and up < 0) or lo > len(free):
-            self.add([])
+        got = self.card_bounds(lits, lo, hi)
+        if got is None:
             return
+        free, lo, up = got
         body = f"{len(free)} " + " ".join(f"{x} 1" for x in free)
         if up is not None and up < len(free):
             self.rules.append(f"1 0 0 1 {up + 1} {body}")  # :- up+1 {free}.
