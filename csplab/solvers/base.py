@@ -291,6 +291,9 @@ STATS: dict[str, str] = {
     "hint": "where the solver started: a seeded Alg. 3.1 solution (catalog solution; cpsat's "
     "hint, sat's choice=catalog phases, asp's diversity=catalog labels) or, when it fails, "
     "random or uniform labels",
+    "hint_s": "seconds spent finding the hint (Alg. 3.1 runs)",
+    "probe_conflicts": "conflicts of sat's short attempt from uniform phases before the "
+    "hint (choice=auto under global constraints)",
     "sat": "figures of the SAT oracle used (a dict with these names)",
     "atoms": "ground atoms (ASP)",
     "rules": "ground rules (ASP)",

@@ -37,3 +37,49 @@ def test_exact_solvers_start_from_the_hint(city, solver, opts, dep):
         r = csplab.solve(city, solver, rng=seed, time_limit=20, **opts)
         assert r.status == "solved" and len(city.violations(r.grid)) == 0
         assert r.stats["hint"] == "catalog solution"
+
+
+def test_sat_default_starts_from_the_hint_under_global_constraints():
+    """``choice="auto"`` (the default): a short attempt from uniform phases, then the hint,
+    which the oracle confirms without a conflict. At 20×20×6 uniform phases need thousands
+    of conflicts (2,554 for a seed that solved; two seeds timed out after 5,698 and 5,876)
+    where the attempt gives up after ``PROBE_CONFLICTS``."""
+    pytest.importorskip("pysat")
+    from csplab.solvers.sat import PROBE_CONFLICTS
+
+    Q = connected_city((20, 20, 6))[1]
+    r = csplab.solve(Q, "sat", rng=0, time_limit=60)
+    assert r.status == "solved" and len(Q.violations(r.grid)) == 0
+    assert r.stats["choice"] == "catalog" and r.stats["hint"] == "catalog solution"
+    assert r.stats["probe_conflicts"] >= PROBE_CONFLICTS
+    assert r.stats["conflicts"] == r.stats["probe_conflicts"]  # the hint: no search
+    again = csplab.solve(Q, "sat", rng=0, time_limit=60)
+    assert np.array_equal(again.grid, r.grid)
+
+
+def test_sat_default_keeps_what_the_uniform_attempt_finds(city):
+    """When the uniform attempt solves the problem (a 12×12×6 connected city: 80-89
+    conflicts) the default's output is ``choice="uniform"``'s, and no hint is computed."""
+    pytest.importorskip("pysat")
+    for seed in range(2):
+        r = csplab.solve(city, "sat", rng=seed)
+        u = csplab.solve(city, "sat", rng=seed, choice="uniform")
+        assert r.status == "solved" and len(city.violations(r.grid)) == 0
+        assert r.stats["choice"] == "uniform" and "hint" not in r.stats
+        assert 0 < r.stats["probe_conflicts"] <= 300
+        assert np.array_equal(r.grid, u.grid)
+
+
+def test_sat_default_without_global_constraints_is_uniform():
+    """No global constraints: the default is ``choice="uniform"``, byte for byte."""
+    pytest.importorskip("pysat")
+    from csplab import from_example, load_example
+
+    for name, size, boundary in (("city", (10, 10, 6), "auto"), ("fig3_1b", (10, 8), None)):
+        P = from_example(load_example(name), size, boundary=boundary)
+        for seed in range(2):
+            r = csplab.solve(P, "sat", rng=seed)
+            u = csplab.solve(P, "sat", rng=seed, choice="uniform")
+            assert r.status == "solved" and len(P.violations(r.grid)) == 0
+            assert r.stats["choice"] == "uniform" and "probe_conflicts" not in r.stats
+            assert np.array_equal(r.grid, u.grid)
