@@ -24,6 +24,12 @@ chooses again (:func:`csplab.engine.alg31.run_alg31`).
 then scanline runs) as its decision phases / preferred labels -- what ``cpsat`` does by
 default with its solution hint. The plain lines keep each solver's defaults.
 
+``sat``'s default is ``choice="auto"``: under global constraints an attempt from uniform
+phases of at most 300 conflicts per solver call (the knot network needs 37-53), then the
+seeded Alg. 3.1 solution, which the solver confirms as assumptions over every label variable
+(0 conflicts); its note says which phases gave the output (``choice``). ``sat+catalog`` is
+that solution at once, without the uniform attempt.
+
 Targets: ``catalog``, ``sat``, ``asp`` <= 10 s each, ``cpsat`` <= 30 s, every output valid.
 
 Usage::
@@ -36,6 +42,18 @@ sat timeout (8,604 conflicts), sat+catalog 3.68 s, asp timeout, asp+catalog 10.5
 its target; asp's reference without the constraints alone takes 6.71 s), cpsat 4.41 s;
 pipes: catalog 2.05 s, sat 1.48 s, sat+catalog 5.21 s, asp 3.58 s, asp+catalog 7.38 s,
 cpsat 4.22 s; every output valid.
+
+``sat``'s default ``choice="auto"`` (``--solvers catalog sat sat+catalog --time-limit 35``,
+load average 3.7-4.1, then the code before it in the same session, load average 3.6-4.0):
+city: sat 5.27 s (300 conflicts, all in the uniform attempt; before: 12.40 s after 2,117
+conflicts, and a timeout after 8,365 in another run), sat+catalog 5.54 s (0 conflicts;
+before: timeout after 6,601 conflicts, 5.65 s after 1,102 in another run: the labels as
+phases left the count's auxiliary variables to the search), catalog 1.28 s; pipes: sat 1.91 s
+(uniform phases, 53 conflicts; before 2.69 s), sat+catalog 6.70 s (before 10.66 s), catalog
+2.89 s; every output valid. ``catalog`` with its own defaults (scanline, no restarts, the
+API's) fails on city for seeds 1-3 (1.1-1.2 CPU s each; ``restarts=10``: 1 of 3 solved in
+35 s, load average 5) and solves pipes (2.2 CPU s); this script gives it ``restarts=50`` and
+min-entropy order on city.
 
 Measured (2-core machine shared by other jobs, load average 9-12; ``--time-limit 60``):
 catalog meets both targets (city 3.05 s, 10 choices withdrawn; pipes 7.45 s); asp's
@@ -140,7 +158,7 @@ def run(
     r = csplab.solve(problem, solver.partition("+")[0], rng=seed, time_limit=limit, **kw)
     dt = time.perf_counter() - t
     ok = r.status == "solved" and r.grid is not None and not problem.violations(r.grid)
-    keys = ("attempts", "constraint_probes", "cuts", "conflicts")
+    keys = ("attempts", "constraint_probes", "cuts", "conflicts", "choice", "probe_conflicts")
     note = ", ".join(f"{k} {r.stats[k]}" for k in keys if k in r.stats)
     return r.status, dt, ok, note
 
