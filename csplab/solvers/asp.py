@@ -709,14 +709,17 @@ class AspSolver(Solver):
     options = (
         Option("encoding", str, "support", "integrity constraints per (arc, label) support "
                "or per forbidden pair", values=("support", "direct")),
-        Option("supports", str, "both", "support constraints in both arc directions or "
-               "forward only", values=("both", "forward")),
+        Option("supports", str, "auto", "support constraints in both arc directions, "
+               "forward only (half; exact with exactly-one), or auto (forward when the "
+               "search starts from a whole catalog solution, else both)",
+               values=("auto", "both", "forward")),
         Option("grounding", str, "csplab", "ground program written by csplab (aspif) or "
                "grounded by gringo from facts", values=("csplab", "gringo")),
-        Option("diversity", str, "sign", "how seeds vary the output: random default signs, "
+        Option("diversity", str, "auto", "how seeds vary the output: random default signs, "
                "a random preferred label per cell, a seeded Alg. 3.1 solution as the "
-               "preferred labels (catalog; random labels when it fails), or the seed alone",
-               values=("sign", "label", "catalog", "none")),
+               "preferred labels (catalog; random labels when it fails), the seed alone, or "
+               "auto (catalog when the problem has global constraints, else sign)",
+               values=("auto", "sign", "label", "catalog", "none")),
         TIME_LIMIT,
     )  # fmt: skip
 
@@ -727,6 +730,14 @@ class AspSolver(Solver):
         clingo = require("clingo", "asp", "solver 'asp'")
         t0, deadline, rng = call.t0, call.deadline, call.rng
         cseed = int(rng.integers(2**31 - 1))
+        if diversity == "auto":  # City 40x40x10 with its constraints needs the catalog start
+            diversity = "catalog" if problem.constraints else "sign"
+        whole, hint_s = None, 0.0  # a seeded Alg. 3.1 solution, as cpsat's hint
+        if diversity == "catalog":
+            whole = solution_hint(problem, rng, call.remaining())
+            hint_s = time.perf_counter() - t0
+        if supports == "auto":  # from a whole solution clasp does not search: forward suffices
+            supports = "forward" if whole is not None else "both"
         empty = np.full(problem.shape, -1, dtype=np.int32)
         stats: dict[str, Any] = {
             "encoding": encoding,
@@ -743,7 +754,7 @@ class AspSolver(Solver):
         except DeadlineExceeded:
             return done("timeout")
         t_enc = time.perf_counter()
-        stats["encode_s"] = t_enc - t0
+        stats["encode_s"] = t_enc - t0 - hint_s
         if not enc.ok:
             stats["proof"] = "arc-consistency wipe-out before encoding (Theorem 3.3.2)"
             stats["fail_cell"] = list(problem.coords(enc.wiped))
@@ -763,10 +774,10 @@ class AspSolver(Solver):
         args = ["--models=1", f"--seed={cseed}"]
         if diversity == "sign":
             args.append("--sign-def=rnd")
-        prefer = None
-        if diversity == "catalog":  # a seeded Alg. 3.1 solution, as cpsat's hint
-            prefer = solution_hint(problem, rng, call.remaining())
+        prefer = whole
+        if diversity == "catalog":
             stats["hint"] = "catalog solution" if prefer is not None else "random labels"
+            stats["hint_s"] = hint_s
         if diversity == "label" or (diversity == "catalog" and prefer is None):
             prefer = preferred_labels(enc.catalog, None, rng)
         if prefer is not None or problem.constraints:  # preferred labels, label atoms first

@@ -291,6 +291,7 @@ STATS: dict[str, str] = {
     "hint": "where the solver started: a seeded Alg. 3.1 solution (catalog solution; cpsat's "
     "hint, sat's choice=catalog phases, asp's diversity=catalog labels) or, when it fails, "
     "random or uniform labels",
+    "hint_s": "seconds spent finding that Alg. 3.1 solution",
     "sat": "figures of the SAT oracle used (a dict with these names)",
     "atoms": "ground atoms (ASP)",
     "rules": "ground rules (ASP)",
