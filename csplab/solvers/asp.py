@@ -394,6 +394,24 @@ class AspContext(ClauseContext):
         self.defined.append(x)
         return x
 
+    def define_set(self, cell: int, mask: NDArray[np.bool_], lits: list[int]) -> Any:
+        """The literal "the label of ``cell`` is in ``mask``" as ``y :- not c1, ..., not cm``
+        over the cell's atoms outside ``mask``: the choice rule gives the cell exactly one label, so
+        none of those is one of ``lits``. One rule where a clause per label defines it
+        otherwise (City 40x40x10: 2 atoms outside the set of non-background labels, about
+        26 in it); the literal ``not c1`` itself when ``m = 1``."""
+        enc = getattr(self.lit, "__self__", None)
+        var = getattr(enc, "var", None)
+        if not isinstance(var, np.ndarray):
+            return super().define_set(cell, mask, lits)
+        out = var[cell][~mask]
+        out = out[out > 0]
+        if out.size <= 1:  # every label of the cell is in mask, or all but one
+            return True if out.size == 0 else -int(out[0])
+        y = self._atom()
+        self.rules.append(f"1 0 1 {y} 0 {out.size} " + " ".join(map(str, (-out).tolist())))
+        return y
+
     def card(self, lits: Any, lo: int, hi: int | None) -> None:
         """``lo <= (number of true lits) <= hi`` as cardinality rules (clasp propagates
         them as one constraint each, where a counter or adder of clauses propagates weakly

@@ -175,6 +175,10 @@ def _constrained():
     yield "count", base.with_constraints([Count([1], min=2, max=3)])
     yield "count at least", base.with_constraints([Count([0], min=7)])
     yield "connected + count", base.with_constraints([Connected([0]), Count([0], min=9, max=10)])
+    # two of four labels: "in the set" is defined by the two labels outside it
+    G = from_example(ExampleModel([[0, 1, 2, 3], [1, 3, 0, 2], [3, 2, 1, 0], [0, 0, 3, 1]]),
+                     (3, 4))  # fmt: skip
+    yield "two of four labels", G.with_constraints([Connected([0, 1]), Count([0, 1], min=4, max=6)])
     # ports: 1 opens its x faces, 2 its y faces; most grids put two of them side by side
     # with a closed face between them (486 of 512), 2 are one network
     F = ExampleModel([[0, 1, 2, 0], [1, 2, 0, 1], [2, 0, 1, 2], [0, 2, 1, 0], [1, 1, 2, 2],
