@@ -362,6 +362,28 @@ def test_global_constraints_start_from_a_catalog_solution_by_default():
     assert (o["diversity"], o["supports"]) == ("label", "both") and "hint" not in o
 
 
+def test_a_failed_hint_loads_both_directions(monkeypatch):
+    """When Alg. 3.1 finds no solution, the search starts from random preferred labels on
+    both directions of supports (forward only propagates too weakly to search); an error
+    in it is raised."""
+    import csplab.solvers.asp as asp
+    from csplab.testing.synthetic import connected_city
+
+    _, P = connected_city((6, 6, 4))
+    monkeypatch.setattr(asp, "solution_hint", lambda *a: None)
+    r = solve(P, "asp", rng=2)
+    assert r.ok and not P.violations(r.grid)
+    assert (r.stats["hint"], r.stats["supports"]) == ("random labels", "both")
+    assert solve(P, "asp", rng=2, supports="forward").stats["supports"] == "forward"
+
+    def broken(*a):
+        raise CsplabError("no hint today")
+
+    monkeypatch.setattr(asp, "solution_hint", broken)
+    with pytest.raises(CsplabError, match="no hint today"):
+        solve(P, "asp", rng=2)
+
+
 def test_seed_is_drawn_from_rng_only():
     P = from_example(CHECKER, (4, 4))
     np.random.seed(1)  # noqa: NPY002 - the global RNG must not matter
