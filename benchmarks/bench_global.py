@@ -22,7 +22,9 @@ chooses again (:func:`csplab.engine.alg31.run_alg31`).
 ``diversity="catalog"``: each starts from a seeded Alg. 3.1 solution
 (:func:`csplab.engine.alg31.solution_hint`: under global constraints min-entropy runs,
 then scanline runs) as its decision phases / preferred labels -- what ``cpsat`` does by
-default with its solution hint. The plain lines keep each solver's defaults.
+default with its solution hint. The plain lines keep each solver's defaults; ``asp``'s default
+(``diversity="auto"``) is that start under global constraints, so its two lines differ only
+in their references without constraints (random signs against the catalog start).
 
 ``sat``'s default is ``choice="auto"``: under global constraints an attempt from uniform
 phases of at most 300 conflicts per solver call (the knot network needs 37-53), then the
@@ -100,6 +102,17 @@ pipes solved in 5.72 s (reference 4.64 s), 0 conflicts, where it timed out befor
 counts became cardinality rules, connectivity got a fixed root and the label atoms are
 decided first (same run set-up: timeout at 60 s, reference 5.31 s); city still times out
 (reference 14.76 s; before 21.90 s). See :mod:`csplab.solvers.asp`, "Global constraints".
+
+``asp`` now starts from the seeded Alg. 3.1 solution by default under global constraints,
+loads only the forward supports then, and defines "in the set" by one rule per cell
+(``--solvers asp asp+catalog --time-limit 35``, one session, 2-core machine shared with
+other jobs). Before, load average 2.9--3.1: city asp timeout (35.35 s; reference 12.36 s),
+asp+catalog 19.34 s (8.74 s); pipes asp 3.74 s (2.25 s), asp+catalog 7.57 s (2.30 s).
+After, load 2.9--3.3: city asp 7.56 s (reference with random signs 10.16 s), asp+catalog
+5.88 s (4.89 s); pipes asp 5.74 s (2.45 s), asp+catalog 6.31 s (1.29 s); at load 5.2--5.5:
+city 8.10 s (12.57 s) and 7.87 s (4.75 s), pipes 8.71 s (2.65 s) and 8.44 s (1.78 s); all
+valid, 0 conflicts. On the pipes the start costs: Alg. 3.1 takes about 2 CPU seconds a run
+at 128x128 and its min-entropy runs fail about half of the time.
 """
 
 from __future__ import annotations

@@ -300,12 +300,17 @@ class ClauseContext:
             if len(lits) == 1:
                 out = lits[0]
             elif lits:
-                y = self.new_var()
-                self.clauses.append([-y, *lits])
-                self.clauses.extend([y, -x] for x in lits)
-                out = y
+                out = self.define_set(int(cell), mask, lits)
         self._sets[key] = out
         return out
+
+    def define_set(self, cell: int, mask: NDArray[np.bool_], lits: list[int]) -> Lit:
+        """A new variable ``y`` for :meth:`in_set` with ``y <-> OR lits`` (the cell's
+        literals of labels in ``mask``, at least two): a clause per literal and one more."""
+        y = self.new_var()
+        self.clauses.append([-y, *lits])
+        self.clauses.extend([y, -x] for x in lits)
+        return y
 
     def link(
         self, lo: int, hi: int, axis: int, ports: NDArray[np.bool_], S: NDArray[np.bool_]

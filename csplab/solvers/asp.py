@@ -71,18 +71,25 @@ Diversity
 The seed comes from ``rng`` (clingo's ``--seed``); the same seed gives the same grid (one
 thread). Mean fraction of cells that differ between two seeds' outputs, with the fraction
 of non-empty cells in brackets, at 16×16×8 (city, canal none; castle auto):
-``diversity="sign"`` (default, ``--sign-def=rnd``: random default signs) 0.28--0.34
-(0.24--0.38); ``"label"`` (one random catalog label per cell preferred through clasp's
-domain heuristic, like the decision phases of ``sat``) 0.40--0.74 (0.45--0.92: a uniform
-label prefers the many non-empty labels); ``"none"`` 0: the seed alone does not change
-clingo's first answer set. ``--rand-freq=0.05`` on top of random signs added nothing
+``diversity="sign"`` (``--sign-def=rnd``: random default signs; the default,
+``"auto"``, without global constraints) 0.28--0.34 (0.24--0.38); ``"label"`` (one random
+catalog label per cell preferred through clasp's domain heuristic, like the decision phases
+of ``sat``) 0.40--0.74 (0.45--0.92: a uniform label prefers the many non-empty labels);
+``"catalog"`` (``"auto"`` under global constraints; see below) prefers the labels of a
+seeded Alg. 3.1 solution (:func:`~csplab.engine.alg31.solution_hint`, as ``cpsat``'s
+hint): clasp decides them without a conflict, so the output is that solution, as diverse
+as Alg. 3.1's, and ``supports="auto"`` (default) then loads the forward supports only (exact
+with exactly-one per cell; their weaker propagation is never used; random labels when
+Alg. 3.1 fails, on both directions); ``"none"`` 0: the seed alone does not change clingo's
+first answer set. ``--rand-freq=0.05`` on top of random signs added nothing
 (0.27--0.38), so it is not offered. For comparison, Alg. 3.1 0.19--0.21 (0.12), ``sat``
 0.49--0.51 (0.44). At 40×40×10 ``"sign"`` gives 0.23--0.50 (0.19--0.37).
 
 Global constraints
 ------------------
 :class:`AspContext` adds the problem's global constraints to the ground program: label
-sets and other clauses as integrity constraints, a count as clasp's cardinality rules
+sets and other clauses as integrity constraints ("the label is in the set" defined by one
+rule, :meth:`AspContext.define_set`), a count as clasp's cardinality rules
 (``:- hi+1 {y}.``, ``:- not lo {y}.``), a connected set as reachability from a fixed root
 (:meth:`AspContext.reach`), so answer sets and constrained solutions still correspond one
 to one (tested against brute force). The label atoms are decided first (domain heuristic
@@ -109,7 +116,30 @@ of search (each one closes a loop of reachability atoms over thousands of cells,
 a count over 16,000 cells); ordering the decisions outward from a random seed cell, with
 the root first in that order and the cells next to the set preferred into it (domain
 heuristics), gave 339--559 conflicts in 30 s and no answer either. Connectivity alone
-is solved there (1,572 conflicts; a set of about 0.1 % of the cells).
+is solved there (1,572 conflicts; a set of about 0.1 % of the cells). Hence
+``diversity="auto"``: under global constraints the search starts from a seeded Alg. 3.1
+solution (``"catalog"``), found by min-entropy runs that grow the one large object.
+
+Where the time goes on City 40×40×10 with the constraints (clingo on the written program,
+CPU seconds, a shared 2-core machine at load 2.5; parsing is clingo's ``load`` of the aspif,
+preparing its clause set-up in ``solve``): with both directions of supports and a clause
+per label defining "in the set" (3.65 M rules) parsing 3.9--4.1 s, preparing 3.2--3.5 s,
+search 0.2 s (0 conflicts); the reference without constraints (2.64 M rules) 2.7 s and
+2.3 s; in Python encoding 0.13 s, Alg. 3.1 0.85 s, the constraints' rules 0.46--0.57 s,
+writing 0.35 s (overlapped with parsing). ``perf`` puts 70 % of parsing in clingo's hash
+tables (about 1 µs a rule, whatever the order of the rules). None of ``--eq=0``,
+``--sat-prepro=no``, ``--no-init-moms``, ``--configuration=frumpy`` changed the total by
+more than noise (7.4--7.9 s); ``trendy`` and ``jumpy`` doubled preparing. What cut it:
+forward supports only (parsing 1.8 s, preparing 1.8 s; 2.37 M rules) and "in the set" as
+one rule over the cell's labels outside the set (:meth:`AspContext.define_set`; 1.92 M
+rules): parent and child CPU together 5.5 s against 6.9--7.1 s for the reference. The
+pipes at 128×128 pay for the start instead: an Alg. 3.1 run there takes about 2 s and the
+min-entropy runs fail about half of the time (random signs alone solve it with 0 conflicts).
+Finding the Alg. 3.1 solution in a thread while the program streams was tried and left
+out: at load 3.4--4.6 it won on City in one series (9.2 and 7.6 s against 9.8 and 10.0 s)
+and not in the next (6.7 and 10.6 s against 7.8 and 10.3 s), and Alg. 3.1, sharing the
+interpreter lock with the writer, twice overran its quarter of the 35 s limit on the pipes
+(14.3 and 16.0 s in all).
 
 Status ``unsat`` comes with a proof: clingo's exhaustive search (no answer set), or an
 arc-consistency wipe-out before encoding (Theorem 3.3.2). When arc consistency leaves one
@@ -393,6 +423,24 @@ class AspContext(ClauseContext):
         x = self.new_var()
         self.defined.append(x)
         return x
+
+    def define_set(self, cell: int, mask: NDArray[np.bool_], lits: list[int]) -> Any:
+        """The literal "the label of ``cell`` is in ``mask``" as ``y :- not c1, ..., not cm``
+        over the cell's atoms outside ``mask``: the choice rule gives the cell exactly one label, so
+        none of those is one of ``lits``. One rule where a clause per label defines it
+        otherwise (City 40x40x10: 2 atoms outside the set of non-background labels, about
+        26 in it); the literal ``not c1`` itself when ``m = 1``."""
+        enc = getattr(self.lit, "__self__", None)
+        var = getattr(enc, "var", None)
+        if not isinstance(var, np.ndarray):
+            return super().define_set(cell, mask, lits)
+        out = var[cell][~mask]
+        out = out[out > 0]
+        if out.size <= 1:  # every label of the cell is in mask, or all but one
+            return True if out.size == 0 else -int(out[0])
+        y = self._atom()
+        self.rules.append(f"1 0 1 {y} 0 {out.size} " + " ".join(map(str, (-out).tolist())))
+        return y
 
     def card(self, lits: Any, lo: int, hi: int | None) -> None:
         """``lo <= (number of true lits) <= hi`` as cardinality rules (clasp propagates
@@ -704,19 +752,23 @@ class AspSolver(Solver):
         'support (`encoding="direct"`: per forbidden pair) on the arc-consistent catalog; '
         'ground by csplab and streamed as aspif (`grounding="gringo"` grounds the '
         "first-order program); clingo runs in a child process, so `time_limit` also stops "
-        "parsing; diverse outputs from `--seed` and random signs"
+        "parsing; diverse outputs from `--seed` and random signs, or under global "
+        "constraints from a seeded Alg. 3.1 solution (then forward supports only)"
     )
     options = (
         Option("encoding", str, "support", "integrity constraints per (arc, label) support "
                "or per forbidden pair", values=("support", "direct")),
-        Option("supports", str, "both", "support constraints in both arc directions or "
-               "forward only", values=("both", "forward")),
+        Option("supports", str, "auto", "support constraints in both arc directions, "
+               "forward only (half; exact with exactly-one), or auto (forward when the "
+               "search starts from a whole catalog solution, else both)",
+               values=("auto", "both", "forward")),
         Option("grounding", str, "csplab", "ground program written by csplab (aspif) or "
                "grounded by gringo from facts", values=("csplab", "gringo")),
-        Option("diversity", str, "sign", "how seeds vary the output: random default signs, "
+        Option("diversity", str, "auto", "how seeds vary the output: random default signs, "
                "a random preferred label per cell, a seeded Alg. 3.1 solution as the "
-               "preferred labels (catalog; random labels when it fails), or the seed alone",
-               values=("sign", "label", "catalog", "none")),
+               "preferred labels (catalog; random labels when it fails), the seed alone, or "
+               "auto (catalog when the problem has global constraints, else sign)",
+               values=("auto", "sign", "label", "catalog", "none")),
         TIME_LIMIT,
     )  # fmt: skip
 
@@ -727,6 +779,14 @@ class AspSolver(Solver):
         clingo = require("clingo", "asp", "solver 'asp'")
         t0, deadline, rng = call.t0, call.deadline, call.rng
         cseed = int(rng.integers(2**31 - 1))
+        if diversity == "auto":  # City 40x40x10 with its constraints needs the catalog start
+            diversity = "catalog" if problem.constraints else "sign"
+        whole, hint_s = None, 0.0  # a seeded Alg. 3.1 solution, as cpsat's hint
+        if diversity == "catalog":
+            whole = solution_hint(problem, rng, call.remaining())
+            hint_s = time.perf_counter() - t0
+        if supports == "auto":  # from a whole solution clasp does not search: forward suffices
+            supports = "forward" if whole is not None else "both"
         empty = np.full(problem.shape, -1, dtype=np.int32)
         stats: dict[str, Any] = {
             "encoding": encoding,
@@ -743,7 +803,7 @@ class AspSolver(Solver):
         except DeadlineExceeded:
             return done("timeout")
         t_enc = time.perf_counter()
-        stats["encode_s"] = t_enc - t0
+        stats["encode_s"] = t_enc - t0 - hint_s
         if not enc.ok:
             stats["proof"] = "arc-consistency wipe-out before encoding (Theorem 3.3.2)"
             stats["fail_cell"] = list(problem.coords(enc.wiped))
@@ -763,10 +823,10 @@ class AspSolver(Solver):
         args = ["--models=1", f"--seed={cseed}"]
         if diversity == "sign":
             args.append("--sign-def=rnd")
-        prefer = None
-        if diversity == "catalog":  # a seeded Alg. 3.1 solution, as cpsat's hint
-            prefer = solution_hint(problem, rng, call.remaining())
+        prefer = whole
+        if diversity == "catalog":
             stats["hint"] = "catalog solution" if prefer is not None else "random labels"
+            stats["hint_s"] = hint_s
         if diversity == "label" or (diversity == "catalog" and prefer is None):
             prefer = preferred_labels(enc.catalog, None, rng)
         if prefer is not None or problem.constraints:  # preferred labels, label atoms first

@@ -291,7 +291,7 @@ STATS: dict[str, str] = {
     "hint": "where the solver started: a seeded Alg. 3.1 solution (catalog solution; cpsat's "
     "hint, sat's choice=catalog phases, asp's diversity=catalog labels) or, when it fails, "
     "random or uniform labels",
-    "hint_s": "seconds spent finding the hint (Alg. 3.1 runs)",
+    "hint_s": "seconds spent finding the hint, a seeded Alg. 3.1 solution",
     "probe_conflicts": "conflicts of sat's short attempt from uniform phases before the "
     "hint (choice=auto under global constraints)",
     "sat": "figures of the SAT oracle used (a dict with these names)",

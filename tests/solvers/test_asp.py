@@ -139,12 +139,12 @@ def test_answer_sets_are_exactly_the_solutions(grounding, encoding, supports, P)
     assert n == count(P)
 
 
-def _answer_grids(P: Problem) -> list[bytes]:
+def _answer_grids(P: Problem, supports: str = "both") -> list[bytes]:
     """The grids of every answer set of the solver's ground program for ``P`` (with its
     global constraints), one entry per answer set."""
     import clingo
 
-    enc = encode(P)
+    enc = encode(P, supports=supports)
     ctl = clingo.Control(["--models=0"], logger=lambda *_: None)
     with tempfile.NamedTemporaryFile(suffix=".aspif", delete=False) as f:
         f.write(b"".join(ground_program(enc, None, AspContext.of(P, enc))))
@@ -175,6 +175,10 @@ def _constrained():
     yield "count", base.with_constraints([Count([1], min=2, max=3)])
     yield "count at least", base.with_constraints([Count([0], min=7)])
     yield "connected + count", base.with_constraints([Connected([0]), Count([0], min=9, max=10)])
+    # two of four labels: "in the set" is defined by the two labels outside it
+    G = from_example(ExampleModel([[0, 1, 2, 3], [1, 3, 0, 2], [3, 2, 1, 0], [0, 0, 3, 1]]),
+                     (3, 4))  # fmt: skip
+    yield "two of four labels", G.with_constraints([Connected([0, 1]), Count([0, 1], min=4, max=6)])
     # ports: 1 opens its x faces, 2 its y faces; most grids put two of them side by side
     # with a closed face between them (486 of 512), 2 are one network
     F = ExampleModel([[0, 1, 2, 0], [1, 2, 0, 1], [2, 0, 1, 2], [0, 2, 1, 0], [1, 1, 2, 2],
@@ -196,16 +200,18 @@ def _constrained():
     )
 
 
+@pytest.mark.parametrize("supports", ["both", "forward"])
 @pytest.mark.parametrize(("what", "P"), list(_constrained()), ids=[w for w, _ in _constrained()])
-def test_answer_sets_with_global_constraints_are_exactly_the_solutions(what, P):
+def test_answer_sets_with_global_constraints_are_exactly_the_solutions(what, P, supports):
     """One answer set per solution of the constrained problem, and no other: reachability
     from a fixed root admits no grid of two components (nor one grid twice, as a chosen
-    root would), the cardinality rules no wrong count."""
+    root would), the cardinality rules no wrong count. With forward supports too (the
+    default program under global constraints, where the search starts from a solution)."""
     from csplab.engine.sat import enumerate_solutions
 
     sols = {g.astype(np.int32).tobytes() for g in enumerate_solutions(P.without_constraints())
             if not P.violations(g)}  # fmt: skip
-    got = _answer_grids(P)
+    got = _answer_grids(P, supports)
     assert len(got) == len(set(got)), what
     assert set(got) == sols, what
     assert 0 < len(sols) < sum(1 for _ in enumerate_solutions(P.without_constraints()))
@@ -329,6 +335,53 @@ def test_same_seed_same_grid_different_seeds_differ():
     assert np.array_equal(d.grid, e.grid)
     f, g = (solve(P, "asp", rng=s, diversity="label") for s in (7, 8))
     assert np.mean(f.grid != g.grid) > 0.05
+
+
+def test_global_constraints_start_from_a_catalog_solution_by_default():
+    """``diversity="auto"``: under global constraints the search starts from a seeded
+    Alg. 3.1 solution (City 40x40x10 with its constraints times out without it) and loads
+    the forward supports only; clasp confirms that solution, so it is the output. Without
+    global constraints the default stays random signs on both directions."""
+    from csplab.engine.alg31 import solution_hint
+    from csplab.testing.synthetic import connected_city
+
+    _, P = connected_city((8, 8, 4))
+    r = solve(P, "asp", rng=4)
+    assert r.ok and not P.violations(r.grid)
+    s = r.stats
+    assert (s["diversity"], s["hint"], s["supports"]) == ("catalog", "catalog solution", "forward")
+    assert s["conflicts"] == 0 and "--sign-def=rnd" not in s["solver_stats"]["args"]
+    rng = np.random.default_rng(4)
+    rng.integers(2**31 - 1)  # clingo's seed comes first
+    assert np.array_equal(r.grid.reshape(-1), solution_hint(P, rng))
+    q = solve(P.without_constraints(), "asp", rng=4).stats
+    assert (q["diversity"], q["supports"]) == ("sign", "both") and "hint" not in q
+    assert "--sign-def=rnd" in q["solver_stats"]["args"]
+    # the defaults stay overridable
+    o = solve(P, "asp", rng=4, diversity="label", supports="both").stats
+    assert (o["diversity"], o["supports"]) == ("label", "both") and "hint" not in o
+
+
+def test_a_failed_hint_loads_both_directions(monkeypatch):
+    """When Alg. 3.1 finds no solution, the search starts from random preferred labels on
+    both directions of supports (forward only propagates too weakly to search); an error
+    in it is raised."""
+    import csplab.solvers.asp as asp
+    from csplab.testing.synthetic import connected_city
+
+    _, P = connected_city((6, 6, 4))
+    monkeypatch.setattr(asp, "solution_hint", lambda *a: None)
+    r = solve(P, "asp", rng=2)
+    assert r.ok and not P.violations(r.grid)
+    assert (r.stats["hint"], r.stats["supports"]) == ("random labels", "both")
+    assert solve(P, "asp", rng=2, supports="forward").stats["supports"] == "forward"
+
+    def broken(*a):
+        raise CsplabError("no hint today")
+
+    monkeypatch.setattr(asp, "solution_hint", broken)
+    with pytest.raises(CsplabError, match="no hint today"):
+        solve(P, "asp", rng=2)
 
 
 def test_seed_is_drawn_from_rng_only():
