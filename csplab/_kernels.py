@@ -583,21 +583,29 @@ def _propagate_w(
         stats[0] += 1
         isfull = True
         known = False
-        nd = 0
-        nr = 0
+        some = False
         for w in range(W):
             if dom[u, w] != full[w]:
                 isfull = False
             if prev[u, w]:
                 known = True
-            nd += popcount64(dom[u, w])
             rem[w] = prev[u, w] & ~dom[u, w]
-            nr += popcount64(rem[w])
-        if known and nr == 0:
+            if rem[w]:
+                some = True
+        if known and not some:
             continue  # nothing changed since u was last processed
         # the delta re-checks the labels the removed ones supported, the table ORs one row
-        # per slice (K=69 with 8-label slices: Alg. 3.1 3% faster without the delta)
-        use_delta = known and nr < nd and (J == 0 or 16 * nr <= J)
+        # per slice (K=69 with 8-label slices: Alg. 3.1 3% faster without the delta); the
+        # labels are counted only where the delta can be chosen (0.97 of the time on the
+        # sample: with a table of fewer than 16 slices, 16 * nr > J once u lost a label)
+        use_delta = False
+        if known and (J == 0 or J >= 16):
+            nd = 0
+            nr = 0
+            for w in range(W):
+                nd += popcount64(dom[u, w])
+                nr += popcount64(rem[w])
+            use_delta = nr < nd and (J == 0 or 16 * nr <= J)
         for w in range(W):
             prev[u, w] = dom[u, w]
         tabled = J > 0 and not use_delta and not isfull
