@@ -26,11 +26,12 @@ the first solve (loading the compiled kernels), and per output the compiled Alg.
 against everything around it (``solve``'s Python: rng, arrays, result), from a profile of
 ``--split-runs`` seeded runs at 48x48. The machine's load average is printed with it.
 
-Measured (``results/overlapping.md``, a shared 2-core machine at load average 6, CPU time
-per valid output): 48x48 3.66 ms after the kernel changes of issue 29 round three (4.57 ms
-before, in the run just before), so Rooms 4.10x and Knot 3.80x meet while City (<= 2.80 ms)
-is missed by 0.86 ms (1.53x fast-wfc); 200x200 87.1 ms (112.6 before), 10.3x. An idle run
-before those changes gave 4.33 ms at 48x48.
+Measured (``results/overlapping.md``, a shared 2-core machine, CPU time per valid output):
+48x48 3.66 ms after the kernel changes of issue 29 round three (4.57 ms before, load average
+6); after round four (a two-word propagation loop compiled with its word count constant,
+no reference counting in Alg. 3.1's step loop) 2.59-2.68 ms against 3.43-3.51 ms for the
+commit before, interleaved runs at load average 2.7-3.8: City (<= 2.80 ms) meets with
+2.09-2.16x, Rooms 5.60-5.78x, Knot 5.19-5.36x; 200x200 60.4-61.3 ms (77.8-83.4 before).
 
 Usage::
 
