@@ -185,9 +185,12 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
     return opts
 
 
-def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> dict[str, Any]:
+def _settings(
+    args: argparse.Namespace, example: Any, opts: dict[str, Any], problem: Problem | None = None
+) -> dict[str, Any]:
     """Fill the order and choice the model's format suits (when the user named none and
-    the solver takes them); return the effective settings and where they came from."""
+    the solver takes them); return the effective settings and where they came from (with
+    ``problem``, the order ``auto`` stands for, :func:`csplab.engine.alg31.auto_order`)."""
     from csplab.io.registry import synthesis_defaults
     from csplab.solvers import solver_class
 
@@ -208,6 +211,12 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
         else:
             origin = "solver default" if suggested else sources.get("*", "solver default")
             settings[key] = f"{o.default} ({origin})"
+        if key == "order" and opts.get(key, o.default) == "auto" and problem is not None:
+            from csplab.engine.alg31 import auto_order
+
+            why = "global constraints" if problem.constraints else "no global constraints"
+            origin = settings[key].removeprefix("auto (").removesuffix(")")
+            settings[key] = f"{auto_order(problem)} (auto: {why}; {origin})"
     settings["restarts"] = 0 if cls.complete else args.restarts
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
@@ -311,7 +320,7 @@ def run(args: argparse.Namespace) -> int:
         problem: Problem | None = problem_from_args(args, example)
     else:
         problem = None
-    settings = _settings(args, example, opts)
+    settings = _settings(args, example, opts, problem)
     if args.out:  # an input, a folder, an unwritable place: refused before the work
         check_output_path(args.out, "--out", inputs=input_files(args))
     out_format = output_format(args.out) if args.out else None  # bad extension: fail early
