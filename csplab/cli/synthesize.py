@@ -201,13 +201,14 @@ def _settings(
         o = cls.option(key)
         if o is None:
             continue
+        value = suggested.get(key)
         if key in opts:
             settings[key] = f"{opts[key]} (given)"
-            continue
-        value = suggested.get(key)
-        if value is not None and (o.values is None or value in o.values):
+        elif value is not None and (o.values is None or value in o.values):
             opts[key] = value
             settings[key] = f"{value} ({sources[key]})"
+        elif o.default == "auto":  # catalog's order: by the problem's constraints, below
+            settings[key] = "auto (solver default)"
         else:
             origin = "solver default" if suggested else sources.get("*", "solver default")
             settings[key] = f"{o.default} ({origin})"

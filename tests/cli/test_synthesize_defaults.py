@@ -51,7 +51,8 @@ def test_settings_follow_the_input(capsys):
                         "1", "--order", "scanline", "--json")  # fmt: skip
     assert json.loads(out)["settings"]["order"] == "scanline (given)"
     code, out, _ = _run(capsys, "synthesize", "line", "--size", "6x4", "--seed", "1")
-    assert "order=scanline (auto: no global constraints; the thesis defaults)" in out
+    assert "order=scanline (auto: no global constraints; solver default)" in out
+    assert "choice=uniform (the thesis defaults)" in out
     # backtrack's order vocabulary has no min-entropy: its own default stays
     code, out, _ = _run(capsys, "synthesize", DATA / "pipes.xml", "--size", "8x8", "--seed",
                         "1", "--solver", "backtrack", "--json")  # fmt: skip
@@ -73,10 +74,13 @@ def test_catalog_default_order_under_global_constraints(capsys, tmp_path):
     code, out, _ = _run(capsys, *argv)
     d = json.loads(out)
     assert code == 0 and d["status"] == "solved" and d["stats"]["order"] == "min-entropy"
-    assert d["settings"]["order"] == "min-entropy (auto: global constraints; the thesis defaults)"
+    assert d["settings"]["order"] == "min-entropy (auto: global constraints; solver default)"
     code, out, _ = _run(capsys, *argv, "--order", "scanline")
     d = json.loads(out)
     assert code == 1 and d["status"] == "failed" and d["settings"]["order"] == "scanline (given)"
+    code, out, _ = _run(capsys, *argv, "--order", "auto")
+    d = json.loads(out)
+    assert d["settings"]["order"] == "min-entropy (auto: global constraints; given)"
 
 
 def test_a_files_own_heuristic_wins():
