@@ -36,6 +36,7 @@ from csplab.cli.common import (
     key_values,
     model_from_args,
     not_written,
+    order_setting,
     outcome,
     problem_from_args,
 )
@@ -61,7 +62,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--order",
         help=f"cell order: {', '.join(option_values('order'))} (scan:AXES e.g. scan:yx, x "
-        f"fastest: the thesis' 2D figures); for {', '.join(solvers_taking('order'))}",
+        f"fastest: the thesis' 2D figures; auto, catalog's default: scanline without global "
+        f"constraints, min-entropy under them); for {', '.join(solvers_taking('order'))}",
     )
     p.add_argument(
         "--choice",
@@ -212,12 +214,8 @@ def _settings(
         else:
             origin = "solver default" if suggested else sources.get("*", "solver default")
             settings[key] = f"{o.default} ({origin})"
-        if key == "order" and opts.get(key, o.default) == "auto" and problem is not None:
-            from csplab.engine.alg31 import auto_order
-
-            why = "global constraints" if problem.constraints else "no global constraints"
-            origin = settings[key].removeprefix("auto (").removesuffix(")")
-            settings[key] = f"{auto_order(problem)} (auto: {why}; {origin})"
+        if key == "order" and problem is not None:
+            settings[key] = order_setting(settings[key], problem)
     settings["restarts"] = 0 if cls.complete else args.restarts
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
