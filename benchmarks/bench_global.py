@@ -13,10 +13,11 @@ limit; the output is re-checked by :meth:`~csplab.problem.Problem.violations`. B
 figure: the same solver on the same problem without the global constraints, in the same
 process (the reference: the machine's load inflates both alike), and the load average.
 
-``catalog`` runs with ``restarts=50`` in the order given per case (``--catalog-order``,
-default: ``min-entropy`` for city, whose one object of at least 800 cells grows best from
-where it started, ``scanline`` for pipes); a refuted choice is withdrawn and the cell
-chooses again (:func:`csplab.engine.alg31.run_alg31`).
+``catalog`` runs with its defaults and ``restarts=50``: its default ``order="auto"`` is
+min-entropy under global constraints (:func:`csplab.engine.alg31.auto_order`; city's one
+object of at least 800 cells grows from where it started), scanline on the references
+without them; a refuted choice is withdrawn and the cell chooses again
+(:func:`csplab.engine.alg31.run_alg31`). ``--catalog-order`` gives it another order.
 
 ``sat+catalog`` and ``asp+catalog`` are ``sat`` with ``choice="catalog"`` and ``asp`` with
 ``diversity="catalog"``: each starts from a seeded Alg. 3.1 solution
@@ -52,10 +53,22 @@ conflicts, and a timeout after 8,365 in another run), sat+catalog 5.54 s (0 conf
 before: timeout after 6,601 conflicts, 5.65 s after 1,102 in another run: the labels as
 phases left the count's auxiliary variables to the search), catalog 1.28 s; pipes: sat 1.91 s
 (uniform phases, 53 conflicts; before 2.69 s), sat+catalog 6.70 s (before 10.66 s), catalog
-2.89 s; every output valid. ``catalog`` with its own defaults (scanline, no restarts, the
-API's) fails on city for seeds 1-3 (1.1-1.2 CPU s each; ``restarts=10``: 1 of 3 solved in
-35 s, load average 5) and solves pipes (2.2 CPU s); this script gives it ``restarts=50`` and
-min-entropy order on city.
+2.89 s; every output valid. The ``catalog`` figures above are min-entropy order on city and
+scanline on pipes, given per case: scanline order fails on city for seeds 1-3 (1.1-1.2 CPU s
+each; ``restarts=10``: 1 of 3 solved in 35 s, load average 5).
+
+``catalog``'s default ``order="auto"`` (``--solvers catalog --time-limit 35``, load average
+5.0-5.1; then ``--catalog-order scanline`` in the next run, load average 5.3): city solved in
+3.46 s (min-entropy, first attempt, 10 choices withdrawn; scanline: timeout after 8
+attempts), pipes in 9.13 s (min-entropy, first attempt; scanline 8.97 s); every output
+valid. With ``restarts=50`` and ``time_limit=35`` per run, seeds 1-3 in one process (load
+average 3.8-5.5), CPU seconds: city min-entropy 0.82-0.90 (first attempt each), scanline a
+timeout for seeds 1 and 2 (7 and 6 attempts) and 4 attempts (4.96 s) for seed 3; pipes
+min-entropy 2.25-2.37, scanline 2.17-2.25 (first attempt each). The command line's default
+path (``csplab synthesize city --size 40x40x10 --boundary auto --seed 1 --constraints FILE``
+with this city's constraints: catalog, 10 restarts, then sat; load average 5.0 for both):
+before, catalog gave up after 11 attempts (57.0 s) and sat finished, 64.3 s in all; with
+``order="auto"`` catalog solved on the first attempt in 3.7 s (6.9 s process wall time).
 
 Measured (2-core machine shared by other jobs, load average 9-12; ``--time-limit 60``):
 catalog meets both targets (city 3.05 s, 10 choices withdrawn; pipes 7.45 s); asp's
@@ -156,22 +169,25 @@ def pipes(size: tuple[int, ...] = (128, 128)) -> tuple[Any, Any]:
 
 CASES = {"city": (city, "city 40x40x10, connected + count"),
          "pipes": (pipes, "pipes (knot) 128x128, one network + at most 2 crossings")}  # fmt: skip
-CATALOG_ORDER = {"city": "min-entropy", "pipes": "scanline"}
 
 
 def run(
-    problem: Any, solver: str, seed: int, limit: float, order: str = "scanline"
+    problem: Any, solver: str, seed: int, limit: float, order: str | None = None
 ) -> tuple[str, float, bool, str]:
-    """Status, seconds, validity (re-checked here) and a note of the run's figures."""
+    """Status, seconds, validity (re-checked here) and a note of the run's figures
+    (``catalog``: its defaults and ``restarts=50``, or the ``order`` given)."""
     import csplab
 
-    kw: dict[str, Any] = {"restarts": 50, "order": order} if solver == "catalog" else {}
+    kw: dict[str, Any] = {"restarts": 50} if solver == "catalog" else {}
+    if solver == "catalog" and order is not None:
+        kw["order"] = order
     kw.update(VARIANT.get(solver, {}))
     t = time.perf_counter()
     r = csplab.solve(problem, solver.partition("+")[0], rng=seed, time_limit=limit, **kw)
     dt = time.perf_counter() - t
     ok = r.status == "solved" and r.grid is not None and not problem.violations(r.grid)
-    keys = ("attempts", "constraint_probes", "cuts", "conflicts", "choice", "probe_conflicts")
+    keys = ("order", "attempts", "constraint_probes", "cuts", "conflicts", "choice",
+            "probe_conflicts")
     note = ", ".join(f"{k} {r.stats[k]}" for k in keys if k in r.stats)
     return r.status, dt, ok, note
 
@@ -185,7 +201,7 @@ def main() -> None:
     ap.add_argument(
         "--catalog-order",
         default=None,
-        help="order of the catalog solver for every case (default: per case)",
+        help="order of the catalog solver for every case (default: its own, auto)",
     )
     args = ap.parse_args()
 
@@ -201,7 +217,7 @@ def main() -> None:
             if solver.partition("+")[0] not in have:
                 print(f"  {solver:11s} not installed")
                 continue
-            order = args.catalog_order or CATALOG_ORDER[case]
+            order = args.catalog_order
             run(build(small[case])[1], solver, args.seed, args.time_limit, order)  # warm: JIT
             ref = run(P, solver, args.seed, args.time_limit, order)
             st, dt, ok, note = run(Q, solver, args.seed, args.time_limit, order)
@@ -211,7 +227,7 @@ def main() -> None:
                 else f"shortfall: {dt / target:.1f}x the {target:.0f} s target"
                 if ok else f"shortfall: {st}, no valid output"
             )  # fmt: skip
-            how = f" [{order}; {note}]" if solver == "catalog" else f" [{note}]" if note else ""
+            how = f" [{note}]" if note else ""
             print(
                 f"  {solver:11s} constrained {st:8s} {dt:7.2f} s  valid={ok}{how}  "
                 f"(reference without constraints: {ref[0]} {ref[1]:.2f} s; "

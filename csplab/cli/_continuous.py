@@ -9,7 +9,14 @@ from typing import Any
 
 import numpy as np
 
-from csplab.cli.common import EXPLAINED_STATS, explain, fallback_setting, not_written, outcome
+from csplab.cli.common import (
+    EXPLAINED_STATS,
+    explain,
+    fallback_setting,
+    not_written,
+    order_setting,
+    outcome,
+)
 from csplab.continuous.model import PolygonModel
 from csplab.continuous.polyhedra import PolyhedralModel
 from csplab.continuous.user3d import UserConstraints3
@@ -171,7 +178,9 @@ def synthesize(
         o = cls.option(key)
         if o is not None:
             settings[key] = (
-                f"{opts[key]} (given)" if key in opts else f"{o.default} (the thesis defaults)"
+                f"{opts[key]} (given)" if key in opts
+                else "auto (solver default)" if o.default == "auto"
+                else f"{o.default} (the thesis defaults)"
             )
     if "choice" not in opts and cls.option("choice") is not None:
         o = cls.option("choice")
@@ -205,6 +214,8 @@ def synthesize(
     except InputError as e:  # the library names its arguments; the user typed flags
         raise InputError(as_flags(str(e))) from None
     r, csp, P = s.result, s.csp, s.csp.problem
+    if "order" in settings:  # catalog's auto: by the CSP's global constraints
+        settings["order"] = order_setting(settings["order"], P)
     wrote = None
     if fmt is not None and s.model is not None and s.ok:  # a failed run writes nothing
         # what check needs to compare the example as it was synthesized (kept by .obj and

@@ -510,6 +510,25 @@ def with_constraint_files(problem: Problem, paths: Sequence[str] | None) -> Prob
 EXPLAINED_STATS = ("proof", "fallback_from", "gave_up_s", "reason")
 
 
+def order_setting(setting: str, problem: Problem) -> str:
+    """The ``settings:`` entry of an order: ``"auto (ORIGIN)"`` names the order ``auto``
+    stands for on ``problem`` (:func:`csplab.engine.alg31.auto_order`) and why; any other
+    entry is returned as it is.
+
+    Examples
+    --------
+    >>> from csplab import from_example, load_example
+    >>> order_setting("auto (given)", from_example(load_example("line"), (4, 3)))
+    'scanline (auto: no global constraints; given)'
+    """
+    if not setting.startswith("auto ("):
+        return setting
+    from csplab.engine.alg31 import auto_order
+
+    why = "global constraints" if problem.constraints else "no global constraints"
+    return f"{auto_order(problem)} (auto: {why}; {setting.removeprefix('auto (')}"
+
+
 def fallback_setting(fallback: str) -> str:
     """The settings line's ``fallback`` entry: the solver ``--fallback`` names, and where
     it came from."""

@@ -36,6 +36,7 @@ from csplab.cli.common import (
     key_values,
     model_from_args,
     not_written,
+    order_setting,
     outcome,
     problem_from_args,
 )
@@ -61,7 +62,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--order",
         help=f"cell order: {', '.join(option_values('order'))} (scan:AXES e.g. scan:yx, x "
-        f"fastest: the thesis' 2D figures); for {', '.join(solvers_taking('order'))}",
+        f"fastest: the thesis' 2D figures; auto, catalog's default: scanline without global "
+        f"constraints, min-entropy under them); for {', '.join(solvers_taking('order'))}",
     )
     p.add_argument(
         "--choice",
@@ -185,9 +187,12 @@ def _options(args: argparse.Namespace) -> dict[str, Any]:
     return opts
 
 
-def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> dict[str, Any]:
+def _settings(
+    args: argparse.Namespace, example: Any, opts: dict[str, Any], problem: Problem | None = None
+) -> dict[str, Any]:
     """Fill the order and choice the model's format suits (when the user named none and
-    the solver takes them); return the effective settings and where they came from."""
+    the solver takes them); return the effective settings and where they came from (with
+    ``problem``, the order ``auto`` stands for, :func:`csplab.engine.alg31.auto_order`)."""
     from csplab.io.registry import synthesis_defaults
     from csplab.solvers import solver_class
 
@@ -198,16 +203,19 @@ def _settings(args: argparse.Namespace, example: Any, opts: dict[str, Any]) -> d
         o = cls.option(key)
         if o is None:
             continue
+        value = suggested.get(key)
         if key in opts:
             settings[key] = f"{opts[key]} (given)"
-            continue
-        value = suggested.get(key)
-        if value is not None and (o.values is None or value in o.values):
+        elif value is not None and (o.values is None or value in o.values):
             opts[key] = value
             settings[key] = f"{value} ({sources[key]})"
+        elif o.default == "auto":  # catalog's order: by the problem's constraints, below
+            settings[key] = "auto (solver default)"
         else:
             origin = "solver default" if suggested else sources.get("*", "solver default")
             settings[key] = f"{o.default} ({origin})"
+        if key == "order" and problem is not None:
+            settings[key] = order_setting(settings[key], problem)
     settings["restarts"] = 0 if cls.complete else args.restarts
     if not cls.complete:
         settings["fallback"] = fallback_setting(args.fallback)
@@ -311,7 +319,7 @@ def run(args: argparse.Namespace) -> int:
         problem: Problem | None = problem_from_args(args, example)
     else:
         problem = None
-    settings = _settings(args, example, opts)
+    settings = _settings(args, example, opts, problem)
     if args.out:  # an input, a folder, an unwritable place: refused before the work
         check_output_path(args.out, "--out", inputs=input_files(args))
     out_format = output_format(args.out) if args.out else None  # bad extension: fail early

@@ -13,11 +13,13 @@ Examples
 >>> r = solve(P, "catalog", rng=1, order="min-entropy")
 >>> r.status, r.stats["assigned"]
 ('solved', 48)
+>>> solve(P, "catalog", rng=1).stats["order"]     # auto: no global constraints
+'scanline'
 """
 
 from __future__ import annotations
 
-from csplab.engine.alg31 import run_alg31
+from csplab.engine.alg31 import ORDERS, run_alg31
 from csplab.problem import Problem
 from csplab.result import Result
 from csplab.solvers.base import CHOICE, TIME_LIMIT, WINDOW, Call, Solver, order_option
@@ -34,12 +36,22 @@ class CatalogSolver(Solver):
     complete = False
     description = "Merrell Alg. 3.1 with the catalog of Alg. 3.2/3.3 (arc consistency)"
     notes = (
-        "orders `scanline` (thesis loop order, default), `random`, `min-entropy` (WFC-style), "
-        "`scan:AXES`; label choice `uniform` (thesis) or `weighted`; `failed` = gave up, "
+        "orders `auto` (default: `scanline`, the thesis loop order, without global constraints, "
+        "`min-entropy` under them; the stats record the order used), `scanline`, `random`, "
+        "`min-entropy` (WFC-style), `min-domain`, `scan:AXES`; label choice `uniform` "
+        "(thesis) or `weighted`; `failed` = gave up, "
         "`unsat` only when arc consistency wipes out before any choice; with global "
         "constraints a refuted choice is withdrawn and the cell chooses again"
     )
-    options = (order_option(), CHOICE, WINDOW, TIME_LIMIT)
+    options = (
+        order_option(
+            ("auto", *ORDERS), "auto",
+            "cell order: auto (scanline without global constraints, min-entropy under them), "
+            "scanline (thesis), random, min-entropy (WFC), min-domain (WFC's MRV), scan:AXES "
+            "(scan:yx)",
+        ),
+        CHOICE, WINDOW, TIME_LIMIT,
+    )  # fmt: skip
 
     def run(self, problem: Problem, call: Call) -> Result:
         order, choice, window = call.get("order", "choice", "window")

@@ -264,6 +264,8 @@ def create_app(
             o = alg31.option(key)
             if v not in (None, "") and o is not None:
                 opts[key] = o.check(str(v), "catalog")
+            if opts.get(key) == "auto":  # the catalog solver's, by its problem's constraints
+                raise InputError("a world's order is one of the Alg. 3.1 orders, not auto")
         seed = _int(body, "seed", 0, 0, 2**62)
 
         def build() -> WorldSession:

@@ -51,12 +51,36 @@ def test_settings_follow_the_input(capsys):
                         "1", "--order", "scanline", "--json")  # fmt: skip
     assert json.loads(out)["settings"]["order"] == "scanline (given)"
     code, out, _ = _run(capsys, "synthesize", "line", "--size", "6x4", "--seed", "1")
-    assert "order=scanline (the thesis defaults)" in out
+    assert "order=scanline (auto: no global constraints; solver default)" in out
+    assert "choice=uniform (the thesis defaults)" in out
     # backtrack's order vocabulary has no min-entropy: its own default stays
     code, out, _ = _run(capsys, "synthesize", DATA / "pipes.xml", "--size", "8x8", "--seed",
                         "1", "--solver", "backtrack", "--json")  # fmt: skip
     s = json.loads(out)["settings"]
     assert s["order"] == "min-domain (solver default)" and s["choice"] == "weighted (wfc defaults)"
+
+
+def test_catalog_default_order_under_global_constraints(capsys, tmp_path):
+    """``catalog``'s ``order=auto`` under a constraints file: the settings and the stats
+    name the order it stands for (min-entropy), and one run without restarts solves a
+    connected City for a seed on which scanline order fails (the order decided it)."""
+    from csplab.constraints import constraints_json
+    from csplab.testing.synthetic import connected_city
+
+    c = tmp_path / "c.json"
+    c.write_text(json.dumps(constraints_json(connected_city((12, 12, 6))[1])))
+    argv = ["synthesize", "city", "--size", "12x12x6", "--boundary", "auto", "--seed", "1",
+            "--constraints", c, "--restarts", "0", "--fallback", "none", "--json"]  # fmt: skip
+    code, out, _ = _run(capsys, *argv)
+    d = json.loads(out)
+    assert code == 0 and d["status"] == "solved" and d["stats"]["order"] == "min-entropy"
+    assert d["settings"]["order"] == "min-entropy (auto: global constraints; solver default)"
+    code, out, _ = _run(capsys, *argv, "--order", "scanline")
+    d = json.loads(out)
+    assert code == 1 and d["status"] == "failed" and d["settings"]["order"] == "scanline (given)"
+    code, out, _ = _run(capsys, *argv, "--order", "auto")
+    d = json.loads(out)
+    assert d["settings"]["order"] == "min-entropy (auto: global constraints; given)"
 
 
 def test_a_files_own_heuristic_wins():

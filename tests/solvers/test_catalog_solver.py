@@ -158,3 +158,28 @@ def test_scan_axis_orders():
         scan_order((2, 2), "scan:xx")
     with pytest.raises(InputError):
         scan_order((2, 2, 2), "scan:yx")
+
+
+def test_default_order_auto_is_scanline_without_global_constraints():
+    """``order="auto"`` (the default) runs the thesis' scanline order on a problem without
+    global constraints: the same grid and trace as ``order="scanline"``, recorded so."""
+    P = from_example(load_example("city"), (10, 10, 6), boundary="auto")
+    for seed in range(4):
+        a, b = solve(P, "catalog", rng=seed), solve(P, "catalog", rng=seed, order="scanline")
+        assert a.status == b.status and a.stats["order"] == "scanline"
+        assert np.array_equal(a.grid, b.grid) and np.array_equal(a.trace, b.trace)
+
+
+def test_default_order_auto_is_min_entropy_under_global_constraints():
+    """On a small connected City (one object of at least 5 % of the cells) scanline
+    Alg. 3.1 fails for seeds 1-5 and min-entropy solves them: the default resolves ``auto``
+    to min-entropy (recorded in the stats), and each output is a solution."""
+    from csplab.testing.synthetic import connected_city
+
+    Q = connected_city((12, 12, 6))[1]
+    for seed in range(1, 6):
+        assert solve(Q, "catalog", rng=seed, order="scanline").status == "failed"
+        r = solve(Q, "catalog", rng=seed)
+        assert r.status == "solved" and r.stats["order"] == "min-entropy"
+        assert len(Q.violations(r.grid)) == 0
+        assert np.array_equal(r.grid, solve(Q, "catalog", rng=seed, order="min-entropy").grid)

@@ -71,6 +71,14 @@ def test_meta_form_comes_from_the_solver_declarations(client: TestClient) -> Non
     assert ".npy" in m["formats"] and ".png" in m["formats"]
 
 
+def test_a_world_takes_the_alg31_orders_not_catalogs_auto(client: TestClient) -> None:
+    """The world form offers the catalog solver's orders; ``auto`` (catalog's default, by
+    a whole problem's global constraints) is refused in one line, the others accepted."""
+    assert _world(client, order="min-entropy")["order"] == "min-entropy"
+    r = client.post("/api/world", json={"model": "loops", "chunk": "16x16", "order": "auto"})
+    assert r.status_code == 400 and "not auto" in r.json()["error"]
+
+
 def test_chunk_pictures_are_world_chunks_cell_by_cell(client: TestClient) -> None:
     w = _world(client)
     ref = World("loops", seed=5, chunk=(16, 16))

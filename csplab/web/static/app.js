@@ -74,9 +74,12 @@ async function init() {
   fill($("solver"), solvers.map((s) => [s.name, `${s.name}${s.complete ? "" : " (incomplete)"}`]), "catalog");
   const setSolver = () => { const s = solvers.find((x) => x.name === $("solver").value); optionInputs($("solver-options"), s.options, "opt-"); };
   $("solver").onchange = setSolver; setSolver();
-  // a world's blocks run Alg. 3.1: the catalog solver's declared order and choice
+  // a world's blocks run Alg. 3.1: the catalog solver's declared order and choice; not the
+  // solver's order auto (it looks at a whole problem's global constraints): scanline
   const alg31 = solvers.find((s) => s.name === "catalog");
-  optionInputs($("world-options"), alg31.options.filter((o) => o.name === "order" || o.name === "choice"), "world-");
+  const worldOption = (o) => o.name !== "order" ? o
+    : { ...o, default: "scanline", values: o.values.filter((v) => v !== "auto") };
+  optionInputs($("world-options"), alg31.options.filter((o) => o.name === "order" || o.name === "choice").map(worldOption), "world-");
   fill($("brush"), S.meta.brushes.map((b) => [b, { label: "must be label", empty: "must stay empty", reroll: "re-synthesize" }[b] || b]));
   fill($("world-format"), S.meta.formats, ".png");
   fill($("run-format"), S.meta.formats, ".png");
