@@ -497,6 +497,45 @@ def test_configuration_defects(small_cert, checker_path):
     assert not ok and "positions of a point" in msg, msg
 
 
+def test_configurations_without_face_flags(small_cert, checker_path):
+    # without at_lower / at_upper (no face rules), a frame edge is on the face exactly
+    # where the region is clipped there; a flag that says otherwise is a wrong position
+    bare = copy.deepcopy(small_cert)
+    for conf in bare["configs"]:
+        conf.pop("at_lower", None)
+        conf.pop("at_upper", None)
+    ok, msg = check_certificate(bare)
+    assert ok, msg
+    bad = copy.deepcopy(small_cert)
+    conf = next(c for c in bad["configs"] if not all(c["at_lower"]))
+    conf["at_lower"] = [True] * len(conf["lower"])  # an edge the region reaches past
+    ok, msg = check_certificate(bad)
+    assert not ok and "positions of a point" in msg, msg
+
+
+def test_dead_labels_in_use_at_some_places(dead_cert, checker_path):
+    # one place's dead labels left out: those labels are in use again (dead everywhere
+    # else), so the cells that may lie elsewhere lose them from their domains -- which the
+    # states need (a check that ignored dead labels in use rejects this certificate)
+    cert = copy.deepcopy(dead_cert)
+    del cert["dead"]["stages"][0][1][0]
+    ok, msg = check_certificate(cert)
+    assert ok, msg
+
+
+def test_dead_stage_places_checked(dead_cert, checker_path):
+    # a stage's place must lie off its face and within the cap -- also for an entry whose
+    # labels an earlier entry already had
+    face, got = dead_cert["dead"]["stages"][0]
+    d, side = "xyzw".index(face[0]), "-+".index(face[1])
+    k = next(k for k in range(1, len(got)) if got[k][1] == got[0][1])
+    for value in (0, dead_cert["dead"]["cap"] + 1):
+        bad = copy.deepcopy(dead_cert)
+        bad["dead"]["stages"][0][1][k][0][d][side] = value
+        ok, msg = check_certificate(bad)
+        assert not ok and "is not a place off" in msg, (value, msg)
+
+
 def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
     import csplab.certcheck as cc
     from csplab.errors import MemoryLimitError
@@ -507,12 +546,16 @@ def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
         check_certificate(small_cert)
 
 
-def test_both_paths_agree_on_every_rule_removed(monkeypatch):
-    # fig3_16 with 4x2 regions: points with cells after them in their region, where the
-    # catalog needs arc consistency; each pair of the rules removed in turn (the hash
+@pytest.mark.parametrize(("region", "order", "back", "history"),
+                         [("4x2", "scan:yx", 1, 1), ("3x3", "scanline", (1, 2), 0)])  # fmt: skip
+def test_both_paths_agree_on_every_rule_removed(region, order, back, history, monkeypatch):
+    # fig3_16 with 4x2 regions (scan:yx) or 3x3 regions reaching back 1x2 and no history
+    # (scanline, as decide proves it): points with cells after them in their region, where
+    # the catalog needs arc consistency (the latter has rules whose removal only the
+    # point's arc consistency sees); each pair of the rules removed in turn (the hash
     # updated), the one-state-at-a-time check and the array check give the same verdict
-    v = prove_infallible(load_model("fig3_16"), "4x2", order="scan:yx", refute=False,
-                         classes=True, certificate=True)  # fmt: skip
+    v = prove_infallible(load_model("fig3_16"), region, order=order, back=back, history=history,
+                         refute=False, classes=True, certificate=True)  # fmt: skip
     cert = json.loads(json.dumps(v.witness["certificate"]))
     verdicts = []
     for d, pairs in enumerate(cert["rules"]["pairs"]):
