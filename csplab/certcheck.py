@@ -1297,6 +1297,10 @@ def _check_lean(
     # cell elsewhere has the domain of the faces it lies on
     dead_far = set(itertools.compress(dead_at, [v & used for v in dead_at.values()]))
     face_doms: dict[int, int] = {}
+    if not plain and not dead_far:  # every cell has its faces' domain: all of them alike?
+        for on in range(1 << 2 * ndim):
+            face_doms[on] = memo.face_domain(on, used, face_rules)
+        plain = set(face_doms.values()) == {used}
     reorder = operator.itemgetter(*scan_at) if ndim > 1 else lambda t: t
 
     # every state a pair of an integer step and integer labels in use (all states at once)
@@ -1610,6 +1614,8 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
             for b in _bits(bits):
                 sup |= table[b]
             sup_of[bits] = sup
+        # (a place is added to ``known`` once checked: the labels dead at a neighbour
+        # are then read as before, known there or in this stage)
         for k, bits in stage.items():
             sup = sup_of[bits]
             head, tail = k[:d], k[d + 1 :]
@@ -1624,7 +1630,6 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
                             f"dead labels: {b} at {[list(t) for t in k]} has a support toward "
                             f"{face} that is not dead: {sorted(_bits(table[b] & ~gone))}"
                         )
-        for k, bits in stage.items():
             known[k] |= bits
     return known
 
