@@ -536,6 +536,23 @@ def test_dead_stage_places_checked(dead_cert, checker_path):
         assert not ok and "is not a place off" in msg, (value, msg)
 
 
+def test_face_domains_of_the_cells(checker_path):
+    # tiny_poms as decide proves it (2x2x2 regions, no history, labels by class): its
+    # frames' cells on a face have that face's domain, which the states need (a check
+    # that gave every cell all labels in use rejects it); with the rule that removes
+    # label 1 above the ground dropped, the states no longer close
+    v = prove_infallible(load_model(str(DATA / "tiny_poms.json")), "2", history=0,
+                         classes=True, refute=False, certificate=True)  # fmt: skip
+    cert = json.loads(json.dumps(v.witness["certificate"]))
+    ok, msg = check_certificate(cert)
+    assert ok, msg
+    bad = copy.deepcopy(cert)
+    bad["rules"]["faces"] = [f for f in bad["rules"]["faces"] if f[1] != "!z-"]
+    bad["rules_sha256"] = rules_hash(bad["rules"])
+    ok, msg = check_certificate(bad)
+    assert not ok and "not closed" in msg, msg
+
+
 def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
     import csplab.certcheck as cc
     from csplab.errors import MemoryLimitError
