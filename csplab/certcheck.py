@@ -1242,7 +1242,9 @@ def _check_lean(
     the point arc consistency runs unless the cell is the region's only one not yet
     labelled and labels are recorded by class: arcs between labelled cells are then left
     out, and the catalog is that superset itself (each neighbour's label supports every
-    label of it, and nothing else narrows it).
+    label of it, and nothing else narrows it). Configurations of one frame (they differ
+    in which of its edges lie on a face) whose cells have the same domains and whose
+    states are equal are the same check, made once.
     """
     fwd, _, used, ndim, face_rules = rules
     K = len(fwd[0])
