@@ -9,6 +9,7 @@ Check and prove times are printed (not asserted).
 from __future__ import annotations
 
 import copy
+import itertools
 import json
 import time
 import warnings
@@ -536,14 +537,20 @@ def test_dead_stage_places_checked(dead_cert, checker_path):
         assert not ok and "is not a place off" in msg, (value, msg)
 
 
-def test_face_domains_of_the_cells(checker_path):
-    # tiny_poms as decide proves it (2x2x2 regions, no history, labels by class): its
-    # frames' cells on a face have that face's domain, which the states need (a check
-    # that gave every cell all labels in use rejects it); with the rule that removes
-    # label 1 above the ground dropped, the states no longer close
+@pytest.fixture(scope="module")
+def poms_cert():
+    """tiny_poms as decide proves it: 2x2x2 regions, no history, labels by class, face
+    rules; 1,200 states in 216 configurations (checked one state at a time)."""
     v = prove_infallible(load_model(str(DATA / "tiny_poms.json")), "2", history=0,
                          classes=True, refute=False, certificate=True)  # fmt: skip
-    cert = json.loads(json.dumps(v.witness["certificate"]))
+    return json.loads(json.dumps(v.witness["certificate"]))
+
+
+def test_face_domains_of_the_cells(poms_cert, checker_path):
+    # tiny_poms' frames' cells on a face have that face's domain, which the states need
+    # (a check that gave every cell all labels in use rejects it); with the rule that
+    # removes label 1 above the ground dropped, the states no longer close
+    cert = poms_cert
     ok, msg = check_certificate(cert)
     assert ok, msg
     bad = copy.deepcopy(cert)
@@ -551,6 +558,27 @@ def test_face_domains_of_the_cells(checker_path):
     bad["rules_sha256"] = rules_hash(bad["rules"])
     ok, msg = check_certificate(bad)
     assert not ok and "not closed" in msg, msg
+
+
+def test_each_configuration_checked_with_its_own_domains(poms_cert, checker_path):
+    # two configurations of one frame differ in which of its edges lie on a face, so in
+    # their cells' domains: the states of one, given to a later one, are checked with the
+    # later one's domains (one of them, at least, must then fail)
+    groups: dict[tuple, list[int]] = {}
+    for k, c in enumerate(poms_cert["configs"]):
+        groups.setdefault((str(c["lower"]), str(c["upper"]), str(c["keys"])), []).append(k)
+    for members in groups.values():
+        for a, b in itertools.combinations(members, 2):
+            states = poms_cert["configs"][a]["states"]
+            if states == poms_cert["configs"][b]["states"]:
+                continue
+            bad = copy.deepcopy(poms_cert)
+            bad["configs"][b]["states"] = copy.deepcopy(states)
+            ok, msg = check_certificate(bad)
+            if not ok:
+                assert msg.startswith("invalid: configuration"), msg
+                return
+    raise AssertionError("every configuration takes the states of every other of its frame")
 
 
 def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
