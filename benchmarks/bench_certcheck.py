@@ -19,13 +19,18 @@ run on one thread in this process): on a loaded machine a check of a few millise
 that loses the processor for a time slice would otherwise count the wait. The wall-clock
 times and their ratio are printed beside.
 
-Measured on the shared 2-core machine (loaded: load average 4.6-7.6), the default models:
-9 of 11 within, check/find CPU 0.044 (fig3_1a), 0.055 (fig3_15), 0.062 (pipes.xml), 0.067
-(tiny_poms), 0.104 (pillar with its boundary; wall clock 9 ms for 1,000 states against a
-0.10 s decision) and 0.222 (pillar without: in CPU seconds 0.38 ms for 92 states in
-8 configurations against a 1.8 ms decision, 0.17 ms of it rebuilding the 8 frames).
-Before this branch (every certificate checked on arrays; loaded the same): 5 of 11,
-worst 0.497 (pillar), fig3_1a 0.230, fig3_15 0.213, pipes.xml 0.219.
+Measured on the shared 2-core machine (load average 2.6-3.9), the default models plus
+``fig3_5a@auto fig3_6a@auto``, this checker and the previous one (a copy) run in turn in one
+process, two rounds: 12 of 13 within both times, the default models 10 of 11: check/find
+CPU 0.043-0.046 (fig3_1a), 0.053-0.055 (fig3_15), 0.058-0.071 (pipes.xml), 0.035-0.037
+(tiny_poms), 0.070-0.071 (pillar with its boundary), 0.076-0.082 (fig3_5a@auto),
+0.081-0.085 (fig3_6a@auto) and 0.210-0.217 (pillar without: a 2 ms decision, wall, 92
+states in 8 configurations, each its own frame -- the check is per-step and per-state
+Python work, best of 200 checks 0.33 ms of CPU against 0.37 ms before). The previous
+checker, the same rounds: 9 of 13, pillar 0.223-0.239, pillar@auto 0.113-0.124,
+fig3_5a@auto 0.110-0.114, fig3_6a@auto 0.106-0.122. Before the one-state-at-a-time check
+(every certificate on arrays; loaded, load average 4.6-7.6): 5 of 11, worst 0.497
+(pillar), fig3_1a 0.230, fig3_15 0.213, pipes.xml 0.219.
 """
 
 from __future__ import annotations

@@ -93,7 +93,7 @@ import itertools
 import json
 import math
 import operator
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -272,11 +272,18 @@ def _face_rules(raw: Sequence[Any], ndim: int, rules: Mapping[str, Any]) -> list
     return out
 
 
-def _domain(face_rules: list[FaceRule], faces: set[str], used: int) -> int:
-    """The domain of a cell lying on ``faces``: the labels in use, edited by the rules."""
+# a face's bit in a set of faces: ``2d`` for the lower face of axis ``d``, ``2d + 1`` the upper
+_FACE_BIT = {a + s: 1 << 2 * d + k for d, a in enumerate(_AXES) for k, s in enumerate("-+")}
+
+
+def _domain(face_rules: list[FaceRule], on: int, used: int) -> int:
+    """The domain of a cell lying on the faces ``on`` (:data:`_FACE_BIT`): the labels in
+    use, edited by the rules."""
     dom = used
     for op, where, bits in face_rules:
-        if where != "*" and (where[1:] in faces if where[0] == "!" else where not in faces):
+        if where != "*" and (
+            on & _FACE_BIT[where[1:]] if where[0] == "!" else not on & _FACE_BIT[where]
+        ):
             continue
         if op == "keep":
             dom &= bits
@@ -340,17 +347,30 @@ def _positions(
     lows = sides([1 + b + h for b, h in zip(back, history, strict=True)],
                  [b + h for b, h in zip(back, history, strict=True)])  # fmt: skip
     highs = sides([r - 1 for r in region], [r - 2 for r in region])
+    # without at_lower / at_upper, an edge is on the face when the region is clipped there
+    near_lo = [b + h for b, h in zip(back, history, strict=True)]
+    near_hi = [r - 2 for r in region]
+    defaults: tuple[dict[Any, tuple[bool, ...]], ...] = ({}, {})
+
+    def on_face(v: tuple[Any, ...], upper: int) -> tuple[bool, ...]:
+        got = defaults[upper].get(v)
+        if got is None:
+            near = near_hi if upper else near_lo
+            got = defaults[upper][v] = tuple(t < x for t, x in zip(v, near, strict=True))
+        return got
+
     got: list[_Conf] = []
     for c in cert["configs"]:
         lo, hi = tuple(c["lower"]), tuple(c["upper"])
-        a = tuple(map(bool, c.get("at_lower", ()))) or tuple(
-            v < b + h for v, b, h in zip(lo, back, history, strict=True))
-        b = tuple(map(bool, c.get("at_upper", ()))) or tuple(
-            v < r - 2 for v, r in zip(hi, region, strict=True))
+        a = c.get("at_lower")
+        a = tuple(map(bool, a)) if a else on_face(lo, 0)
+        b = c.get("at_upper")
+        b = tuple(map(bool, b)) if b else on_face(hi, 1)
         got.append((lo, hi, a, b))
     want = len(lows) * len(highs)
     if (len(got) != want or len(set(got)) != want
-            or any((lo, a) not in lows or (hi, b) not in highs for lo, hi, a, b in got)):
+            or not {(g[0], g[2]) for g in got} <= lows
+            or not {(g[1], g[3]) for g in got} <= highs):
         raise _Invalid(f"the configurations are not the {want} positions of a point")
     return region, back, axes, got
 
@@ -717,8 +737,7 @@ class _Memo:
         """The labels in use, edited by the face rules of the faces ``on``."""
         dom = self.faces.get(on)
         if dom is None:
-            faces = {_AXES[t // 2] + "-+"[t % 2] for t in _bits(on)}
-            dom = self.faces[on] = _domain(face_rules, faces, used)
+            dom = self.faces[on] = _domain(face_rules, on, used)
         return dom
 
     def dead_in(self, key: tuple[int, ...]) -> int:
@@ -1087,114 +1106,122 @@ def _small_ac(
 _LEAN_STATES = 1000
 
 
-class _Step(NamedTuple):
-    """Step ``i`` of a frame, as :func:`_check_lean` uses it: the slot and axis of each
-    labelled backward neighbour of the step's cell in its region (``near``); the slot in
-    this step's state and the axes on which the cell is open at the next step (a bit mask)
-    of each label the next state keeps (``kept``, in the next state's order), whether the
-    next state records the label chosen here (last, ``chosen``) and that label's open axes
-    (``chosen_open``); the step's region (``box``) and the cells not yet labelled in it
-    (``free``), as bit masks over the scan ranks."""
-
-    near: list[tuple[int, int]]
-    kept: list[tuple[int, int]]
-    chosen: bool
-    chosen_open: int
-    box: int
-    free: int
-
-
 class _LeanFrame(NamedTuple):
-    """A frame's cells in scan order (``coords``, every cell of the box) and its steps."""
+    """A frame as :func:`_check_lean` uses it: its ``n`` steps, its cells in scan order
+    (``coords``, every cell of the box) and ``keys``; per step, the step's region
+    (``box``) and the cells not yet labelled in it (``free``), as bit masks over the scan
+    ranks; the slot and support table (``fwd[d]``, ``d`` its axis) of each labelled
+    backward neighbour of the step's cell in its region (``near``); the slot in this
+    step's state and the class map of the axes on which the cell is open at the next step
+    of each label the next state keeps (``kept``, in the next state's order); and the
+    open axes (a bit mask) of the label chosen here if the next state records it (last),
+    else -1 (``chosen``)."""
 
     n: int
     coords: list[Cell]
     keys: list[list[int]]
-    steps: list[_Step]
+    box: list[int]
+    free: list[int]
+    near: list[list[tuple[int, list[int]]]]
+    kept: list[list[tuple[int, list[int]]]]
+    chosen: list[int]
 
 
 def _lean_frame(
     lo: Cell, hi: Cell, keys: list[list[int]], region: list[int], back: list[int],
-    axes: tuple[int, ...],
+    axes: tuple[int, ...], fwd: list[list[int]], cls: Callable[[int], list[int]],
 ) -> _LeanFrame:  # fmt: skip
     """The frame of ``(lower, upper)`` with its ``keys`` verified (the checks of
-    :func:`_frame_chunk`, with sets of cells as bit masks over the scan ranks)."""
+    :func:`_frame_chunk`, with sets of cells as bit masks over the scan ranks); a
+    neighbour's axis is given as its support table ``fwd[d]``, open axes as the class
+    map ``cls`` gives for them."""
     ndim = len(lo)
-    rd = range(ndim)
     ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
     sc = [0] * ndim
     s = 1
     for d in reversed(axes):
         sc[d] = s
         s *= ext[d]
-    n = sum(v * sc[d] for d, v in enumerate(lo)) + 1
+    n = 1
+    for d in range(ndim):
+        n += lo[d] * sc[d]
     if len(keys) != n or keys[0]:
         raise _Invalid(f"{_where(lo, hi)}: keys must list {n} steps, the first empty")
     scan = itertools.product(*[range(ext[d]) for d in axes])
     if list(axes) == sorted(axes):
         coords = list(scan)
     else:
-        at = [axes.index(d) for d in rd]
+        at = [axes.index(d) for d in range(ndim)]
         coords = [tuple(c[k] for k in at) for c in scan]
-    # per axis, the cells whose coordinate lies in a range: a block of sc[d] ranks per
-    # coordinate, repeated every sc[d] * ext[d] ranks
+    # per axis, the cells whose coordinate lies in a range a .. b: a block of sc[d] ranks
+    # per coordinate, repeated every sc[d] * ext[d] ranks (``rep``)
     full = (1 << s) - 1
-
-    def layers(d: int, a: int, b: int) -> int:
-        period = sc[d] * ext[d]
-        return ((1 << (b - a + 1) * sc[d]) - 1 << a * sc[d]) * (full // ((1 << period) - 1))
-
-    # the region's layers about each layer (clipped); per axis, all but the last / first
-    win = [[layers(d, max(v - back[d], 0), min(v + region[d] - 2, ext[d] - 1))
-            for v in range(ext[d])] for d in rd]  # fmt: skip
-    inner = [(d, sc[d], full & ~layers(d, ext[d] - 1, ext[d] - 1), full & ~layers(d, 0, 0))
-             for d in rd]  # fmt: skip
+    win: list[list[int]] = []  # the region's layers about each layer (clipped)
+    inner = []  # per axis, its stride, all cells but the last layer and but the first
+    for d in range(ndim):
+        e, t, r, b = ext[d], sc[d], region[d] - 2, back[d]
+        rep = full // ((1 << t * e) - 1)
+        win.append([
+            ((1 << (min(v + r, e - 1) - max(v - b, 0) + 1) * t) - 1 << max(v - b, 0) * t) * rep
+            for v in range(e)
+        ])  # fmt: skip
+        layer = (1 << t) - 1
+        inner.append((d, t, full & ~((layer << (e - 1) * t) * rep), full & ~(layer * rep)))
+    # keys[i]: sorted earlier steps; keys[i + 1] within keys[i] and step i
     masks = []
     for i, ks in enumerate(keys):
         m = 0
         for j in ks:
-            if not (_is_int(j) and 0 <= j < i and not m >> j):
+            if not ((type(j) is int or _is_int(j)) and 0 <= j < i and not m >> j):
                 raise _Invalid(f"{_where(lo, hi)}: keys[{i}] must be sorted earlier steps")
             m |= 1 << j
         masks.append(m)
     for i in range(n - 1):
         if masks[i + 1] & ~(masks[i] | 1 << i):
             raise _Invalid(f"{_where(lo, hi)}: keys[{i + 1}] records a label step {i} forgot")
-    steps = []
+    # per axis, the cells whose + neighbour is in the frame (open while it is not labelled)
+    plus = [(1 << d, t, not_last) for d, t, not_last, _ in inner]
+    boxes, frees, nears, kepts, chosens = [], [], [], [], []
     for i in range(n):
         c = coords[i]
         box = -1
-        for d in rd:
+        for d in range(ndim):
             box &= win[d][c[d]]
-        done = (1 << i) - 1
-        free = box & ~done
+        free = box >> i << i  # the cells of the box not yet labelled (ranks i and up)
         near_free = 0
-        for _, s, not_last, not_first in inner:
-            near_free |= (free & not_last) << s | (free & not_first) >> s
-        miss = box & done & near_free & ~masks[i]
+        for _, t, not_last, not_first in inner:
+            near_free |= (free & not_last) << t | (free & not_first) >> t
+        miss = box & near_free & ~masks[i] & ((1 << i) - 1)
         if miss:
             x = coords[(miss & -miss).bit_length() - 1]
             raise _Invalid(
                 f"{_where(lo, hi)}: step {i} depends on cell {list(x)}, not in keys[{i}]"
             )
         ks = keys[i]
-        near = [(ks.index(i - s), d) for d, s, _, _ in inner if c[d] and box >> (i - s) & 1]
-        kept: list[tuple[int, int]] = []
-        chosen, chosen_open = False, 0
+        # the backward neighbours (in the region: back >= 1), recorded (the miss above)
+        near = []
+        for d, t, _, _ in inner:
+            if c[d]:
+                near.append((ks.index(i - t), fwd[d]))
+        nears.append(near)
+        kept: list[tuple[int, list[int]]] = []
+        chosen = -1
         if i + 1 < n:
             for j in keys[i + 1]:
                 # the axes on which j's + neighbour is in the frame, not yet labelled
                 op = 0
-                cj = coords[j]
-                for d, sd, _, _ in inner:
-                    if j + sd > i and cj[d] + 1 < ext[d]:
-                        op |= 1 << d
+                for bit, t, has in plus:
+                    if j + t > i and has >> j & 1:
+                        op |= bit
                 if j == i:
-                    chosen, chosen_open = True, op
+                    chosen = op
                 else:
-                    kept.append((ks.index(j), op))
-        steps.append(_Step(near, kept, chosen, chosen_open, box, free))
-    return _LeanFrame(n, coords, keys, steps)
+                    kept.append((ks.index(j), cls(op)))
+        boxes.append(box)
+        frees.append(free)
+        kepts.append(kept)
+        chosens.append(chosen)
+    return _LeanFrame(n, coords, keys, boxes, frees, nears, kepts, chosens)
 
 
 def _check_lean(
@@ -1215,7 +1242,9 @@ def _check_lean(
     the point arc consistency runs unless the cell is the region's only one not yet
     labelled and labels are recorded by class: arcs between labelled cells are then left
     out, and the catalog is that superset itself (each neighbour's label supports every
-    label of it, and nothing else narrows it).
+    label of it, and nothing else narrows it). Configurations of one frame (they differ
+    in which of its edges lie on a face) whose cells have the same domains and whose
+    states are equal are the same check, made once.
     """
     fwd, _, used, ndim, face_rules = rules
     K = len(fwd[0])
@@ -1231,17 +1260,20 @@ def _check_lean(
             got_m = class_maps[m] = _class_of(fwd, used, frozenset(_bits(m)))
         return got_m
 
+    # per class map (by its open axes): a set of labels -> the set of their classes
+    class_sets: dict[int, dict[int, int]] = {}
     ac = _LeanAC(rules, memo, classes)
     cap = max(memo.cap, 1)
     plain = not face_rules and not memo.dead
     # the labels in use, and a state's labels as they are checked: every one in use
     in_use = {b for b in range(K) if used >> b & 1}
-    pair = (list, tuple)
     # configurations by frame (the same frame: the same steps and keys)
     by_frame: dict[Any, list[tuple[Mapping[str, Any], _Conf]]] = {}
     for conf, g in zip(configs, got, strict=True):
         by_frame.setdefault((g[0], g[1], tuple(map(tuple, conf["keys"]))), []).append((conf, g))
-    axis_places: dict[tuple[int, int, bool, bool, int], list[AxisPlace]] = {}
+    # per axis signature: its places, and their faces and farthest distances apart
+    AxisKinds = tuple[list[AxisPlace], list[int], list[tuple[int, int]]]
+    axis_places: dict[tuple[int, int, bool, bool, int], AxisKinds] = {}
     # a cell's domain by its faces and places along each axis (in scan order)
     cell_doms: dict[tuple[AxisPlace, ...], int] = {}
     scan_at = [axes.index(d) for d in range(ndim)]
@@ -1263,66 +1295,107 @@ def _check_lean(
         cell_doms[it] = dom
         return dom
 
-    # every state a pair, every label an integer in use (all states at once)
+    # the places (capped distances to the faces, per axis) where a label in use is dead: a
+    # cell elsewhere has the domain of the faces it lies on
+    dead_far = set(itertools.compress(dead_at, [v & used for v in dead_at.values()]))
+    face_doms: dict[int, int] = {}
+    if not plain and not dead_far:  # every cell has its faces' domain: all of them alike?
+        for on in range(1 << 2 * ndim):
+            face_doms[on] = memo.face_domain(on, used, face_rules)
+        plain = set(face_doms.values()) == {used}
+    reorder = operator.itemgetter(*scan_at) if ndim > 1 else lambda t: t
+
+    # every state a pair of an integer step and integer labels in use (all states at once)
     every = [s for c in configs for s in c["states"]]
-    if not all(isinstance(s, pair) and len(s) == 2 for s in every):
+    if set(map(type, every)) - {list, tuple} or set(map(len, every)) - {2}:
         raise _Invalid("a state is not a pair [step, labels]")
-    flat = set(itertools.chain.from_iterable(s[1] for s in every))
-    if not in_use.issuperset(flat) or set(map(type, flat)) - {int}:
+    if set(map(type, (s[0] for s in every))) - {int}:
+        if any(not issubclass(t, np.integer) for t in set(type(s[0]) for s in every) - {int}):
+            raise _Invalid("a state's step or labels are not integers")
+    rows = [s[1] for s in every]
+    if set(map(type, rows)) - {list, tuple}:
+        raise _Invalid("a state's step or labels are not integers")
+    flat = set(itertools.chain.from_iterable(rows))
+    as_int = bool(set(map(type, flat)) - {int})  # numpy integers: Python ints (shifts)
+    if as_int or not in_use.issuperset(flat):
         for c in configs:
             lo, hi = c["lower"], c["upper"]
             _labels_in_use(c["states"], set(itertools.chain.from_iterable(
                 s[1] for s in c["states"])), in_use, _where(lo, hi))  # fmt: skip
     total = len(every)
     for (lo, hi, _), members in by_frame.items():
-        fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes)
-        n, coords, keys, steps = fr.n, fr.coords, fr.keys, fr.steps
+        fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes, fwd, cls)
+        n, coords, keys = fr.n, fr.coords, fr.keys
         ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
         widths = [len(k) for k in keys]
-        # per step: the neighbours' slots and axes, the kept labels' slots and class maps,
-        # the chosen label's class map, whether the next state records it, whether the
-        # states here are looked up by all labels but the last (the step before chose it)
-        plans = [
-            (st.near, [(k, cls(m)) for k, m in st.kept], cls(st.chosen_open), st.chosen,
-             i > 0 and steps[i - 1].chosen)
-            for i, st in enumerate(steps)
-        ]  # fmt: skip
-        exact = classes and steps[-1].free == 1 << (n - 1)
+        # per step: the neighbours' slots and support tables, the kept labels' slots and
+        # class maps, the chosen label's class map and its sets of classes (None: the
+        # next state does not record it)
+        plans: list[tuple[Any, ...]] = []
+        for near, keeps, chosen in zip(fr.near, fr.kept, fr.chosen, strict=True):
+            if chosen >= 0:
+                op = chosen if classes else 0
+                pick, sets = cls(op), class_sets.get(op)
+                if sets is None:
+                    sets = class_sets[op] = {}
+            else:
+                pick, sets = ident, None
+            # the kept labels as the next state holds them, by the labels of their slots
+            get = operator.itemgetter(*[k for k, _ in keeps]) if keeps else None
+            plans.append((near, keeps, pick, sets, get, {}))
+        exact = classes and fr.free[-1] == 1 << (n - 1)
+        # the states checked in this frame, by the domains of its cells: a configuration
+        # with the same frame, domains and states (its positions on the faces differ) is
+        # the same check, with the same outcome
+        checked: dict[tuple[int, ...], list[Any]] = {}
         for conf, (_, _, at_lo, at_hi) in members:
             # the domain of each cell of the frame (labels in use, face rules, dead labels)
             if plain:
                 base = [used] * len(coords)
             else:
-                per = []
-                for d in axes:  # in scan order: the product below runs as the cells do
+                per, faces, fars = [], [], []
+                for d in axes:  # in scan order: the products below run as the cells do
                     sig = (d, ext[d], at_lo[d], at_hi[d], cap)
                     p = axis_places.get(sig)
                     if p is None:
-                        p = axis_places[sig] = _axis_places(*sig)
-                    per.append(p)
-                base = [
-                    cell_doms[it] if it in cell_doms else cell_dom(it)
-                    for it in itertools.product(*per)
-                ]
-            # the states by step, checked for their form
+                        q = _axis_places(*sig)
+                        p = axis_places[sig] = (q, [t[0] for t in q], [t[2] for t in q])
+                    per.append(p[0])
+                    faces.append(p[1])
+                    fars.append(p[2])
+                # the faces of each cell (the axes' bits are disjoint: their sum)
+                ons = list(map(sum, itertools.product(*faces)))
+                for on in set(ons) - face_doms.keys():
+                    face_doms[on] = memo.face_domain(on, used, face_rules)
+                base = list(map(face_doms.__getitem__, ons))
+                if dead_far:  # the cells that may lie where a label in use is dead
+                    cells = zip(map(reorder, itertools.product(*fars)), itertools.product(*per),
+                                strict=True)  # fmt: skip
+                    for x, (far, it) in enumerate(cells):
+                        if far in dead_far:
+                            base[x] = cell_doms[it] if it in cell_doms else cell_dom(it)
             states = conf["states"]
-            by_step: list[list[tuple[int, ...]]] = [[] for _ in range(n)]
+            same = checked.setdefault(tuple(base), [])
+            if any(states == other for other in same):
+                continue
+            same.append(states)
+            # the states by step, checked for their form
+            by_step: list[list[Sequence[int]]] = [[] for _ in range(n)]
             for i, labs in states:
-                if not (type(i) is int or _is_int(i)) or not isinstance(labs, pair):
-                    raise _Invalid("a state's step or labels are not integers")
                 if not 0 <= i < n:
                     raise _Invalid(f"{_where(lo, hi)}: a state's step is not one of its {n} steps")
                 if len(labs) != widths[i]:
                     raise _Invalid(f"{_where(lo, hi)}: a state at step {i} does not fit keys[{i}]")
-                by_step[i].append(tuple(map(int, labs)))  # numpy ints: shifts past 63
+                by_step[int(i)].append(tuple(map(int, labs)) if as_int else labs)
             if not by_step[0]:
                 raise _Invalid(f"{_where(lo, hi)}: no start state")
             # closed: each state's labels lead to recorded states; the point's catalog
-            near, _, _, _, keyed = plans[n - 1]
+            near_t = plans[n - 1][0]
+            b0 = base[n - 1]
             for labs in by_step[n - 1]:
-                fc = base[n - 1]
-                for k, d in near:
-                    fc &= fwd[d][labs[k]]
+                fc = b0
+                for k, t in near_t:
+                    fc &= t[labs[k]]
                 if fc and not exact:
                     fc = ac.catalog(fr, n - 1, labs, base)
                 if not fc:
@@ -1330,36 +1403,50 @@ def _check_lean(
                                    f"{[n - 1, list(labs)]}")  # fmt: skip
             later = by_step[n - 1]
             for i in range(n - 2, -1, -1):
+                near_t, maps, pick, sets, get, kept_of = plans[i]
                 # the next step's states (by their labels but the last: its bits, if chosen)
-                if keyed:
+                if sets is not None:
                     nxt: Any = {}
                     for labs in later:
-                        nxt[labs[:-1]] = nxt.get(labs[:-1], 0) | 1 << labs[-1]
+                        head = tuple(labs[:-1])
+                        nxt[head] = nxt.get(head, 0) | 1 << labs[-1]
                 else:
-                    nxt = set(later)
+                    nxt = set(map(tuple, later))
                 later = here = by_step[i]
-                near, maps, pick, chosen, keyed = plans[i]
                 b0 = base[i]
                 for labs in here:
                     fc = b0
-                    for k, d in near:
-                        fc &= fwd[d][labs[k]]
+                    for k, t in near_t:
+                        fc &= t[labs[k]]
                     if not fc:
                         continue
-                    kept = tuple([m[labs[k]] for k, m in maps])
-                    if chosen:
+                    if get is None:
+                        kept = ()
+                    else:
+                        raw = get(labs)
+                        kept = kept_of.get(raw)
+                        if kept is None:
+                            kept = kept_of[raw] = tuple([m[labs[k]] for k, m in maps])
+                    if sets is not None:
+                        want = sets.get(fc)
+                        if want is None:
+                            want = 0
+                            for b in _bits(fc):
+                                want |= 1 << pick[b]
+                            sets[fc] = want
                         avail = nxt.get(kept, 0)
                         miss = 0
-                        for b in _bits(fc):
-                            if not avail >> pick[b] & 1:
-                                miss |= 1 << b
+                        if want & ~avail:
+                            for b in _bits(fc):
+                                if not avail >> pick[b] & 1:
+                                    miss |= 1 << b
                     else:
                         miss = 0 if kept in nxt else fc
                     if miss:
                         miss &= ac.catalog(fr, i, labs, base)
                     if miss:
                         b = (miss & -miss).bit_length() - 1
-                        nx = [*kept, pick[b]] if chosen else list(kept)
+                        nx = [*kept, pick[b]] if sets is not None else list(kept)
                         raise _Invalid(
                             f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} with "
                             f"label {b} leads to {[i + 1, nx]}, which is missing"
@@ -1408,12 +1495,12 @@ class _LeanAC:
         self.graphs: dict[Any, tuple[Arcs, int]] = {}
         self.catalogs: dict[Any, int] = {}
 
-    def catalog(self, fr: _LeanFrame, i: int, labs: tuple[int, ...], base: list[int]) -> int:
-        st = fr.steps[i]
+    def catalog(self, fr: _LeanFrame, i: int, labs: Sequence[int], base: list[int]) -> int:
         c = fr.coords[i]
         keys = fr.keys[i]
-        fixed = [(fr.coords[j], k) for k, j in enumerate(keys) if st.box >> j & 1]
-        free = list(_bits(st.free))
+        box = fr.box[i]
+        fixed = [(fr.coords[j], k) for k, j in enumerate(keys) if box >> j & 1]
+        free = list(_bits(fr.free[i]))
         rel = [tuple(a - b for a, b in zip(x, c, strict=True)) for x, _ in fixed]
         rel.append(())  # the labelled cells, then those not yet labelled
         rel += [tuple(a - b for a, b in zip(fr.coords[j], c, strict=True)) for j in free]
@@ -1447,11 +1534,10 @@ def _is_int(x: Any) -> bool:
 
 def _class_of(fwd: list[list[int]], used: int, ax: frozenset[int]) -> list[int]:
     """Label -> the least label in use with the same ``fwd[d]`` for every ``d`` in ``ax``."""
+    # each label's forward supports along the axes of ``ax`` (one row per label)
+    rows = list(zip(*[fwd[d] for d in sorted(ax)], strict=True)) if ax else [()] * len(fwd[0])
     first: dict[tuple[int, ...], int] = {}
-    return [
-        first.setdefault(tuple(fwd[d][a] for d in sorted(ax)), a) if used >> a & 1 else a
-        for a in range(len(fwd[0]))
-    ]
+    return [first.setdefault(r, a) if used >> a & 1 else a for a, r in enumerate(rows)]
 
 
 # ----------------------------------------------------------------------------- dead labels
@@ -1482,10 +1568,7 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         raise _Invalid("dead labels: cap must be 1 to 8")
     span = list(itertools.product(range(cap + 1), repeat=2))
     # the labels the face rules exclude, by the faces a place lies on (bits 2d, 2d + 1)
-    excluded = [
-        used & ~_domain(face_rules, {_AXES[t // 2] + "-+"[t % 2] for t in _bits(f)}, used)
-        for f in range(1 << 2 * ndim)
-    ]
+    excluded = [used & ~_domain(face_rules, f, used) for f in range(1 << 2 * ndim)]
     # every place, and the faces it lies on, in the same order (iterated in C)
     on = [0]
     for d in range(ndim):
@@ -1502,20 +1585,20 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
         d, minus = _AXES.index(face[0]), face[1] == "-"
         stage: dict[Where, int] = {}
         side = 0 if minus else 1
+        at, bits_of = stage.get, label_bits.get
         for where, labels in got:
             k: Where = tuple(map(tuple, where))
-            if k not in known or k[d][side] == 0:
-                raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
-            t = tuple(labels)
-            m = label_bits.get(t)
-            if m is None:
+            m = bits_of(tuple(labels))
+            if m is None or k not in known or k[d][side] == 0:  # (labels seen first here)
+                if k not in known or k[d][side] == 0:
+                    raise _Invalid(f"dead labels: {list(where)} is not a place off {face}")
                 m = 0
-                for b in t:
+                for b in labels:
                     if not (isinstance(b, int) and 0 <= b < len(fwd[0]) and used >> b & 1):
                         raise _Invalid(f"dead labels: {b!r} is not a label in use")
                     m |= 1 << b
-                label_bits[t] = m
-            stage[k] = stage.get(k, 0) | m
+                label_bits[tuple(labels)] = m
+            stage[k] = at(k, 0) | m
         table = bwd[d] if minus else fwd[d]
         sup_of: dict[int, int] = {}  # labels -> their supports toward the face
         # per distances along d, those the neighbour one cell nearer the face may have
@@ -1528,17 +1611,19 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
                 else:
                     los, his = [min(lo + 1, cap)], ([hi - 1] if hi < cap else [cap - 1, cap])
                 toward[lo, hi] = list(itertools.product(los, his))
+        for bits in set(stage.values()):
+            sup = 0
+            for b in _bits(bits):
+                sup |= table[b]
+            sup_of[bits] = sup
+        # (a place is added to ``known`` once checked: the labels dead at a neighbour
+        # are then read as before, known there or in this stage)
         for k, bits in stage.items():
-            sup = sup_of.get(bits)
-            if sup is None:
-                sup = 0
-                for b in _bits(bits):
-                    sup |= table[b]
-                sup_of[bits] = sup
+            sup = sup_of[bits]
             head, tail = k[:d], k[d + 1 :]
             for p in toward[k[d]]:
                 n = (*head, p, *tail)
-                gone = known[n] | stage.get(n, 0)
+                gone = known[n] | at(n, 0)
                 if not sup & ~gone:
                     continue
                 for b in _bits(bits):
@@ -1547,7 +1632,7 @@ def _check_dead(dead: Mapping[str, Any], rules: _Rules) -> dict[Where, int]:
                             f"dead labels: {b} at {[list(t) for t in k]} has a support toward "
                             f"{face} that is not dead: {sorted(_bits(table[b] & ~gone))}"
                         )
-        known.update({k: known[k] | bits for k, bits in stage.items()})
+            known[k] |= bits
     return known
 
 
@@ -1575,9 +1660,8 @@ def _check_run(cert: Mapping[str, Any], rules: _Rules) -> str:
         itertools.product(*[range(s) for s in shape]), key=lambda c: tuple(c[a] for a in axes)
     )
 
-    def faces(c: Cell) -> set[str]:
-        on = {_AXES[d] + "-" for d in range(ndim) if c[d] == 0}
-        return on | {_AXES[d] + "+" for d in range(ndim) if c[d] == shape[d] - 1}
+    def faces(c: Cell) -> int:
+        return sum((c[d] == 0) << 2 * d | (c[d] == shape[d] - 1) << 2 * d + 1 for d in range(ndim))
 
     bnd = run.get("boundary") or {}
     if bnd == "auto":  # the certificate's face rules

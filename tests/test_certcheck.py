@@ -9,6 +9,7 @@ Check and prove times are printed (not asserted).
 from __future__ import annotations
 
 import copy
+import itertools
 import json
 import time
 import warnings
@@ -497,6 +498,89 @@ def test_configuration_defects(small_cert, checker_path):
     assert not ok and "positions of a point" in msg, msg
 
 
+def test_configurations_without_face_flags(small_cert, checker_path):
+    # without at_lower / at_upper (no face rules), a frame edge is on the face exactly
+    # where the region is clipped there; a flag that says otherwise is a wrong position
+    bare = copy.deepcopy(small_cert)
+    for conf in bare["configs"]:
+        conf.pop("at_lower", None)
+        conf.pop("at_upper", None)
+    ok, msg = check_certificate(bare)
+    assert ok, msg
+    bad = copy.deepcopy(small_cert)
+    conf = next(c for c in bad["configs"] if not all(c["at_lower"]))
+    conf["at_lower"] = [True] * len(conf["lower"])  # an edge the region reaches past
+    ok, msg = check_certificate(bad)
+    assert not ok and "positions of a point" in msg, msg
+
+
+def test_dead_labels_in_use_at_some_places(dead_cert, checker_path):
+    # one place's dead labels left out: those labels are in use again (dead everywhere
+    # else), so the cells that may lie elsewhere lose them from their domains -- which the
+    # states need (a check that ignored dead labels in use rejects this certificate)
+    cert = copy.deepcopy(dead_cert)
+    del cert["dead"]["stages"][0][1][0]
+    ok, msg = check_certificate(cert)
+    assert ok, msg
+
+
+def test_dead_stage_places_checked(dead_cert, checker_path):
+    # a stage's place must lie off its face and within the cap -- also for an entry whose
+    # labels an earlier entry already had
+    face, got = dead_cert["dead"]["stages"][0]
+    d, side = "xyzw".index(face[0]), "-+".index(face[1])
+    k = next(k for k in range(1, len(got)) if got[k][1] == got[0][1])
+    for value in (0, dead_cert["dead"]["cap"] + 1):
+        bad = copy.deepcopy(dead_cert)
+        bad["dead"]["stages"][0][1][k][0][d][side] = value
+        ok, msg = check_certificate(bad)
+        assert not ok and "is not a place off" in msg, (value, msg)
+
+
+@pytest.fixture(scope="module")
+def poms_cert():
+    """tiny_poms as decide proves it: 2x2x2 regions, no history, labels by class, face
+    rules; 1,200 states in 216 configurations (checked one state at a time)."""
+    v = prove_infallible(load_model(str(DATA / "tiny_poms.json")), "2", history=0,
+                         classes=True, refute=False, certificate=True)  # fmt: skip
+    return json.loads(json.dumps(v.witness["certificate"]))
+
+
+def test_face_domains_of_the_cells(poms_cert, checker_path):
+    # tiny_poms' frames' cells on a face have that face's domain, which the states need
+    # (a check that gave every cell all labels in use rejects it); with the rule that
+    # removes label 1 above the ground dropped, the states no longer close
+    cert = poms_cert
+    ok, msg = check_certificate(cert)
+    assert ok, msg
+    bad = copy.deepcopy(cert)
+    bad["rules"]["faces"] = [f for f in bad["rules"]["faces"] if f[1] != "!z-"]
+    bad["rules_sha256"] = rules_hash(bad["rules"])
+    ok, msg = check_certificate(bad)
+    assert not ok and "not closed" in msg, msg
+
+
+def test_each_configuration_checked_with_its_own_domains(poms_cert, checker_path):
+    # two configurations of one frame differ in which of its edges lie on a face, so in
+    # their cells' domains: the states of one, given to a later one, are checked with the
+    # later one's domains (one of them, at least, must then fail)
+    groups: dict[tuple, list[int]] = {}
+    for k, c in enumerate(poms_cert["configs"]):
+        groups.setdefault((str(c["lower"]), str(c["upper"]), str(c["keys"])), []).append(k)
+    for members in groups.values():
+        for a, b in itertools.combinations(members, 2):
+            states = poms_cert["configs"][a]["states"]
+            if states == poms_cert["configs"][b]["states"]:
+                continue
+            bad = copy.deepcopy(poms_cert)
+            bad["configs"][b]["states"] = copy.deepcopy(states)
+            ok, msg = check_certificate(bad)
+            if not ok:
+                assert msg.startswith("invalid: configuration"), msg
+                return
+    raise AssertionError("every configuration takes the states of every other of its frame")
+
+
 def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
     import csplab.certcheck as cc
     from csplab.errors import MemoryLimitError
@@ -507,12 +591,16 @@ def test_a_certificate_too_large_to_hold_is_refused(small_cert, monkeypatch):
         check_certificate(small_cert)
 
 
-def test_both_paths_agree_on_every_rule_removed(monkeypatch):
-    # fig3_16 with 4x2 regions: points with cells after them in their region, where the
-    # catalog needs arc consistency; each pair of the rules removed in turn (the hash
+@pytest.mark.parametrize(("region", "order", "back", "history"),
+                         [("4x2", "scan:yx", 1, 1), ("3x3", "scanline", (1, 2), 0)])  # fmt: skip
+def test_both_paths_agree_on_every_rule_removed(region, order, back, history, monkeypatch):
+    # fig3_16 with 4x2 regions (scan:yx) or 3x3 regions reaching back 1x2 and no history
+    # (scanline, as decide proves it): points with cells after them in their region, where
+    # the catalog needs arc consistency (the latter has rules whose removal only the
+    # point's arc consistency sees); each pair of the rules removed in turn (the hash
     # updated), the one-state-at-a-time check and the array check give the same verdict
-    v = prove_infallible(load_model("fig3_16"), "4x2", order="scan:yx", refute=False,
-                         classes=True, certificate=True)  # fmt: skip
+    v = prove_infallible(load_model("fig3_16"), region, order=order, back=back, history=history,
+                         refute=False, classes=True, certificate=True)  # fmt: skip
     cert = json.loads(json.dumps(v.witness["certificate"]))
     verdicts = []
     for d, pairs in enumerate(cert["rules"]["pairs"]):
