@@ -204,11 +204,24 @@ def _settings(
         if o is None:
             continue
         value = suggested.get(key)
+        # sat's phases under global constraints: its auto (the Alg. 3.1 start) over the
+        # format's suggested label weights, which as phases alone do not find the object
+        constrained_auto = (
+            key == "choice" and o.default == "auto" and problem is not None
+            and bool(problem.constraints)
+        )  # fmt: skip
         if key in opts:
             settings[key] = f"{opts[key]} (given)"
+        elif constrained_auto:
+            settings[key] = (
+                "auto (solver default: global constraints, a short uniform attempt, then a "
+                "seeded Alg. 3.1 solution)"
+            )
         elif value is not None and (o.values is None or value in o.values):
             opts[key] = value
             settings[key] = f"{value} ({sources[key]})"
+        elif o.default == "auto" and key == "choice" and problem is not None:
+            settings[key] = "uniform (auto: no global constraints; solver default)"
         elif o.default == "auto":  # catalog's order: by the problem's constraints, below
             settings[key] = "auto (solver default)"
         else:

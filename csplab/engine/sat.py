@@ -480,12 +480,29 @@ class SatOracle(Closing):
         self, assumptions: list[int], deadline: float | None, conflicts: int | None = None
     ) -> bool | None:
         S = self.solver
-        if conflicts is not None:  # one call, whatever the clock: the answer is reproducible
-            late = deadline is not None and time.perf_counter() > deadline
-            if late or self.backend in _NO_LIMIT:
+        if conflicts is not None:
+            # one call of at most that many conflicts: its answer does not depend on the
+            # clock, except that the deadline interrupts it where the backend can be
+            # interrupted (not CaDiCaL through pysat: it may overrun by the budget), and the
+            # run's answer is then a timeout whatever the call would have found
+            left = None if deadline is None else deadline - time.perf_counter()
+            if (left is not None and left <= 0) or self.backend in _NO_LIMIT:
                 return None
+            timer = None
+            if left is not None and not self.backend.startswith("cadical"):
+                timer = threading.Timer(left, S.interrupt)
             S.conf_budget(int(conflicts))
-            r = S.solve_limited(assumptions=assumptions)
+            if timer is not None:
+                timer.start()
+            try:
+                r = S.solve_limited(assumptions=assumptions, expect_interrupt=timer is not None)
+            finally:
+                if timer is not None:
+                    timer.cancel()
+                    S.clear_interrupt()
+                # MiniSat's family keeps a budget for later calls (CaDiCaL forgets it): a
+                # later call under the deadline would stop at once
+                S.conf_budget(-1)
             return None if r is None else bool(r)
         if deadline is None:
             return bool(S.solve(assumptions=assumptions))
@@ -537,10 +554,11 @@ class SatOracle(Closing):
     ) -> str:
         """``"sat"`` (``grid`` holds a solution), ``"unsat"`` (``core()`` explains it under
         the assumptions) or ``"timeout"``: the deadline passed or, with ``conflicts``, a
-        backend call (one per refinement or cut) reached that many conflicts. Such a call is
-        not cut by the deadline (it may overrun it by its conflicts), so that its answer
-        does not depend on the clock; backends without conflict budgets (lingeling) answer
-        ``"timeout"`` at once."""
+        backend call (one per refinement or cut) reached that many conflicts. Such a call's
+        answer does not depend on the clock: the deadline interrupts it where the backend
+        can be interrupted (CaDiCaL cannot: it may overrun the deadline by the budget), and
+        the budget is cleared after it (MiniSat's family would keep it); backends without
+        conflict budgets (lingeling) answer ``"timeout"`` at once."""
         if self.timed_out:
             return "timeout"
         assume = [int(a) for a in assumptions]

@@ -777,14 +777,17 @@ class AspSolver(Solver):
             "encoding", "supports", "grounding", "diversity"
         )
         clingo = require("clingo", "asp", "solver 'asp'")
+        if problem.constraints and grounding != "csplab":  # before any work
+            raise InputError("solver 'asp': global constraints need grounding='csplab'")
         t0, deadline, rng = call.t0, call.deadline, call.rng
         cseed = int(rng.integers(2**31 - 1))
         if diversity == "auto":  # City 40x40x10 with its constraints needs the catalog start
             diversity = "catalog" if problem.constraints else "sign"
         whole, hint_s = None, 0.0  # a seeded Alg. 3.1 solution, as cpsat's hint
         if diversity == "catalog":
+            t_hint = time.perf_counter()
             whole = solution_hint(problem, rng, call.remaining())
-            hint_s = time.perf_counter() - t0
+            hint_s = time.perf_counter() - t_hint
         if supports == "auto":  # from a whole solution clasp does not search: forward suffices
             supports = "forward" if whole is not None else "both"
         empty = np.full(problem.shape, -1, dtype=np.int32)
@@ -834,8 +837,6 @@ class AspSolver(Solver):
         pieces: Iterator[bytes]
         ctx = None
         if problem.constraints:  # global constraints: choice atoms and integrity constraints
-            if grounding != "csplab":
-                raise InputError("solver 'asp': global constraints need grounding='csplab'")
             ctx = AspContext.of(problem, enc)
             stats["constraint_clauses"] = len(ctx.clauses)
             stats["constraint_rules"] = len(ctx.rules)

@@ -290,7 +290,8 @@ STATS: dict[str, str] = {
     "diversity": "how outputs are diversified across seeds",
     "hint": "where the solver started: a seeded Alg. 3.1 solution (catalog solution; cpsat's "
     "hint, sat's choice=catalog phases, asp's diversity=catalog labels) or, when it fails, "
-    "random or uniform labels",
+    "random or uniform labels; sat's \"catalog solution (refuted)\": the solution broke a "
+    "constraint and the search went on from its phases",
     "hint_s": "seconds spent finding the hint, a seeded Alg. 3.1 solution",
     "probe_conflicts": "conflicts of sat's short attempt from uniform phases before the "
     "hint (choice=auto under global constraints)",

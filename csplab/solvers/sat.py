@@ -22,8 +22,10 @@ conflicts, solved in 5.7 s or timed out at 35 s by the run); so confirmed, 0 con
 
 The default ``choice="auto"`` is ``"uniform"`` without global constraints (the same outputs
 as before it existed) and with them a short attempt from uniform phases
-(:data:`PROBE_CONFLICTS` conflicts per backend call, not cut by the clock so that its answer
-is reproducible), then ``"catalog"``: CDCL alone does not find one connected object of
+(:data:`PROBE_CONFLICTS` conflicts per backend call, counted in conflicts and not in
+seconds so that its answer is reproducible; the deadline stops it where the backend can be
+interrupted, not CaDiCaL), then
+``"catalog"``: CDCL alone does not find one connected object of
 hundreds of cells (City 40×40×10: timeout at 35 s after 8,365 conflicts; at 20×20×6 one of
 three seeds solved, after 2,554 conflicts, two timed out at 30 s after 5,698 and 5,876),
 Alg. 3.1 grows it (0.8-1.6 s), while the knot tileset's network at 128×128 takes uniform
@@ -159,9 +161,12 @@ class SatSolver(Solver):
                         # the oracle confirms it by propagation (no conflict) and it is the
                         # output; were it refuted, the search goes on from its phases
                         status = o.solve(o.assignment(hint), deadline=deadline)
-                        if status == "unsat":
+                        if status == "unsat":  # under the hint's assumptions: no proof
+                            stats["hint"] = "catalog solution (refuted)"
                             status = o.solve(deadline=deadline)
                     else:
+                        if probe:  # no hint: the search goes on from the attempt's phases
+                            stats["choice"] = "uniform"
                         if choice != "none" and not probe:
                             w = None
                             if choice == "weighted":  # per cell when weights are per class

@@ -5,6 +5,7 @@ from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from csplab.cli import main
 from csplab.io.registry import synthesis_defaults
@@ -146,3 +147,23 @@ def test_an_unwritable_output_is_refused_before_the_work(capsys, tmp_path):
     code, out, err = _run(capsys, "synthesize", "line", "--size", "6x4", "--out",
                           tmp_path / "missing" / "x.npy")  # fmt: skip
     assert code == 2 and out == "" and "does not exist" in err and len(err.splitlines()) == 1
+
+
+def test_sat_under_global_constraints_keeps_its_auto_phases(capsys, tmp_path):
+    """A WFC tileset suggests weighted label choices; for ``sat`` under a constraints file
+    its ``choice=auto`` (the Alg. 3.1 start after a short uniform attempt) wins over that
+    suggestion, and the settings say so; without constraints the suggestion stands."""
+    pytest.importorskip("pysat")
+    model = str(Path(__file__).resolve().parents[1] / "io" / "data" / "pipes.xml")
+    c = tmp_path / "c.json"
+    c.write_text(json.dumps([{"type": "connected", "labels": ["line", "corner", "tee", "cross"]}]))
+    argv = ["synthesize", model, "--size", "12x12", "--seed", "1", "--solver", "sat", "--json"]
+    code, out, _ = _run(capsys, *argv, "--constraints", c)
+    d = json.loads(out)
+    assert code == 0 and d["status"] == "solved"
+    assert d["settings"]["choice"].startswith("auto (solver default: global constraints")
+    assert d["stats"]["choice"] in ("uniform", "catalog") and "probe_conflicts" in d["stats"]
+    code, out, _ = _run(capsys, *argv)
+    d = json.loads(out)
+    assert code == 0 and d["settings"]["choice"] == "weighted (wfc defaults)"
+    assert d["stats"]["choice"] == "weighted"

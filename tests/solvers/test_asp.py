@@ -445,3 +445,17 @@ def test_a_child_crash_is_an_error(monkeypatch):
     P = from_example(box_town(2, rng=0), (5, 5, 3))
     with pytest.raises(CsplabError, match="exited with code 3"):
         solve(P, "asp", rng=0)
+
+
+def test_global_constraints_with_gringo_are_refused_before_any_work(monkeypatch):
+    """The refusal comes before the Alg. 3.1 start (which could run long), in one line."""
+    import csplab.solvers.asp as asp
+    from csplab.testing.synthetic import connected_city
+
+    def no_hint(*a, **k):
+        raise AssertionError("the hint ran before the refusal")
+
+    monkeypatch.setattr(asp, "solution_hint", no_hint)
+    _, P = connected_city((8, 8, 4))
+    with pytest.raises(InputError, match="global constraints need grounding='csplab'"):
+        solve(P, "asp", rng=0, grounding="gringo")

@@ -83,3 +83,58 @@ def test_sat_default_without_global_constraints_is_uniform():
             assert r.status == "solved" and len(P.violations(r.grid)) == 0
             assert r.stats["choice"] == "uniform" and "probe_conflicts" not in r.stats
             assert np.array_equal(r.grid, u.grid)
+
+
+def _broken(hint_of):
+    """A hint that breaks the problem: the true hint with one inner cell (not fixed by the
+    boundary) relabelled so that the grid has violations."""
+
+    def hint(problem, rng, remaining=None):
+        h = np.array(hint_of(problem, rng, remaining), dtype=np.int32).reshape(problem.shape)
+        mid = tuple(n // 2 for n in problem.shape)
+        for k in range(problem.K):
+            h2 = h.copy()
+            h2[mid] = k
+            if len(problem.violations(h2)):
+                return h2.reshape(-1)
+        raise AssertionError("no label breaks the hint")
+
+    return hint
+
+
+def test_sat_goes_on_searching_when_the_hint_is_refuted(city, monkeypatch):
+    """A hint refuted under its assumptions is no proof: the search goes on from its phases
+    and solves (removing that second call would answer ``unsat`` on a solvable problem)."""
+    pytest.importorskip("pysat")
+    import csplab.solvers.sat as sat
+
+    monkeypatch.setattr(sat, "PROBE_CONFLICTS", 1)  # the attempt gives up (it needs ~80)
+    monkeypatch.setattr(sat, "solution_hint", _broken(solution_hint))
+    r = csplab.solve(city, "sat", rng=0, time_limit=30)
+    assert r.status == "solved" and len(city.violations(r.grid)) == 0
+    assert r.stats["hint"] == "catalog solution (refuted)" and "proof" not in r.stats
+
+
+def test_sat_default_without_a_hint_goes_on_from_the_attempt(city, monkeypatch):
+    pytest.importorskip("pysat")
+    import csplab.solvers.sat as sat
+
+    monkeypatch.setattr(sat, "PROBE_CONFLICTS", 1)
+    monkeypatch.setattr(sat, "solution_hint", lambda *a, **k: None)
+    r = csplab.solve(city, "sat", rng=0, time_limit=30)
+    assert r.status == "solved" and len(city.violations(r.grid)) == 0
+    assert r.stats["hint"] == "uniform labels" and r.stats["choice"] == "uniform"
+
+
+@pytest.mark.parametrize("backend", ["minisat22", "glucose4"])
+def test_the_attempts_budget_does_not_outlive_it(city, monkeypatch, backend):
+    """MiniSat's family keeps a conflict budget for later calls: after the attempt's, the
+    confirmation of the hint under a time limit stopped at once (a timeout after 1 s of
+    20)."""
+    pytest.importorskip("pysat")
+    import csplab.solvers.sat as sat
+
+    monkeypatch.setattr(sat, "PROBE_CONFLICTS", 3)
+    r = csplab.solve(city, f"sat:{backend}", rng=0, time_limit=20)
+    assert r.status == "solved" and len(city.violations(r.grid)) == 0
+    assert r.stats["hint"] == "catalog solution"
