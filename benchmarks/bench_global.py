@@ -40,11 +40,16 @@ Usage::
     python benchmarks/bench_global.py [--cases city pipes] [--solvers catalog sat asp cpsat]
                                       [--time-limit 60] [--seed 1] [--catalog-order ORDER]
 
-Idle run (``--time-limit 35``, load average 0.3-1.0, 2026-11-27): city: catalog 0.86 s,
-sat timeout (8,604 conflicts), sat+catalog 3.68 s, asp timeout, asp+catalog 10.59 s (1.1x
-its target; asp's reference without the constraints alone takes 6.71 s), cpsat 4.41 s;
-pipes: catalog 2.05 s, sat 1.48 s, sat+catalog 5.21 s, asp 3.58 s, asp+catalog 7.38 s,
-cpsat 4.22 s; every output valid.
+Idle run with every solver's defaults of 2026-11-27 (``--time-limit 35``, load average
+0.9-1.0; catalog ``order="auto"``, sat ``choice="auto"``, asp ``diversity="auto"``): city:
+catalog 0.88 s (min-entropy, first attempt), sat 3.44 s (300 conflicts in the uniform
+attempt, then the confirmed hint), sat+catalog 3.22 s, asp 5.28 s, asp+catalog 5.34 s, cpsat
+4.53 s; pipes: catalog 2.16 s, sat 1.57 s (uniform phases, 53 conflicts), sat+catalog
+4.55 s, asp 5.44 s, asp+catalog 5.54 s, cpsat 4.24 s; every target meets, every output
+valid. The idle run before these defaults (load average 0.3-1.0): city: catalog 0.86 s
+(``restarts=50``, min-entropy given), sat timeout (8,604 conflicts), sat+catalog 3.68 s, asp
+timeout, asp+catalog 10.59 s, cpsat 4.41 s; pipes: catalog 2.05 s, sat 1.48 s,
+sat+catalog 5.21 s, asp 3.58 s, asp+catalog 7.38 s, cpsat 4.22 s.
 
 ``sat``'s default ``choice="auto"`` (``--solvers catalog sat sat+catalog --time-limit 35``,
 load average 3.7-4.1, then the code before it in the same session, load average 3.6-4.0):

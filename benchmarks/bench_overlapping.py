@@ -32,6 +32,8 @@ Measured (``results/overlapping.md``, a shared 2-core machine, CPU time per vali
 no reference counting in Alg. 3.1's step loop) 2.59-2.68 ms against 3.43-3.51 ms for the
 commit before, interleaved runs at load average 2.7-3.8: City (<= 2.80 ms) meets with
 2.09-2.16x, Rooms 5.60-5.78x, Knot 5.19-5.36x; 200x200 60.4-61.3 ms (77.8-83.4 before).
+Idle (load average 0.6-0.8): 48x48 2.57 ms, City 2.18x, Rooms 5.85x, Knot 5.42x; 200x200
+57.9 ms, 15.5x.
 
 Usage::
 
