@@ -126,7 +126,7 @@ TARGETS: tuple[Target, ...] = (
         "engine.kernels",
         "csplab/_kernels.py",
         (
-            "alg31", "_propagate", "_propagate1", "propagate", "choose_label", "entropy_of",
+            "alg31", "_propagate", "_propagate_w", "propagate", "choose_label", "entropy_of",
             "domain_size", "nth_label", "heap_update", "heap_build", "heap_pop", "_heap_up",
             "_heap_down", "_heap_swap", "ctz64", "popcount64",
         ),

@@ -46,15 +46,15 @@ within 5-9%). Measured again with only the full revision (the covering loop that
 ``inline="always"`` helper: Alg. 3.1 at 40x40x10, three runs, median of shuffled A/B
 rounds in one process on a busy 2-core machine, helper / copies = 1.21 (castle) and 1.15
 (city) over 8 rounds, 1.00 and 1.21 over 16: still slower, so the copies stay.
-:func:`_propagate1` is a third copy, for domains of one word (``K <= 64``: castle, city),
-which :func:`_propagate` hands over to (inlined like it, with the same slice table): with
-the words in registers, Alg. 3.4's blocks on castle (K = 62) took 25% less time (A/B in one
-process, 10 alternating rounds); again after :func:`_propagate` was inlined with byte
-slices, castle 300x300x10 streamed took 1.18 s of CPU against 1.56 s without the hand-over
-(medians of 5 alternating rounds in one process), the same bytes. Domains of more words
-go to :func:`_propagate_w`, compiled once with ``W = 2`` (:func:`_propagate_w2`, 65-128
-labels: the overlapping model's patterns, city) and once for any ``W``
-(:func:`_propagate_wn`). The step loop of Alg. 3.1 (:func:`_alg31_loop`) and those two
+Domains of one word (``K <= 64``: castle) go to :func:`_propagate_w` compiled with
+``W = 1`` (:func:`_propagate_w1`), two words to the same loop compiled with ``W = 2``
+(:func:`_propagate_w2`, 65-128 labels: the overlapping model's patterns, city), and any
+other number of words to it with ``W`` read from the array (:func:`_propagate_wn`): with
+``W`` a constant its word loops unroll. A hand-written copy for one word held in registers
+(``_propagate1``) was once 25% faster than the loop over ``W`` words; against the loop
+compiled with ``W = 1`` it measured the same (castle 300x300x10 via blocks, 5 alternating
+runs each: medians 2.05 s and 2.03 s of CPU; castle and pillar by catalog the same within
+noise; the same bytes), so it went. The step loop of Alg. 3.1 (:func:`_alg31_loop`) and those two
 are compiled without numba's reference counting (``_nrt=False``: they allocate nothing).
 """
 
@@ -450,17 +450,17 @@ def _propagate(
     counted references to its 30 arrays and allocated its buffers: inlined with the
     caller's buffers, a 48x48 overlapping run took 5% less time).
 
-    Domains of one word go to :func:`_propagate1`; two words (65-128 labels) run
-    :func:`_propagate_w` with ``W`` the constant 2, so its word loops unroll: the kernel of a
+    Domains of one or two words (up to 128 labels) run :func:`_propagate_w` with ``W``
+    the constant 1 or 2, so its word loops unroll: the kernel of a
     48x48 overlapping run of the sample (K=69) took 0.89 of the time with ``W`` read from
     the array (A/B in one process, 600 runs each, the same outputs).
     """
     W = dom.shape[1]
     if W == 1:
-        return _propagate1(
+        return _propagate_w1(
             dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, nstart, stats,
             heap, hpos, hkey, hsize, noise, weights, wlogw, wclass, weighted, sw, swl, nib,
-            dirty, isdirty, accs,
+            dirty, isdirty, (acc, rem, accs),
         )  # fmt: skip
     # the buffers travel as one tuple: CPython compiles a call of more than 30 arguments
     # to f(*args), which numba cannot compile
@@ -477,11 +477,29 @@ def _propagate(
     )  # fmt: skip
 
 
-# The loop of two words and the loop of any number of words are compiled once each, called
+# The loops of one word, two words and any number of words are compiled once each, called
 # (not inlined) by every caller of _propagate: inlined, each caller compiled three copies
 # of the loop and the first run after a change of this file took 2.4 times the CPU time
 # to compile. Compiled without numba's reference counting (``_nrt=False``; they allocate
 # nothing): a call then costs no atomic count per array argument.
+@njit(cache=True, _nrt=False)
+def _propagate_w1(
+    dom: np.ndarray, prev: np.ndarray, full: np.ndarray, ptr: np.ndarray, nbr: np.ndarray,
+    sidx: np.ndarray, sup: np.ndarray, supall: np.ndarray, queue: np.ndarray,
+    inq: np.ndarray, start: np.ndarray, nstart: int, stats: np.ndarray, heap: np.ndarray,
+    hpos: np.ndarray, hkey: np.ndarray, hsize: int, noise: np.ndarray, weights: np.ndarray,
+    wlogw: np.ndarray, wclass: np.ndarray, weighted: bool, sw: np.ndarray, swl: np.ndarray,
+    nib: np.ndarray, dirty: np.ndarray, isdirty: np.ndarray,
+    bufs: tuple[np.ndarray, np.ndarray, np.ndarray],
+) -> int:  # fmt: skip
+    """:func:`_propagate_w` for domains of one word."""
+    return _propagate_w(
+        dom, prev, full, ptr, nbr, sidx, sup, supall, queue, inq, start, nstart, stats,
+        heap, hpos, hkey, hsize, noise, weights, wlogw, wclass, weighted, sw, swl, nib,
+        dirty, isdirty, bufs, 1,
+    )  # fmt: skip
+
+
 @njit(cache=True, _nrt=False)
 def _propagate_w2(
     dom: np.ndarray, prev: np.ndarray, full: np.ndarray, ptr: np.ndarray, nbr: np.ndarray,
@@ -803,237 +821,6 @@ def _propagate_w(
         inq[q] = False
         for w in range(W):
             prev[q, w] = 0
-        head += 1
-        if head == n:
-            head = 0
-        count -= 1
-    return wiped
-
-
-@njit(cache=True, inline="always")
-def _propagate1(
-    dom: np.ndarray,
-    prev: np.ndarray,
-    full: np.ndarray,
-    ptr: np.ndarray,
-    nbr: np.ndarray,
-    sidx: np.ndarray,
-    sup: np.ndarray,
-    supall: np.ndarray,
-    queue: np.ndarray,
-    inq: np.ndarray,
-    start: np.ndarray,
-    nstart: int,
-    stats: np.ndarray,
-    heap: np.ndarray,
-    hpos: np.ndarray,
-    hkey: np.ndarray,
-    hsize: int,
-    noise: np.ndarray,
-    weights: np.ndarray,
-    wlogw: np.ndarray,
-    wclass: np.ndarray,
-    weighted: bool,
-    sw: np.ndarray,
-    swl: np.ndarray,
-    nib: np.ndarray,
-    dirty: np.ndarray,
-    isdirty: np.ndarray,
-    accs: np.ndarray,
-) -> int:
-    """:func:`_propagate` for domains of one word (``K <= 64``): the same queue, revisions,
-    slice table, counts and heap updates, the words held in registers instead of arrays of
-    ``W`` (a copy on purpose, see the module docstring). ``accs`` (``nib.shape[2]``) is a
-    scratch buffer of the caller."""
-    n = dom.shape[0]
-    head = 0
-    tail = 0
-    count = 0
-    for i in range(nstart):
-        c = start[i]
-        if not inq[c]:
-            inq[c] = True
-            queue[tail] = c
-            tail += 1
-            if tail == n:
-                tail = 0
-            count += 1
-    J = nib.shape[0]
-    B = nib.shape[1]
-    lb = 4 if B == 16 else 8
-    sh = 2 if B == 16 else 3
-    SW = nib.shape[2]
-    fullw = full[0]
-    zero = np.uint64(0)
-    wiped = -1
-    ndirty = 0
-    while count > 0:
-        u = queue[head]
-        head += 1
-        if head == n:
-            head = 0
-        count -= 1
-        inq[u] = False
-        stats[0] += 1
-        du = dom[u, 0]
-        pu = prev[u, 0]
-        isfull = du == fullw
-        known = pu != zero
-        nd = popcount64(du)
-        rem = pu & ~du
-        nr = popcount64(rem)
-        if known and nr == 0:
-            continue
-        use_delta = known and nr < nd and (J == 0 or 16 * nr <= J)
-        prev[u, 0] = du
-        tabled = J > 0 and not use_delta and not isfull
-        if use_delta and J > 0:
-            for q in range(SW):
-                accs[q] = 0
-            x = rem
-            while x:
-                a = ctz64(x)
-                x &= x - np.uint64(1)
-                for q in range(SW):
-                    accs[q] |= nib[a >> sh, 1 << (a & (lb - 1)), q]
-        if tabled and SW <= 8:
-            a0 = zero
-            a1 = zero
-            a2 = zero
-            a3 = zero
-            a4 = zero
-            a5 = zero
-            a6 = zero
-            a7 = zero
-            for j in range(J):
-                x = (du >> np.uint64(j * lb)) & np.uint64(B - 1)
-                if x:
-                    a0 |= nib[j, x, 0]
-                    if SW > 1:
-                        a1 |= nib[j, x, 1]
-                    if SW > 2:
-                        a2 |= nib[j, x, 2]
-                    if SW > 3:
-                        a3 |= nib[j, x, 3]
-                    if SW > 4:
-                        a4 |= nib[j, x, 4]
-                    if SW > 5:
-                        a5 |= nib[j, x, 5]
-                    if SW > 6:
-                        a6 |= nib[j, x, 6]
-                    if SW > 7:
-                        a7 |= nib[j, x, 7]
-            accs[0] = a0
-            if SW > 1:
-                accs[1] = a1
-            if SW > 2:
-                accs[2] = a2
-            if SW > 3:
-                accs[3] = a3
-            if SW > 4:
-                accs[4] = a4
-            if SW > 5:
-                accs[5] = a5
-            if SW > 6:
-                accs[6] = a6
-            if SW > 7:
-                accs[7] = a7
-        elif tabled:
-            for q in range(SW):
-                accs[q] = 0
-            for j in range(J):
-                x = (du >> np.uint64(j * lb)) & np.uint64(B - 1)
-                if x:
-                    for q in range(SW):
-                        accs[q] |= nib[j, x, q]
-        for e in range(ptr[u], ptr[u + 1]):
-            v = nbr[e]
-            s = sidx[e]
-            if use_delta:
-                if J > 0:
-                    acc = accs[s]
-                else:
-                    acc = zero
-                    x = rem
-                    while x:
-                        a = ctz64(x)
-                        x &= x - np.uint64(1)
-                        acc |= sup[s, a, 0]
-                x = dom[v, 0] & acc
-                keep = ~x
-                while x:
-                    cbit = x & (~x + np.uint64(1))
-                    c = ctz64(x)
-                    x ^= cbit
-                    if du & sup[s ^ 1, c, 0]:
-                        keep |= cbit
-                acc = keep
-            elif isfull:
-                acc = supall[s, 0]
-            elif tabled:
-                acc = accs[s]
-            else:
-                acc = zero
-                dv = dom[v, 0]
-                covered = False
-                x = du
-                while x:
-                    a = ctz64(x)
-                    x &= x - np.uint64(1)
-                    acc |= sup[s, a, 0]
-                    if not (dv & ~acc):
-                        covered = True
-                        break
-                if covered:
-                    continue
-            old = dom[v, 0]
-            new = old & acc
-            if new != old:
-                stats[1] += popcount64(old ^ new)
-                dom[v, 0] = new
-                inheap = hsize > 0 and hpos[v] >= 0 and hpos[v] < hsize
-                if inheap and weighted and sw.shape[0] > 0:
-                    r = wrow(wclass, v)
-                    s1 = sw[v]
-                    s2 = swl[v]
-                    x = old & ~new
-                    while x:
-                        a = ctz64(x)
-                        x &= x - np.uint64(1)
-                        s1 -= weights[r, a]
-                        s2 -= wlogw[r, a]
-                    sw[v] = s1
-                    swl[v] = s2
-                if not new:
-                    wiped = v
-                    break
-                if inheap and not isdirty[v]:
-                    isdirty[v] = True
-                    dirty[ndirty] = v
-                    ndirty += 1
-                if not inq[v]:
-                    inq[v] = True
-                    queue[tail] = v
-                    tail += 1
-                    if tail == n:
-                        tail = 0
-                    count += 1
-        if wiped >= 0:
-            break
-    for i in range(ndirty):
-        v = dirty[i]
-        isdirty[v] = False
-        if wiped < 0:
-            if weighted and sw.shape[0] > 0 and sw[v] > 1e-12:
-                k = np.log(sw[v]) - swl[v] / sw[v] + 1e-6 * noise[v]
-            else:
-                r = wrow(wclass, v)
-                k = entropy_of(dom, v, weights[r], wlogw[r], weighted) + 1e-6 * noise[v]
-            heap_update(heap, hpos, hkey, hsize, v, k)
-    while count > 0:
-        q = queue[head]
-        inq[q] = False
-        prev[q, 0] = 0
         head += 1
         if head == n:
             head = 0

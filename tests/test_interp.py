@@ -152,7 +152,7 @@ def test_alg31_same_as_kernels_on_builtins(engine, name, shape, kw):
 
 @pytest.mark.parametrize(
     "name,shape,kw",
-    [("fig3_10", (9, 11), {}),  # one word per domain: the kernels' _propagate1
+    [("fig3_10", (9, 11), {}),  # one word per domain: the kernels' _propagate_w1
      ("city", (6, 6, 4), {"boundary": "auto"})],  # K = 119, two words: _propagate's loops
 )  # fmt: skip
 def test_propagate_same_as_kernels_on_random_catalogs(engine, name, shape, kw):
