@@ -424,8 +424,7 @@ def _check_closed(
     maps = None
     if classes:  # per set of open axes (a bit mask), label -> class; -1 (padding) kept
         maps = np.full((1 << ndim, len(fwd[0]) + 1), -1, dtype=np.int64)
-        for m in range(1 << ndim):
-            maps[m, :-1] = _class_of(fwd, used, frozenset(d for d in range(ndim) if m >> d & 1))
+        maps[:, :-1] = _class_maps(fwd, used)
     nstates = _check_states(configs, plans, fwd, bwd, used, memo, maps)
     return _closed_message(cert, nstates, len(configs), region, back, classes)
 
@@ -1249,19 +1248,13 @@ def _check_lean(
     fwd, _, used, ndim, face_rules = rules
     K = len(fwd[0])
     configs = cert["configs"]
-    class_maps: dict[int, list[int]] = {}
     ident = list(range(K))
+    # per set of open axes (a bit mask): label -> its class (every label its own without
+    # classes)
+    cls = _class_maps(fwd, used).__getitem__ if classes else lambda m: ident
 
-    def cls(m: int) -> list[int]:
-        if not classes:
-            return ident
-        got_m = class_maps.get(m)
-        if got_m is None:
-            got_m = class_maps[m] = _class_of(fwd, used, frozenset(_bits(m)))
-        return got_m
-
-    # per class map (by its open axes): a set of labels -> the set of their classes
-    class_sets: dict[int, dict[int, int]] = {}
+    # per class map (by its open axes): the map, and a set of labels -> the set of their classes
+    pick_sets: dict[int, tuple[list[int], dict[int, int]]] = {}
     ac = _LeanAC(rules, memo, classes)
     cap = max(memo.cap, 1)
     plain = not face_rules and not memo.dead
@@ -1317,6 +1310,8 @@ def _check_lean(
         raise _Invalid("a state's step or labels are not integers")
     flat = set(itertools.chain.from_iterable(rows))
     as_int = bool(set(map(type, flat)) - {int})  # numpy integers: Python ints (shifts)
+    # numpy integers as steps or labels: the states as Python ints (shifts, keys)
+    convert = as_int or bool(set(map(type, (s[0] for s in every))) - {int})
     if as_int or not in_use.issuperset(flat):
         for c in configs:
             lo, hi = c["lower"], c["upper"]
@@ -1325,25 +1320,32 @@ def _check_lean(
     total = len(every)
     for (lo, hi, _), members in by_frame.items():
         fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes, fwd, cls)
-        n, coords, keys = fr.n, fr.coords, fr.keys
+        n, coords = fr.n, fr.coords
         ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
-        widths = [len(k) for k in keys]
-        # per step: the neighbours' slots and support tables, the kept labels' slots and
-        # class maps, the chosen label's class map and its sets of classes (None: the
-        # next state does not record it)
-        plans: list[tuple[Any, ...]] = []
-        for near, keeps, chosen in zip(fr.near, fr.kept, fr.chosen, strict=True):
+        widths = [len(k) for k in fr.keys]
+        # per step: the neighbours' slots and support tables (``near``); the next state's
+        # kept labels as (slot, class map) pairs; whether the next state records the label
+        # chosen here (last), and then the chosen label's class map and its sets of classes
+        near_of = fr.near
+        keep_of = fr.kept
+        pick_of: list[list[int]] = []
+        sets_of: list[dict[int, int] | None] = []
+        for chosen in fr.chosen:
             if chosen >= 0:
                 op = chosen if classes else 0
-                pick, sets = cls(op), class_sets.get(op)
-                if sets is None:
-                    sets = class_sets[op] = {}
+                ps = pick_sets.get(op)
+                if ps is None:
+                    ps = pick_sets[op] = (cls(op), {})
+                pick_of.append(ps[0])
+                sets_of.append(ps[1])
             else:
-                pick, sets = ident, None
-            # the kept labels as the next state holds them, by the labels of their slots
-            get = operator.itemgetter(*[k for k, _ in keeps]) if keeps else None
-            plans.append((near, keeps, pick, sets, get, {}))
-        exact = classes and fr.free[-1] == 1 << (n - 1)
+                pick_of.append(ident)
+                sets_of.append(None)
+        # a state at step i is recorded by its labels but the last (-> the set of last
+        # labels) when step i - 1 records its chosen label, else by all its labels
+        split = [False, *[s is not None for s in sets_of[:-1]]]
+        last = n - 1
+        exact = classes and fr.free[-1] == 1 << last
         # the states checked in this frame, by the domains of its cells: a configuration
         # with the same frame, domains and states (its positions on the faces differ) is
         # the same check, with the same outcome
@@ -1379,78 +1381,80 @@ def _check_lean(
             if any(states == other for other in same):
                 continue
             same.append(states)
-            # the states by step, checked for their form
-            by_step: list[list[Sequence[int]]] = [[] for _ in range(n)]
+            if convert:
+                states = [(int(i), tuple(map(int, labs))) for i, labs in states]
+            # the states checked for their form and recorded: (step, labels) -> 0, or with
+            # ``split``, (step, labels but the last) -> the set of last labels
+            rec: dict[tuple[int, ...], int] = {}
             for i, labs in states:
                 if not 0 <= i < n:
                     raise _Invalid(f"{_where(lo, hi)}: a state's step is not one of its {n} steps")
                 if len(labs) != widths[i]:
                     raise _Invalid(f"{_where(lo, hi)}: a state at step {i} does not fit keys[{i}]")
-                by_step[int(i)].append(tuple(map(int, labs)) if as_int else labs)
-            if not by_step[0]:
-                raise _Invalid(f"{_where(lo, hi)}: no start state")
-            # closed: each state's labels lead to recorded states; the point's catalog
-            near_t = plans[n - 1][0]
-            b0 = base[n - 1]
-            for labs in by_step[n - 1]:
-                fc = b0
-                for k, t in near_t:
-                    fc &= t[labs[k]]
-                if fc and not exact:
-                    fc = ac.catalog(fr, n - 1, labs, base)
-                if not fc:
-                    raise _Invalid(f"{_where(lo, hi)}: the point's catalog is empty in state "
-                                   f"{[n - 1, list(labs)]}")  # fmt: skip
-            later = by_step[n - 1]
-            for i in range(n - 2, -1, -1):
-                near_t, maps, pick, sets, get, kept_of = plans[i]
-                # the next step's states (by their labels but the last: its bits, if chosen)
-                if sets is not None:
-                    nxt: Any = {}
-                    for labs in later:
-                        head = tuple(labs[:-1])
-                        nxt[head] = nxt.get(head, 0) | 1 << labs[-1]
+                if split[i]:
+                    key = (i, *labs[:-1])
+                    rec[key] = rec.get(key, 0) | 1 << labs[-1]
                 else:
-                    nxt = set(map(tuple, later))
-                later = here = by_step[i]
-                b0 = base[i]
-                for labs in here:
-                    fc = b0
-                    for k, t in near_t:
-                        fc &= t[labs[k]]
+                    rec[i, *labs] = 0
+            if (0,) not in rec:
+                raise _Invalid(f"{_where(lo, hi)}: no start state")
+            # closed: each state's labels lead to recorded states; the point's catalog is
+            # never empty. The first defect reported is the first of the point's states,
+            # else the first at the latest step (in file order)
+            bad: tuple[int, str] | None = None
+            for i, labs in states:
+                fc = base[i]
+                for k, t in near_of[i]:
+                    fc &= t[labs[k]]
+                if i == last:
+                    if fc and not exact:
+                        fc = ac.catalog(fr, i, labs, base)
                     if not fc:
+                        raise _Invalid(f"{_where(lo, hi)}: the point's catalog is empty in "
+                                       f"state {[i, list(labs)]}")  # fmt: skip
+                    continue
+                if not fc:
+                    continue
+                # the next state's key: the kept labels by class (one or two spelled out)
+                kp = keep_of[i]
+                if len(kp) == 1:
+                    ((k, m),) = kp
+                    key = (i + 1, m[labs[k]])
+                elif len(kp) == 2:
+                    (k, m), (k1, m1) = kp
+                    key = (i + 1, m[labs[k]], m1[labs[k1]])
+                else:
+                    key = (i + 1, *[m[labs[k]] for k, m in kp])
+                sets = sets_of[i]
+                if sets is not None:
+                    pick = pick_of[i]
+                    want = sets.get(fc)
+                    if want is None:
+                        want = 0
+                        for b in _bits(fc):
+                            want |= 1 << pick[b]
+                        sets[fc] = want
+                    avail = rec.get(key, 0)
+                    if not want & ~avail:
                         continue
-                    if get is None:
-                        kept = ()
-                    else:
-                        raw = get(labs)
-                        kept = kept_of.get(raw)
-                        if kept is None:
-                            kept = kept_of[raw] = tuple([m[labs[k]] for k, m in maps])
-                    if sets is not None:
-                        want = sets.get(fc)
-                        if want is None:
-                            want = 0
-                            for b in _bits(fc):
-                                want |= 1 << pick[b]
-                            sets[fc] = want
-                        avail = nxt.get(kept, 0)
-                        miss = 0
-                        if want & ~avail:
-                            for b in _bits(fc):
-                                if not avail >> pick[b] & 1:
-                                    miss |= 1 << b
-                    else:
-                        miss = 0 if kept in nxt else fc
-                    if miss:
-                        miss &= ac.catalog(fr, i, labs, base)
+                    miss = 0
+                    for b in _bits(fc):
+                        if not avail >> pick[b] & 1:
+                            miss |= 1 << b
+                elif key in rec:
+                    continue
+                else:
+                    miss = fc
+                if bad is None or -i < bad[0]:
+                    miss &= ac.catalog(fr, i, labs, base)
                     if miss:
                         b = (miss & -miss).bit_length() - 1
-                        nx = [*kept, pick[b]] if sets is not None else list(kept)
-                        raise _Invalid(
-                            f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} with "
-                            f"label {b} leads to {[i + 1, nx]}, which is missing"
-                        )
+                        nx = [*key[1:], pick[b]] if sets is not None else list(key[1:])
+                        bad = (-i, f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} "
+                                   f"with label {b} leads to {[i + 1, nx]}, which is missing")
+            if bad is not None:
+                # (every point state was checked: the point's defects come first)
+                raise _Invalid(bad[1])
     return total
 
 
@@ -1532,12 +1536,24 @@ def _is_int(x: Any) -> bool:
 # ----------------------------------------------------------------------------- label classes
 
 
-def _class_of(fwd: list[list[int]], used: int, ax: frozenset[int]) -> list[int]:
-    """Label -> the least label in use with the same ``fwd[d]`` for every ``d`` in ``ax``."""
-    # each label's forward supports along the axes of ``ax`` (one row per label)
-    rows = list(zip(*[fwd[d] for d in sorted(ax)], strict=True)) if ax else [()] * len(fwd[0])
-    first: dict[tuple[int, ...], int] = {}
-    return [first.setdefault(r, a) if used >> a & 1 else a for a, r in enumerate(rows)]
+def _class_maps(fwd: list[list[int]], used: int) -> list[list[int]]:
+    """Per set of axes (a bit mask ``m``: axis ``d`` when ``m >> d & 1``), label -> the least
+    label in use with the same ``fwd[d]`` for every ``d`` in the set (a label out of use
+    maps to itself)."""
+    K = len(fwd[0])
+    # each label's forward supports along the axes of the set, as nested pairs: the set
+    # without its highest axis, then that axis
+    rows: list[list[Any]] = [[()] * K]
+    maps = []
+    for m in range(1 << len(fwd)):
+        if m:
+            d = m.bit_length() - 1
+            t, prev = fwd[d], rows[m ^ 1 << d]
+            rows.append([(prev[a], t[a]) for a in range(K)])
+        first: dict[Any, int] = {}
+        maps.append([first.setdefault(r, a) if used >> a & 1 else a
+                     for a, r in enumerate(rows[m])])  # fmt: skip
+    return maps
 
 
 # ----------------------------------------------------------------------------- dead labels
