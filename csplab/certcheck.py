@@ -1253,8 +1253,9 @@ def _check_lean(
     # classes)
     cls = _class_maps(fwd, used).__getitem__ if classes else lambda m: ident
 
-    # per class map (by its open axes): the map, and a set of labels -> the set of their classes
-    pick_sets: dict[int, tuple[list[int], dict[int, int]]] = {}
+    # per chosen label's open axes (a bit mask; -1: not recorded): its class map, and a set
+    # of labels -> the set of their classes
+    pick_sets: dict[int, tuple[list[int], dict[int, int] | None]] = {-1: (ident, None)}
     ac = _LeanAC(rules, memo, classes)
     cap = max(memo.cap, 1)
     plain = not face_rules and not memo.dead
@@ -1321,29 +1322,18 @@ def _check_lean(
     for (lo, hi, _), members in by_frame.items():
         fr = _lean_frame(lo, hi, members[0][0]["keys"], region, back, axes, fwd, cls)
         n, coords = fr.n, fr.coords
-        ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
-        widths = [len(k) for k in fr.keys]
+        widths = list(map(len, fr.keys))
         # per step: the neighbours' slots and support tables (``near``); the next state's
-        # kept labels as (slot, class map) pairs; whether the next state records the label
-        # chosen here (last), and then the chosen label's class map and its sets of classes
+        # kept labels as (slot, class map) pairs; the chosen label's class map and its sets
+        # of classes, when the next state records it (last), else None
         near_of = fr.near
         keep_of = fr.kept
-        pick_of: list[list[int]] = []
-        sets_of: list[dict[int, int] | None] = []
-        for chosen in fr.chosen:
-            if chosen >= 0:
-                op = chosen if classes else 0
-                ps = pick_sets.get(op)
-                if ps is None:
-                    ps = pick_sets[op] = (cls(op), {})
-                pick_of.append(ps[0])
-                sets_of.append(ps[1])
-            else:
-                pick_of.append(ident)
-                sets_of.append(None)
+        for c in set(fr.chosen) - pick_sets.keys():
+            pick_sets[c] = (cls(c), {})
+        pick_of, sets_of = zip(*map(pick_sets.__getitem__, fr.chosen), strict=True)
         # a state at step i is recorded by its labels but the last (-> the set of last
         # labels) when step i - 1 records its chosen label, else by all its labels
-        split = [False, *[s is not None for s in sets_of[:-1]]]
+        split = [False, *[c >= 0 for c in fr.chosen[:-1]]]
         last = n - 1
         exact = classes and fr.free[-1] == 1 << last
         # the states checked in this frame, by the domains of its cells: a configuration
@@ -1355,6 +1345,7 @@ def _check_lean(
             if plain:
                 base = [used] * len(coords)
             else:
+                ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
                 per, faces, fars = [], [], []
                 for d in axes:  # in scan order: the products below run as the cells do
                     sig = (d, ext[d], at_lo[d], at_hi[d], cap)
@@ -1377,10 +1368,11 @@ def _check_lean(
                         if far in dead_far:
                             base[x] = cell_doms[it] if it in cell_doms else cell_dom(it)
             states = conf["states"]
-            same = checked.setdefault(tuple(base), [])
-            if any(states == other for other in same):
-                continue
-            same.append(states)
+            if len(members) > 1:
+                same = checked.setdefault(tuple(base), [])
+                if any(states == other for other in same):
+                    continue
+                same.append(states)
             if convert:
                 states = [(int(i), tuple(map(int, labs))) for i, labs in states]
             # the states checked for their form and recorded: (step, labels) -> 0, or with
