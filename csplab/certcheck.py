@@ -325,33 +325,33 @@ def _positions(
     """The region, back and axes of an *infallible* certificate (its history checked), and its
     configurations ``(lower, upper, at_lower, at_upper)`` in file order, checked to be
     exactly the positions of a point in the region (each once)."""
-    region = [int(t) for t in cert["region"]]
-    history = [int(t) for t in cert["history"]]
-    axes = tuple(int(a) for a in cert["axes"])
-    if len(region) != ndim or len(history) != ndim or any(r < 2 for r in region):
+    region = list(map(int, cert["region"]))
+    history = list(map(int, cert["history"]))
+    axes = tuple(map(int, cert["axes"]))
+    if len(region) != ndim or len(history) != ndim or min(region) < 2:
         raise _Invalid("region needs at least 2 cells on every axis of the rules")
-    if any(h < 0 for h in history):
+    if min(history) < 0:
         raise _Invalid("history must be non-negative")
-    back = [int(t) for t in cert.get("back", [1] * ndim)]
-    if len(back) != ndim or any(b < 1 for b in back):
+    back = list(map(int, cert.get("back", [1] * ndim)))
+    if len(back) != ndim or min(back) < 1:
         raise _Invalid("back needs a value of at least 1 on every axis")
     if _axes_of(str(cert["order"]), ndim) != axes:
         raise _Invalid("axes do not match the order")
     both = (False, True) if face_rules else (False,)
 
-    def sides(extent: list[int], exact: list[int]) -> set[tuple[Any, ...]]:
+    def sides(exact: list[int]) -> set[tuple[Any, ...]]:
         # per axis the pairs (distance, edge on the face): on the face when the region is
-        # clipped there (distance below ``exact``), either way otherwise
-        per = [[(v, a) for v in range(e) for a in ((True,) if v < x else both)]
-               for e, x in zip(extent, exact, strict=True)]  # fmt: skip
-        return {(*zip(*p, strict=True),) for p in itertools.product(*per)}
+        # clipped there (distance below ``exact``), either way at ``exact`` ("at least");
+        # the distances and the flags of every position run through two products in step
+        dists = [range(x + 1) if len(both) == 1 else [*range(x), x, x] for x in exact]
+        flags = [[True] * x + [*both] for x in exact]
+        return set(zip(itertools.product(*dists), itertools.product(*flags), strict=True))
 
-    lows = sides([1 + b + h for b, h in zip(back, history, strict=True)],
-                 [b + h for b, h in zip(back, history, strict=True)])  # fmt: skip
-    highs = sides([r - 1 for r in region], [r - 2 for r in region])
-    # without at_lower / at_upper, an edge is on the face when the region is clipped there
+    # the distances below which the region is clipped at the lower and the upper edges
     near_lo = [b + h for b, h in zip(back, history, strict=True)]
     near_hi = [r - 2 for r in region]
+    lows, highs = sides(near_lo), sides(near_hi)
+    # without at_lower / at_upper, an edge is on the face when the region is clipped there
     defaults: tuple[dict[Any, tuple[bool, ...]], ...] = ({}, {})
 
     def on_face(v: tuple[Any, ...], upper: int) -> tuple[bool, ...]:
