@@ -93,7 +93,7 @@ import itertools
 import json
 import math
 import operator
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -305,6 +305,10 @@ def _bits(x: int) -> Iterator[int]:
         x ^= low
 
 
+# per bit mask of axes, the set of its axes
+_AXIS_SETS = [frozenset(_bits(m)) for m in range(1 << len(_AXES))]
+
+
 def _axes_of(order: str, ndim: int) -> tuple[int, ...]:
     if order == "scanline":
         return tuple(range(ndim))
@@ -427,7 +431,7 @@ def _check_closed(
     if classes:  # per set of open axes (a bit mask), label -> class; -1 (padding) kept
         maps = np.full((1 << ndim, len(fwd[0]) + 1), -1, dtype=np.int64)
         for m in range(1 << ndim):
-            maps[m, :-1] = _class_of(fwd, used, frozenset(d for d in range(ndim) if m >> d & 1))
+            maps[m, :-1] = _class_of(fwd, used, _AXIS_SETS[m])
     nstates = _check_states(configs, plans, fwd, bwd, used, memo, maps)
     return _closed_message(cert, nstates, len(configs), region, back, classes)
 
@@ -1279,7 +1283,7 @@ def _check_lean(
             return ident
         got_m = class_maps.get(m)
         if got_m is None:
-            got_m = class_maps[m] = _class_of(fwd, used, frozenset(_bits(m)))
+            got_m = class_maps[m] = _class_of(fwd, used, _AXIS_SETS[m])
         return got_m
 
     # per class map (by its open axes): a set of labels -> the set of their classes
@@ -1556,9 +1560,15 @@ def _is_int(x: Any) -> bool:
 
 def _class_of(fwd: list[list[int]], used: int, ax: frozenset[int]) -> list[int]:
     """Label -> the least label in use with the same ``fwd[d]`` for every ``d`` in ``ax``."""
-    # each label's forward supports along the axes of ``ax`` (one row per label)
-    rows = list(zip(*[fwd[d] for d in sorted(ax)], strict=True)) if ax else [()] * len(fwd[0])
-    first: dict[tuple[int, ...], int] = {}
+    if not ax:  # every label in use is of one class
+        least = (used & -used).bit_length() - 1
+        return [least if used >> a & 1 else a for a in range(len(fwd[0]))]
+    # each label's forward supports along the axes of ``ax`` (one row per label; along
+    # one axis, the support bitset itself)
+    rows: Iterable[Any] = (
+        fwd[next(iter(ax))] if len(ax) == 1 else zip(*[fwd[d] for d in sorted(ax)], strict=True)
+    )
+    first: dict[Any, int] = {}
     return [first.setdefault(r, a) if used >> a & 1 else a for a, r in enumerate(rows)]
 
 
