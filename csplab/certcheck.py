@@ -134,9 +134,11 @@ def rules_hash(rules: Mapping[str, Any]) -> str:
     >>> rules_hash({"labels": 1, "used": [1], "pairs": [[[0, 0]]]})[:12]
     '2d2bbe2d9229'
     """
-    return hashlib.sha256(
-        json.dumps(rules, sort_keys=True, separators=(",", ":")).encode()
-    ).hexdigest()
+    return hashlib.sha256(_RULES_JSON.encode(rules).encode()).hexdigest()
+
+
+# compact JSON with sorted keys, as ``json.dumps(..., sort_keys=True, separators=(",", ":"))``
+_RULES_JSON = json.JSONEncoder(sort_keys=True, separators=(",", ":"))
 
 
 def load_certificate(path: str | Path) -> dict[str, Any]:
