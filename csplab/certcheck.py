@@ -1187,7 +1187,8 @@ def _lean_frame(
     # the ranks: a block of ``t`` ranks per layer, repeated every ``t * e`` ranks) and the
     # axes on which the cell's + neighbour is in the frame (``opn``)
     full = (1 << s) - 1
-    boxes, opn = [full], [0]
+    boxes: list[int] = []
+    opn: list[int] = []
     for d, t, e, _ in live:
         r, b = region[d] - 2, back[d]
         rep = full // ((1 << t * e) - 1)
@@ -1195,11 +1196,13 @@ def _lean_frame(
             ((1 << (v + r + 1 if v + r < e else e) * t) - (1 << (v - b if v > b else 0) * t))
             * rep for v in range(e)
         ]  # fmt: skip
-        boxes = [box & w for box in boxes for w in win]
+        boxes = [box & w for box in boxes for w in win] if boxes else win
         if n > 1:
             row = [1 << d] * (e - 1)
             row.append(0)
-            opn = [o | p for o in opn for p in row]
+            opn = [o | p for o in opn for p in row] if opn else row
+    if not live:  # a frame of one cell
+        boxes, opn = [full], [0]
     del boxes[n:]
     frees = [box >> i << i for i, box in enumerate(boxes)]  # the cells not yet labelled
     # a labelled cell of the region bordering one not yet labelled must be recorded: of
