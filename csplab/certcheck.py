@@ -106,6 +106,8 @@ __all__ = ["check_certificate", "load_certificate", "rules_hash"]
 FORMAT = "csplab-certificate"
 VERSION = 1
 _AXES = "xyzw"
+# the scan order of each number of axes
+_SCANLINE = [tuple(range(k)) for k in range(len(_AXES) + 1)]
 
 Cell = tuple[int, ...]
 
@@ -132,9 +134,11 @@ def rules_hash(rules: Mapping[str, Any]) -> str:
     >>> rules_hash({"labels": 1, "used": [1], "pairs": [[[0, 0]]]})[:12]
     '2d2bbe2d9229'
     """
-    return hashlib.sha256(
-        json.dumps(rules, sort_keys=True, separators=(",", ":")).encode()
-    ).hexdigest()
+    return hashlib.sha256(_RULES_JSON.encode(rules).encode()).hexdigest()
+
+
+# compact JSON with sorted keys, as ``json.dumps(..., sort_keys=True, separators=(",", ":"))``
+_RULES_JSON = json.JSONEncoder(sort_keys=True, separators=(",", ":"))
 
 
 def load_certificate(path: str | Path) -> dict[str, Any]:
@@ -323,33 +327,33 @@ def _positions(
     """The region, back and axes of an *infallible* certificate (its history checked), and its
     configurations ``(lower, upper, at_lower, at_upper)`` in file order, checked to be
     exactly the positions of a point in the region (each once)."""
-    region = [int(t) for t in cert["region"]]
-    history = [int(t) for t in cert["history"]]
-    axes = tuple(int(a) for a in cert["axes"])
-    if len(region) != ndim or len(history) != ndim or any(r < 2 for r in region):
+    region = list(map(int, cert["region"]))
+    history = list(map(int, cert["history"]))
+    axes = tuple(map(int, cert["axes"]))
+    if len(region) != ndim or len(history) != ndim or min(region) < 2:
         raise _Invalid("region needs at least 2 cells on every axis of the rules")
-    if any(h < 0 for h in history):
+    if min(history) < 0:
         raise _Invalid("history must be non-negative")
-    back = [int(t) for t in cert.get("back", [1] * ndim)]
-    if len(back) != ndim or any(b < 1 for b in back):
+    back = list(map(int, cert.get("back", [1] * ndim)))
+    if len(back) != ndim or min(back) < 1:
         raise _Invalid("back needs a value of at least 1 on every axis")
     if _axes_of(str(cert["order"]), ndim) != axes:
         raise _Invalid("axes do not match the order")
     both = (False, True) if face_rules else (False,)
 
-    def sides(extent: list[int], exact: list[int]) -> set[tuple[Any, ...]]:
+    def sides(exact: list[int]) -> set[tuple[Any, ...]]:
         # per axis the pairs (distance, edge on the face): on the face when the region is
-        # clipped there (distance below ``exact``), either way otherwise
-        per = [[(v, a) for v in range(e) for a in ((True,) if v < x else both)]
-               for e, x in zip(extent, exact, strict=True)]  # fmt: skip
-        return {(*zip(*p, strict=True),) for p in itertools.product(*per)}
+        # clipped there (distance below ``exact``), either way at ``exact`` ("at least");
+        # the distances and the flags of every position run through two products in step
+        dists = [range(x + 1) if len(both) == 1 else [*range(x), x, x] for x in exact]
+        flags = [[True] * x + [*both] for x in exact]
+        return set(zip(itertools.product(*dists), itertools.product(*flags), strict=True))
 
-    lows = sides([1 + b + h for b, h in zip(back, history, strict=True)],
-                 [b + h for b, h in zip(back, history, strict=True)])  # fmt: skip
-    highs = sides([r - 1 for r in region], [r - 2 for r in region])
-    # without at_lower / at_upper, an edge is on the face when the region is clipped there
+    # the distances below which the region is clipped at the lower and the upper edges
     near_lo = [b + h for b, h in zip(back, history, strict=True)]
     near_hi = [r - 2 for r in region]
+    lows, highs = sides(near_lo), sides(near_hi)
+    # without at_lower / at_upper, an edge is on the face when the region is clipped there
     defaults: tuple[dict[Any, tuple[bool, ...]], ...] = ({}, {})
 
     def on_face(v: tuple[Any, ...], upper: int) -> tuple[bool, ...]:
@@ -1133,39 +1137,34 @@ def _lean_frame(
     """The frame of ``(lower, upper)`` with its ``keys`` verified (the checks of
     :func:`_frame_chunk`, with sets of cells as bit masks over the scan ranks); a
     neighbour's axis is given as its support table ``fwd[d]``, open axes as the class
-    map ``cls`` gives for them."""
+    map ``cls`` gives for them.
+
+    Only the axes along which the frame is at least two cells thick are looked at (along
+    the others a region is the whole frame and a cell has no neighbour), and the cells a
+    step depends on only when a labelled cell of its region is not recorded."""
     ndim = len(lo)
-    ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
-    sc = [0] * ndim
-    s = 1
+    ext = [x + 1 for x in map(operator.add, lo, hi)]
+    # the axes along which the frame is 2+ cells thick, in scan order (outermost first):
+    # (axis, stride in the scan, extent, support table ``fwd[d]``)
+    live: list[tuple[int, int, int, list[int]]] = []
+    s = n = 1
+    bits = 0  # the axes of ``live``
     for d in reversed(axes):
-        sc[d] = s
-        s *= ext[d]
-    n = 1
-    for d in range(ndim):
-        n += lo[d] * sc[d]
+        e = ext[d]
+        n += lo[d] * s
+        if e > 1:
+            live.insert(0, (d, s, e, fwd[d]))
+            bits |= 1 << d
+        s *= e
     if len(keys) != n or keys[0]:
         raise _Invalid(f"{_where(lo, hi)}: keys must list {n} steps, the first empty")
-    scan = itertools.product(*[range(ext[d]) for d in axes])
-    if list(axes) == sorted(axes):
-        coords = list(scan)
+    scanline = axes == _SCANLINE[ndim]
+    if scanline:
+        coords = list(itertools.product(*map(range, ext)))
     else:
         at = [axes.index(d) for d in range(ndim)]
+        scan = itertools.product(*[range(ext[d]) for d in axes])
         coords = [tuple(c[k] for k in at) for c in scan]
-    # per axis, the cells whose coordinate lies in a range a .. b: a block of sc[d] ranks
-    # per coordinate, repeated every sc[d] * ext[d] ranks (``rep``)
-    full = (1 << s) - 1
-    win: list[list[int]] = []  # the region's layers about each layer (clipped)
-    inner = []  # per axis, its stride, all cells but the last layer and but the first
-    for d in range(ndim):
-        e, t, r, b = ext[d], sc[d], region[d] - 2, back[d]
-        rep = full // ((1 << t * e) - 1)
-        win.append([
-            ((1 << (min(v + r, e - 1) - max(v - b, 0) + 1) * t) - 1 << max(v - b, 0) * t) * rep
-            for v in range(e)
-        ])  # fmt: skip
-        layer = (1 << t) - 1
-        inner.append((d, t, full & ~((layer << (e - 1) * t) * rep), full & ~(layer * rep)))
     # keys[i]: sorted earlier steps; keys[i + 1] within keys[i] and step i
     masks = []
     for i, ks in enumerate(keys):
@@ -1178,48 +1177,76 @@ def _lean_frame(
     for i in range(n - 1):
         if masks[i + 1] & ~(masks[i] | 1 << i):
             raise _Invalid(f"{_where(lo, hi)}: keys[{i + 1}] records a label step {i} forgot")
-    # per axis, the cells whose + neighbour is in the frame (open while it is not labelled)
-    plus = [(1 << d, t, not_last) for d, t, not_last, _ in inner]
-    boxes, frees, nears, kepts, chosens = [], [], [], [], []
-    for i in range(n):
+    # per scan rank, built an axis at a time as the ranks run (outermost axis first): the
+    # step's region (the region's layers about the cell's layer, clipped, as masks over
+    # the ranks: a block of ``t`` ranks per layer, repeated every ``t * e`` ranks) and the
+    # axes on which the cell's + neighbour is in the frame (``opn``)
+    full = (1 << s) - 1
+    boxes: list[int] = []
+    opn: list[int] = []
+    for d, t, e, _ in live:
+        r, b = region[d] - 2, back[d]
+        rep = full // ((1 << t * e) - 1)
+        win = [
+            ((1 << (v + r + 1 if v + r < e else e) * t) - (1 << (v - b if v > b else 0) * t))
+            * rep for v in range(e)
+        ]  # fmt: skip
+        boxes = [box & w for box in boxes for w in win] if boxes else win
+        if n > 1:
+            row = [1 << d] * (e - 1)
+            row.append(0)
+            opn = [o | p for o in opn for p in row] if opn else row
+    if not live:  # a frame of one cell
+        boxes, opn = [full], [0]
+    del boxes[n:]
+    frees = [box >> i << i for i, box in enumerate(boxes)]  # the cells not yet labelled
+    # a labelled cell of the region bordering one not yet labelled must be recorded: of
+    # those not recorded (``unrec``), none has a + neighbour not yet labelled in the region
+    # (its - neighbours come before it in the scan)
+    unrec = list(map(operator.and_, boxes, map(operator.invert, map(operator.or_, frees, masks))))
+    if any(unrec):
+        # per axis, its stride and the cells but its first layer
+        inner = [(t, full & ~(((1 << t) - 1) * (full // ((1 << t * e) - 1))))
+                 for _, t, e, _ in live]  # fmt: skip
+        for i, u in enumerate(unrec):
+            if u:
+                free, near_free = frees[i], 0
+                for t, not_first in inner:
+                    near_free |= (free & not_first) >> t
+                miss = u & near_free
+                if miss:
+                    x = coords[(miss & -miss).bit_length() - 1]
+                    raise _Invalid(
+                        f"{_where(lo, hi)}: step {i} depends on cell {list(x)}, not in keys[{i}]"
+                    )
+    # om[g]: the axes whose stride exceeds g (a label recorded g steps back has its +
+    # neighbour along them not yet labelled)
+    om: list[int] = []
+    if n > 2:  # (else no step keeps a label)
+        for d, t, _, _ in reversed(live):
+            om += [bits] * (t - len(om))
+            bits ^= 1 << d
+        om += [0] * (n - len(om))
+    if not scanline:  # the backward neighbours by axis
+        live.sort()
+    nears, kepts, chosens = [], [], []
+    ks = keys[0]
+    for i in range(n - 1):
         c = coords[i]
-        box = -1
-        for d in range(ndim):
-            box &= win[d][c[d]]
-        free = box >> i << i  # the cells of the box not yet labelled (ranks i and up)
-        near_free = 0
-        for _, t, not_last, not_first in inner:
-            near_free |= (free & not_last) << t | (free & not_first) >> t
-        miss = box & near_free & ~masks[i] & ((1 << i) - 1)
-        if miss:
-            x = coords[(miss & -miss).bit_length() - 1]
-            raise _Invalid(
-                f"{_where(lo, hi)}: step {i} depends on cell {list(x)}, not in keys[{i}]"
-            )
-        ks = keys[i]
         # the backward neighbours (in the region: back >= 1), recorded (the miss above)
-        near = []
-        for d, t, _, _ in inner:
-            if c[d]:
-                near.append((ks.index(i - t), fwd[d]))
-        nears.append(near)
-        kept: list[tuple[int, list[int]]] = []
-        chosen = -1
-        if i + 1 < n:
-            for j in keys[i + 1]:
-                # the axes on which j's + neighbour is in the frame, not yet labelled
-                op = 0
-                for bit, t, has in plus:
-                    if j + t > i and has >> j & 1:
-                        op |= bit
-                if j == i:
-                    chosen = op
-                else:
-                    kept.append((ks.index(j), cls(op)))
-        boxes.append(box)
-        frees.append(free)
-        kepts.append(kept)
-        chosens.append(chosen)
+        nears.append([(ks.index(i - t), f) for d, t, _, f in live if c[d]])
+        nk = keys[i + 1]
+        if nk and nk[-1] == i:  # the label chosen here (keys are sorted earlier steps)
+            chosens.append(opn[i])
+            nk = nk[:-1]
+        else:
+            chosens.append(-1)
+        kepts.append([(ks.index(j), cls(opn[j] & om[i - j])) for j in nk])
+        ks = keys[i + 1]
+    c = coords[n - 1]
+    nears.append([(ks.index(n - 1 - t), f) for d, t, _, f in live if c[d]])
+    kepts.append([])
+    chosens.append(-1)
     return _LeanFrame(n, coords, keys, boxes, frees, nears, kepts, chosens)
 
 
