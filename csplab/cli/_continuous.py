@@ -110,14 +110,16 @@ def estimate_peak(
     region (at most 12x12, or 6x6x4 in 3D; a fraction of a second) scaled to ``size`` by
     area (volume), times the bytes per vertex and edge (:data:`BYTES_PER_ELEMENT`).
     Scaling a probe overestimates a little (its border is a larger share). A region no
-    larger than the probe is not estimated (0)."""
+    larger than the probe is not built twice: its estimate is :data:`BASE_BYTES`, the
+    process's own, as every estimate includes (so ``--memory-limit`` bounds small runs
+    too)."""
     import math
 
     dim = len(size)
     probe = tuple(min(s, p) for s, p in zip(size, (12, 12) if dim == 2 else (6, 6, 4), strict=True))
     ratio = math.prod(size) / math.prod(probe)
     if ratio <= 1:
-        return 0.0
+        return BASE_BYTES
     if dim == 2:
         from csplab.continuous.csp import ContinuousCSP
 
@@ -160,7 +162,7 @@ def synthesize(
     boundary = boundary_label(args, example)
     fmt = polygon_output(args.out, gives=type(example).__name__, args=args)
     cls = solver_class(args.solver.partition(":")[0])
-    from csplab.limits import check_memory, memory_budget
+    from csplab.limits import check_memory, fmt_bytes, memory_budget
 
     budget = memory_budget(getattr(args, "memory_limit", None))
     if dim == 2:  # a probe arrangement scaled up; 3D: estimate3 before any arrangement
@@ -169,7 +171,9 @@ def synthesize(
         check_memory(
             need,
             f"{example.name or args.model} --size {'x'.join(map(str, size))}",
-            "use a smaller --size or a larger --spacing",
+            "use a smaller --size or a larger --spacing" if budget >= BASE_BYTES else
+            f"no --size fits in it (the interpreter, numpy and numba alone take about "
+            f"{fmt_bytes(BASE_BYTES)})",
             budget=budget,
         )
     restarts = 0 if cls.complete else args.restarts

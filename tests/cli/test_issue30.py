@@ -302,6 +302,17 @@ def test_row12_estimate_is_not_below_a_measured_peak():
     assert 712e6 <= estimate_peak(load_model("triangle"), (200, 200)) <= 3 * 712e6
 
 
+@pytest.mark.parametrize("limit", ["1e-320", "0.2"])
+def test_row12_memory_limit_bounds_small_polygon_runs(capsys, limit):
+    """A region no larger than the estimate's probe is not built twice, yet --memory-limit
+    still bounds it: every continuous run takes the interpreter's own memory (a budget
+    below it once let a small triangle run through, as if the limit were not there)."""
+    words = ("triangle --size 8x8", "250 MB", "no --size fits", "--memory-limit")
+    refused(capsys, "synthesize", "triangle", "--size", "8x8", "--memory-limit", limit, words=words)
+    code, _, err = run(capsys, "synthesize", "triangle", "--size", "8x8", "--memory-limit", "0.3")
+    assert code == 0, err
+
+
 # ---------------------------------------------------------------- row 19: messages
 def test_row19_no_numpy_reprs_in_messages():
     from csplab.cli import readable
