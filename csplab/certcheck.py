@@ -219,7 +219,7 @@ def check_certificate(cert: Mapping[str, Any]) -> tuple[bool, str]:
             raise _Invalid(f"unknown claim {claim!r}")
     except _Invalid as e:
         return False, f"invalid: {e}"
-    except (KeyError, TypeError, ValueError, IndexError) as e:
+    except (KeyError, TypeError, ValueError, IndexError, OverflowError) as e:
         return False, f"invalid: malformed certificate ({type(e).__name__}: {e})"
     return True, msg
 
@@ -1223,9 +1223,10 @@ def _lean_frame(
     # neighbour along them not yet labelled)
     om: list[int] = []
     if n > 2:  # (else no step keeps a label)
+        left = bits
         for d, t, _, _ in reversed(live):
-            om += [bits] * (t - len(om))
-            bits ^= 1 << d
+            om += [left] * (t - len(om))
+            left ^= 1 << d
         om += [0] * (n - len(om))
     if not scanline:  # the backward neighbours by axis
         live.sort()
@@ -1337,7 +1338,9 @@ def _check_lean(
     if set(map(type, rows)) - {list, tuple}:
         raise _Invalid("a state's step or labels are not integers")
     flat = set(itertools.chain.from_iterable(rows))
-    as_int = bool(set(map(type, flat)) - {int})  # numpy integers: Python ints (shifts)
+    # numpy integers: Python ints (shifts); by the labels' types, not the set's (which keeps
+    # one of 7 and np.int8(7))
+    as_int = bool(set(map(type, itertools.chain.from_iterable(rows))) - {int})
     # numpy integers as steps or labels: the states as Python ints (shifts, keys)
     convert = as_int or bool(set(map(type, (s[0] for s in every))) - {int})
     if as_int or not in_use.issuperset(flat):
@@ -1352,7 +1355,7 @@ def _check_lean(
         widths = list(map(len, fr.keys))
         # per step: the neighbours' slots and support tables (``near``); the next state's
         # kept labels as (slot, class map) pairs; the chosen label's class map and its sets
-        # of classes, when the next state records it (last), else None
+        # of classes when the next state records it (last), else ``ident`` and None
         near_of = fr.near
         keep_of = fr.kept
         for c in set(fr.chosen) - pick_sets.keys():
@@ -1367,12 +1370,12 @@ def _check_lean(
         # with the same frame, domains and states (its positions on the faces differ) is
         # the same check, with the same outcome
         checked: dict[tuple[int, ...], list[Any]] = {}
+        ext = [] if plain else [a + 1 + b for a, b in zip(lo, hi, strict=True)]
         for conf, (_, _, at_lo, at_hi) in members:
             # the domain of each cell of the frame (labels in use, face rules, dead labels)
             if plain:
                 base = [used] * len(coords)
             else:
-                ext = [a + 1 + b for a, b in zip(lo, hi, strict=True)]
                 per, faces, fars = [], [], []
                 for d in axes:  # in scan order: the products below run as the cells do
                     sig = (d, ext[d], at_lo[d], at_hi[d], cap)
@@ -1469,8 +1472,9 @@ def _check_lean(
                     if miss:
                         b = (miss & -miss).bit_length() - 1
                         nx = [*key[1:], pick[b]] if sets is not None else list(key[1:])
-                        bad = (-i, f"{_where(lo, hi)}: not closed: state {[i, list(labs)]} "
-                                   f"with label {b} leads to {[i + 1, nx]}, which is missing")
+                        state = [i, list(labs)]
+                        bad = (-i, f"{_where(lo, hi)}: not closed: state {state} with label "
+                                   f"{b} leads to {[i + 1, nx]}, which is missing")  # fmt: skip
             if bad is not None:
                 # (every point state was checked: the point's defects come first)
                 raise _Invalid(bad[1])

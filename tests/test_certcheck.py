@@ -487,6 +487,20 @@ def test_state_shape_defects(small_cert, checker_path):
     rejected(triple, "not a pair")
 
 
+@pytest.mark.parametrize("dtype", [np.int8, np.int64])
+@pytest.mark.parametrize("which", ["small_cert", "class_cert"])
+def test_numpy_labels_read_as_their_values(which, checker_path, dtype, request):
+    # a certificate built in memory may hold numpy integers: the last configuration's labels
+    # as numpy, the earlier ones' the same values as Python ints (a set of the labels keeps
+    # the first of 7 and np.int8(7), so the types are read from the labels themselves);
+    # int8 shifts would overflow
+    good = request.getfixturevalue(which)
+    cert = copy.deepcopy(good)
+    for s in cert["configs"][-1]["states"]:
+        s[1] = [dtype(x) for x in s[1]]
+    assert check_certificate(cert) == check_certificate(good)
+
+
 def test_configuration_defects(small_cert, checker_path):
     bad = copy.deepcopy(small_cert)
     bad["configs"].append(copy.deepcopy(bad["configs"][0]))
